@@ -1,0 +1,239 @@
+//! Message types of `msg/`. Field order is wire order: keep it identical to the `.msg` files.
+
+use crate::ros_message;
+
+ros_message! {
+    /// `builtin_interfaces/Time`.
+    pub struct Time("builtin_interfaces/msg/Time") {
+        consts {}
+        sec: i32,
+        nanosec: u32,
+    }
+}
+
+impl Time {
+    /// Time from nanoseconds since the epoch of the clock in use.
+    pub fn from_nanos(ns: u64) -> Self {
+        Time { sec: (ns / 1_000_000_000) as i32, nanosec: (ns % 1_000_000_000) as u32 }
+    }
+    pub fn as_secs_f64(&self) -> f64 {
+        self.sec as f64 + self.nanosec as f64 * 1e-9
+    }
+}
+
+ros_message! {
+    /// One alarm, numbered as in the manual's alarm tables.
+    pub struct Alarm("cnc_msgs/msg/Alarm") {
+        consts {
+            SEVERITY_INFO: u8 = 0,
+            SEVERITY_WARNING: u8 = 1,
+            SEVERITY_ERROR: u8 = 2,
+            SEVERITY_FATAL: u8 = 3,
+        }
+        number: u32,
+        severity: u8,
+        text: String,
+        source: String,
+        program: String,
+        line: u32,
+        stamp: Time,
+    }
+}
+
+ros_message! {
+    /// Every alarm that is active now.
+    pub struct ActiveAlarms("cnc_msgs/msg/ActiveAlarms") {
+        consts {}
+        stamp: Time,
+        alarms: Vec<Alarm>,
+    }
+}
+
+ros_message! {
+    /// An alarm was raised or cleared.
+    pub struct AlarmEvent("cnc_msgs/msg/AlarmEvent") {
+        consts { RAISED: u8 = 1, CLEARED: u8 = 2 }
+        kind: u8,
+        alarm: Alarm,
+    }
+}
+
+ros_message! {
+    /// One axis in machine coordinates.
+    pub struct Axis("cnc_msgs/msg/Axis") {
+        consts {}
+        name: String,
+        commanded_position: f64,
+        actual_position: f64,
+        following_error: f64,
+        homed: bool,
+    }
+}
+
+ros_message! {
+    pub struct AxisState("cnc_msgs/msg/AxisState") {
+        consts {}
+        stamp: Time,
+        axes: Vec<Axis>,
+    }
+}
+
+ros_message! {
+    /// Mode and execution state of the machine.
+    pub struct MachineState("cnc_msgs/msg/MachineState") {
+        consts {
+            MODE_AUTO: u8 = 0,
+            MODE_MDI: u8 = 1,
+            MODE_JOG: u8 = 2,
+            MODE_HOME: u8 = 3,
+            MODE_EDIT: u8 = 4,
+            MODE_HANDWHEEL: u8 = 5,
+            READY: u8 = 0,
+            ACTIVE: u8 = 1,
+            INTERRUPTED: u8 = 2,
+            FEED_HOLD: u8 = 3,
+            STOPPED: u8 = 4,
+            PROGRAM_STOPPED: u8 = 5,
+            PROGRAM_COMPLETED: u8 = 6,
+        }
+        stamp: Time,
+        mode: u8,
+        execution: u8,
+        execution_name: String,
+        program: String,
+        line: u32,
+        emergency_stop: bool,
+        alarm_active: bool,
+    }
+}
+
+impl MachineState {
+    /// MTConnect name of an execution state.
+    pub fn execution_name_of(execution: u8) -> &'static str {
+        match execution {
+            Self::READY => "READY",
+            Self::ACTIVE => "ACTIVE",
+            Self::INTERRUPTED => "INTERRUPTED",
+            Self::FEED_HOLD => "FEED_HOLD",
+            Self::STOPPED => "STOPPED",
+            Self::PROGRAM_STOPPED => "PROGRAM_STOPPED",
+            Self::PROGRAM_COMPLETED => "PROGRAM_COMPLETED",
+            _ => "UNAVAILABLE",
+        }
+    }
+}
+
+ros_message! {
+    pub struct PartCount("cnc_msgs/msg/PartCount") {
+        consts {}
+        stamp: Time,
+        count: u32,
+        target: u32,
+        last_cycle_time: f64,
+    }
+}
+
+ros_message! {
+    pub struct SpindleState("cnc_msgs/msg/SpindleState") {
+        consts { DIRECTION_STOP: u8 = 0, DIRECTION_CW: u8 = 1, DIRECTION_CCW: u8 = 2 }
+        stamp: Time,
+        commanded_rpm: f64,
+        actual_rpm: f64,
+        direction: u8,
+        load: f32,
+        override_percent: f32,
+        at_speed: bool,
+    }
+}
+
+ros_message! {
+    /// Servo loop statistics since start, in microseconds.
+    pub struct ServoStats("cnc_msgs/msg/ServoStats") {
+        consts {}
+        stamp: Time,
+        period_us: f64,
+        ticks: u64,
+        late_ticks: u64,
+        interval_min_us: f64,
+        interval_p50_us: f64,
+        interval_p99_us: f64,
+        interval_max_us: f64,
+        round_trips: u64,
+        round_trip_min_us: f64,
+        round_trip_p50_us: f64,
+        round_trip_p99_us: f64,
+        round_trip_max_us: f64,
+    }
+}
+
+ros_message! {
+    /// One canonical block from the interpreter to motion.
+    pub struct MotionBlock("cnc_msgs/msg/MotionBlock") {
+        consts {
+            KIND_RAPID: u8 = 0,
+            KIND_LINEAR: u8 = 1,
+            KIND_ARC_CW: u8 = 2,
+            KIND_ARC_CCW: u8 = 3,
+            KIND_DWELL: u8 = 4,
+            KIND_AUX: u8 = 5,
+            KIND_PROGRAM_END: u8 = 6,
+            AUX_M: u8 = 1,
+            AUX_S: u8 = 2,
+            AUX_T: u8 = 3,
+        }
+        run_id: u64,
+        seq: u64,
+        program: String,
+        line: u32,
+        kind: u8,
+        end: Vec<f64>,
+        center: Vec<f64>,
+        feed: f64,
+        dwell_seconds: f64,
+        aux_kind: u8,
+        aux_code: i32,
+        aux_value: f64,
+    }
+}
+
+ros_message! {
+    /// Motion's report to the interpreter: queue credit and execution progress.
+    pub struct MotionStatus("cnc_msgs/msg/MotionStatus") {
+        consts { STATE_IDLE: u8 = 0, STATE_RUNNING: u8 = 1, STATE_HOLD: u8 = 2, STATE_ALARM: u8 = 3 }
+        run_id: u64,
+        accepted_seq: u64,
+        done_seq: u64,
+        capacity: u32,
+        line: u32,
+        state: u8,
+    }
+}
+
+ros_message! {
+    /// Internal command from hmi_bridge to the nodes.
+    pub struct ProgramCommand("cnc_msgs/msg/ProgramCommand") {
+        consts { LOAD: u8 = 1, START: u8 = 2, FEED_HOLD: u8 = 3, CYCLE_STOP: u8 = 4, RESET: u8 = 5 }
+        id: u64,
+        command: u8,
+        program: String,
+        text: String,
+    }
+}
+
+ros_message! {
+    pub struct CommandResult("cnc_msgs/msg/CommandResult") {
+        consts {}
+        id: u64,
+        accepted: bool,
+        message: String,
+    }
+}
+
+ros_message! {
+    /// Operator or test input to the simulated machine.
+    pub struct SimInput("cnc_msgs/msg/SimInput") {
+        consts { EMERGENCY_STOP: u8 = 1 }
+        input: u8,
+        value: bool,
+    }
+}

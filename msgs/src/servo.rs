@@ -1,0 +1,61 @@
+//! Servo payloads between motion and io over iceoryx2: fixed size, `#[repr(C)]`, no heap.
+
+use iceoryx2::prelude::ZeroCopySend;
+
+/// Most axes a channel can drive.
+pub const MAX_AXES: usize = 8;
+
+/// Position command for every axis, sent by motion every servo period.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("cnc_msgs::ServoSetpoint")]
+pub struct ServoSetpoint {
+    /// Tick number, from 1; io echoes it in the feedback.
+    pub seq: u64,
+    /// Motion's monotonic clock when sent, ns; echoed to measure the round trip.
+    pub sent_ns: u64,
+    /// Commanded position per axis, mm (X in diameter on a lathe).
+    pub position: [f64; MAX_AXES],
+    pub axis_count: u32,
+    /// 1 = drives enabled (servo on).
+    pub enable: u32,
+}
+
+impl Default for ServoSetpoint {
+    fn default() -> Self {
+        ServoSetpoint { seq: 0, sent_ns: 0, position: [0.0; MAX_AXES], axis_count: 0, enable: 0 }
+    }
+}
+
+/// Drive feedback, sent by io in answer to each setpoint.
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("cnc_msgs::ServoFeedback")]
+pub struct ServoFeedback {
+    /// `seq` of the setpoint this answers.
+    pub seq: u64,
+    /// `sent_ns` of the setpoint this answers.
+    pub setpoint_sent_ns: u64,
+    /// Actual position per axis, mm.
+    pub position: [f64; MAX_AXES],
+    pub axis_count: u32,
+    /// Bit per axis: drive fault.
+    pub drive_fault: u32,
+    /// Spindle encoder: speed in rpm and angle in degrees (0..360).
+    pub spindle_rpm: f64,
+    pub spindle_angle_deg: f64,
+}
+
+impl Default for ServoFeedback {
+    fn default() -> Self {
+        ServoFeedback {
+            seq: 0,
+            setpoint_sent_ns: 0,
+            position: [0.0; MAX_AXES],
+            axis_count: 0,
+            drive_fault: 0,
+            spindle_rpm: 0.0,
+            spindle_angle_deg: 0.0,
+        }
+    }
+}

@@ -1,0 +1,85 @@
+//! Service types of `srv/`. ROS 2 gives an empty request or response one `uint8` member named
+//! `structure_needs_at_least_one_member`; the types here do the same so the CDR matches.
+
+use crate::ros_message;
+
+/// A service: its ROS name and its request and response types.
+pub trait RosService {
+    type Request: crate::RosMessage + ros2_client::Message;
+    type Response: crate::RosMessage + ros2_client::Message;
+    /// `cnc_msgs/srv/Name`.
+    const TYPE_NAME: &'static str;
+    /// Name of the `.srv` file without extension.
+    const NAME: &'static str;
+}
+
+ros_message! {
+    pub struct LoadProgramRequest("cnc_msgs/srv/LoadProgram_Request") {
+        consts {}
+        name: String,
+        text: String,
+    }
+}
+ros_message! {
+    pub struct LoadProgramResponse("cnc_msgs/srv/LoadProgram_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct StartProgramRequest("cnc_msgs/srv/StartProgram_Request") {
+        consts {}
+        name: String,
+    }
+}
+ros_message! {
+    pub struct StartProgramResponse("cnc_msgs/srv/StartProgram_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct StopRequest("cnc_msgs/srv/Stop_Request") {
+        consts { FEED_HOLD: u8 = 1, CYCLE_STOP: u8 = 2 }
+        mode: u8,
+    }
+}
+ros_message! {
+    pub struct StopResponse("cnc_msgs/srv/Stop_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct ResetRequest("cnc_msgs/srv/Reset_Request") {
+        consts {}
+        structure_needs_at_least_one_member: u8,
+    }
+}
+ros_message! {
+    pub struct ResetResponse("cnc_msgs/srv/Reset_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+
+macro_rules! service {
+    ($marker:ident, $name:literal, $req:ident, $resp:ident) => {
+        /// Marker type naming the service.
+        pub struct $marker;
+        impl RosService for $marker {
+            type Request = $req;
+            type Response = $resp;
+            const TYPE_NAME: &'static str = concat!("cnc_msgs/srv/", $name);
+            const NAME: &'static str = $name;
+        }
+    };
+}
+service!(LoadProgram, "LoadProgram", LoadProgramRequest, LoadProgramResponse);
+service!(StartProgram, "StartProgram", StartProgramRequest, StartProgramResponse);
+service!(Stop, "Stop", StopRequest, StopResponse);
+service!(Reset, "Reset", ResetRequest, ResetResponse);
