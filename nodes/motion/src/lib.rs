@@ -1,1 +1,14 @@
-//! placeholder
+//! Motion: block queue, per-block velocity profiles, interpolation at the servo period.
+//!
+//! A block's path: [`block`] (what arrives) → [`motion`] (queue, limits, handshake) →
+//! [`profile`] (velocity along the block) → setpoint. [`servo`] measures the loop;
+//! [`node`] runs it on its own thread against iceoryx2.
+
+pub mod block;
+pub mod config;
+pub mod motion;
+pub mod profile;
+
+pub use block::{AuxCode, Block, BlockKind};
+pub use config::{AxisConfig, MotionConfig};
+pub use motion::{Motion, MotionEvent, RunState};

@@ -1,0 +1,153 @@
+//! Motion core on a perfect drive. `Motion::new` takes slide positions (X as radius): X50 is 25.
+//! (actual = commanded) and a simple PLC that answers strobes.
+
+use cnc_motion::{motion::alarm, AuxCode, AxisConfig, Block, BlockKind, Motion, MotionConfig, MotionEvent, RunState};
+use cnc_msgs::signals::GImage;
+
+fn lathe() -> MotionConfig {
+    let axis = |name: &str, diameter, min, max| AxisConfig {
+        name: name.into(),
+        diameter,
+        min,
+        max,
+        max_velocity: 6000.0,
+        max_acceleration: 1000.0,
+        in_position: 0.0005,
+        drive_lag: 0.008,
+    };
+    MotionConfig { axes: vec![axis("X", true, -10.0, 300.0), axis("Z", false, -400.0, 100.0)], period: 0.004, queue_capacity: 16, arc_plane: (1, 0) }
+}
+
+fn block(seq: u64, line: u32, kind: BlockKind) -> Block {
+    Block { run_id: 1, seq, line, kind }
+}
+
+/// Runs until idle or alarm; answers every strobe with FIN after `fin_delay` ticks.
+fn run(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(u64, i32)>) {
+    let mut trace = vec![];
+    let mut strobes = vec![];
+    let mut g = GImage::default();
+    for _ in 0..max_ticks {
+        let actual = m.commanded().to_vec();
+        m.tick(Some(&actual), &g);
+        let f = *m.f_image();
+        if f.mf == 1 && g.fin_seq != f.strobe_seq {
+            strobes.push((f.strobe_seq, f.m_code));
+            g.fin_seq = f.strobe_seq;
+        }
+        trace.push(m.commanded_display());
+        if matches!(m.state(), RunState::Idle | RunState::Alarm) {
+            break;
+        }
+    }
+    (trace, strobes)
+}
+
+#[test]
+fn program_runs_to_its_end_point_with_fin_handshake() {
+    let mut m = Motion::new(lathe(), &[25.0, 50.0]);
+    m.push(block(1, 1, BlockKind::Aux(AuxCode::M(3))));
+    m.push(block(2, 2, BlockKind::Rapid { end: vec![50.0, 2.0] }));
+    m.push(block(3, 3, BlockKind::Linear { end: vec![50.0, -30.0], feed: 600.0 }));
+    m.push(block(4, 4, BlockKind::Arc { end: vec![70.0, -40.0], center: vec![50.0, -40.0], clockwise: false, feed: 600.0 }));
+    m.push(block(5, 5, BlockKind::Aux(AuxCode::M(30))));
+    m.push(block(6, 5, BlockKind::ProgramEnd));
+    let (trace, strobes) = run(&mut m, 100_000);
+    assert_eq!(m.state(), RunState::Idle);
+    assert_eq!(m.done_seq(), 6);
+    assert_eq!(m.commanded_display(), vec![70.0, -40.0]);
+    assert_eq!(strobes.iter().map(|s| s.1).collect::<Vec<_>>(), [3, 30]);
+    // The arc stays on its circle: radius 10 around X50 (radius 25) Z-40 in slide units.
+    let arc_points = trace.iter().filter(|p| p[1] < -30.0 && p[1] > -40.0);
+    for p in arc_points {
+        let r = ((p[0] / 2.0 - 25.0).powi(2) + (p[1] + 40.0).powi(2)).sqrt();
+        assert!((r - 10.0).abs() < 1e-9, "{p:?} off the arc (r={r})");
+    }
+    // Feed 600 mm/min = 10 mm/s: no tick moves more than 10 mm/s * 4 ms along the line.
+    for w in trace.windows(2).filter(|w| w[0][1] <= 2.0 && w[1][1] >= -30.0 && w[0][0] == 50.0) {
+        assert!((w[1][1] - w[0][1]).abs() <= 0.04 + 1e-9);
+    }
+}
+
+#[test]
+fn soft_limit_is_refused_before_any_motion() {
+    let mut m = Motion::new(lathe(), &[25.0, 50.0]);
+    m.push(block(1, 7, BlockKind::Linear { end: vec![50.0, -500.0], feed: 600.0 }));
+    m.push(block(2, 8, BlockKind::Rapid { end: vec![0.0, 0.0] }));
+    let (trace, _) = run(&mut m, 100);
+    assert_eq!(m.state(), RunState::Alarm);
+    assert!(trace.iter().all(|p| p == &vec![50.0, 50.0]), "axes moved");
+    let events = m.take_events();
+    assert!(matches!(&events[..], [MotionEvent::Alarm { number, line: 7, .. }] if *number == alarm::SOFT_LIMIT), "{events:?}");
+    // An arc whose end is inside but whose bulge leaves the limits is refused too.
+    // From X20 Z50 counter-clockwise around Z70 (radius 20) the arc dips to X-20, below -10.
+    let mut m = Motion::new(lathe(), &[10.0, 50.0]);
+    let arc = |clockwise| BlockKind::Arc { end: vec![20.0, 90.0], center: vec![20.0, 70.0], clockwise, feed: 100.0 };
+    m.push(Block { run_id: 2, seq: 1, line: 3, kind: arc(false) });
+    run(&mut m, 100);
+    assert_eq!(m.state(), RunState::Alarm);
+    assert_eq!(m.commanded_display(), vec![20.0, 50.0]);
+    // The same arc clockwise goes over the top (X60) and is allowed.
+    let mut m = Motion::new(lathe(), &[10.0, 50.0]);
+    m.push(Block { run_id: 2, seq: 1, line: 3, kind: arc(true) });
+    run(&mut m, 100_000);
+    assert_eq!(m.state(), RunState::Idle);
+    assert_eq!(m.commanded_display(), vec![20.0, 90.0]);
+}
+
+#[test]
+fn feed_hold_stops_on_the_path_and_cycle_start_resumes() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(1, 1, BlockKind::Linear { end: vec![50.0, -50.0], feed: 1200.0 }));
+    m.push(block(2, 2, BlockKind::ProgramEnd));
+    let g = GImage::default();
+    for _ in 0..200 {
+        let a = m.commanded().to_vec();
+        m.tick(Some(&a), &g);
+    }
+    m.feed_hold();
+    for _ in 0..200 {
+        let a = m.commanded().to_vec();
+        m.tick(Some(&a), &g);
+    }
+    assert_eq!(m.state(), RunState::Hold);
+    let held = m.commanded_display();
+    let a = m.commanded().to_vec();
+    m.tick(Some(&a), &g);
+    assert_eq!(m.commanded_display(), held, "still moving in hold");
+    assert_eq!(held[0], 50.0);
+    m.cycle_start();
+    let (_, _) = run(&mut m, 10_000);
+    assert_eq!(m.commanded_display(), vec![50.0, -50.0]);
+    assert_eq!(m.state(), RunState::Idle);
+}
+
+#[test]
+fn emergency_stop_drops_the_run_and_holds_position() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(1, 1, BlockKind::Linear { end: vec![50.0, -50.0], feed: 1200.0 }));
+    let mut g = GImage::default();
+    for _ in 0..50 {
+        let a = m.commanded().to_vec();
+        m.tick(Some(&a), &g);
+    }
+    g.emergency_stop = 1;
+    let a = m.commanded().to_vec();
+    m.tick(Some(&a), &g);
+    let stopped = m.commanded_display();
+    for _ in 0..10 {
+        let a = m.commanded().to_vec();
+        m.tick(Some(&a), &g);
+    }
+    assert_eq!(m.commanded_display(), stopped);
+    assert_eq!(m.state(), RunState::Alarm);
+}
+
+#[test]
+fn blocks_of_an_old_run_are_ignored() {
+    let mut m = Motion::new(lathe(), &[0.0, 0.0]);
+    m.push(Block { run_id: 2, seq: 1, line: 1, kind: BlockKind::Rapid { end: vec![10.0, 0.0] } });
+    m.push(Block { run_id: 1, seq: 2, line: 1, kind: BlockKind::Rapid { end: vec![99.0, 0.0] } });
+    run(&mut m, 10_000);
+    assert_eq!(m.commanded_display(), vec![10.0, 0.0]);
+}
