@@ -1,1 +1,5 @@
-//! placeholder
+//! io: the hardware boundary. The default backend is [`sim`], a simulated lathe.
+
+pub mod sim;
+
+pub use sim::{SimConfig, SimLathe};

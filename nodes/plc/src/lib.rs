@@ -1,1 +1,6 @@
-//! placeholder
+//! plc: the machine logic. [`logic`] is the scanned core; [`node`] binds it to iceoryx2 images
+//! and ROS 2 topics.
+
+pub mod logic;
+
+pub use logic::{Plc, PlcEvent};

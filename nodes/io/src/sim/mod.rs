@@ -1,0 +1,165 @@
+//! The simulated lathe: axes that follow setpoints with a first-order drive lag, a spindle that
+//! ramps to its commanded speed, coolant with a pressure switch, a chuck, an emergency-stop input.
+//!
+//! Pure: [`SimLathe::step`] advances the machine by `dt` seconds.
+
+use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
+use cnc_msgs::signals::{XImage, YImage};
+
+/// Simulation parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimConfig {
+    /// Drive time constant per axis, s.
+    pub drive_lag: Vec<f64>,
+    /// Spindle ramp, rpm/s.
+    pub spindle_acceleration: f64,
+    /// "At speed" window, fraction of the commanded speed.
+    pub at_speed_tolerance: f64,
+    /// Coolant pressure builds this long after the pump starts, s.
+    pub coolant_delay: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct SimLathe {
+    cfg: SimConfig,
+    position: [f64; MAX_AXES],
+    spindle_rpm: f64,
+    spindle_angle: f64,
+    coolant_time: f64,
+    chuck_clamped: bool,
+    emergency_stop: bool,
+    x_seq: u64,
+}
+
+impl SimLathe {
+    /// `start` is the slide position at power-on.
+    pub fn new(cfg: SimConfig, start: &[f64]) -> Self {
+        let mut position = [0.0; MAX_AXES];
+        for (p, s) in position.iter_mut().zip(start) {
+            *p = *s;
+        }
+        SimLathe { cfg, position, spindle_rpm: 0.0, spindle_angle: 0.0, coolant_time: 0.0, chuck_clamped: false, emergency_stop: false, x_seq: 0 }
+    }
+
+    pub fn set_emergency_stop(&mut self, pressed: bool) {
+        self.emergency_stop = pressed;
+    }
+
+    pub fn position(&self) -> &[f64] {
+        &self.position[..self.cfg.drive_lag.len()]
+    }
+
+    pub fn spindle_rpm(&self) -> f64 {
+        self.spindle_rpm
+    }
+
+    /// Advances by `dt`: drives follow `setpoint` when enabled; devices follow `y`.
+    pub fn step(&mut self, setpoint: &ServoSetpoint, y: &YImage, dt: f64) -> ServoFeedback {
+        let n = self.cfg.drive_lag.len().min(MAX_AXES);
+        if setpoint.enable != 0 && !self.emergency_stop {
+            for i in 0..n {
+                let target = setpoint.position[i];
+                if !target.is_finite() {
+                    continue;
+                }
+                let tau = self.cfg.drive_lag[i];
+                let k = if tau > 0.0 { 1.0 - (-dt / tau).exp() } else { 1.0 };
+                self.position[i] += (target - self.position[i]) * k;
+            }
+        }
+        // Spindle: ramp toward the signed command; stops on emergency stop.
+        let command = if self.emergency_stop {
+            0.0
+        } else {
+            match y.spindle_direction {
+                1 => y.spindle_rpm.max(0.0),
+                2 => -y.spindle_rpm.max(0.0),
+                _ => 0.0,
+            }
+        };
+        let step = self.cfg.spindle_acceleration * dt;
+        self.spindle_rpm += (command - self.spindle_rpm).clamp(-step, step);
+        self.spindle_angle = (self.spindle_angle + self.spindle_rpm / 60.0 * 360.0 * dt).rem_euclid(360.0);
+        self.coolant_time = if y.coolant != 0 && !self.emergency_stop { self.coolant_time + dt } else { 0.0 };
+        self.chuck_clamped = y.chuck_clamp != 0;
+        ServoFeedback {
+            seq: setpoint.seq,
+            setpoint_sent_ns: setpoint.sent_ns,
+            position: self.position,
+            axis_count: n as u32,
+            drive_fault: 0,
+            spindle_rpm: self.spindle_rpm,
+            spindle_angle_deg: self.spindle_angle,
+        }
+    }
+
+    /// The machine's inputs as the PLC reads them.
+    pub fn x_image(&mut self, y: &YImage) -> XImage {
+        self.x_seq += 1;
+        let commanded = match y.spindle_direction {
+            1 => y.spindle_rpm,
+            2 => -y.spindle_rpm,
+            _ => 0.0,
+        };
+        let tol = (commanded.abs() * self.cfg.at_speed_tolerance).max(1.0);
+        XImage {
+            seq: self.x_seq,
+            emergency_stop: u32::from(self.emergency_stop),
+            spindle_actual_rpm: self.spindle_rpm,
+            spindle_at_speed: u32::from((self.spindle_rpm - commanded).abs() <= tol),
+            coolant_pressure: u32::from(self.coolant_time >= self.cfg.coolant_delay),
+            chuck_clamped: u32::from(self.chuck_clamped),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sim() -> SimLathe {
+        SimLathe::new(SimConfig { drive_lag: vec![0.008, 0.008], spindle_acceleration: 2000.0, at_speed_tolerance: 0.02, coolant_delay: 0.2 }, &[10.0, 20.0])
+    }
+
+    #[test]
+    fn axes_follow_with_first_order_lag() {
+        let mut m = sim();
+        let mut sp = ServoSetpoint { enable: 1, axis_count: 2, ..Default::default() };
+        sp.position[0] = 11.0;
+        sp.position[1] = 20.0;
+        let fb = m.step(&sp, &YImage::default(), 0.008);
+        // One time constant: 63.2 % of the step.
+        assert!((fb.position[0] - (10.0 + (1.0 - (-1.0f64).exp()))).abs() < 1e-12);
+        for _ in 0..200 {
+            m.step(&sp, &YImage::default(), 0.004);
+        }
+        assert!((m.position()[0] - 11.0).abs() < 1e-9);
+        // Servo off: the axes stay.
+        sp.enable = 0;
+        sp.position[0] = 50.0;
+        m.step(&sp, &YImage::default(), 0.004);
+        assert!((m.position()[0] - 11.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn spindle_ramps_and_reports_at_speed() {
+        let mut m = sim();
+        let y = YImage { spindle_direction: 1, spindle_rpm: 1000.0, ..Default::default() };
+        let sp = ServoSetpoint::default();
+        for _ in 0..100 {
+            m.step(&sp, &y, 0.004); // 0.4 s at 2000 rpm/s = 800 rpm
+        }
+        assert!((m.spindle_rpm() - 800.0).abs() < 1e-6);
+        assert_eq!(m.x_image(&y).spindle_at_speed, 0);
+        for _ in 0..100 {
+            m.step(&sp, &y, 0.004);
+        }
+        assert_eq!(m.x_image(&y).spindle_at_speed, 1);
+        m.set_emergency_stop(true);
+        for _ in 0..300 {
+            m.step(&sp, &y, 0.004);
+        }
+        assert_eq!(m.spindle_rpm(), 0.0);
+        assert_eq!(m.x_image(&y).emergency_stop, 1);
+    }
+}
