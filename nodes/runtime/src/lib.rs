@@ -1,1 +1,12 @@
-//! placeholder
+//! What every node shares: launch config, DDS participants and QoS, iceoryx2 channels, clocks,
+//! lifecycle, and the alarm reporting helper.
+
+pub mod alarms;
+pub mod clock;
+pub mod config;
+pub mod dds;
+pub mod lifecycle;
+pub mod shm;
+
+pub use config::LaunchConfig;
+pub use lifecycle::Shutdown;

@@ -1,0 +1,240 @@
+//! The launch config: one YAML file describes the machine, the network and the nodes.
+
+use serde::Deserialize;
+use std::net::IpAddr;
+
+/// Top level of `launch_configs/*.yaml`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LaunchConfig {
+    pub machine: MachineConfig,
+    #[serde(default)]
+    pub network: NetworkConfig,
+    #[serde(default)]
+    pub servo: ServoConfig,
+    #[serde(default)]
+    pub sim: SimConfig,
+    #[serde(default)]
+    pub plc: PlcConfig,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachineConfig {
+    /// ROS 2 namespace of every topic and service, e.g. `lathe1` → `/lathe1/spindle`.
+    pub namespace: String,
+    /// Program dialect: `iso-lathe` for now.
+    pub dialect: String,
+    pub axes: Vec<AxisEntry>,
+    /// Arc plane as (horizontal, vertical) axis names; G02 is clockwise seen this way.
+    #[serde(default = "default_arc_plane")]
+    pub arc_plane: [String; 2],
+}
+
+fn default_arc_plane() -> [String; 2] {
+    ["Z".into(), "X".into()]
+}
+
+/// One axis: limits in display units (X as diameter when `diameter`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisEntry {
+    pub name: String,
+    #[serde(default)]
+    pub diameter: bool,
+    pub min: f64,
+    pub max: f64,
+    /// Rapid rate, mm/min of slide travel.
+    pub max_velocity: f64,
+    /// mm/s² of slide travel.
+    pub max_acceleration: f64,
+    #[serde(default = "default_in_position")]
+    pub in_position: f64,
+    /// Simulated drive time constant, s.
+    #[serde(default = "default_drive_lag")]
+    pub drive_lag: f64,
+    /// Simulated power-on position, display units.
+    #[serde(default)]
+    pub home: f64,
+}
+
+fn default_in_position() -> f64 {
+    0.0005
+}
+fn default_drive_lag() -> f64 {
+    0.008
+}
+
+/// Where DDS may send traffic.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NetworkConfig {
+    /// DDS domain; when absent, `ROS_DOMAIN_ID`, else 0.
+    #[serde(default)]
+    pub domain_id: Option<u16>,
+    /// Addresses of the interfaces DDS uses for multicast and advertises. Default: loopback only.
+    #[serde(default = "default_interfaces")]
+    pub interfaces: Vec<IpAddr>,
+}
+
+fn default_interfaces() -> Vec<IpAddr> {
+    vec![IpAddr::from([127, 0, 0, 1])]
+}
+
+impl Default for NetworkConfig {
+    fn default() -> Self {
+        NetworkConfig { domain_id: None, interfaces: default_interfaces() }
+    }
+}
+
+impl NetworkConfig {
+    /// The domain to join: the config's, else `ROS_DOMAIN_ID`, else 0.
+    pub fn effective_domain_id(&self) -> Result<u16, String> {
+        if let Some(d) = self.domain_id {
+            return valid_domain(d);
+        }
+        match std::env::var("ROS_DOMAIN_ID") {
+            Ok(v) if !v.trim().is_empty() => {
+                let d: u16 = v.trim().parse().map_err(|_| format!("ROS_DOMAIN_ID={v:?} is not a number"))?;
+                valid_domain(d)
+            }
+            _ => Ok(0),
+        }
+    }
+}
+
+fn valid_domain(d: u16) -> Result<u16, String> {
+    // RTPS port mapping: 7400 + 250·domain must stay below 65535.
+    if d > 232 {
+        Err(format!("DDS domain id {d} out of range 0..232"))
+    } else {
+        Ok(d)
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ServoConfig {
+    /// Servo period, ms (1..8).
+    #[serde(default = "default_period")]
+    pub period_ms: f64,
+    /// Blocks motion queues ahead.
+    #[serde(default = "default_queue")]
+    pub queue_capacity: usize,
+}
+
+fn default_period() -> f64 {
+    4.0
+}
+fn default_queue() -> usize {
+    32
+}
+
+impl Default for ServoConfig {
+    fn default() -> Self {
+        ServoConfig { period_ms: default_period(), queue_capacity: default_queue() }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimConfig {
+    #[serde(default = "default_spindle_acc")]
+    pub spindle_acceleration: f64,
+    #[serde(default = "default_at_speed")]
+    pub at_speed_tolerance: f64,
+    #[serde(default = "default_coolant_delay")]
+    pub coolant_delay: f64,
+}
+
+fn default_spindle_acc() -> f64 {
+    3000.0
+}
+fn default_at_speed() -> f64 {
+    0.02
+}
+fn default_coolant_delay() -> f64 {
+    0.1
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig { spindle_acceleration: default_spindle_acc(), at_speed_tolerance: default_at_speed(), coolant_delay: default_coolant_delay() }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlcConfig {
+    /// Level-1 scan period, ms.
+    #[serde(default = "default_scan")]
+    pub scan_ms: f64,
+}
+
+fn default_scan() -> f64 {
+    10.0
+}
+
+impl Default for PlcConfig {
+    fn default() -> Self {
+        PlcConfig { scan_ms: default_scan() }
+    }
+}
+
+impl LaunchConfig {
+    pub fn from_yaml(text: &str) -> Result<Self, String> {
+        let cfg: LaunchConfig = serde_yaml::from_str(text).map_err(|e| format!("launch config: {e}"))?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    pub fn load(path: &std::path::Path) -> Result<Self, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        Self::from_yaml(&text).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        let ns = &self.machine.namespace;
+        if ns.is_empty() || !ns.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') || ns.starts_with(|c: char| c.is_ascii_digit()) {
+            return Err(format!("machine.namespace {ns:?}: letters, digits and _ only, not starting with a digit"));
+        }
+        let n = self.machine.axes.len();
+        if n == 0 || n > cnc_msgs::servo::MAX_AXES {
+            return Err(format!("machine.axes: 1..{} axes, found {n}", cnc_msgs::servo::MAX_AXES));
+        }
+        for a in &self.machine.axes {
+            let ok = a.min < a.max && a.max_velocity > 0.0 && a.max_acceleration > 0.0 && a.in_position > 0.0 && a.drive_lag >= 0.0;
+            if !ok || a.home < a.min || a.home > a.max {
+                return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, in_position", a.name));
+            }
+        }
+        for p in &self.machine.arc_plane {
+            if !self.machine.axes.iter().any(|a| &a.name == p) {
+                return Err(format!("machine.arc_plane names axis {p}, which is not configured"));
+            }
+        }
+        if !(1.0..=8.0).contains(&self.servo.period_ms) {
+            return Err(format!("servo.period_ms {} outside 1..8", self.servo.period_ms));
+        }
+        if self.servo.queue_capacity < 2 || self.servo.queue_capacity > 10_000 {
+            return Err("servo.queue_capacity must be 2..10000".into());
+        }
+        if self.network.interfaces.is_empty() {
+            return Err("network.interfaces must name at least one interface address".into());
+        }
+        if !(1.0..=100.0).contains(&self.plc.scan_ms) {
+            return Err(format!("plc.scan_ms {} outside 1..100", self.plc.scan_ms));
+        }
+        self.network.effective_domain_id()?;
+        Ok(())
+    }
+
+    pub fn axis_index(&self, name: &str) -> Option<usize> {
+        self.machine.axes.iter().position(|a| a.name == name)
+    }
+
+    /// Power-on slide positions (X as radius).
+    pub fn home_slide(&self) -> Vec<f64> {
+        self.machine.axes.iter().map(|a| if a.diameter { a.home / 2.0 } else { a.home }).collect()
+    }
+}

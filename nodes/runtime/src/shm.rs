@@ -1,0 +1,159 @@
+//! iceoryx2 channels for the fixed-size payloads of `cnc_msgs::servo` and `cnc_msgs::signals`.
+//!
+//! Service names are `cnc/<instance>/<channel>`, where the instance is unique per running cell
+//! (namespace plus DDS domain), so two cells, or two tests, never share a channel.
+
+use std::fmt::Debug;
+use std::time::Duration;
+
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+
+/// One iceoryx2 node per thread (iceoryx2 nodes are not shared across threads).
+pub struct ShmNode {
+    node: Node<ipc::Service>,
+    instance: String,
+}
+
+/// Sends the latest value of `T`.
+pub struct Sender<T: Debug + ZeroCopySend + 'static> {
+    publisher: Publisher<ipc::Service, T, ()>,
+    notifier: Option<Notifier<ipc::Service>>,
+}
+
+/// Receives values of `T`; `latest` drains to the newest.
+pub struct Receiver<T: Debug + ZeroCopySend + 'static> {
+    subscriber: Subscriber<ipc::Service, T, ()>,
+    listener: Option<Listener<ipc::Service>>,
+}
+
+fn err(what: &str, e: impl Debug) -> String {
+    format!("iceoryx2 {what}: {e:?}")
+}
+
+impl ShmNode {
+    pub fn new(instance: &str, node_name: &str) -> Result<Self, String> {
+        let name: NodeName = node_name.try_into().map_err(|e| err("node name", e))?;
+        let node = NodeBuilder::new().name(&name).create::<ipc::Service>().map_err(|e| err("node", e))?;
+        Ok(ShmNode { node, instance: instance.to_string() })
+    }
+
+    fn service_name(&self, channel: &str) -> Result<ServiceName, String> {
+        format!("cnc/{}/{}", self.instance, channel).as_str().try_into().map_err(|e| err("service name", e))
+    }
+
+    /// Sender on `channel`; with `wake`, it also notifies the receiver's listener on each send.
+    pub fn sender<T: Debug + ZeroCopySend + Copy + 'static>(&self, channel: &str, wake: bool) -> Result<Sender<T>, String> {
+        let service = self
+            .node
+            .service_builder(&self.service_name(channel)?)
+            .publish_subscribe::<T>()
+            .subscriber_max_buffer_size(4)
+            .history_size(1)
+            .open_or_create()
+            .map_err(|e| err(channel, e))?;
+        let publisher = service.publisher_builder().create().map_err(|e| err(channel, e))?;
+        let notifier = if wake {
+            let ev = self.node.service_builder(&self.service_name(&format!("{channel}/wake"))?).event().open_or_create().map_err(|e| err(channel, e))?;
+            Some(ev.notifier_builder().create().map_err(|e| err(channel, e))?)
+        } else {
+            None
+        };
+        Ok(Sender { publisher, notifier })
+    }
+
+    pub fn receiver<T: Debug + ZeroCopySend + Copy + 'static>(&self, channel: &str, wake: bool) -> Result<Receiver<T>, String> {
+        let service = self
+            .node
+            .service_builder(&self.service_name(channel)?)
+            .publish_subscribe::<T>()
+            .subscriber_max_buffer_size(4)
+            .history_size(1)
+            .open_or_create()
+            .map_err(|e| err(channel, e))?;
+        let subscriber = service.subscriber_builder().create().map_err(|e| err(channel, e))?;
+        let listener = if wake {
+            let ev = self.node.service_builder(&self.service_name(&format!("{channel}/wake"))?).event().open_or_create().map_err(|e| err(channel, e))?;
+            Some(ev.listener_builder().create().map_err(|e| err(channel, e))?)
+        } else {
+            None
+        };
+        Ok(Receiver { subscriber, listener })
+    }
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> Sender<T> {
+    pub fn send(&self, value: T) -> Result<(), String> {
+        self.publisher.send_copy(value).map_err(|e| err("send", e))?;
+        if let Some(n) = &self.notifier {
+            n.notify().map_err(|e| err("notify", e))?;
+        }
+        Ok(())
+    }
+}
+
+impl<T: Debug + ZeroCopySend + Copy + 'static> Receiver<T> {
+    /// The newest value received since the last call, if any.
+    pub fn latest(&self) -> Result<Option<T>, String> {
+        let mut last = None;
+        while let Some(sample) = self.subscriber.receive().map_err(|e| err("receive", e))? {
+            last = Some(*sample);
+        }
+        Ok(last)
+    }
+
+    /// Waits up to `timeout` for a wake-up (needs `wake`), then returns the newest value.
+    pub fn wait(&self, timeout: Duration) -> Result<Option<T>, String> {
+        if let Some(value) = self.latest()? {
+            return Ok(Some(value));
+        }
+        if let Some(l) = &self.listener {
+            l.timed_wait(|_| {}, timeout).map_err(|e| err("wait", e))?;
+        }
+        self.latest()
+    }
+}
+
+/// Channel names.
+pub mod channel {
+    pub const SETPOINT: &str = "servo/setpoint";
+    pub const FEEDBACK: &str = "servo/feedback";
+    pub const F_IMAGE: &str = "signals/f";
+    pub const G_IMAGE: &str = "signals/g";
+    pub const X_IMAGE: &str = "signals/x";
+    pub const Y_IMAGE: &str = "signals/y";
+}
+
+/// Instance name of a cell: namespace plus domain, so cells and tests never share channels.
+pub fn instance(namespace: &str, domain: u16) -> String {
+    format!("{namespace}_d{domain}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cnc_msgs::servo::ServoSetpoint;
+
+    #[test]
+    fn values_cross_shared_memory_with_wake_up() {
+        let instance = format!("test_shm_{}", std::process::id());
+        let node = ShmNode::new(&instance, "test_node").unwrap();
+        let tx = node.sender::<ServoSetpoint>(channel::SETPOINT, true).unwrap();
+        let rx = node.receiver::<ServoSetpoint>(channel::SETPOINT, true).unwrap();
+        let handle = std::thread::spawn(move || {
+            let node = ShmNode::new(&instance, "test_node2").unwrap();
+            let rx2 = node.receiver::<ServoSetpoint>("other", false).unwrap();
+            rx2.latest().unwrap()
+        });
+        assert_eq!(handle.join().unwrap(), None);
+        for seq in 1..=3 {
+            tx.send(ServoSetpoint { seq, ..Default::default() }).unwrap();
+        }
+        let got = rx.wait(Duration::from_millis(100)).unwrap().unwrap();
+        assert_eq!(got.seq, 3, "latest wins");
+        assert_eq!(rx.latest().unwrap(), None);
+    }
+}
