@@ -7,7 +7,9 @@
 pub mod block;
 pub mod config;
 pub mod motion;
+pub mod node;
 pub mod profile;
+pub mod servo;
 
 pub use block::{AuxCode, Block, BlockKind};
 pub use config::{AxisConfig, MotionConfig};

@@ -1,0 +1,66 @@
+//! io node shell: steps the simulated lathe once per servo setpoint and answers with feedback.
+//!
+//! The simulated machine's time advances one servo period per setpoint, so it runs exactly as
+//! fast as motion drives it. Emergency stop can be pressed from DDS (`/<ns>/sim/input`).
+
+use std::time::Duration;
+
+use cnc_msgs::msg::SimInput;
+use cnc_msgs::servo::{ServoFeedback, ServoSetpoint};
+use cnc_msgs::signals::{XImage, YImage};
+use cnc_runtime::dds::{qos, RosNode};
+use cnc_runtime::shm::{channel, ShmNode};
+use cnc_runtime::{LaunchConfig, Shutdown};
+
+use crate::sim::{SimConfig, SimLathe};
+
+pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
+    SimConfig {
+        drive_lag: cfg.machine.axes.iter().map(|a| a.drive_lag).collect(),
+        spindle_acceleration: cfg.sim.spindle_acceleration,
+        at_speed_tolerance: cfg.sim.at_speed_tolerance,
+        coolant_delay: cfg.sim.coolant_delay,
+    }
+}
+
+/// Runs the io node until shutdown (blocking).
+pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
+    let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "io")?;
+    let inputs = ros.subscription::<SimInput>("sim/input", "cnc_msgs/msg/SimInput", qos::events(10))?;
+    let shm = ShmNode::new(&instance, "io")?;
+    let setpoints = shm.receiver::<ServoSetpoint>(channel::SETPOINT, true)?;
+    let feedback = shm.sender::<ServoFeedback>(channel::FEEDBACK, true)?;
+    let outputs = shm.receiver::<YImage>(channel::Y_IMAGE, false)?;
+    let x_out = shm.sender::<XImage>(channel::X_IMAGE, false)?;
+    let period = cfg.servo.period_ms / 1000.0;
+    let mut sim = SimLathe::new(sim_config(&cfg), &cfg.home_slide());
+    let mut y = YImage::default();
+    // Report the power-on position before motion starts.
+    let idle = ServoSetpoint::default();
+    feedback.send(sim.step(&idle, &y, 0.0))?;
+    while !shutdown.requested() {
+        while let Ok(Some((input, _))) = inputs.take() {
+            if input.input == SimInput::EMERGENCY_STOP {
+                log::warn!("simulated emergency stop {}", if input.value { "pressed" } else { "released" });
+                sim.set_emergency_stop(input.value);
+            }
+        }
+        if let Some(latest) = outputs.latest()? {
+            y = latest;
+        }
+        match setpoints.wait(Duration::from_millis(50))? {
+            Some(sp) => {
+                let fb = sim.step(&sp, &y, period);
+                feedback.send(fb)?;
+            }
+            None => {
+                // No motion node: keep the spindle and devices alive in real time.
+                let mut hold = idle;
+                hold.position = sim.step(&idle, &y, 0.0).position;
+                sim.step(&hold, &y, 0.05);
+            }
+        }
+        x_out.send(sim.x_image(&y))?;
+    }
+    Ok(())
+}

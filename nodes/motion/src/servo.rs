@@ -1,0 +1,109 @@
+//! Servo loop statistics: tick interval and iceoryx2 round trip, kept as fixed histograms so
+//! the loop allocates nothing after start-up.
+
+/// 1 µs bins up to 100 ms; slower values land in the last bin.
+const BINS: usize = 100_000;
+
+pub struct Histogram {
+    bins: Vec<u32>,
+    count: u64,
+    min_us: f64,
+    max_us: f64,
+}
+
+impl Default for Histogram {
+    fn default() -> Self {
+        Histogram { bins: vec![0; BINS], count: 0, min_us: f64::INFINITY, max_us: 0.0 }
+    }
+}
+
+impl Histogram {
+    pub fn record(&mut self, us: f64) {
+        if !us.is_finite() || us < 0.0 {
+            return;
+        }
+        let bin = (us as usize).min(BINS - 1);
+        self.bins[bin] += 1;
+        self.count += 1;
+        self.min_us = self.min_us.min(us);
+        self.max_us = self.max_us.max(us);
+    }
+
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+
+    /// Value below which `q` (0..1) of the samples lie, to 1 µs.
+    pub fn quantile(&self, q: f64) -> f64 {
+        if self.count == 0 {
+            return 0.0;
+        }
+        let target = ((self.count as f64) * q).ceil().max(1.0) as u64;
+        let mut seen = 0;
+        for (i, &n) in self.bins.iter().enumerate() {
+            seen += n as u64;
+            if seen >= target {
+                return (i as f64 + 0.5).clamp(self.min_us, self.max_us);
+            }
+        }
+        self.max_us
+    }
+
+    pub fn min(&self) -> f64 {
+        if self.count == 0 {
+            0.0
+        } else {
+            self.min_us
+        }
+    }
+    pub fn max(&self) -> f64 {
+        self.max_us
+    }
+}
+
+#[derive(Default)]
+pub struct ServoStatistics {
+    pub interval: Histogram,
+    pub round_trip: Histogram,
+    pub ticks: u64,
+    pub late_ticks: u64,
+}
+
+impl ServoStatistics {
+    pub fn summary(&self, period_us: f64) -> String {
+        format!(
+            "servo loop: {} ticks of {:.0} us, {} late; interval us min/p50/p99/max {:.0}/{:.0}/{:.0}/{:.0}; iceoryx2 round trip us min/p50/p99/max {:.1}/{:.0}/{:.0}/{:.0} ({} samples)",
+            self.ticks,
+            period_us,
+            self.late_ticks,
+            self.interval.min(),
+            self.interval.quantile(0.5),
+            self.interval.quantile(0.99),
+            self.interval.max(),
+            self.round_trip.min(),
+            self.round_trip.quantile(0.5),
+            self.round_trip.quantile(0.99),
+            self.round_trip.max(),
+            self.round_trip.count()
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_of_a_known_distribution() {
+        let mut h = Histogram::default();
+        for i in 1..=1000 {
+            h.record(i as f64);
+        }
+        assert_eq!(h.min(), 1.0);
+        assert_eq!(h.max(), 1000.0);
+        assert!((h.quantile(0.5) - 500.5).abs() <= 1.0);
+        assert!((h.quantile(0.99) - 990.5).abs() <= 1.0);
+        h.record(1e9);
+        assert_eq!(h.max(), 1e9);
+    }
+}
