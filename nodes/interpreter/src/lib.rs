@@ -9,6 +9,7 @@ pub mod dialect;
 pub mod error;
 pub mod interpreter;
 pub mod lexer;
+pub mod node;
 
 pub use canon::{Aux, Canon, Command};
 pub use dialect::Dialect;

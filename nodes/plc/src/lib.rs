@@ -2,5 +2,6 @@
 //! and ROS 2 topics.
 
 pub mod logic;
+pub mod node;
 
 pub use logic::{Plc, PlcEvent};

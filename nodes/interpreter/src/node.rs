@@ -1,0 +1,278 @@
+//! interpreter node shell: program memory, program runs, the credit-based block stream to
+//! motion, and the machine state.
+//!
+//! Commands arrive from hmi_bridge on `_internal/program_command`, each answered on
+//! `_internal/command_result`. During a run, at most `capacity` unfinished blocks are in flight:
+//! motion's `done_seq` returns the credit.
+
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+use cnc_msgs::msg::{Alarm, AlarmEvent, AxisState, CommandResult, MachineState, MotionBlock, MotionStatus, ProgramCommand};
+use cnc_runtime::alarms::AlarmReporter;
+use cnc_runtime::clock::monotonic_ns;
+use cnc_runtime::dds::{qos, stamp, RosNode};
+use cnc_runtime::{LaunchConfig, Shutdown};
+
+use crate::{Aux, Command, Dialect, Interpreter};
+
+/// Largest program text accepted, bytes.
+pub const MAX_PROGRAM_BYTES: usize = 4 * 1024 * 1024;
+/// Programs kept in memory.
+pub const MAX_PROGRAMS: usize = 1000;
+
+/// A program name: what a control's directory shows, e.g. `O0001` or `part7.nc`.
+pub fn valid_program_name(name: &str) -> bool {
+    !name.is_empty() && name.len() <= 64 && name.chars().all(|c| c.is_ascii_alphanumeric() || "._-".contains(c)) && !name.starts_with('.')
+}
+
+struct Run {
+    id: u64,
+    program: String,
+    interp: Interpreter,
+    sent_seq: u64,
+    end_seq: Option<u64>,
+    failed: bool,
+}
+
+pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
+    let dialect = Dialect::from_name(&cfg.machine.dialect).ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
+    let axes: Vec<char> = cfg.machine.axes.iter().map(|a| a.name.chars().next().unwrap_or('?')).collect();
+    let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
+    let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
+    let commands = ros.subscription::<ProgramCommand>("_internal/program_command", "cnc_msgs/msg/ProgramCommand", qos::commands())?;
+    let results = ros.publisher::<CommandResult>("_internal/command_result", "cnc_msgs/msg/CommandResult", qos::commands())?;
+    let to_motion_cmd = ros.publisher::<ProgramCommand>("_internal/program_command", "cnc_msgs/msg/ProgramCommand", qos::commands())?;
+    let blocks = ros.publisher::<MotionBlock>("_internal/motion_blocks", "cnc_msgs/msg/MotionBlock", qos::commands())?;
+    let status_sub = ros.subscription::<MotionStatus>("_internal/motion_status", "cnc_msgs/msg/MotionStatus", qos::state())?;
+    let axes_sub = ros.subscription::<AxisState>("axes", "cnc_msgs/msg/AxisState", qos::state())?;
+    let alarm_sub = ros.subscription::<AlarmEvent>("alarm_events", "cnc_msgs/msg/AlarmEvent", qos::events(100))?;
+    let state_pub = ros.publisher::<MachineState>("machine_state", "cnc_msgs/msg/MachineState", qos::state())?;
+    let alarms = AlarmReporter::new(&mut ros, "interpreter")?;
+
+    let mut programs: BTreeMap<String, String> = BTreeMap::new();
+    let mut run: Option<Run> = None;
+    let mut run_counter = monotonic_ns() / 1000; // run ids grow across restarts of this node
+    let mut status = MotionStatus::default();
+    let mut position: Option<Vec<f64>> = None;
+    let mut active_alarms: Vec<(String, u32)> = Vec::new();
+    let mut execution = MachineState::READY;
+    let mut program_name = String::new();
+    let mut last_published: Option<(u8, u32, bool, bool, String)> = None;
+    let mut last_publish_ns = 0u64;
+    let mut stop_command_id = 0u64;
+
+    while !shutdown.requested() {
+        let mut busy = false;
+        while let Ok(Some((s, _))) = status_sub.take() {
+            status = s;
+        }
+        while let Ok(Some((a, _))) = axes_sub.take() {
+            position = Some(a.axes.iter().map(|x| x.commanded_position).collect());
+        }
+        while let Ok(Some((e, _))) = alarm_sub.take() {
+            let key = (e.alarm.source.clone(), e.alarm.number);
+            if e.kind == AlarmEvent::RAISED {
+                if !active_alarms.contains(&key) {
+                    active_alarms.push(key);
+                }
+                // Any alarm stops the run: nothing more is sent; motion stops on its own or by
+                // the cycle stop below.
+                if let Some(r) = run.as_mut() {
+                    if !r.failed {
+                        r.failed = true;
+                        stop_command_id += 1;
+                        let _ = to_motion_cmd.publish(ProgramCommand { id: stop_command_id, command: ProgramCommand::CYCLE_STOP, program: String::new(), text: String::new() });
+                    }
+                }
+                if execution == MachineState::ACTIVE || execution == MachineState::FEED_HOLD {
+                    execution = MachineState::STOPPED;
+                }
+            } else {
+                active_alarms.retain(|k| k != &key);
+            }
+        }
+        while let Ok(Some((c, _))) = commands.take() {
+            busy = true;
+            let (accepted, message) = match c.command {
+                ProgramCommand::LOAD => {
+                    if !valid_program_name(&c.program) {
+                        (false, format!("invalid program name {:?}: letters, digits, '.', '_', '-', at most 64", c.program))
+                    } else if c.text.len() > MAX_PROGRAM_BYTES {
+                        (false, format!("program too large: {} bytes, limit {MAX_PROGRAM_BYTES}", c.text.len()))
+                    } else if programs.len() >= MAX_PROGRAMS && !programs.contains_key(&c.program) {
+                        (false, format!("program memory full ({MAX_PROGRAMS} programs)"))
+                    } else if run.as_ref().is_some_and(|r| r.program == c.program) && execution == MachineState::ACTIVE {
+                        (false, format!("{} is running", c.program))
+                    } else {
+                        let lines = c.text.lines().count();
+                        programs.insert(c.program.clone(), c.text.clone());
+                        (true, format!("{} stored ({lines} lines)", c.program))
+                    }
+                }
+                ProgramCommand::START => {
+                    if !active_alarms.is_empty() {
+                        (false, format!("alarm active ({} alarms): reset first", active_alarms.len()))
+                    } else if matches!(execution, MachineState::ACTIVE) {
+                        (false, "a program is running".into())
+                    } else if execution == MachineState::FEED_HOLD && c.program.is_empty() {
+                        execution = MachineState::ACTIVE;
+                        (true, "resumed".into())
+                    } else if let Some(text) = programs.get(&c.program) {
+                        match position.clone() {
+                            None => (false, "no axis position from motion yet".into()),
+                            Some(start) => {
+                                run_counter += 1;
+                                let interp = Interpreter::new(dialect, text, &axes, &diameter, &start);
+                                run = Some(Run { id: run_counter, program: c.program.clone(), interp, sent_seq: 0, end_seq: None, failed: false });
+                                program_name = c.program.clone();
+                                execution = MachineState::ACTIVE;
+                                (true, format!("{} started", c.program))
+                            }
+                        }
+                    } else {
+                        (false, format!("program {:?} not found (alarm 22)", c.program))
+                    }
+                }
+                ProgramCommand::FEED_HOLD => {
+                    if execution == MachineState::ACTIVE {
+                        execution = MachineState::FEED_HOLD;
+                        (true, "feed hold".into())
+                    } else {
+                        (false, "no program running".into())
+                    }
+                }
+                ProgramCommand::CYCLE_STOP => {
+                    if let Some(r) = run.as_mut() {
+                        r.failed = true;
+                    }
+                    if matches!(execution, MachineState::ACTIVE | MachineState::FEED_HOLD) {
+                        execution = MachineState::STOPPED;
+                    }
+                    (true, "cycle stop".into())
+                }
+                ProgramCommand::RESET => {
+                    run = None;
+                    // Program alarms are cleared by reset; alarms whose cause persists (emergency
+                    // stop) stay until their source clears them.
+                    for (source, number) in active_alarms.clone() {
+                        if source == "interpreter" {
+                            alarms.clear(number);
+                            active_alarms.retain(|k| k != &(source.clone(), number));
+                        }
+                    }
+                    execution = MachineState::READY;
+                    (true, "reset".into())
+                }
+                other => (false, format!("unknown command {other}")),
+            };
+            let _ = results.publish(CommandResult { id: c.id, accepted, message });
+        }
+        // Feed the motion queue while credit lasts.
+        if let Some(r) = run.as_mut() {
+            let in_flight = if status.run_id == r.id { r.sent_seq.saturating_sub(status.done_seq) } else { r.sent_seq };
+            let credit = (status.capacity.max(2) as u64).saturating_sub(in_flight);
+            for _ in 0..credit {
+                if r.failed || r.end_seq.is_some() {
+                    break;
+                }
+                match r.interp.next_command() {
+                    Ok(Some(canon)) => {
+                        busy = true;
+                        r.sent_seq += 1;
+                        let msg = to_block(r.id, r.sent_seq, &r.program, canon.line, &canon.command);
+                        if canon.command == Command::ProgramEnd {
+                            r.end_seq = Some(r.sent_seq);
+                        }
+                        if let Err(e) = blocks.publish(msg) {
+                            log::error!("interpreter: block not sent: {e:?}");
+                        }
+                    }
+                    Ok(None) => break,
+                    Err(e) => {
+                        r.failed = true;
+                        alarms.raise(alarms.alarm(e.number, Alarm::SEVERITY_ERROR, &e.text, &r.program, e.line));
+                    }
+                }
+            }
+            if status.run_id == r.id && Some(status.done_seq) == r.end_seq && r.end_seq.is_some() && execution == MachineState::ACTIVE {
+                execution = MachineState::PROGRAM_COMPLETED;
+                run = None;
+            }
+        }
+        if let Some(r) = run.as_ref() {
+            if status.run_id == r.id && status.state == MotionStatus::STATE_HOLD && execution == MachineState::ACTIVE {
+                execution = MachineState::FEED_HOLD;
+            }
+            if status.run_id == r.id && status.state == MotionStatus::STATE_RUNNING && execution == MachineState::FEED_HOLD {
+                execution = MachineState::ACTIVE;
+            }
+        }
+        let line = if run.as_ref().is_some_and(|r| r.id == status.run_id) || execution != MachineState::READY { status.line } else { 0 };
+        let estop = active_alarms.iter().any(|(s, n)| s == "plc" && *n == 65);
+        let key = (execution, line, estop, !active_alarms.is_empty(), program_name.clone());
+        let now = monotonic_ns();
+        if last_published.as_ref() != Some(&key) || now - last_publish_ns > 500_000_000 {
+            last_publish_ns = now;
+            last_published = Some(key);
+            let _ = state_pub.publish(MachineState {
+                stamp: stamp(),
+                mode: MachineState::MODE_AUTO,
+                execution,
+                execution_name: MachineState::execution_name_of(execution).into(),
+                program: program_name.clone(),
+                line,
+                emergency_stop: estop,
+                alarm_active: !active_alarms.is_empty(),
+            });
+        }
+        if !busy {
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+    Ok(())
+}
+
+fn to_block(run_id: u64, seq: u64, program: &str, line: u32, c: &Command) -> MotionBlock {
+    let mut m = MotionBlock { run_id, seq, program: program.into(), line, ..MotionBlock::default() };
+    match c {
+        Command::Rapid { end } => {
+            m.kind = MotionBlock::KIND_RAPID;
+            m.end = end.clone();
+        }
+        Command::Linear { end, feed } => {
+            m.kind = MotionBlock::KIND_LINEAR;
+            m.end = end.clone();
+            m.feed = *feed;
+        }
+        Command::Arc { end, center, clockwise, feed } => {
+            m.kind = if *clockwise { MotionBlock::KIND_ARC_CW } else { MotionBlock::KIND_ARC_CCW };
+            m.end = end.clone();
+            m.center = center.clone();
+            m.feed = *feed;
+        }
+        Command::Dwell { seconds } => {
+            m.kind = MotionBlock::KIND_DWELL;
+            m.dwell_seconds = *seconds;
+        }
+        Command::Aux(a) => {
+            m.kind = MotionBlock::KIND_AUX;
+            match *a {
+                Aux::M(code) => {
+                    m.aux_kind = MotionBlock::AUX_M;
+                    m.aux_code = code;
+                }
+                Aux::S(v) => {
+                    m.aux_kind = MotionBlock::AUX_S;
+                    m.aux_value = v;
+                }
+                Aux::T(code) => {
+                    m.aux_kind = MotionBlock::AUX_T;
+                    m.aux_code = code;
+                }
+            }
+        }
+        Command::ProgramEnd => m.kind = MotionBlock::KIND_PROGRAM_END,
+    }
+    m
+}
