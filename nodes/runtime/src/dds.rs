@@ -14,7 +14,7 @@ use crate::config::NetworkConfig;
 pub struct RosNode {
     pub node: Node,
     pub namespace: String,
-    _context: Context,
+    context: Context,
 }
 
 /// Creates a participant in the configured domain that uses only the configured interfaces.
@@ -42,7 +42,12 @@ impl RosNode {
             }
             Err(e) => log::warn!("{name}: no spinner: {e:?}"),
         }
-        Ok(RosNode { node, namespace: namespace.to_string(), _context: context })
+        Ok(RosNode { node, namespace: namespace.to_string(), context })
+    }
+
+    /// The node's DDS participant, for entities ros2-client does not offer.
+    pub fn participant(&self) -> ros2_client::dds::rustdds::DomainParticipant {
+        self.context.domain_participant()
     }
 
     fn topic(&mut self, topic: &str, type_name: &str, qos: &QosProfile) -> Result<ros2_client::dds::rustdds::Topic, String> {

@@ -1,0 +1,147 @@
+//! A service server that answers rmw_cyclonedds-style and rmw_fastrtps-style clients on the same
+//! topics, built on rustdds directly because ros2-client's `Server` speaks one mapping only.
+
+use std::marker::PhantomData;
+
+use byteorder::LittleEndian;
+use ros2_client::dds::rustdds::{
+    self,
+    bytes::Bytes,
+    no_key::{self, DataWriter, SimpleDataReader},
+    rpc::SampleIdentity,
+    QosPolicies, RepresentationIdentifier, SequenceNumber, Timestamp, TopicKind, WriteOptionsBuilder,
+};
+use serde::{de::DeserializeOwned, Serialize};
+
+use crate::mapping::{classify, Mapping};
+use cnc_msgs::srv::RosService;
+
+/// Payload bytes as they travel, without the encapsulation header.
+#[derive(Debug)]
+pub struct Raw {
+    bytes: Vec<u8>,
+    little_endian: bool,
+}
+
+pub struct RawAdapter;
+
+impl no_key::DeserializerAdapter<Raw> for RawAdapter {
+    type Error = std::io::Error;
+    type Decoded = Raw;
+    fn supported_encodings() -> &'static [RepresentationIdentifier] {
+        &[RepresentationIdentifier::CDR_LE, RepresentationIdentifier::CDR_BE]
+    }
+    fn transform_decoded(decoded: Raw) -> Raw {
+        decoded
+    }
+}
+
+impl no_key::DefaultDecoder<Raw> for RawAdapter {
+    type Decoder = RawDecoder;
+    const DECODER: RawDecoder = RawDecoder;
+}
+
+#[derive(Clone)]
+pub struct RawDecoder;
+
+impl<'de> no_key::Decode<'de, Raw> for RawDecoder {
+    type Error = std::io::Error;
+    fn decode_bytes(self, input: &'de [u8], encoding: RepresentationIdentifier) -> Result<Raw, Self::Error> {
+        Ok(Raw { bytes: input.to_vec(), little_endian: encoding != RepresentationIdentifier::CDR_BE })
+    }
+}
+
+impl no_key::SerializerAdapter<Raw> for RawAdapter {
+    type Error = std::io::Error;
+    fn output_encoding() -> RepresentationIdentifier {
+        RepresentationIdentifier::CDR_LE
+    }
+    fn to_bytes(value: &Raw) -> Result<Bytes, Self::Error> {
+        Ok(Bytes::from(value.bytes.clone()))
+    }
+}
+
+/// One received request, ready to be answered.
+pub struct Request<Req> {
+    pub request: Req,
+    pub mapping: Mapping,
+    identity: SampleIdentity,
+    /// GUID of the client's writer, for logs and events.
+    pub client: String,
+}
+
+pub struct DualServer<S: RosService> {
+    reader: SimpleDataReader<Raw, RawAdapter>,
+    writer: DataWriter<Raw, RawAdapter>,
+    name: String,
+    _service: PhantomData<S>,
+}
+
+impl<S: RosService> DualServer<S>
+where
+    S::Request: DeserializeOwned,
+    S::Response: Serialize,
+{
+    /// Serves `/<namespace>/<service>` as DDS topics `rq/<ns>/<service>Request` and `rr/…Reply`.
+    pub fn new(participant: &rustdds::DomainParticipant, namespace: &str, service: &str, qos: QosPolicies) -> Result<Self, String> {
+        let (pkg, ty) = (cnc_msgs::PACKAGE, S::NAME);
+        let rq = participant
+            .create_topic(format!("rq/{namespace}/{service}Request"), format!("{pkg}::srv::dds_::{ty}_Request_"), &qos, TopicKind::NoKey)
+            .map_err(|e| format!("{service}: {e:?}"))?;
+        let rr = participant
+            .create_topic(format!("rr/{namespace}/{service}Reply"), format!("{pkg}::srv::dds_::{ty}_Response_"), &qos, TopicKind::NoKey)
+            .map_err(|e| format!("{service}: {e:?}"))?;
+        let subscriber = participant.create_subscriber(&qos).map_err(|e| format!("{service}: {e:?}"))?;
+        let publisher = participant.create_publisher(&qos).map_err(|e| format!("{service}: {e:?}"))?;
+        let reader = subscriber.create_simple_datareader_no_key::<Raw, RawAdapter>(&rq, None).map_err(|e| format!("{service}: {e:?}"))?;
+        let writer = publisher.create_datawriter_no_key::<Raw, RawAdapter>(&rr, None).map_err(|e| format!("{service}: {e:?}"))?;
+        Ok(DualServer { reader, writer, name: service.into(), _service: PhantomData })
+    }
+
+    /// The next request, if any. Undecodable requests are logged and dropped: without a valid
+    /// request there is no reliable way to address a reply to the client.
+    pub fn receive(&self) -> Option<Request<S::Request>> {
+        self.reader.drain_read_notifications();
+        loop {
+            let dcc = match self.reader.try_take_one() {
+                Ok(Some(d)) => d,
+                Ok(None) => return None,
+                Err(e) => {
+                    log::warn!("{}: request not readable: {e:?}", self.name);
+                    continue;
+                }
+            };
+            let related = dcc.related_sample_identity();
+            let own = SampleIdentity { writer_guid: dcc.writer_guid, sequence_number: dcc.sequence_number };
+            let client = format!("{:?}", dcc.writer_guid);
+            let raw = dcc.into_value();
+            let related_seq = related.map(|r| i64::from(r.sequence_number));
+            match classify::<S::Request>(&raw.bytes, raw.little_endian, related_seq) {
+                Some((mapping, request)) => {
+                    let identity = match related {
+                        // rmw_fastrtps names the reply reader with an unknown sequence number.
+                        Some(r) if r.sequence_number != SequenceNumber::UNKNOWN => r,
+                        Some(r) => SampleIdentity { writer_guid: r.writer_guid, sequence_number: own.sequence_number },
+                        None => own,
+                    };
+                    return Some(Request { request, mapping, identity, client });
+                }
+                None => log::warn!("{}: malformed request ({} bytes) from {client} dropped", self.name, raw.bytes.len()),
+            }
+        }
+    }
+
+    pub fn reply(&self, to: &Request<S::Request>, response: &S::Response) -> Result<(), String> {
+        let body = cdr_encoding::to_vec::<_, LittleEndian>(response).map_err(|e| format!("{}: {e}", self.name))?;
+        let bytes = match to.mapping {
+            Mapping::Enhanced => body,
+            Mapping::Cyclone(header) => {
+                let mut b = header.to_vec();
+                b.extend(body);
+                b
+            }
+        };
+        let options = WriteOptionsBuilder::new().source_timestamp(Timestamp::now()).related_sample_identity(to.identity).build();
+        self.writer.write_with_options(Raw { bytes, little_endian: true }, options).map(|_| ()).map_err(|e| format!("{}: reply not sent: {e:?}", self.name))
+    }
+}
