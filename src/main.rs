@@ -1,1 +1,200 @@
-fn main() {}
+//! `cnc`: run a cell on the simulated machine, or check a part program.
+//!
+//! `cnc run CONFIG` runs until Ctrl-C; with `--program FILE --cycles N` it loads and runs the
+//! program N times through the cell's own ROS 2 services and exits 0 when done, 1 on any alarm.
+//! With no arguments it runs `launch_configs/sim_lathe.yaml` with the demo part, looping.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use clap::{Parser, Subcommand};
+use cnc::cell::Cell;
+use cnc::client::CellClient;
+use cnc_msgs::msg::MachineState;
+use cnc_runtime::LaunchConfig;
+use ros2_client::ServiceMapping;
+
+const DEFAULT_CONFIG: &str = "launch_configs/sim_lathe.yaml";
+const DEMO_PROGRAM: &str = "examples/lathe/demo_shaft.nc";
+
+#[derive(Parser)]
+#[command(name = "cnc", about = "Soft CNC for robot-tended machine cells")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Verb>,
+}
+
+#[derive(Subcommand)]
+enum Verb {
+    /// Start every node of the cell in this process.
+    Run {
+        config: PathBuf,
+        /// Load and run this program, then exit.
+        #[arg(long)]
+        program: Option<PathBuf>,
+        /// Cycles to run (with --program). 0 = until Ctrl-C.
+        #[arg(long, default_value_t = 1)]
+        cycles: u32,
+    },
+    /// Interpret a program without running it; report the first error with line and alarm number.
+    Check {
+        program: PathBuf,
+        #[arg(long, default_value = DEFAULT_CONFIG)]
+        config: PathBuf,
+    },
+}
+
+static STOP: AtomicBool = AtomicBool::new(false);
+
+extern "C" fn on_signal(_: libc::c_int) {
+    STOP.store(true, Ordering::SeqCst);
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Verb::Run { config, program, cycles }) => run(&config, program.as_deref(), cycles),
+        Some(Verb::Check { program, config }) => check(&program, &config),
+        None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("cnc: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn check(program: &Path, config: &Path) -> Result<(), String> {
+    let cfg = LaunchConfig::load(config)?;
+    let text = read_program(program)?;
+    let dialect = cnc_interpreter::Dialect::from_name(&cfg.machine.dialect).ok_or("unknown dialect")?;
+    let axes: Vec<char> = cfg.machine.axes.iter().map(|a| a.name.chars().next().unwrap_or('?')).collect();
+    let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
+    let home: Vec<f64> = cfg.machine.axes.iter().map(|a| a.home).collect();
+    let cmds = cnc_interpreter::check(dialect, &text, &axes, &diameter, &home).map_err(|e| format!("{}: {e}", program.display()))?;
+    println!("{}: {} canonical commands, no alarm", program.display(), cmds.len());
+    Ok(())
+}
+
+fn read_program(path: &Path) -> Result<String, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    String::from_utf8(bytes).map_err(|_| format!("{}: not UTF-8 text", path.display()))
+}
+
+fn program_name(path: &Path) -> String {
+    path.file_name().and_then(|n| n.to_str()).unwrap_or("program").chars().filter(|c| c.is_ascii_alphanumeric() || "._-".contains(*c)).collect()
+}
+
+fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String> {
+    let cfg = LaunchConfig::load(config)?;
+    let text = program.map(read_program).transpose()?;
+    // SAFETY: installing a handler that only stores to an atomic.
+    unsafe {
+        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
+    }
+    let domain = cfg.network.effective_domain_id()?;
+    let ns = cfg.machine.namespace.clone();
+    let cell = Cell::start(&cfg)?;
+    println!(
+        "cell '{ns}' running: DDS domain {domain} on {:?}; services /{ns}/load_program, /{ns}/start_program, /{ns}/stop, /{ns}/reset; topics /{ns}/machine_state, /{ns}/spindle, /{ns}/axes, /{ns}/part_count, /{ns}/alarms, /{ns}/alarm_events",
+        cfg.network.interfaces
+    );
+    let outcome = supervise(&cfg, program, text.as_deref(), cycles);
+    let (summary, errors) = cell.stop();
+    if !summary.is_empty() {
+        println!("{summary}");
+    }
+    for e in &errors {
+        eprintln!("cnc: {e}");
+    }
+    outcome?;
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err("a node failed".into())
+    }
+}
+
+/// Loads and runs the program for the requested cycles, printing progress; or just waits.
+fn supervise(cfg: &LaunchConfig, program: Option<&Path>, text: Option<&str>, cycles: u32) -> Result<(), String> {
+    let ns = &cfg.machine.namespace;
+    let mut client = CellClient::new(&cfg.network, ns, "cnc_cli", ServiceMapping::Enhanced)?;
+    let (Some(path), Some(text)) = (program, text) else {
+        while !STOP.load(Ordering::SeqCst) {
+            client.poll();
+            std::thread::sleep(Duration::from_millis(200));
+        }
+        return Ok(());
+    };
+    let name = program_name(path);
+    let r = client.load_program(&name, text)?;
+    if !r.accepted {
+        return Err(format!("load refused: {}", r.message));
+    }
+    let mut done = 0u32;
+    let mut last_print = Instant::now() - Duration::from_secs(1);
+    while !STOP.load(Ordering::SeqCst) && (cycles == 0 || done < cycles) {
+        let r = client.start_program(&name)?;
+        if !r.accepted {
+            return Err(format!("start refused: {}", r.message));
+        }
+        let started = Instant::now();
+        let mut seen_active = false;
+        loop {
+            if STOP.load(Ordering::SeqCst) {
+                return Ok(());
+            }
+            for s in client.poll() {
+                match s.execution {
+                    MachineState::ACTIVE => seen_active = true,
+                    MachineState::PROGRAM_COMPLETED if seen_active => {
+                        done += 1;
+                        print_progress(&client, done);
+                        seen_active = false;
+                        break;
+                    }
+                    MachineState::STOPPED | MachineState::READY if seen_active || s.alarm_active => {
+                        let alarms = client.alarms.as_ref().map(|a| a.alarms.iter().map(|a| format!("alarm {} ({}): {} [line {}]", a.number, a.source, a.text, a.line)).collect::<Vec<_>>().join("; ")).unwrap_or_default();
+                        return Err(format!("cycle {} stopped: {alarms}", done + 1));
+                    }
+                    _ => {}
+                }
+            }
+            if client.state.as_ref().is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED) && !seen_active && started.elapsed() > Duration::from_millis(100) {
+                break;
+            }
+            if last_print.elapsed() > Duration::from_millis(500) {
+                last_print = Instant::now();
+                print_progress(&client, done);
+            }
+            if started.elapsed() > Duration::from_secs(3600) {
+                return Err("cycle did not complete within an hour".into());
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+    Ok(())
+}
+
+fn print_progress(c: &CellClient, done: u32) {
+    let s = c.state.as_ref();
+    let sp = c.spindle.as_ref();
+    let pos = c.axes.as_ref().map(|a| a.axes.iter().map(|x| format!("{}{:.3}", x.name, x.actual_position)).collect::<Vec<_>>().join(" ")).unwrap_or_default();
+    println!(
+        "{:<17} {} line {:>4} | {} | spindle {:>6.0} rpm (cmd {:.0}) | parts {} | cycles done {}",
+        s.map(|s| s.execution_name.as_str()).unwrap_or("-"),
+        s.map(|s| s.program.as_str()).unwrap_or(""),
+        s.map(|s| s.line).unwrap_or(0),
+        pos,
+        sp.map(|s| s.actual_rpm).unwrap_or(0.0),
+        sp.map(|s| s.commanded_rpm).unwrap_or(0.0),
+        c.part_count.as_ref().map(|p| p.count).unwrap_or(0),
+        done
+    );
+}

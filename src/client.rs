@@ -1,0 +1,129 @@
+//! A ROS 2 client of a running cell: calls its services and follows its state topics.
+
+use std::time::{Duration, Instant};
+
+use cnc_msgs::msg::{ActiveAlarms, AxisState, MachineState, PartCount, ServoStats, SpindleState};
+use cnc_msgs::srv::*;
+use cnc_runtime::config::NetworkConfig;
+use cnc_runtime::dds::{qos, RosNode};
+use ros2_client::dds::{Client, Subscription};
+use ros2_client::{Name, ServiceMapping, ServiceTypeName};
+
+pub struct CellClient {
+    ros: RosNode,
+    load: Client<LoadProgramRequest, LoadProgramResponse>,
+    start: Client<StartProgramRequest, StartProgramResponse>,
+    stop: Client<StopRequest, StopResponse>,
+    reset: Client<ResetRequest, ResetResponse>,
+    machine: Subscription<MachineState>,
+    spindle_sub: Subscription<SpindleState>,
+    parts: Subscription<PartCount>,
+    alarms_sub: Subscription<ActiveAlarms>,
+    axes_sub: Subscription<AxisState>,
+    stats_sub: Subscription<ServoStats>,
+    pub state: Option<MachineState>,
+    pub spindle: Option<SpindleState>,
+    pub part_count: Option<PartCount>,
+    pub alarms: Option<ActiveAlarms>,
+    pub axes: Option<AxisState>,
+    pub servo_stats: Option<ServoStats>,
+}
+
+fn client<S: RosService>(ros: &mut RosNode, mapping: ServiceMapping, ns: &str, service: &str) -> Result<Client<S::Request, S::Response>, String> {
+    let name = Name::new(&format!("/{ns}"), service).map_err(|e| format!("{e:?}"))?;
+    let q = qos::services();
+    ros.node.create_client::<S::Request, S::Response>(mapping, &name, &ServiceTypeName::new(cnc_msgs::PACKAGE, S::NAME), q.clone(), q).map_err(|e| format!("client {service}: {e:?}"))
+}
+
+impl CellClient {
+    /// A client node named `name` that speaks the given service mapping.
+    pub fn new(net: &NetworkConfig, ns: &str, name: &str, mapping: ServiceMapping) -> Result<Self, String> {
+        let mut ros = RosNode::new(net, ns, name)?;
+        Ok(CellClient {
+            load: client::<LoadProgram>(&mut ros, mapping, ns, "load_program")?,
+            start: client::<StartProgram>(&mut ros, mapping, ns, "start_program")?,
+            stop: client::<Stop>(&mut ros, mapping, ns, "stop")?,
+            reset: client::<Reset>(&mut ros, mapping, ns, "reset")?,
+            machine: ros.subscription("machine_state", "cnc_msgs/msg/MachineState", qos::state())?,
+            spindle_sub: ros.subscription("spindle", "cnc_msgs/msg/SpindleState", qos::state())?,
+            parts: ros.subscription("part_count", "cnc_msgs/msg/PartCount", qos::state())?,
+            alarms_sub: ros.subscription("alarms", "cnc_msgs/msg/ActiveAlarms", qos::state())?,
+            axes_sub: ros.subscription("axes", "cnc_msgs/msg/AxisState", qos::state())?,
+            stats_sub: ros.subscription("servo_stats", "cnc_msgs/msg/ServoStats", qos::state())?,
+            ros,
+            state: None,
+            spindle: None,
+            part_count: None,
+            alarms: None,
+            axes: None,
+            servo_stats: None,
+        })
+    }
+
+    /// Takes every new sample of the state topics; returns the machine states seen, in order.
+    pub fn poll(&mut self) -> Vec<MachineState> {
+        let mut states = Vec::new();
+        while let Ok(Some((m, _))) = self.machine.take() {
+            states.push(m.clone());
+            self.state = Some(m);
+        }
+        while let Ok(Some((m, _))) = self.spindle_sub.take() {
+            self.spindle = Some(m);
+        }
+        while let Ok(Some((m, _))) = self.parts.take() {
+            self.part_count = Some(m);
+        }
+        while let Ok(Some((m, _))) = self.alarms_sub.take() {
+            self.alarms = Some(m);
+        }
+        while let Ok(Some((m, _))) = self.axes_sub.take() {
+            self.axes = Some(m);
+        }
+        while let Ok(Some((m, _))) = self.stats_sub.take() {
+            self.servo_stats = Some(m);
+        }
+        states
+    }
+
+    pub fn load_program(&mut self, name: &str, text: &str) -> Result<LoadProgramResponse, String> {
+        call(&self.load, LoadProgramRequest { name: name.into(), text: text.into() })
+    }
+    pub fn start_program(&mut self, name: &str) -> Result<StartProgramResponse, String> {
+        call(&self.start, StartProgramRequest { name: name.into() })
+    }
+    pub fn stop(&mut self, mode: u8) -> Result<StopResponse, String> {
+        call(&self.stop, StopRequest { mode })
+    }
+    pub fn reset(&mut self) -> Result<ResetResponse, String> {
+        call(&self.reset, ResetRequest::default())
+    }
+
+    pub fn node(&self) -> &RosNode {
+        &self.ros
+    }
+}
+
+/// Calls a service; until the server is discovered the request is repeated every second, and
+/// the first reply to any of the copies is taken. Gives up after 20 s.
+fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(client: &Client<Req, Resp>, req: Req) -> Result<Resp, String> {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let mut ids = Vec::new();
+    let mut last_send = None::<Instant>;
+    while Instant::now() < deadline {
+        if last_send.is_none_or(|t| t.elapsed() > Duration::from_secs(1)) && ids.is_empty() {
+            ids.push(client.send_request(req.clone()).map_err(|e| format!("request not sent: {e:?}"))?);
+            last_send = Some(Instant::now());
+        } else if last_send.is_some_and(|t| t.elapsed() > Duration::from_secs(1)) && ids.len() < 3 {
+            // Nothing yet: the reply reader may not have been matched when the server answered.
+            ids.push(client.send_request(req.clone()).map_err(|e| format!("request not sent: {e:?}"))?);
+            last_send = Some(Instant::now());
+        }
+        while let Ok(Some((id, resp))) = client.receive_response() {
+            if ids.contains(&id) {
+                return Ok(resp);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    Err("no reply from the cell within 20 s".into())
+}
