@@ -53,7 +53,7 @@ extern "C" fn on_signal(_: libc::c_int) {
 }
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,rustdds=off,ros2_client=error")).init();
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Verb::Run { config, program, cycles }) => run(&config, program.as_deref(), cycles),

@@ -51,7 +51,7 @@ impl RosNode {
     }
 
     fn topic(&mut self, topic: &str, type_name: &str, qos: &QosProfile) -> Result<ros2_client::dds::rustdds::Topic, String> {
-        let name = Name::new(&format!("/{}", self.namespace), topic).map_err(|e| format!("topic {topic}: {e:?}"))?;
+        let name = ros_name(&self.namespace, topic)?;
         let (pkg, ty) = split_type(type_name);
         self.node.create_topic(&name, MessageTypeName::new(pkg, ty), qos).map_err(|e| format!("topic {topic}: {e:?}"))
     }
@@ -66,6 +66,15 @@ impl RosNode {
         let t = self.topic(topic, type_name, &qos)?;
         self.node.create_subscription::<M>(&t, Some(qos)).map_err(|e| format!("subscription {topic}: {e:?}"))
     }
+}
+
+/// `/<namespace>/<path>` as a ROS name; `path` may have segments (`sim/input`).
+pub fn ros_name(namespace: &str, path: &str) -> Result<Name, String> {
+    let (prefix, base) = match path.rsplit_once('/') {
+        Some((p, b)) => (format!("/{namespace}/{p}"), b),
+        None => (format!("/{namespace}"), path),
+    };
+    Name::new(&prefix, base).map_err(|e| format!("name /{namespace}/{path}: {e:?}"))
 }
 
 /// `cnc_msgs/msg/SpindleState` → (`cnc_msgs`, `SpindleState`).
