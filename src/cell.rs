@@ -16,27 +16,63 @@ impl Cell {
         let domain = cfg.network.effective_domain_id()?;
         let inst = instance(&cfg.machine.namespace, domain);
         let shutdown = Shutdown::default();
-        let mut cell = Cell { shutdown: shutdown.clone(), threads: Vec::new() };
+        let mut cell = Cell {
+            shutdown: shutdown.clone(),
+            threads: Vec::new(),
+        };
         let spawn = |name: &'static str, f: Box<dyn FnOnce() -> Result<String, String> + Send>| {
-            std::thread::Builder::new().name(name.into()).spawn(f).map_err(|e| format!("{name}: {e}"))
+            std::thread::Builder::new()
+                .name(name.into())
+                .spawn(f)
+                .map_err(|e| format!("{name}: {e}"))
         };
         // io first: motion starts from the position the drives report.
         let (c, i, s) = (cfg.clone(), inst.clone(), shutdown.clone());
-        cell.threads.push(("io", spawn("io", Box::new(move || cnc_io::node::run(c, i, s).map(|_| String::new())))?));
+        cell.threads.push((
+            "io",
+            spawn(
+                "io",
+                Box::new(move || cnc_io::node::run(c, i, s).map(|_| String::new())),
+            )?,
+        ));
         let (c, i, s) = (cfg.clone(), inst.clone(), shutdown.clone());
-        cell.threads.push(("plc", spawn("plc", Box::new(move || cnc_plc::node::run(c, i, s).map(|_| String::new())))?));
+        cell.threads.push((
+            "plc",
+            spawn(
+                "plc",
+                Box::new(move || cnc_plc::node::run(c, i, s).map(|_| String::new())),
+            )?,
+        ));
         let (c, i, s) = (cfg.clone(), inst, shutdown.clone());
-        cell.threads.push(("motion", spawn("motion", Box::new(move || cnc_motion::node::run(c, i, s)))?));
+        cell.threads.push((
+            "motion",
+            spawn("motion", Box::new(move || cnc_motion::node::run(c, i, s)))?,
+        ));
         let (c, s) = (cfg.clone(), shutdown.clone());
-        cell.threads.push(("interpreter", spawn("interpreter", Box::new(move || cnc_interpreter::node::run(c, s).map(|_| String::new())))?));
+        cell.threads.push((
+            "interpreter",
+            spawn(
+                "interpreter",
+                Box::new(move || cnc_interpreter::node::run(c, s).map(|_| String::new())),
+            )?,
+        ));
         let (c, s) = (cfg.clone(), shutdown);
-        cell.threads.push(("hmi_bridge", spawn("hmi_bridge", Box::new(move || cnc_hmi_bridge::node::run(c, s).map(|_| String::new())))?));
+        cell.threads.push((
+            "hmi_bridge",
+            spawn(
+                "hmi_bridge",
+                Box::new(move || cnc_hmi_bridge::node::run(c, s).map(|_| String::new())),
+            )?,
+        ));
         Ok(cell)
     }
 
     /// A node that has stopped on its own, with its error.
     pub fn failed_node(&self) -> Option<&'static str> {
-        self.threads.iter().find(|(_, h)| h.is_finished()).map(|(n, _)| *n)
+        self.threads
+            .iter()
+            .find(|(_, h)| h.is_finished())
+            .map(|(n, _)| *n)
     }
 
     /// Stops every node; returns the servo statistics line and any node errors.

@@ -29,22 +29,44 @@ pub struct CellClient {
     pub servo_stats: Option<ServoStats>,
 }
 
-fn client<S: RosService>(ros: &mut RosNode, mapping: ServiceMapping, ns: &str, service: &str) -> Result<Client<S::Request, S::Response>, String> {
+fn client<S: RosService>(
+    ros: &mut RosNode,
+    mapping: ServiceMapping,
+    ns: &str,
+    service: &str,
+) -> Result<Client<S::Request, S::Response>, String> {
     let name = Name::new(&format!("/{ns}"), service).map_err(|e| format!("{e:?}"))?;
     let q = qos::services();
-    ros.node.create_client::<S::Request, S::Response>(mapping, &name, &ServiceTypeName::new(cnc_msgs::PACKAGE, S::NAME), q.clone(), q).map_err(|e| format!("client {service}: {e:?}"))
+    ros.node
+        .create_client::<S::Request, S::Response>(
+            mapping,
+            &name,
+            &ServiceTypeName::new(cnc_msgs::PACKAGE, S::NAME),
+            q.clone(),
+            q,
+        )
+        .map_err(|e| format!("client {service}: {e:?}"))
 }
 
 impl CellClient {
     /// A client node named `name` that speaks the given service mapping.
-    pub fn new(net: &NetworkConfig, ns: &str, name: &str, mapping: ServiceMapping) -> Result<Self, String> {
+    pub fn new(
+        net: &NetworkConfig,
+        ns: &str,
+        name: &str,
+        mapping: ServiceMapping,
+    ) -> Result<Self, String> {
         let mut ros = RosNode::new(net, ns, name)?;
         Ok(CellClient {
             load: client::<LoadProgram>(&mut ros, mapping, ns, "load_program")?,
             start: client::<StartProgram>(&mut ros, mapping, ns, "start_program")?,
             stop: client::<Stop>(&mut ros, mapping, ns, "stop")?,
             reset: client::<Reset>(&mut ros, mapping, ns, "reset")?,
-            machine: ros.subscription("machine_state", "cnc_msgs/msg/MachineState", qos::state())?,
+            machine: ros.subscription(
+                "machine_state",
+                "cnc_msgs/msg/MachineState",
+                qos::state(),
+            )?,
             spindle_sub: ros.subscription("spindle", "cnc_msgs/msg/SpindleState", qos::state())?,
             parts: ros.subscription("part_count", "cnc_msgs/msg/PartCount", qos::state())?,
             alarms_sub: ros.subscription("alarms", "cnc_msgs/msg/ActiveAlarms", qos::state())?,
@@ -86,7 +108,13 @@ impl CellClient {
     }
 
     pub fn load_program(&mut self, name: &str, text: &str) -> Result<LoadProgramResponse, String> {
-        call(&self.load, LoadProgramRequest { name: name.into(), text: text.into() })
+        call(
+            &self.load,
+            LoadProgramRequest {
+                name: name.into(),
+                text: text.into(),
+            },
+        )
     }
     pub fn start_program(&mut self, name: &str) -> Result<StartProgramResponse, String> {
         call(&self.start, StartProgramRequest { name: name.into() })
@@ -105,17 +133,28 @@ impl CellClient {
 
 /// Calls a service; until the server is discovered the request is repeated every second, and
 /// the first reply to any of the copies is taken. Gives up after 20 s.
-fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(client: &Client<Req, Resp>, req: Req) -> Result<Resp, String> {
+fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
+    client: &Client<Req, Resp>,
+    req: Req,
+) -> Result<Resp, String> {
     let deadline = Instant::now() + Duration::from_secs(20);
     let mut ids = Vec::new();
     let mut last_send = None::<Instant>;
     while Instant::now() < deadline {
         if last_send.is_none_or(|t| t.elapsed() > Duration::from_secs(1)) && ids.is_empty() {
-            ids.push(client.send_request(req.clone()).map_err(|e| format!("request not sent: {e:?}"))?);
+            ids.push(
+                client
+                    .send_request(req.clone())
+                    .map_err(|e| format!("request not sent: {e:?}"))?,
+            );
             last_send = Some(Instant::now());
         } else if last_send.is_some_and(|t| t.elapsed() > Duration::from_secs(1)) && ids.len() < 3 {
             // Nothing yet: the reply reader may not have been matched when the server answered.
-            ids.push(client.send_request(req.clone()).map_err(|e| format!("request not sent: {e:?}"))?);
+            ids.push(
+                client
+                    .send_request(req.clone())
+                    .map_err(|e| format!("request not sent: {e:?}"))?,
+            );
             last_send = Some(Instant::now());
         }
         while let Ok(Some((id, resp))) = client.receive_response() {

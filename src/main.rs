@@ -53,10 +53,17 @@ extern "C" fn on_signal(_: libc::c_int) {
 }
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,rustdds=off,ros2_client=error")).init();
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or("warn,rustdds=off,ros2_client=error"),
+    )
+    .init();
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Verb::Run { config, program, cycles }) => run(&config, program.as_deref(), cycles),
+        Some(Verb::Run {
+            config,
+            program,
+            cycles,
+        }) => run(&config, program.as_deref(), cycles),
         Some(Verb::Check { program, config }) => check(&program, &config),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
@@ -72,12 +79,23 @@ fn main() -> ExitCode {
 fn check(program: &Path, config: &Path) -> Result<(), String> {
     let cfg = LaunchConfig::load(config)?;
     let text = read_program(program)?;
-    let dialect = cnc_interpreter::Dialect::from_name(&cfg.machine.dialect).ok_or("unknown dialect")?;
-    let axes: Vec<char> = cfg.machine.axes.iter().map(|a| a.name.chars().next().unwrap_or('?')).collect();
+    let dialect =
+        cnc_interpreter::Dialect::from_name(&cfg.machine.dialect).ok_or("unknown dialect")?;
+    let axes: Vec<char> = cfg
+        .machine
+        .axes
+        .iter()
+        .map(|a| a.name.chars().next().unwrap_or('?'))
+        .collect();
     let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
     let home: Vec<f64> = cfg.machine.axes.iter().map(|a| a.home).collect();
-    let cmds = cnc_interpreter::check(dialect, &text, &axes, &diameter, &home).map_err(|e| format!("{}: {e}", program.display()))?;
-    println!("{}: {} canonical commands, no alarm", program.display(), cmds.len());
+    let cmds = cnc_interpreter::check(dialect, &text, &axes, &diameter, &home)
+        .map_err(|e| format!("{}: {e}", program.display()))?;
+    println!(
+        "{}: {} canonical commands, no alarm",
+        program.display(),
+        cmds.len()
+    );
     Ok(())
 }
 
@@ -87,7 +105,12 @@ fn read_program(path: &Path) -> Result<String, String> {
 }
 
 fn program_name(path: &Path) -> String {
-    path.file_name().and_then(|n| n.to_str()).unwrap_or("program").chars().filter(|c| c.is_ascii_alphanumeric() || "._-".contains(*c)).collect()
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or("program")
+        .chars()
+        .filter(|c| c.is_ascii_alphanumeric() || "._-".contains(*c))
+        .collect()
 }
 
 fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String> {
@@ -122,7 +145,12 @@ fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String>
 }
 
 /// Loads and runs the program for the requested cycles, printing progress; or just waits.
-fn supervise(cfg: &LaunchConfig, program: Option<&Path>, text: Option<&str>, cycles: u32) -> Result<(), String> {
+fn supervise(
+    cfg: &LaunchConfig,
+    program: Option<&Path>,
+    text: Option<&str>,
+    cycles: u32,
+) -> Result<(), String> {
     let ns = &cfg.machine.namespace;
     let mut client = CellClient::new(&cfg.network, ns, "cnc_cli", ServiceMapping::Enhanced)?;
     let (Some(path), Some(text)) = (program, text) else {
@@ -159,14 +187,37 @@ fn supervise(cfg: &LaunchConfig, program: Option<&Path>, text: Option<&str>, cyc
                         seen_active = false;
                         break;
                     }
-                    MachineState::STOPPED | MachineState::READY if seen_active || s.alarm_active => {
-                        let alarms = client.alarms.as_ref().map(|a| a.alarms.iter().map(|a| format!("alarm {} ({}): {} [line {}]", a.number, a.source, a.text, a.line)).collect::<Vec<_>>().join("; ")).unwrap_or_default();
+                    MachineState::STOPPED | MachineState::READY
+                        if seen_active || s.alarm_active =>
+                    {
+                        let alarms = client
+                            .alarms
+                            .as_ref()
+                            .map(|a| {
+                                a.alarms
+                                    .iter()
+                                    .map(|a| {
+                                        format!(
+                                            "alarm {} ({}): {} [line {}]",
+                                            a.number, a.source, a.text, a.line
+                                        )
+                                    })
+                                    .collect::<Vec<_>>()
+                                    .join("; ")
+                            })
+                            .unwrap_or_default();
                         return Err(format!("cycle {} stopped: {alarms}", done + 1));
                     }
                     _ => {}
                 }
             }
-            if client.state.as_ref().is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED) && !seen_active && started.elapsed() > Duration::from_millis(100) {
+            if client
+                .state
+                .as_ref()
+                .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+                && !seen_active
+                && started.elapsed() > Duration::from_millis(100)
+            {
                 break;
             }
             if last_print.elapsed() > Duration::from_millis(500) {
@@ -185,7 +236,17 @@ fn supervise(cfg: &LaunchConfig, program: Option<&Path>, text: Option<&str>, cyc
 fn print_progress(c: &CellClient, done: u32) {
     let s = c.state.as_ref();
     let sp = c.spindle.as_ref();
-    let pos = c.axes.as_ref().map(|a| a.axes.iter().map(|x| format!("{}{:.3}", x.name, x.actual_position)).collect::<Vec<_>>().join(" ")).unwrap_or_default();
+    let pos = c
+        .axes
+        .as_ref()
+        .map(|a| {
+            a.axes
+                .iter()
+                .map(|x| format!("{}{:.3}", x.name, x.actual_position))
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+        .unwrap_or_default();
     println!(
         "{:<17} {} line {:>4} | {} | spindle {:>6.0} rpm (cmd {:.0}) | parts {} | cycles done {}",
         s.map(|s| s.execution_name.as_str()).unwrap_or("-"),

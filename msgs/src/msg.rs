@@ -14,7 +14,10 @@ ros_message! {
 impl Time {
     /// Time from nanoseconds since the epoch of the clock in use.
     pub fn from_nanos(ns: u64) -> Self {
-        Time { sec: (ns / 1_000_000_000) as i32, nanosec: (ns % 1_000_000_000) as u32 }
+        Time {
+            sec: (ns / 1_000_000_000) as i32,
+            nanosec: (ns % 1_000_000_000) as u32,
+        }
     }
     pub fn as_secs_f64(&self) -> f64 {
         self.sec as f64 + self.nanosec as f64 * 1e-9

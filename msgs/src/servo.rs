@@ -23,7 +23,13 @@ pub struct ServoSetpoint {
 
 impl Default for ServoSetpoint {
     fn default() -> Self {
-        ServoSetpoint { seq: 0, sent_ns: 0, position: [0.0; MAX_AXES], axis_count: 0, enable: 0 }
+        ServoSetpoint {
+            seq: 0,
+            sent_ns: 0,
+            position: [0.0; MAX_AXES],
+            axis_count: 0,
+            enable: 0,
+        }
     }
 }
 

@@ -79,7 +79,17 @@ macro_rules! service {
         }
     };
 }
-service!(LoadProgram, "LoadProgram", LoadProgramRequest, LoadProgramResponse);
-service!(StartProgram, "StartProgram", StartProgramRequest, StartProgramResponse);
+service!(
+    LoadProgram,
+    "LoadProgram",
+    LoadProgramRequest,
+    LoadProgramResponse
+);
+service!(
+    StartProgram,
+    "StartProgram",
+    StartProgramRequest,
+    StartProgramResponse
+);
 service!(Stop, "Stop", StopRequest, StopResponse);
 service!(Reset, "Reset", ResetRequest, ResetResponse);

@@ -37,28 +37,42 @@ fn parse_section(text: &str) -> Section {
         }
         let mut parts = line.splitn(2, char::is_whitespace);
         let ty = parts.next().expect("type").trim();
-        let rest = parts.next().unwrap_or_else(|| panic!("no name in line {raw:?}")).trim();
+        let rest = parts
+            .next()
+            .unwrap_or_else(|| panic!("no name in line {raw:?}"))
+            .trim();
         if let Some((name, value)) = rest.split_once('=') {
-            section.constants.push((name.trim().into(), ty.into(), value.trim().into()));
+            section
+                .constants
+                .push((name.trim().into(), ty.into(), value.trim().into()));
         } else {
             let name = rest.split_whitespace().next().expect("name");
             assert!(
-                name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_'),
+                name.chars()
+                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_'),
                 "field name {name} is not a valid ROS 2 field name"
             );
             section.fields.push((name.into(), qualify(ty)));
         }
     }
     if section.fields.is_empty() {
-        section.fields.push(("structure_needs_at_least_one_member".into(), "uint8".into()));
+        section
+            .fields
+            .push(("structure_needs_at_least_one_member".into(), "uint8".into()));
     }
     section
 }
 
 fn rust_section<T: RosMessage>() -> Section {
     Section {
-        fields: T::fields().into_iter().map(|(n, t)| (n.to_string(), t)).collect(),
-        constants: T::constants().into_iter().map(|(n, t, v)| (n.to_string(), t, v)).collect(),
+        fields: T::fields()
+            .into_iter()
+            .map(|(n, t)| (n.to_string(), t))
+            .collect(),
+        constants: T::constants()
+            .into_iter()
+            .map(|(n, t, v)| (n.to_string(), t, v))
+            .collect(),
     }
 }
 
@@ -68,15 +82,28 @@ fn root() -> &'static Path {
 
 fn check_msg<T: RosMessage>(file: &str) {
     let text = std::fs::read_to_string(root().join("msg").join(file)).expect("msg file");
-    assert_eq!(parse_section(&text), rust_section::<T>(), "{file} vs {}", T::TYPE_NAME);
+    assert_eq!(
+        parse_section(&text),
+        rust_section::<T>(),
+        "{file} vs {}",
+        T::TYPE_NAME
+    );
 }
 
 fn check_srv<S: RosService>() {
     let file = format!("{}.srv", S::NAME);
     let text = std::fs::read_to_string(root().join("srv").join(&file)).expect("srv file");
     let (req, resp) = text.split_once("\n---").expect("--- separator");
-    assert_eq!(parse_section(req), rust_section::<S::Request>(), "{file} request");
-    assert_eq!(parse_section(resp), rust_section::<S::Response>(), "{file} response");
+    assert_eq!(
+        parse_section(req),
+        rust_section::<S::Request>(),
+        "{file} request"
+    );
+    assert_eq!(
+        parse_section(resp),
+        rust_section::<S::Response>(),
+        "{file} response"
+    );
 }
 
 #[test]
@@ -109,17 +136,46 @@ fn every_srv_file_matches_its_rust_types() {
 fn every_interface_file_is_checked_and_listed_in_cmake() {
     let cmake = std::fs::read_to_string(root().join("CMakeLists.txt")).expect("CMakeLists.txt");
     let checked = [
-        "Alarm", "ActiveAlarms", "AlarmEvent", "Axis", "AxisState", "MachineState", "PartCount",
-        "SpindleState", "ServoStats", "MotionBlock", "MotionStatus", "ProgramCommand",
-        "CommandResult", "SimInput", "LoadProgram", "StartProgram", "Stop", "Reset",
+        "Alarm",
+        "ActiveAlarms",
+        "AlarmEvent",
+        "Axis",
+        "AxisState",
+        "MachineState",
+        "PartCount",
+        "SpindleState",
+        "ServoStats",
+        "MotionBlock",
+        "MotionStatus",
+        "ProgramCommand",
+        "CommandResult",
+        "SimInput",
+        "LoadProgram",
+        "StartProgram",
+        "Stop",
+        "Reset",
     ];
     for dir in ["msg", "srv"] {
         for entry in std::fs::read_dir(root().join(dir)).expect("dir") {
             let path = entry.expect("entry").path();
-            let stem = path.file_stem().and_then(|s| s.to_str()).expect("name").to_string();
-            assert!(checked.contains(&stem.as_str()), "{} has no field check", path.display());
-            let rel = format!("\"{dir}/{}\"", path.file_name().and_then(|s| s.to_str()).expect("name"));
-            assert!(cmake.contains(&rel), "{rel} missing from rosidl_generate_interfaces");
+            let stem = path
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .expect("name")
+                .to_string();
+            assert!(
+                checked.contains(&stem.as_str()),
+                "{} has no field check",
+                path.display()
+            );
+            let rel = format!(
+                "\"{dir}/{}\"",
+                path.file_name().and_then(|s| s.to_str()).expect("name")
+            );
+            assert!(
+                cmake.contains(&rel),
+                "{rel} missing from rosidl_generate_interfaces"
+            );
         }
     }
 }

@@ -21,9 +21,19 @@ pub enum Mapping {
 
 /// Decodes `bytes` as exactly one `T` (up to 3 bytes of final alignment padding).
 pub fn decode_exact<T: DeserializeOwned>(bytes: &[u8], little_endian: bool) -> Option<T> {
-    let result = if little_endian { cdr_encoding::from_bytes::<T, LittleEndian>(bytes) } else { cdr_encoding::from_bytes::<T, BigEndian>(bytes) };
+    let result = if little_endian {
+        cdr_encoding::from_bytes::<T, LittleEndian>(bytes)
+    } else {
+        cdr_encoding::from_bytes::<T, BigEndian>(bytes)
+    };
     match result {
-        Ok((value, used)) if used <= bytes.len() && bytes.len() - used <= 3 && bytes[used..].iter().all(|&b| b == 0) => Some(value),
+        Ok((value, used))
+            if used <= bytes.len()
+                && bytes.len() - used <= 3
+                && bytes[used..].iter().all(|&b| b == 0) =>
+        {
+            Some(value)
+        }
         _ => None,
     }
 }
@@ -31,16 +41,26 @@ pub fn decode_exact<T: DeserializeOwned>(bytes: &[u8], little_endian: bool) -> O
 /// Sequence number in a Cyclone header: `seq_high: i32`, `seq_low: u32` after 8 GUID bytes.
 fn header_seq(header: &[u8], little_endian: bool) -> i64 {
     let (hi, lo) = if little_endian {
-        (i32::from_le_bytes([header[8], header[9], header[10], header[11]]), u32::from_le_bytes([header[12], header[13], header[14], header[15]]))
+        (
+            i32::from_le_bytes([header[8], header[9], header[10], header[11]]),
+            u32::from_le_bytes([header[12], header[13], header[14], header[15]]),
+        )
     } else {
-        (i32::from_be_bytes([header[8], header[9], header[10], header[11]]), u32::from_be_bytes([header[12], header[13], header[14], header[15]]))
+        (
+            i32::from_be_bytes([header[8], header[9], header[10], header[11]]),
+            u32::from_be_bytes([header[12], header[13], header[14], header[15]]),
+        )
     };
     ((hi as i64) << 32) | lo as i64
 }
 
 /// Classifies a request payload. `related_seq` is the sequence number of the sample's
 /// `related_sample_identity`, if it had one.
-pub fn classify<T: DeserializeOwned>(bytes: &[u8], little_endian: bool, related_seq: Option<i64>) -> Option<(Mapping, T)> {
+pub fn classify<T: DeserializeOwned>(
+    bytes: &[u8],
+    little_endian: bool,
+    related_seq: Option<i64>,
+) -> Option<(Mapping, T)> {
     let with_header = || -> Option<(Mapping, T)> {
         if bytes.len() < 16 {
             return None;
@@ -82,25 +102,45 @@ mod tests {
 
     #[test]
     fn both_mappings_of_every_request_type_are_told_apart() {
-        for name in ["p", "part7.nc", "O0001", "a_longer_program_name_with_digits_0123456789"] {
+        for name in [
+            "p",
+            "part7.nc",
+            "O0001",
+            "a_longer_program_name_with_digits_0123456789",
+        ] {
             let req = StartProgramRequest { name: name.into() };
             let plain = cdr(&req);
-            assert_eq!(classify::<StartProgramRequest>(&plain, true, None), Some((Mapping::Enhanced, req.clone())));
+            assert_eq!(
+                classify::<StartProgramRequest>(&plain, true, None),
+                Some((Mapping::Enhanced, req.clone()))
+            );
             let cy = cyclone(42, &plain);
             let (m, v) = classify::<StartProgramRequest>(&cy, true, None).unwrap();
             assert_eq!(v, req);
             assert!(matches!(m, Mapping::Cyclone(h) if h[..8] == [1, 2, 3, 4, 5, 6, 7, 8]));
         }
         let reset = cdr(&ResetRequest::default());
-        assert_eq!(classify::<ResetRequest>(&reset, true, None).map(|x| x.0), Some(Mapping::Enhanced));
-        assert!(matches!(classify::<ResetRequest>(&cyclone(1, &reset), true, None), Some((Mapping::Cyclone(_), _))));
+        assert_eq!(
+            classify::<ResetRequest>(&reset, true, None).map(|x| x.0),
+            Some(Mapping::Enhanced)
+        );
+        assert!(matches!(
+            classify::<ResetRequest>(&cyclone(1, &reset), true, None),
+            Some((Mapping::Cyclone(_), _))
+        ));
         let stop = cdr(&StopRequest { mode: 2 });
-        assert!(matches!(classify::<StopRequest>(&cyclone(9, &stop), true, Some(9)), Some((Mapping::Cyclone(_), StopRequest { mode: 2 }))));
+        assert!(matches!(
+            classify::<StopRequest>(&cyclone(9, &stop), true, Some(9)),
+            Some((Mapping::Cyclone(_), StopRequest { mode: 2 }))
+        ));
     }
 
     #[test]
     fn garbage_is_rejected_not_guessed() {
-        assert_eq!(classify::<StartProgramRequest>(&[0xff; 7], true, None), None);
+        assert_eq!(
+            classify::<StartProgramRequest>(&[0xff; 7], true, None),
+            None
+        );
         assert_eq!(classify::<StartProgramRequest>(&[], true, None), None);
         // Invalid UTF-8 in the string.
         let mut bad = vec![3, 0, 0, 0, 0xc3, 0x28, 0];

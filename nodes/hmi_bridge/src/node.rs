@@ -26,7 +26,12 @@ impl Commands {
     fn call(&mut self, command: u8, program: &str, text: &str) -> (bool, String) {
         self.next_id += 1;
         let id = self.next_id;
-        let msg = ProgramCommand { id, command, program: program.into(), text: text.into() };
+        let msg = ProgramCommand {
+            id,
+            command,
+            program: program.into(),
+            text: text.into(),
+        };
         if let Err(e) = self.publisher.publish(msg) {
             return (false, format!("command not delivered: {e:?}"));
         }
@@ -47,12 +52,25 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let ns = cfg.machine.namespace.clone();
     let mut ros = RosNode::new(&cfg.network, &ns, "hmi_bridge")?;
     let mut commands = Commands {
-        publisher: ros.publisher("_internal/program_command", "cnc_msgs/msg/ProgramCommand", qos::commands())?,
-        results: ros.subscription("_internal/command_result", "cnc_msgs/msg/CommandResult", qos::commands())?,
+        publisher: ros.publisher(
+            "_internal/program_command",
+            "cnc_msgs/msg/ProgramCommand",
+            qos::commands(),
+        )?,
+        results: ros.subscription(
+            "_internal/command_result",
+            "cnc_msgs/msg/CommandResult",
+            qos::commands(),
+        )?,
         next_id: cnc_runtime::clock::monotonic_ns(),
     };
-    let alarm_events = ros.subscription::<AlarmEvent>("alarm_events", "cnc_msgs/msg/AlarmEvent", qos::events(100))?;
-    let alarms_pub = ros.publisher::<ActiveAlarms>("alarms", "cnc_msgs/msg/ActiveAlarms", qos::state())?;
+    let alarm_events = ros.subscription::<AlarmEvent>(
+        "alarm_events",
+        "cnc_msgs/msg/AlarmEvent",
+        qos::events(100),
+    )?;
+    let alarms_pub =
+        ros.publisher::<ActiveAlarms>("alarms", "cnc_msgs/msg/ActiveAlarms", qos::state())?;
     let participant = ros.participant();
     let sq: QosPolicies = (&qos::services()).into();
     let load = DualServer::<LoadProgram>::new(&participant, &ns, "load_program", sq.clone())?;
@@ -62,7 +80,10 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
 
     let mut active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm> = BTreeMap::new();
     let publish_alarms = |active: &BTreeMap<(String, u32), cnc_msgs::msg::Alarm>| {
-        let _ = alarms_pub.publish(ActiveAlarms { stamp: stamp(), alarms: active.values().cloned().collect() });
+        let _ = alarms_pub.publish(ActiveAlarms {
+            stamp: stamp(),
+            alarms: active.values().cloned().collect(),
+        });
     };
     publish_alarms(&active);
     while !shutdown.requested() {
@@ -82,7 +103,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         if let Some(r) = load.receive() {
             busy = true;
-            let (accepted, message) = commands.call(ProgramCommand::LOAD, &r.request.name, &r.request.text);
+            let (accepted, message) =
+                commands.call(ProgramCommand::LOAD, &r.request.name, &r.request.text);
             answer(&load, &r, &LoadProgramResponse { accepted, message });
         }
         if let Some(r) = start.receive() {
@@ -95,7 +117,10 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             let (accepted, message) = match r.request.mode {
                 StopRequest::FEED_HOLD => commands.call(ProgramCommand::FEED_HOLD, "", ""),
                 StopRequest::CYCLE_STOP => commands.call(ProgramCommand::CYCLE_STOP, "", ""),
-                other => (false, format!("unknown stop mode {other}: use 1 (FEED_HOLD) or 2 (CYCLE_STOP)")),
+                other => (
+                    false,
+                    format!("unknown stop mode {other}: use 1 (FEED_HOLD) or 2 (CYCLE_STOP)"),
+                ),
             };
             answer(&stop, &r, &StopResponse { accepted, message });
         }
@@ -111,12 +136,21 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     Ok(())
 }
 
-fn answer<S: RosService>(server: &DualServer<S>, request: &Request<S::Request>, response: &S::Response)
-where
+fn answer<S: RosService>(
+    server: &DualServer<S>,
+    request: &Request<S::Request>,
+    response: &S::Response,
+) where
     S::Request: serde::de::DeserializeOwned,
     S::Response: serde::Serialize + std::fmt::Debug,
 {
-    log::info!("{}: {:?} via {:?} from {}", S::NAME, response, request.mapping, request.client);
+    log::info!(
+        "{}: {:?} via {:?} from {}",
+        S::NAME,
+        response,
+        request.mapping,
+        request.client
+    );
     if let Err(e) = server.reply(request, response) {
         log::error!("{e}");
     }

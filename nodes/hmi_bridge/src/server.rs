@@ -9,7 +9,8 @@ use ros2_client::dds::rustdds::{
     bytes::Bytes,
     no_key::{self, DataWriter, SimpleDataReader},
     rpc::SampleIdentity,
-    QosPolicies, RepresentationIdentifier, SequenceNumber, Timestamp, TopicKind, WriteOptionsBuilder,
+    QosPolicies, RepresentationIdentifier, SequenceNumber, Timestamp, TopicKind,
+    WriteOptionsBuilder,
 };
 use serde::{de::DeserializeOwned, Serialize};
 
@@ -29,7 +30,10 @@ impl no_key::DeserializerAdapter<Raw> for RawAdapter {
     type Error = std::io::Error;
     type Decoded = Raw;
     fn supported_encodings() -> &'static [RepresentationIdentifier] {
-        &[RepresentationIdentifier::CDR_LE, RepresentationIdentifier::CDR_BE]
+        &[
+            RepresentationIdentifier::CDR_LE,
+            RepresentationIdentifier::CDR_BE,
+        ]
     }
     fn transform_decoded(decoded: Raw) -> Raw {
         decoded
@@ -46,8 +50,15 @@ pub struct RawDecoder;
 
 impl<'de> no_key::Decode<'de, Raw> for RawDecoder {
     type Error = std::io::Error;
-    fn decode_bytes(self, input: &'de [u8], encoding: RepresentationIdentifier) -> Result<Raw, Self::Error> {
-        Ok(Raw { bytes: input.to_vec(), little_endian: encoding != RepresentationIdentifier::CDR_BE })
+    fn decode_bytes(
+        self,
+        input: &'de [u8],
+        encoding: RepresentationIdentifier,
+    ) -> Result<Raw, Self::Error> {
+        Ok(Raw {
+            bytes: input.to_vec(),
+            little_endian: encoding != RepresentationIdentifier::CDR_BE,
+        })
     }
 }
 
@@ -83,19 +94,47 @@ where
     S::Response: Serialize,
 {
     /// Serves `/<namespace>/<service>` as DDS topics `rq/<ns>/<service>Request` and `rr/…Reply`.
-    pub fn new(participant: &rustdds::DomainParticipant, namespace: &str, service: &str, qos: QosPolicies) -> Result<Self, String> {
+    pub fn new(
+        participant: &rustdds::DomainParticipant,
+        namespace: &str,
+        service: &str,
+        qos: QosPolicies,
+    ) -> Result<Self, String> {
         let (pkg, ty) = (cnc_msgs::PACKAGE, S::NAME);
         let rq = participant
-            .create_topic(format!("rq/{namespace}/{service}Request"), format!("{pkg}::srv::dds_::{ty}_Request_"), &qos, TopicKind::NoKey)
+            .create_topic(
+                format!("rq/{namespace}/{service}Request"),
+                format!("{pkg}::srv::dds_::{ty}_Request_"),
+                &qos,
+                TopicKind::NoKey,
+            )
             .map_err(|e| format!("{service}: {e:?}"))?;
         let rr = participant
-            .create_topic(format!("rr/{namespace}/{service}Reply"), format!("{pkg}::srv::dds_::{ty}_Response_"), &qos, TopicKind::NoKey)
+            .create_topic(
+                format!("rr/{namespace}/{service}Reply"),
+                format!("{pkg}::srv::dds_::{ty}_Response_"),
+                &qos,
+                TopicKind::NoKey,
+            )
             .map_err(|e| format!("{service}: {e:?}"))?;
-        let subscriber = participant.create_subscriber(&qos).map_err(|e| format!("{service}: {e:?}"))?;
-        let publisher = participant.create_publisher(&qos).map_err(|e| format!("{service}: {e:?}"))?;
-        let reader = subscriber.create_simple_datareader_no_key::<Raw, RawAdapter>(&rq, None).map_err(|e| format!("{service}: {e:?}"))?;
-        let writer = publisher.create_datawriter_no_key::<Raw, RawAdapter>(&rr, None).map_err(|e| format!("{service}: {e:?}"))?;
-        Ok(DualServer { reader, writer, name: service.into(), _service: PhantomData })
+        let subscriber = participant
+            .create_subscriber(&qos)
+            .map_err(|e| format!("{service}: {e:?}"))?;
+        let publisher = participant
+            .create_publisher(&qos)
+            .map_err(|e| format!("{service}: {e:?}"))?;
+        let reader = subscriber
+            .create_simple_datareader_no_key::<Raw, RawAdapter>(&rq, None)
+            .map_err(|e| format!("{service}: {e:?}"))?;
+        let writer = publisher
+            .create_datawriter_no_key::<Raw, RawAdapter>(&rr, None)
+            .map_err(|e| format!("{service}: {e:?}"))?;
+        Ok(DualServer {
+            reader,
+            writer,
+            name: service.into(),
+            _service: PhantomData,
+        })
     }
 
     /// The next request, if any. Undecodable requests are logged and dropped: without a valid
@@ -112,7 +151,10 @@ where
                 }
             };
             let related = dcc.related_sample_identity();
-            let own = SampleIdentity { writer_guid: dcc.writer_guid, sequence_number: dcc.sequence_number };
+            let own = SampleIdentity {
+                writer_guid: dcc.writer_guid,
+                sequence_number: dcc.sequence_number,
+            };
             let client = format!("{:?}", dcc.writer_guid);
             let raw = dcc.into_value();
             let related_seq = related.map(|r| i64::from(r.sequence_number));
@@ -121,18 +163,31 @@ where
                     let identity = match related {
                         // rmw_fastrtps names the reply reader with an unknown sequence number.
                         Some(r) if r.sequence_number != SequenceNumber::UNKNOWN => r,
-                        Some(r) => SampleIdentity { writer_guid: r.writer_guid, sequence_number: own.sequence_number },
+                        Some(r) => SampleIdentity {
+                            writer_guid: r.writer_guid,
+                            sequence_number: own.sequence_number,
+                        },
                         None => own,
                     };
-                    return Some(Request { request, mapping, identity, client });
+                    return Some(Request {
+                        request,
+                        mapping,
+                        identity,
+                        client,
+                    });
                 }
-                None => log::warn!("{}: malformed request ({} bytes) from {client} dropped", self.name, raw.bytes.len()),
+                None => log::warn!(
+                    "{}: malformed request ({} bytes) from {client} dropped",
+                    self.name,
+                    raw.bytes.len()
+                ),
             }
         }
     }
 
     pub fn reply(&self, to: &Request<S::Request>, response: &S::Response) -> Result<(), String> {
-        let body = cdr_encoding::to_vec::<_, LittleEndian>(response).map_err(|e| format!("{}: {e}", self.name))?;
+        let body = cdr_encoding::to_vec::<_, LittleEndian>(response)
+            .map_err(|e| format!("{}: {e}", self.name))?;
         let bytes = match to.mapping {
             Mapping::Enhanced => body,
             Mapping::Cyclone(header) => {
@@ -141,7 +196,19 @@ where
                 b
             }
         };
-        let options = WriteOptionsBuilder::new().source_timestamp(Timestamp::now()).related_sample_identity(to.identity).build();
-        self.writer.write_with_options(Raw { bytes, little_endian: true }, options).map(|_| ()).map_err(|e| format!("{}: reply not sent: {e:?}", self.name))
+        let options = WriteOptionsBuilder::new()
+            .source_timestamp(Timestamp::now())
+            .related_sample_identity(to.identity)
+            .build();
+        self.writer
+            .write_with_options(
+                Raw {
+                    bytes,
+                    little_endian: true,
+                },
+                options,
+            )
+            .map(|_| ())
+            .map_err(|e| format!("{}: reply not sent: {e:?}", self.name))
     }
 }

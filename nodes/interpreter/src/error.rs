@@ -16,7 +16,11 @@ pub struct ProgramError {
 
 impl fmt::Display for ProgramError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "alarm {} at line {}: {}", self.number, self.line, self.text)
+        write!(
+            f,
+            "alarm {} at line {}: {}",
+            self.number, self.line, self.text
+        )
     }
 }
 
@@ -40,6 +44,10 @@ pub mod alarm {
 
 impl ProgramError {
     pub fn new(number: u32, line: u32, text: impl Into<String>) -> Self {
-        ProgramError { number, text: text.into(), line }
+        ProgramError {
+            number,
+            text: text.into(),
+            line,
+        }
     }
 }

@@ -60,7 +60,13 @@ pub struct Interpreter {
 
 impl Interpreter {
     /// `axes` are the machine's axis letters; `start` its commanded position (X as diameter).
-    pub fn new(dialect: Dialect, text: &str, axes: &[char], diameter: &[bool], start: &[f64]) -> Self {
+    pub fn new(
+        dialect: Dialect,
+        text: &str,
+        axes: &[char],
+        diameter: &[bool],
+        start: &[f64],
+    ) -> Self {
         Interpreter {
             dialect,
             text: text.to_string(),
@@ -130,7 +136,10 @@ impl Interpreter {
     }
 
     fn finish(&mut self, line: u32) {
-        self.pending.push_back(Canon { line, command: Command::ProgramEnd });
+        self.pending.push_back(Canon {
+            line,
+            command: Command::ProgramEnd,
+        });
         self.done = true;
     }
 
@@ -141,17 +150,26 @@ impl Interpreter {
     /// Checks every word of a block and sorts it into a [`Block`].
     fn decode(&self, words: &[Word]) -> Result<Block, ProgramError> {
         let n = self.axes.len();
-        let mut b = Block { absolute: vec![None; n], incremental: vec![None; n], ..Block::default() };
+        let mut b = Block {
+            absolute: vec![None; n],
+            incremental: vec![None; n],
+            ..Block::default()
+        };
         let mut group1_explicit = false;
         let mut group0_explicit = false;
         let mut seen = Vec::new();
         // G04 takes X/U as its time: find it first.
-        let dwell_block = words.iter().any(|w| w.letter == 'G' && (w.value * 10.0).round() == 40.0);
+        let dwell_block = words
+            .iter()
+            .any(|w| w.letter == 'G' && (w.value * 10.0).round() == 40.0);
         for w in words {
             let letter = w.letter;
             if letter != 'G' && letter != 'M' {
                 if seen.contains(&letter) {
-                    return Err(self.err(alarm::DATA_FORMAT, format!("address {letter} twice in one block")));
+                    return Err(self.err(
+                        alarm::DATA_FORMAT,
+                        format!("address {letter} twice in one block"),
+                    ));
                 }
                 seen.push(letter);
             }
@@ -159,12 +177,18 @@ impl Interpreter {
                 'O' | 'N' => {}
                 'G' => {
                     let x10 = (w.value * 10.0).round();
-                    let code = if w.value >= 0.0 && (w.value * 10.0 - x10).abs() < 1e-6 && x10 < 10000.0 {
-                        self.dialect.g_code(x10 as u32)
-                    } else {
-                        None
-                    };
-                    let code = code.ok_or_else(|| self.err(alarm::UNDEFINED_CODE, format!("undefined G code G{}", w.value)))?;
+                    let code =
+                        if w.value >= 0.0 && (w.value * 10.0 - x10).abs() < 1e-6 && x10 < 10000.0 {
+                            self.dialect.g_code(x10 as u32)
+                        } else {
+                            None
+                        };
+                    let code = code.ok_or_else(|| {
+                        self.err(
+                            alarm::UNDEFINED_CODE,
+                            format!("undefined G code G{}", w.value),
+                        )
+                    })?;
                     match code.group {
                         0 => {
                             group0_explicit = true;
@@ -178,11 +202,18 @@ impl Interpreter {
                     }
                 }
                 'M' => {
-                    let m = integer(w).ok_or_else(|| self.err(alarm::DATA_FORMAT, format!("M code must be an integer, found M{}", w.value)))?;
+                    let m = integer(w).ok_or_else(|| {
+                        self.err(
+                            alarm::DATA_FORMAT,
+                            format!("M code must be an integer, found M{}", w.value),
+                        )
+                    })?;
                     let meaning = u32::try_from(m)
                         .ok()
                         .and_then(|m| self.dialect.m_code(m))
-                        .ok_or_else(|| self.err(alarm::UNDEFINED_CODE, format!("undefined M code M{m}")))?;
+                        .ok_or_else(|| {
+                            self.err(alarm::UNDEFINED_CODE, format!("undefined M code M{m}"))
+                        })?;
                     b.m.push((m, meaning));
                     if b.m.len() > MAX_M_PER_BLOCK {
                         return Err(self.err(alarm::TOO_MANY_M, "more than 3 M codes in one block"));
@@ -199,40 +230,67 @@ impl Interpreter {
                 'K' => b.k = Some(w.value),
                 'F' => {
                     if !(0.0..=MAX_FEED).contains(&w.value) {
-                        return Err(self.err(alarm::FEED_OUT_OF_RANGE, format!("feed F{} out of range 0..{MAX_FEED}", w.value)));
+                        return Err(self.err(
+                            alarm::FEED_OUT_OF_RANGE,
+                            format!("feed F{} out of range 0..{MAX_FEED}", w.value),
+                        ));
                     }
                     b.f = Some(w.value);
                 }
                 'S' => {
                     if !(0.0..=99999.0).contains(&w.value) {
-                        return Err(self.err(alarm::DATA_FORMAT, format!("spindle speed S{} out of range", w.value)));
+                        return Err(self.err(
+                            alarm::DATA_FORMAT,
+                            format!("spindle speed S{} out of range", w.value),
+                        ));
                     }
                     b.s = Some(w.value);
                 }
                 'T' => {
-                    b.t = Some(integer(w).filter(|t| (0..=9999).contains(t)).ok_or_else(|| {
-                        self.err(alarm::DATA_FORMAT, format!("tool word T{} must be an integer 0..9999", w.value))
-                    })?);
+                    b.t = Some(
+                        integer(w)
+                            .filter(|t| (0..=9999).contains(t))
+                            .ok_or_else(|| {
+                                self.err(
+                                    alarm::DATA_FORMAT,
+                                    format!("tool word T{} must be an integer 0..9999", w.value),
+                                )
+                            })?,
+                    );
                 }
                 _ => {
                     let axis = self.dialect.axis_words().iter().find_map(|&(abs, inc)| {
                         let idx = self.axes.iter().position(|&a| a == abs)?;
-                        (letter == abs).then_some((idx, true)).or((letter == inc).then_some((idx, false)))
+                        (letter == abs)
+                            .then_some((idx, true))
+                            .or((letter == inc).then_some((idx, false)))
                     });
                     match axis {
                         Some((idx, true)) => b.absolute[idx] = Some(w.value),
                         Some((idx, false)) => b.incremental[idx] = Some(w.value),
-                        None => return Err(self.err(alarm::UNDEFINED_CODE, format!("undefined address {letter}"))),
+                        None => {
+                            return Err(self
+                                .err(alarm::UNDEFINED_CODE, format!("undefined address {letter}")))
+                        }
                     }
                 }
             }
         }
         if group0_explicit && group1_explicit {
-            return Err(self.err(alarm::GROUP_00_WITH_01, "G codes of groups 00 and 01 in one block"));
+            return Err(self.err(
+                alarm::GROUP_00_WITH_01,
+                "G codes of groups 00 and 01 in one block",
+            ));
         }
         for idx in 0..n {
             if b.absolute[idx].is_some() && b.incremental[idx].is_some() {
-                return Err(self.err(alarm::ABS_AND_INC_SAME_AXIS, format!("absolute and incremental word for axis {} in one block", self.axes[idx])));
+                return Err(self.err(
+                    alarm::ABS_AND_INC_SAME_AXIS,
+                    format!(
+                        "absolute and incremental word for axis {} in one block",
+                        self.axes[idx]
+                    ),
+                ));
             }
         }
         Ok(b)
@@ -269,7 +327,9 @@ impl Interpreter {
             if ms.abs() > 99_999_999.0 {
                 return Err(self.err(alarm::DWELL_TIME, "G04 dwell time out of range"));
             }
-            out.push(Command::Dwell { seconds: ms.max(0.0) / 1000.0 });
+            out.push(Command::Dwell {
+                seconds: ms.max(0.0) / 1000.0,
+            });
         } else {
             let has_axis = b.absolute.iter().chain(&b.incremental).any(Option::is_some);
             let arc = matches!(self.motion_mode, GMeaning::ArcCw | GMeaning::ArcCcw);
@@ -287,7 +347,8 @@ impl Interpreter {
         if let Some(&(m, _)) = ends {
             out.push(Command::Aux(Aux::M(m)));
         }
-        self.pending.extend(out.into_iter().map(|command| Canon { line, command }));
+        self.pending
+            .extend(out.into_iter().map(|command| Canon { line, command }));
         if ends.is_some() {
             self.finish(line);
         }
@@ -308,14 +369,24 @@ impl Interpreter {
     fn motion(&mut self, b: &Block, end: Vec<f64>) -> Result<Command, ProgramError> {
         let cmd = match self.motion_mode {
             GMeaning::Rapid => Command::Rapid { end: end.clone() },
-            GMeaning::Linear => Command::Linear { end: end.clone(), feed: self.cutting_feed()? },
+            GMeaning::Linear => Command::Linear {
+                end: end.clone(),
+                feed: self.cutting_feed()?,
+            },
             GMeaning::ArcCw | GMeaning::ArcCcw => {
                 let clockwise = self.motion_mode == GMeaning::ArcCw;
                 let feed = self.cutting_feed()?;
                 let center = self.arc_center(b, &end, clockwise)?;
-                Command::Arc { end: end.clone(), center, clockwise, feed }
+                Command::Arc {
+                    end: end.clone(),
+                    center,
+                    clockwise,
+                    feed,
+                }
             }
-            other => return Err(self.err(alarm::UNDEFINED_CODE, format!("{other:?} is not a motion"))),
+            other => {
+                return Err(self.err(alarm::UNDEFINED_CODE, format!("{other:?} is not a motion")))
+            }
         };
         self.position = end;
         Ok(cmd)
@@ -323,14 +394,22 @@ impl Interpreter {
 
     fn cutting_feed(&self) -> Result<f64, ProgramError> {
         if self.feed <= 0.0 {
-            return Err(self.err(alarm::FEED_OUT_OF_RANGE, "no feed programmed for a cutting move (F missing or 0)"));
+            return Err(self.err(
+                alarm::FEED_OUT_OF_RANGE,
+                "no feed programmed for a cutting move (F missing or 0)",
+            ));
         }
         Ok(self.feed)
     }
 
     /// Arc centre in machine coordinates. Geometry runs in the ZX plane with X as radius;
     /// seen with Z to the right and X up, G02 turns clockwise (decision D3).
-    fn arc_center(&self, b: &Block, end: &[f64], clockwise: bool) -> Result<Vec<f64>, ProgramError> {
+    fn arc_center(
+        &self,
+        b: &Block,
+        end: &[f64],
+        clockwise: bool,
+    ) -> Result<Vec<f64>, ProgramError> {
         let (xi, zi) = match (self.axis_index('X'), self.axis_index('Z')) {
             (Some(x), Some(z)) => (x, z),
             _ => return Err(self.err(alarm::AXIS_ADDRESS, "arcs need the X and Z axes")),
@@ -341,14 +420,22 @@ impl Interpreter {
         let (dz, dx) = (ez - sz, ex - sx);
         let chord = (dz * dz + dx * dx).sqrt();
         let (cz, cx) = match (b.r, b.i.is_some() || b.k.is_some()) {
-            (Some(_), true) => return Err(self.err(alarm::ARC_R_AND_IJK, "arc with both R and I/K")),
+            (Some(_), true) => {
+                return Err(self.err(alarm::ARC_R_AND_IJK, "arc with both R and I/K"))
+            }
             (Some(r), false) => {
                 if chord < ARC_TOLERANCE {
-                    return Err(self.err(alarm::ARC_RADIUS_TOO_SMALL, "a full circle cannot be programmed with R"));
+                    return Err(self.err(
+                        alarm::ARC_RADIUS_TOO_SMALL,
+                        "a full circle cannot be programmed with R",
+                    ));
                 }
                 let half = chord / 2.0;
                 if r.abs() + 1e-9 < half {
-                    return Err(self.err(alarm::ARC_RADIUS_TOO_SMALL, format!("arc radius R{r} is smaller than half the chord ({half:.4})")));
+                    return Err(self.err(
+                        alarm::ARC_RADIUS_TOO_SMALL,
+                        format!("arc radius R{r} is smaller than half the chord ({half:.4})"),
+                    ));
                 }
                 let h = (r * r - half * half).max(0.0).sqrt();
                 // Left of the chord direction in the (Z right, X up) plane.
@@ -369,7 +456,9 @@ impl Interpreter {
                 }
                 (cz, cx)
             }
-            (None, false) => return Err(self.err(alarm::ARC_RADIUS_TOO_SMALL, "arc needs R or I/K")),
+            (None, false) => {
+                return Err(self.err(alarm::ARC_RADIUS_TOO_SMALL, "arc needs R or I/K"))
+            }
         };
         let mut center = self.position.clone();
         center[xi] = cx / scale(xi);
@@ -387,7 +476,13 @@ fn integer(w: &Word) -> Option<i32> {
 }
 
 /// Interprets a whole program without running it: every command, or the first error.
-pub fn check(dialect: Dialect, text: &str, axes: &[char], diameter: &[bool], start: &[f64]) -> Result<Vec<Canon>, ProgramError> {
+pub fn check(
+    dialect: Dialect,
+    text: &str,
+    axes: &[char],
+    diameter: &[bool],
+    start: &[f64],
+) -> Result<Vec<Canon>, ProgramError> {
     let mut interp = Interpreter::new(dialect, text, axes, diameter, start);
     let mut out = Vec::new();
     while let Some(c) = interp.next_command()? {

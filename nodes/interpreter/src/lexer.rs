@@ -31,7 +31,10 @@ const MAX_NUMBER_CHARS: usize = 24;
 
 /// Lexes one line. `number` is its 1-based line number, used in errors.
 pub fn lex_line(text: &str, number: u32) -> Result<Line, ProgramError> {
-    let mut line = Line { number, ..Line::default() };
+    let mut line = Line {
+        number,
+        ..Line::default()
+    };
     let mut chars = text.char_indices().peekable();
     let mut first = true;
     while let Some(&(_, c)) = chars.peek() {
@@ -50,7 +53,11 @@ pub fn lex_line(text: &str, number: u32) -> Result<Line, ProgramError> {
                     }
                 }
                 if !closed {
-                    return Err(ProgramError::new(alarm::DATA_FORMAT, number, "comment not closed: ')' missing"));
+                    return Err(ProgramError::new(
+                        alarm::DATA_FORMAT,
+                        number,
+                        "comment not closed: ')' missing",
+                    ));
                 }
             }
             '/' if first => {
@@ -70,26 +77,42 @@ pub fn lex_line(text: &str, number: u32) -> Result<Line, ProgramError> {
                 let letter = c.to_ascii_uppercase();
                 let mut num = String::new();
                 while let Some(&(_, d)) = chars.peek() {
-                    if d.is_ascii_digit() || d == '.' || ((d == '-' || d == '+') && num.is_empty()) {
+                    if d.is_ascii_digit() || d == '.' || ((d == '-' || d == '+') && num.is_empty())
+                    {
                         num.push(d);
                         chars.next();
                         if num.len() > MAX_NUMBER_CHARS {
-                            return Err(ProgramError::new(alarm::DATA_FORMAT, number, format!("number after {letter} too long")));
+                            return Err(ProgramError::new(
+                                alarm::DATA_FORMAT,
+                                number,
+                                format!("number after {letter} too long"),
+                            ));
                         }
-                    } else if d == ' ' && !num.is_empty() && num.chars().all(|x| x == '-' || x == '+') {
+                    } else if d == ' '
+                        && !num.is_empty()
+                        && num.chars().all(|x| x == '-' || x == '+')
+                    {
                         chars.next();
                     } else {
                         break;
                     }
                 }
                 let value = parse_number(&num).ok_or_else(|| {
-                    ProgramError::new(alarm::DATA_FORMAT, number, format!("address {letter} needs a number, found {:?}", num))
+                    ProgramError::new(
+                        alarm::DATA_FORMAT,
+                        number,
+                        format!("address {letter} needs a number, found {:?}", num),
+                    )
                 })?;
                 line.words.push(Word { letter, value });
             }
             c if !c.is_ascii() => break,
             c => {
-                return Err(ProgramError::new(alarm::DATA_FORMAT, number, format!("unexpected character {c:?}")));
+                return Err(ProgramError::new(
+                    alarm::DATA_FORMAT,
+                    number,
+                    format!("unexpected character {c:?}"),
+                ));
             }
         }
         first = false;
@@ -98,7 +121,8 @@ pub fn lex_line(text: &str, number: u32) -> Result<Line, ProgramError> {
 }
 
 fn parse_number(text: &str) -> Option<f64> {
-    if text.is_empty() || text.matches('.').count() > 1 || !text.chars().any(|c| c.is_ascii_digit()) {
+    if text.is_empty() || text.matches('.').count() > 1 || !text.chars().any(|c| c.is_ascii_digit())
+    {
         return None;
     }
     let value: f64 = text.parse().ok()?;
@@ -110,7 +134,11 @@ mod tests {
     use super::*;
 
     fn letters(l: &Line) -> String {
-        l.words.iter().map(|w| format!("{}{}", w.letter, w.value)).collect::<Vec<_>>().join(" ")
+        l.words
+            .iter()
+            .map(|w| format!("{}{}", w.letter, w.value))
+            .collect::<Vec<_>>()
+            .join(" ")
     }
 
     #[test]
@@ -136,8 +164,19 @@ mod tests {
         let e = lex_line("G01 X1..2", 5).unwrap_err();
         assert_eq!((e.number, e.line), (alarm::DATA_FORMAT, 5));
         assert_eq!(lex_line("G01 X", 2).unwrap_err().number, alarm::DATA_FORMAT);
-        assert_eq!(lex_line("G01 (open", 3).unwrap_err().number, alarm::DATA_FORMAT);
-        assert_eq!(lex_line("G01 X1 = 2", 3).unwrap_err().number, alarm::DATA_FORMAT);
-        assert_eq!(lex_line(&format!("X{}", "9".repeat(400)), 1).unwrap_err().number, alarm::DATA_FORMAT);
+        assert_eq!(
+            lex_line("G01 (open", 3).unwrap_err().number,
+            alarm::DATA_FORMAT
+        );
+        assert_eq!(
+            lex_line("G01 X1 = 2", 3).unwrap_err().number,
+            alarm::DATA_FORMAT
+        );
+        assert_eq!(
+            lex_line(&format!("X{}", "9".repeat(400)), 1)
+                .unwrap_err()
+                .number,
+            alarm::DATA_FORMAT
+        );
     }
 }

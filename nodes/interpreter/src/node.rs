@@ -8,7 +8,10 @@
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use cnc_msgs::msg::{Alarm, AlarmEvent, AxisState, CommandResult, MachineState, MotionBlock, MotionStatus, ProgramCommand};
+use cnc_msgs::msg::{
+    Alarm, AlarmEvent, AxisState, CommandResult, MachineState, MotionBlock, MotionStatus,
+    ProgramCommand,
+};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -23,7 +26,12 @@ pub const MAX_PROGRAMS: usize = 1000;
 
 /// A program name: what a control's directory shows, e.g. `O0001` or `part7.nc`.
 pub fn valid_program_name(name: &str) -> bool {
-    !name.is_empty() && name.len() <= 64 && name.chars().all(|c| c.is_ascii_alphanumeric() || "._-".contains(c)) && !name.starts_with('.')
+    !name.is_empty()
+        && name.len() <= 64
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c))
+        && !name.starts_with('.')
 }
 
 struct Run {
@@ -36,18 +44,49 @@ struct Run {
 }
 
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
-    let dialect = Dialect::from_name(&cfg.machine.dialect).ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
-    let axes: Vec<char> = cfg.machine.axes.iter().map(|a| a.name.chars().next().unwrap_or('?')).collect();
+    let dialect = Dialect::from_name(&cfg.machine.dialect)
+        .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
+    let axes: Vec<char> = cfg
+        .machine
+        .axes
+        .iter()
+        .map(|a| a.name.chars().next().unwrap_or('?'))
+        .collect();
     let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
-    let commands = ros.subscription::<ProgramCommand>("_internal/program_command", "cnc_msgs/msg/ProgramCommand", qos::commands())?;
-    let results = ros.publisher::<CommandResult>("_internal/command_result", "cnc_msgs/msg/CommandResult", qos::commands())?;
-    let to_motion_cmd = ros.publisher::<ProgramCommand>("_internal/program_command", "cnc_msgs/msg/ProgramCommand", qos::commands())?;
-    let blocks = ros.publisher::<MotionBlock>("_internal/motion_blocks", "cnc_msgs/msg/MotionBlock", qos::commands())?;
-    let status_sub = ros.subscription::<MotionStatus>("_internal/motion_status", "cnc_msgs/msg/MotionStatus", qos::state())?;
+    let commands = ros.subscription::<ProgramCommand>(
+        "_internal/program_command",
+        "cnc_msgs/msg/ProgramCommand",
+        qos::commands(),
+    )?;
+    let results = ros.publisher::<CommandResult>(
+        "_internal/command_result",
+        "cnc_msgs/msg/CommandResult",
+        qos::commands(),
+    )?;
+    let to_motion_cmd = ros.publisher::<ProgramCommand>(
+        "_internal/program_command",
+        "cnc_msgs/msg/ProgramCommand",
+        qos::commands(),
+    )?;
+    let blocks = ros.publisher::<MotionBlock>(
+        "_internal/motion_blocks",
+        "cnc_msgs/msg/MotionBlock",
+        qos::commands(),
+    )?;
+    let status_sub = ros.subscription::<MotionStatus>(
+        "_internal/motion_status",
+        "cnc_msgs/msg/MotionStatus",
+        qos::state(),
+    )?;
     let axes_sub = ros.subscription::<AxisState>("axes", "cnc_msgs/msg/AxisState", qos::state())?;
-    let alarm_sub = ros.subscription::<AlarmEvent>("alarm_events", "cnc_msgs/msg/AlarmEvent", qos::events(100))?;
-    let state_pub = ros.publisher::<MachineState>("machine_state", "cnc_msgs/msg/MachineState", qos::state())?;
+    let alarm_sub = ros.subscription::<AlarmEvent>(
+        "alarm_events",
+        "cnc_msgs/msg/AlarmEvent",
+        qos::events(100),
+    )?;
+    let state_pub =
+        ros.publisher::<MachineState>("machine_state", "cnc_msgs/msg/MachineState", qos::state())?;
     let alarms = AlarmReporter::new(&mut ros, "interpreter")?;
 
     let mut programs: BTreeMap<String, String> = BTreeMap::new();
@@ -82,7 +121,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     if !r.failed {
                         r.failed = true;
                         stop_command_id += 1;
-                        let _ = to_motion_cmd.publish(ProgramCommand { id: stop_command_id, command: ProgramCommand::CYCLE_STOP, program: String::new(), text: String::new() });
+                        let _ = to_motion_cmd.publish(ProgramCommand {
+                            id: stop_command_id,
+                            command: ProgramCommand::CYCLE_STOP,
+                            program: String::new(),
+                            text: String::new(),
+                        });
                     }
                 }
                 if execution == MachineState::ACTIVE || execution == MachineState::FEED_HOLD {
@@ -99,10 +143,21 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     if !valid_program_name(&c.program) {
                         (false, format!("invalid program name {:?}: letters, digits, '.', '_', '-', at most 64", c.program))
                     } else if c.text.len() > MAX_PROGRAM_BYTES {
-                        (false, format!("program too large: {} bytes, limit {MAX_PROGRAM_BYTES}", c.text.len()))
+                        (
+                            false,
+                            format!(
+                                "program too large: {} bytes, limit {MAX_PROGRAM_BYTES}",
+                                c.text.len()
+                            ),
+                        )
                     } else if programs.len() >= MAX_PROGRAMS && !programs.contains_key(&c.program) {
-                        (false, format!("program memory full ({MAX_PROGRAMS} programs)"))
-                    } else if run.as_ref().is_some_and(|r| r.program == c.program) && execution == MachineState::ACTIVE {
+                        (
+                            false,
+                            format!("program memory full ({MAX_PROGRAMS} programs)"),
+                        )
+                    } else if run.as_ref().is_some_and(|r| r.program == c.program)
+                        && execution == MachineState::ACTIVE
+                    {
                         (false, format!("{} is running", c.program))
                     } else {
                         let lines = c.text.lines().count();
@@ -112,7 +167,10 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 }
                 ProgramCommand::START => {
                     if !active_alarms.is_empty() {
-                        (false, format!("alarm active ({} alarms): reset first", active_alarms.len()))
+                        (
+                            false,
+                            format!("alarm active ({} alarms): reset first", active_alarms.len()),
+                        )
                     } else if matches!(execution, MachineState::ACTIVE) {
                         (false, "a program is running".into())
                     } else if execution == MachineState::FEED_HOLD && c.program.is_empty() {
@@ -123,15 +181,26 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                             None => (false, "no axis position from motion yet".into()),
                             Some(start) => {
                                 run_counter += 1;
-                                let interp = Interpreter::new(dialect, text, &axes, &diameter, &start);
-                                run = Some(Run { id: run_counter, program: c.program.clone(), interp, sent_seq: 0, end_seq: None, failed: false });
+                                let interp =
+                                    Interpreter::new(dialect, text, &axes, &diameter, &start);
+                                run = Some(Run {
+                                    id: run_counter,
+                                    program: c.program.clone(),
+                                    interp,
+                                    sent_seq: 0,
+                                    end_seq: None,
+                                    failed: false,
+                                });
                                 program_name = c.program.clone();
                                 execution = MachineState::ACTIVE;
                                 (true, format!("{} started", c.program))
                             }
                         }
                     } else {
-                        (false, format!("program {:?} not found (alarm 22)", c.program))
+                        (
+                            false,
+                            format!("program {:?} not found (alarm 22)", c.program),
+                        )
                     }
                 }
                 ProgramCommand::FEED_HOLD => {
@@ -166,11 +235,19 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 }
                 other => (false, format!("unknown command {other}")),
             };
-            let _ = results.publish(CommandResult { id: c.id, accepted, message });
+            let _ = results.publish(CommandResult {
+                id: c.id,
+                accepted,
+                message,
+            });
         }
         // Feed the motion queue while credit lasts.
         if let Some(r) = run.as_mut() {
-            let in_flight = if status.run_id == r.id { r.sent_seq.saturating_sub(status.done_seq) } else { r.sent_seq };
+            let in_flight = if status.run_id == r.id {
+                r.sent_seq.saturating_sub(status.done_seq)
+            } else {
+                r.sent_seq
+            };
             let credit = (status.capacity.max(2) as u64).saturating_sub(in_flight);
             for _ in 0..credit {
                 if r.failed || r.end_seq.is_some() {
@@ -180,7 +257,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     Ok(Some(canon)) => {
                         busy = true;
                         r.sent_seq += 1;
-                        let msg = to_block(r.id, r.sent_seq, &r.program, canon.line, &canon.command);
+                        let msg =
+                            to_block(r.id, r.sent_seq, &r.program, canon.line, &canon.command);
                         if canon.command == Command::ProgramEnd {
                             r.end_seq = Some(r.sent_seq);
                         }
@@ -191,26 +269,54 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     Ok(None) => break,
                     Err(e) => {
                         r.failed = true;
-                        alarms.raise(alarms.alarm(e.number, Alarm::SEVERITY_ERROR, &e.text, &r.program, e.line));
+                        alarms.raise(alarms.alarm(
+                            e.number,
+                            Alarm::SEVERITY_ERROR,
+                            &e.text,
+                            &r.program,
+                            e.line,
+                        ));
                     }
                 }
             }
-            if status.run_id == r.id && Some(status.done_seq) == r.end_seq && r.end_seq.is_some() && execution == MachineState::ACTIVE {
+            if status.run_id == r.id
+                && Some(status.done_seq) == r.end_seq
+                && r.end_seq.is_some()
+                && execution == MachineState::ACTIVE
+            {
                 execution = MachineState::PROGRAM_COMPLETED;
                 run = None;
             }
         }
         if let Some(r) = run.as_ref() {
-            if status.run_id == r.id && status.state == MotionStatus::STATE_HOLD && execution == MachineState::ACTIVE {
+            if status.run_id == r.id
+                && status.state == MotionStatus::STATE_HOLD
+                && execution == MachineState::ACTIVE
+            {
                 execution = MachineState::FEED_HOLD;
             }
-            if status.run_id == r.id && status.state == MotionStatus::STATE_RUNNING && execution == MachineState::FEED_HOLD {
+            if status.run_id == r.id
+                && status.state == MotionStatus::STATE_RUNNING
+                && execution == MachineState::FEED_HOLD
+            {
                 execution = MachineState::ACTIVE;
             }
         }
-        let line = if run.as_ref().is_some_and(|r| r.id == status.run_id) || execution != MachineState::READY { status.line } else { 0 };
+        let line = if run.as_ref().is_some_and(|r| r.id == status.run_id)
+            || execution != MachineState::READY
+        {
+            status.line
+        } else {
+            0
+        };
         let estop = active_alarms.iter().any(|(s, n)| s == "plc" && *n == 65);
-        let key = (execution, line, estop, !active_alarms.is_empty(), program_name.clone());
+        let key = (
+            execution,
+            line,
+            estop,
+            !active_alarms.is_empty(),
+            program_name.clone(),
+        );
         let now = monotonic_ns();
         if last_published.as_ref() != Some(&key) || now - last_publish_ns > 500_000_000 {
             last_publish_ns = now;
@@ -234,7 +340,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
 }
 
 fn to_block(run_id: u64, seq: u64, program: &str, line: u32, c: &Command) -> MotionBlock {
-    let mut m = MotionBlock { run_id, seq, program: program.into(), line, ..MotionBlock::default() };
+    let mut m = MotionBlock {
+        run_id,
+        seq,
+        program: program.into(),
+        line,
+        ..MotionBlock::default()
+    };
     match c {
         Command::Rapid { end } => {
             m.kind = MotionBlock::KIND_RAPID;
@@ -245,8 +357,17 @@ fn to_block(run_id: u64, seq: u64, program: &str, line: u32, c: &Command) -> Mot
             m.end = end.clone();
             m.feed = *feed;
         }
-        Command::Arc { end, center, clockwise, feed } => {
-            m.kind = if *clockwise { MotionBlock::KIND_ARC_CW } else { MotionBlock::KIND_ARC_CCW };
+        Command::Arc {
+            end,
+            center,
+            clockwise,
+            feed,
+        } => {
+            m.kind = if *clockwise {
+                MotionBlock::KIND_ARC_CW
+            } else {
+                MotionBlock::KIND_ARC_CCW
+            };
             m.end = end.clone();
             m.center = center.clone();
             m.feed = *feed;

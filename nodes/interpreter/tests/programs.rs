@@ -6,51 +6,123 @@ const AXES: [char; 2] = ['X', 'Z'];
 const DIAMETER: [bool; 2] = [true, false];
 
 fn fixture(name: &str) -> String {
-    let path = format!("{}/../../../shared/fixtures/000/{name}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!(
+        "{}/../../../shared/fixtures/000/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
 /// The fixture's program text after its header.
 fn listing(text: &str) -> String {
-    text.split("(--- listing as printed ---)").nth(1).expect("listing marker").to_string()
+    text.split("(--- listing as printed ---)")
+        .nth(1)
+        .expect("listing marker")
+        .to_string()
 }
 
 fn end_of(c: &Command) -> Option<Vec<f64>> {
     match c {
-        Command::Rapid { end } | Command::Linear { end, .. } | Command::Arc { end, .. } => Some(end.clone()),
+        Command::Rapid { end } | Command::Linear { end, .. } | Command::Arc { end, .. } => {
+            Some(end.clone())
+        }
         _ => None,
     }
 }
 
 fn assert_close(a: &[f64], b: &[f64]) {
-    assert!(a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9), "{a:?} != {b:?}");
+    assert!(
+        a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9),
+        "{a:?} != {b:?}"
+    );
 }
 
 #[test]
 fn fixture_001_basic_program_visits_a_b_c_d() {
-    let cmds = check(Dialect::IsoLathe, &listing(&fixture("001_basic_program_ABCD.nc")), &AXES, &DIAMETER, &[0.0, 0.0]).unwrap();
+    let cmds = check(
+        Dialect::IsoLathe,
+        &listing(&fixture("001_basic_program_ABCD.nc")),
+        &AXES,
+        &DIAMETER,
+        &[0.0, 0.0],
+    )
+    .unwrap();
     let ends: Vec<Vec<f64>> = cmds.iter().filter_map(|c| end_of(&c.command)).collect();
     // A=[X100,Z50], B=[X50,Z2], C=B+W-32, D=[X80, C.Z-20], back to A (header of the fixture).
-    let expected = [[100.0, 50.0], [50.0, 2.0], [50.0, -30.0], [80.0, -50.0], [100.0, 50.0]];
+    let expected = [
+        [100.0, 50.0],
+        [50.0, 2.0],
+        [50.0, -30.0],
+        [80.0, -50.0],
+        [100.0, 50.0],
+    ];
     assert_eq!(ends.len(), expected.len());
     for (e, x) in ends.iter().zip(expected) {
         assert_close(e, &x);
     }
-    let aux: Vec<Aux> = cmds.iter().filter_map(|c| if let Command::Aux(a) = c.command { Some(a) } else { None }).collect();
+    let aux: Vec<Aux> = cmds
+        .iter()
+        .filter_map(|c| {
+            if let Command::Aux(a) = c.command {
+                Some(a)
+            } else {
+                None
+            }
+        })
+        .collect();
     assert_eq!(
         aux,
-        [Aux::M(10), Aux::T(101), Aux::S(600.0), Aux::M(3), Aux::M(8), Aux::T(100), Aux::S(0.0), Aux::M(5), Aux::M(9), Aux::M(11), Aux::M(30)]
+        [
+            Aux::M(10),
+            Aux::T(101),
+            Aux::S(600.0),
+            Aux::M(3),
+            Aux::M(8),
+            Aux::T(100),
+            Aux::S(0.0),
+            Aux::M(5),
+            Aux::M(9),
+            Aux::M(11),
+            Aux::M(30)
+        ]
     );
-    assert_eq!(cmds.last().map(|c| (&c.command, c.line)), Some((&Command::ProgramEnd, 16)));
+    assert_eq!(
+        cmds.last().map(|c| (&c.command, c.line)),
+        Some((&Command::ProgramEnd, 16))
+    );
     // The listing never selects G01: `W-32 F200` follows `G0 X50 Z2`, so by the modal rules of
     // `000` §5.1 it is a rapid although the comment says "cut"; F only sets the modal feed.
-    assert!(cmds.iter().all(|c| !matches!(c.command, Command::Linear { .. } | Command::Arc { .. })));
+    assert!(cmds
+        .iter()
+        .all(|c| !matches!(c.command, Command::Linear { .. } | Command::Arc { .. })));
 }
 
 #[test]
 fn fixture_010_arcs_have_the_stated_end_points_and_centres() {
-    let cmds = check(Dialect::IsoLathe, &listing(&fixture("010_g02_g03_comprehensive_O0001.nc")), &AXES, &DIAMETER, &[0.0, 0.0]).unwrap();
-    let arcs: Vec<_> = cmds.iter().filter_map(|c| if let Command::Arc { end, center, clockwise, .. } = &c.command { Some((end.clone(), center.clone(), *clockwise)) } else { None }).collect();
+    let cmds = check(
+        Dialect::IsoLathe,
+        &listing(&fixture("010_g02_g03_comprehensive_O0001.nc")),
+        &AXES,
+        &DIAMETER,
+        &[0.0, 0.0],
+    )
+    .unwrap();
+    let arcs: Vec<_> = cmds
+        .iter()
+        .filter_map(|c| {
+            if let Command::Arc {
+                end,
+                center,
+                clockwise,
+                ..
+            } = &c.command
+            {
+                Some((end.clone(), center.clone(), *clockwise))
+            } else {
+                None
+            }
+        })
+        .collect();
     assert_eq!(arcs.len(), 2);
     // G03 U24 W-24 R15 from X0 Z0: ends at X24 Z-24; the centre is 15 mm (radius) from both ends.
     let (end, center, cw) = &arcs[0];
@@ -70,13 +142,20 @@ fn fixture_010_arcs_have_the_stated_end_points_and_centres() {
         assert!((r - 5.0).abs() < 1e-9, "radius {r}");
     }
     // Final point: back to X40 Z5.
-    let last = cmds.iter().filter_map(|c| end_of(&c.command)).last().unwrap();
+    let last = cmds.iter().rev().find_map(|c| end_of(&c.command)).unwrap();
     assert_close(&last, &[40.0, 5.0]);
 }
 
 #[test]
 fn incremental_mode_and_u_w_words() {
-    let cmds = check(Dialect::IsoLathe, "G00 X10 Z10\nG91 G01 X5 Z-2 F100\nG90 U4 W1\nM30\n", &AXES, &DIAMETER, &[0.0, 0.0]).unwrap();
+    let cmds = check(
+        Dialect::IsoLathe,
+        "G00 X10 Z10\nG91 G01 X5 Z-2 F100\nG90 U4 W1\nM30\n",
+        &AXES,
+        &DIAMETER,
+        &[0.0, 0.0],
+    )
+    .unwrap();
     let ends: Vec<_> = cmds.iter().filter_map(|c| end_of(&c.command)).collect();
     assert_close(&ends[1], &[15.0, 8.0]);
     assert_close(&ends[2], &[19.0, 9.0]);
@@ -84,16 +163,40 @@ fn incremental_mode_and_u_w_words() {
 
 #[test]
 fn full_circle_with_i_k_and_dwell_forms() {
-    let cmds = check(Dialect::IsoLathe, "G01 X20 Z0 F100\nG02 I-5\nG04 P1500\nG04 X2\nG04 U3 P500\n", &AXES, &DIAMETER, &[20.0, 0.0]).unwrap();
-    assert!(matches!(&cmds[1].command, Command::Arc { end, center, .. } if end == &vec![20.0, 0.0] && center == &vec![10.0, 0.0]));
-    let dwells: Vec<f64> = cmds.iter().filter_map(|c| if let Command::Dwell { seconds } = c.command { Some(seconds) } else { None }).collect();
+    let cmds = check(
+        Dialect::IsoLathe,
+        "G01 X20 Z0 F100\nG02 I-5\nG04 P1500\nG04 X2\nG04 U3 P500\n",
+        &AXES,
+        &DIAMETER,
+        &[20.0, 0.0],
+    )
+    .unwrap();
+    assert!(
+        matches!(&cmds[1].command, Command::Arc { end, center, .. } if end == &vec![20.0, 0.0] && center == &vec![10.0, 0.0])
+    );
+    let dwells: Vec<f64> = cmds
+        .iter()
+        .filter_map(|c| {
+            if let Command::Dwell { seconds } = c.command {
+                Some(seconds)
+            } else {
+                None
+            }
+        })
+        .collect();
     assert_eq!(dwells, [1.5, 2.0, 0.5]);
 }
 
 #[test]
 fn unknown_g_code_on_line_3_stops_before_it() {
     let text = "G00 X50 Z5\nG01 Z-10 F100\nG07.5 X60\nG01 X70\n";
-    let mut interp = cnc_interpreter::Interpreter::new(Dialect::IsoLathe, text, &AXES, &DIAMETER, &[100.0, 50.0]);
+    let mut interp = cnc_interpreter::Interpreter::new(
+        Dialect::IsoLathe,
+        text,
+        &AXES,
+        &DIAMETER,
+        &[100.0, 50.0],
+    );
     let mut lines = vec![];
     let err = loop {
         match interp.next_command() {
@@ -112,11 +215,31 @@ fn unknown_g_code_on_line_3_stops_before_it() {
 #[test]
 fn program_errors_carry_number_and_line() {
     let cases: &[(&str, u32, u32)] = &[
-        ("G00 X10\nG02 X20 Z-50 R5 F100\n", alarm::ARC_RADIUS_TOO_SMALL, 2),
-        ("G01 X10 Z0 F100\nG02 X10 Z0 R5\n", alarm::ARC_RADIUS_TOO_SMALL, 2),
-        ("G01 X10 Z0 F100\nG02 X20 Z-5 I3 K0\n", alarm::ARC_END_NOT_ON_CIRCLE, 2),
-        ("G01 X10 Z0 F100\nG02 X20 Z-5 R10 I3\n", alarm::ARC_R_AND_IJK, 2),
-        ("G01 X10 Z0 F100\nG02 X20 Z-5\n", alarm::ARC_RADIUS_TOO_SMALL, 2),
+        (
+            "G00 X10\nG02 X20 Z-50 R5 F100\n",
+            alarm::ARC_RADIUS_TOO_SMALL,
+            2,
+        ),
+        (
+            "G01 X10 Z0 F100\nG02 X10 Z0 R5\n",
+            alarm::ARC_RADIUS_TOO_SMALL,
+            2,
+        ),
+        (
+            "G01 X10 Z0 F100\nG02 X20 Z-5 I3 K0\n",
+            alarm::ARC_END_NOT_ON_CIRCLE,
+            2,
+        ),
+        (
+            "G01 X10 Z0 F100\nG02 X20 Z-5 R10 I3\n",
+            alarm::ARC_R_AND_IJK,
+            2,
+        ),
+        (
+            "G01 X10 Z0 F100\nG02 X20 Z-5\n",
+            alarm::ARC_RADIUS_TOO_SMALL,
+            2,
+        ),
         ("G01 X10\n", alarm::FEED_OUT_OF_RANGE, 1),
         ("M3 M8 M10 M5\n", alarm::TOO_MANY_M, 1),
         ("M77\n", alarm::UNDEFINED_CODE, 1),

@@ -26,7 +26,8 @@ pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
 /// Runs the io node until shutdown (blocking).
 pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "io")?;
-    let inputs = ros.subscription::<SimInput>("sim/input", "cnc_msgs/msg/SimInput", qos::events(10))?;
+    let inputs =
+        ros.subscription::<SimInput>("sim/input", "cnc_msgs/msg/SimInput", qos::events(10))?;
     let shm = ShmNode::new(&instance, "io")?;
     let setpoints = shm.receiver::<ServoSetpoint>(channel::SETPOINT, true)?;
     let feedback = shm.sender::<ServoFeedback>(channel::FEEDBACK, true)?;
@@ -41,7 +42,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     while !shutdown.requested() {
         while let Ok(Some((input, _))) = inputs.take() {
             if input.input == SimInput::EMERGENCY_STOP {
-                log::warn!("simulated emergency stop {}", if input.value { "pressed" } else { "released" });
+                log::warn!(
+                    "simulated emergency stop {}",
+                    if input.value { "pressed" } else { "released" }
+                );
                 sim.set_emergency_stop(input.value);
             }
         }

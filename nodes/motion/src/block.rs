@@ -3,10 +3,22 @@
 /// What a block does.
 #[derive(Debug, Clone, PartialEq)]
 pub enum BlockKind {
-    Rapid { end: Vec<f64> },
-    Linear { end: Vec<f64>, feed: f64 },
-    Arc { end: Vec<f64>, center: Vec<f64>, clockwise: bool, feed: f64 },
-    Dwell { seconds: f64 },
+    Rapid {
+        end: Vec<f64>,
+    },
+    Linear {
+        end: Vec<f64>,
+        feed: f64,
+    },
+    Arc {
+        end: Vec<f64>,
+        center: Vec<f64>,
+        clockwise: bool,
+        feed: f64,
+    },
+    Dwell {
+        seconds: f64,
+    },
     Aux(AuxCode),
     ProgramEnd,
 }

@@ -23,7 +23,11 @@ pub mod alarm {
 /// Something the shell must publish.
 #[derive(Debug, Clone, PartialEq)]
 pub enum MotionEvent {
-    Alarm { number: u32, text: String, line: u32 },
+    Alarm {
+        number: u32,
+        text: String,
+        line: u32,
+    },
 }
 
 /// Run state reported to the interpreter.
@@ -38,19 +42,41 @@ pub enum RunState {
 #[derive(Debug, Clone)]
 enum Active {
     /// Straight line or arc along one path profile.
-    Path { path: Path, profile: Profile },
+    Path {
+        path: Path,
+        profile: Profile,
+    },
     /// Each axis on its own profile (dog-leg rapid).
-    Rapid { start: Vec<f64>, end: Vec<f64>, profiles: Vec<Profile> },
-    Dwell { remaining: f64 },
+    Rapid {
+        start: Vec<f64>,
+        end: Vec<f64>,
+        profiles: Vec<Profile>,
+    },
+    Dwell {
+        remaining: f64,
+    },
     /// Waits for the axes to settle, then sends the strobe and waits for FIN.
-    Aux { code: AuxCode, strobe: Option<u64> },
+    Aux {
+        code: AuxCode,
+        strobe: Option<u64>,
+    },
     End,
 }
 
 #[derive(Debug, Clone)]
 enum Path {
-    Line { start: Vec<f64>, end: Vec<f64> },
-    Arc { start: Vec<f64>, end: Vec<f64>, center: (f64, f64), radius: f64, start_angle: f64, sweep: f64 },
+    Line {
+        start: Vec<f64>,
+        end: Vec<f64>,
+    },
+    Arc {
+        start: Vec<f64>,
+        end: Vec<f64>,
+        center: (f64, f64),
+        radius: f64,
+        start_angle: f64,
+        sweep: f64,
+    },
 }
 
 pub struct Motion {
@@ -77,7 +103,9 @@ impl Motion {
     /// `start` is the slide position the drives report at start-up.
     pub fn new(cfg: MotionConfig, start: &[f64]) -> Self {
         let n = cfg.axes.len();
-        let commanded: Vec<f64> = (0..n).map(|i| start.get(i).copied().unwrap_or(0.0)).collect();
+        let commanded: Vec<f64> = (0..n)
+            .map(|i| start.get(i).copied().unwrap_or(0.0))
+            .collect();
         Motion {
             cfg,
             queue: VecDeque::new(),
@@ -117,7 +145,14 @@ impl Motion {
             return;
         }
         if self.queue.len() >= self.cfg.queue_capacity {
-            self.raise(alarm::QUEUE_OVERFLOW, format!("motion queue full ({} blocks): block {} dropped", self.cfg.queue_capacity, block.seq), block.line);
+            self.raise(
+                alarm::QUEUE_OVERFLOW,
+                format!(
+                    "motion queue full ({} blocks): block {} dropped",
+                    self.cfg.queue_capacity, block.seq
+                ),
+                block.line,
+            );
             return;
         }
         self.accepted_seq = block.seq;
@@ -193,7 +228,11 @@ impl Motion {
 
     /// Commanded position in display units.
     pub fn commanded_display(&self) -> Vec<f64> {
-        self.commanded.iter().zip(&self.cfg.axes).map(|(p, a)| p / a.scale()).collect()
+        self.commanded
+            .iter()
+            .zip(&self.cfg.axes)
+            .map(|(p, a)| p / a.scale())
+            .collect()
     }
 
     /// One servo period. `actual` is the drives' slide position (None if no feedback arrived).
@@ -227,7 +266,9 @@ impl Motion {
                     self.feed_hold = false;
                     break;
                 }
-                let Some(block) = self.queue.pop_front() else { break };
+                let Some(block) = self.queue.pop_front() else {
+                    break;
+                };
                 self.line = block.line;
                 match self.activate(&block) {
                     Ok(a) => self.active = Some((block, a)),
@@ -239,7 +280,10 @@ impl Motion {
                 }
             }
             if self.advance(dt, plc) {
-                let moved = matches!(self.active, Some((_, Active::Path { .. } | Active::Rapid { .. })));
+                let moved = matches!(
+                    self.active,
+                    Some((_, Active::Path { .. } | Active::Rapid { .. }))
+                );
                 if let Some((block, _)) = self.active.take() {
                     self.done_seq = block.seq;
                 }
@@ -291,7 +335,12 @@ impl Motion {
 
     /// Slide positions of a display-unit point.
     fn to_slide(&self, p: &[f64]) -> Vec<f64> {
-        self.cfg.axes.iter().enumerate().map(|(i, a)| p.get(i).copied().unwrap_or(0.0) * a.scale()).collect()
+        self.cfg
+            .axes
+            .iter()
+            .enumerate()
+            .map(|(i, a)| p.get(i).copied().unwrap_or(0.0) * a.scale())
+            .collect()
     }
 
     /// Checks a display-unit point against the soft limits.
@@ -299,7 +348,13 @@ impl Motion {
         for (i, a) in self.cfg.axes.iter().enumerate() {
             let v = p.get(i).copied().unwrap_or(0.0);
             if v < a.min - 1e-9 || v > a.max + 1e-9 {
-                return Err((alarm::SOFT_LIMIT, format!("soft limit: {} {:.4} outside {:.3}..{:.3}", a.name, v, a.min, a.max)));
+                return Err((
+                    alarm::SOFT_LIMIT,
+                    format!(
+                        "soft limit: {} {:.4} outside {:.3}..{:.3}",
+                        a.name, v, a.min, a.max
+                    ),
+                ));
             }
         }
         Ok(())
@@ -310,8 +365,15 @@ impl Motion {
         let n = self.cfg.axes.len();
         let bad_len = |v: &Vec<f64>| v.len() != n || v.iter().any(|x| !x.is_finite());
         match &block.kind {
-            BlockKind::Rapid { end } | BlockKind::Linear { end, .. } | BlockKind::Arc { end, .. } if bad_len(end) => {
-                Err((alarm::QUEUE_OVERFLOW, format!("block has {} axis values, machine has {n}", end.len())))
+            BlockKind::Rapid { end }
+            | BlockKind::Linear { end, .. }
+            | BlockKind::Arc { end, .. }
+                if bad_len(end) =>
+            {
+                Err((
+                    alarm::QUEUE_OVERFLOW,
+                    format!("block has {} axis values, machine has {n}", end.len()),
+                ))
             }
             BlockKind::Rapid { end } => {
                 self.check_limits(end)?;
@@ -320,10 +382,18 @@ impl Motion {
                 let profiles = (0..n)
                     .map(|i| {
                         let a = &self.cfg.axes[i];
-                        Profile::new((end[i] - start[i]).abs(), a.max_velocity / 60.0, a.max_acceleration)
+                        Profile::new(
+                            (end[i] - start[i]).abs(),
+                            a.max_velocity / 60.0,
+                            a.max_acceleration,
+                        )
                     })
                     .collect();
-                Ok(Active::Rapid { start, end, profiles })
+                Ok(Active::Rapid {
+                    start,
+                    end,
+                    profiles,
+                })
             }
             BlockKind::Linear { end, feed } => {
                 self.check_limits(end)?;
@@ -340,11 +410,22 @@ impl Motion {
                     }
                 }
                 let acc = if acc.is_finite() { acc } else { 1.0 };
-                Ok(Active::Path { path: Path::Line { start, end }, profile: Profile::new(length, vmax, acc) })
+                Ok(Active::Path {
+                    path: Path::Line { start, end },
+                    profile: Profile::new(length, vmax, acc),
+                })
             }
-            BlockKind::Arc { end, center, clockwise, feed } => {
+            BlockKind::Arc {
+                end,
+                center,
+                clockwise,
+                feed,
+            } => {
                 if bad_len(center) {
-                    return Err((alarm::QUEUE_OVERFLOW, "arc centre has the wrong number of axes".into()));
+                    return Err((
+                        alarm::QUEUE_OVERFLOW,
+                        "arc centre has the wrong number of axes".into(),
+                    ));
                 }
                 self.check_limits(end)?;
                 let (h, v) = self.cfg.arc_plane;
@@ -359,22 +440,34 @@ impl Motion {
                     while sweep >= -1e-12 {
                         sweep -= TAU;
                     }
-                    if sweep < -TAU + 1e-9 && ((end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9) {
+                    if sweep < -TAU + 1e-9
+                        && ((end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9)
+                    {
                         sweep += TAU;
                     }
                 } else {
                     while sweep <= 1e-12 {
                         sweep += TAU;
                     }
-                    if sweep > TAU - 1e-9 && ((end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9) {
+                    if sweep > TAU - 1e-9
+                        && ((end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9)
+                    {
                         sweep -= TAU;
                     }
                 }
                 // Soft limits at the arc's extreme points (every quadrant crossing).
                 let mut k = (a0 / (TAU / 4.0)).floor() as i64;
                 loop {
-                    let ang = if sweep > 0.0 { (k + 1) as f64 * TAU / 4.0 } else { k as f64 * TAU / 4.0 };
-                    let passed = if sweep > 0.0 { ang - a0 < sweep } else { ang - a0 > sweep && ang < a0 };
+                    let ang = if sweep > 0.0 {
+                        (k + 1) as f64 * TAU / 4.0
+                    } else {
+                        k as f64 * TAU / 4.0
+                    };
+                    let passed = if sweep > 0.0 {
+                        ang - a0 < sweep
+                    } else {
+                        ang - a0 > sweep && ang < a0
+                    };
                     if !passed || (k - (a0 / (TAU / 4.0)).floor() as i64).abs() > 5 {
                         break;
                     }
@@ -385,30 +478,58 @@ impl Motion {
                     k += if sweep > 0.0 { 1 } else { -1 };
                 }
                 let length = radius * sweep.abs();
-                let amin = self.cfg.axes.iter().map(|a| a.max_acceleration).fold(f64::INFINITY, f64::min);
-                let vmin = self.cfg.axes.iter().map(|a| a.max_velocity / 60.0).fold(f64::INFINITY, f64::min);
+                let amin = self
+                    .cfg
+                    .axes
+                    .iter()
+                    .map(|a| a.max_acceleration)
+                    .fold(f64::INFINITY, f64::min);
+                let vmin = self
+                    .cfg
+                    .axes
+                    .iter()
+                    .map(|a| a.max_velocity / 60.0)
+                    .fold(f64::INFINITY, f64::min);
                 // Half the acceleration for the path, the rest for the centripetal part.
                 let vmax = (feed / 60.0).min(vmin).min((0.5 * amin * radius).sqrt());
                 Ok(Active::Path {
-                    path: Path::Arc { start, end, center: (c[h], c[v]), radius, start_angle: a0, sweep },
+                    path: Path::Arc {
+                        start,
+                        end,
+                        center: (c[h], c[v]),
+                        radius,
+                        start_angle: a0,
+                        sweep,
+                    },
                     profile: Profile::new(length, vmax, 0.5 * amin),
                 })
             }
-            BlockKind::Dwell { seconds } => Ok(Active::Dwell { remaining: *seconds }),
-            BlockKind::Aux(code) => Ok(Active::Aux { code: *code, strobe: None }),
+            BlockKind::Dwell { seconds } => Ok(Active::Dwell {
+                remaining: *seconds,
+            }),
+            BlockKind::Aux(code) => Ok(Active::Aux {
+                code: *code,
+                strobe: None,
+            }),
             BlockKind::ProgramEnd => Ok(Active::End),
         }
     }
 
     fn in_position(&self) -> bool {
-        self.cfg.axes.iter().enumerate().all(|(i, a)| (self.actual[i] - self.commanded[i]).abs() <= a.in_position)
+        self.cfg
+            .axes
+            .iter()
+            .enumerate()
+            .all(|(i, a)| (self.actual[i] - self.commanded[i]).abs() <= a.in_position)
     }
 
     /// Advances the active block by one tick; true when it is finished.
     fn advance(&mut self, dt: f64, plc: &GImage) -> bool {
         let hold = self.feed_hold;
         let in_pos = self.in_position();
-        let Some((_, active)) = self.active.as_mut() else { return false };
+        let Some((_, active)) = self.active.as_mut() else {
+            return false;
+        };
         match active {
             Active::Path { path, profile } => {
                 profile.step(dt, hold);
@@ -419,10 +540,21 @@ impl Motion {
                     Path::Line { start, end } => {
                         let f = if total > 0.0 { s / total } else { 1.0 };
                         for i in 0..self.commanded.len() {
-                            self.commanded[i] = if profile.done() { end[i] } else { start[i] + (end[i] - start[i]) * f };
+                            self.commanded[i] = if profile.done() {
+                                end[i]
+                            } else {
+                                start[i] + (end[i] - start[i]) * f
+                            };
                         }
                     }
-                    Path::Arc { start, end, center, radius, start_angle, sweep } => {
+                    Path::Arc {
+                        start,
+                        end,
+                        center,
+                        radius,
+                        start_angle,
+                        sweep,
+                    } => {
                         let f = if total > 0.0 { s / total } else { 1.0 };
                         if profile.done() {
                             self.commanded.clone_from(end);
@@ -438,11 +570,19 @@ impl Motion {
                 }
                 profile.done()
             }
-            Active::Rapid { start, end, profiles } => {
+            Active::Rapid {
+                start,
+                end,
+                profiles,
+            } => {
                 for (i, p) in profiles.iter_mut().enumerate() {
                     p.step(dt, hold);
                     let dir = (end[i] - start[i]).signum();
-                    self.commanded[i] = if p.done() { end[i] } else { start[i] + dir * p.position };
+                    self.commanded[i] = if p.done() {
+                        end[i]
+                    } else {
+                        start[i] + dir * p.position
+                    };
                 }
                 profiles.iter().all(Profile::done)
             }

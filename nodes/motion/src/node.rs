@@ -4,7 +4,9 @@
 use std::sync::mpsc::{channel as mpsc, Receiver, Sender, TryRecvError};
 use std::time::Duration;
 
-use cnc_msgs::msg::{Alarm, Axis, AxisState, MotionBlock, MotionStatus, ProgramCommand, ServoStats};
+use cnc_msgs::msg::{
+    Alarm, Axis, AxisState, MotionBlock, MotionStatus, ProgramCommand, ServoStats,
+};
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{FImage, GImage};
 use cnc_runtime::alarms::AlarmReporter;
@@ -49,7 +51,10 @@ pub fn motion_config(cfg: &LaunchConfig) -> MotionConfig {
         axes,
         period: cfg.servo.period_ms / 1000.0,
         queue_capacity: cfg.servo.queue_capacity,
-        arc_plane: (idx(&cfg.machine.arc_plane[0]), idx(&cfg.machine.arc_plane[1])),
+        arc_plane: (
+            idx(&cfg.machine.arc_plane[0]),
+            idx(&cfg.machine.arc_plane[1]),
+        ),
     }
 }
 
@@ -57,11 +62,19 @@ pub fn motion_config(cfg: &LaunchConfig) -> MotionConfig {
 fn block_from_msg(m: &MotionBlock) -> Option<Block> {
     let kind = match m.kind {
         MotionBlock::KIND_RAPID => BlockKind::Rapid { end: m.end.clone() },
-        MotionBlock::KIND_LINEAR => BlockKind::Linear { end: m.end.clone(), feed: m.feed },
-        MotionBlock::KIND_ARC_CW | MotionBlock::KIND_ARC_CCW => {
-            BlockKind::Arc { end: m.end.clone(), center: m.center.clone(), clockwise: m.kind == MotionBlock::KIND_ARC_CW, feed: m.feed }
-        }
-        MotionBlock::KIND_DWELL => BlockKind::Dwell { seconds: m.dwell_seconds },
+        MotionBlock::KIND_LINEAR => BlockKind::Linear {
+            end: m.end.clone(),
+            feed: m.feed,
+        },
+        MotionBlock::KIND_ARC_CW | MotionBlock::KIND_ARC_CCW => BlockKind::Arc {
+            end: m.end.clone(),
+            center: m.center.clone(),
+            clockwise: m.kind == MotionBlock::KIND_ARC_CW,
+            feed: m.feed,
+        },
+        MotionBlock::KIND_DWELL => BlockKind::Dwell {
+            seconds: m.dwell_seconds,
+        },
         MotionBlock::KIND_AUX => BlockKind::Aux(match m.aux_kind {
             MotionBlock::AUX_M => AuxCode::M(m.aux_code),
             MotionBlock::AUX_S => AuxCode::S(m.aux_value),
@@ -71,7 +84,12 @@ fn block_from_msg(m: &MotionBlock) -> Option<Block> {
         MotionBlock::KIND_PROGRAM_END => BlockKind::ProgramEnd,
         _ => return None,
     };
-    Some(Block { run_id: m.run_id, seq: m.seq, line: m.line, kind })
+    Some(Block {
+        run_id: m.run_id,
+        seq: m.seq,
+        line: m.line,
+        kind,
+    })
 }
 
 /// Runs the motion node until shutdown (blocking). Prints the servo statistics at exit.
@@ -87,18 +105,38 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<St
         .map_err(|e| format!("servo thread: {e}"))?;
     let dds_result = dds_loop(&cfg, in_tx, out_rx, &shutdown);
     shutdown.request();
-    let servo_result = servo.join().map_err(|_| "servo thread panicked".to_string())?;
+    let servo_result = servo
+        .join()
+        .map_err(|_| "servo thread panicked".to_string())?;
     dds_result?;
     servo_result
 }
 
-fn dds_loop(cfg: &LaunchConfig, to_servo: Sender<Input>, from_servo: Receiver<Report>, shutdown: &Shutdown) -> Result<(), String> {
+fn dds_loop(
+    cfg: &LaunchConfig,
+    to_servo: Sender<Input>,
+    from_servo: Receiver<Report>,
+    shutdown: &Shutdown,
+) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "motion")?;
-    let blocks = ros.subscription::<MotionBlock>("_internal/motion_blocks", "cnc_msgs/msg/MotionBlock", qos::commands())?;
-    let commands = ros.subscription::<ProgramCommand>("_internal/program_command", "cnc_msgs/msg/ProgramCommand", qos::commands())?;
-    let status_pub = ros.publisher::<MotionStatus>("_internal/motion_status", "cnc_msgs/msg/MotionStatus", qos::state())?;
+    let blocks = ros.subscription::<MotionBlock>(
+        "_internal/motion_blocks",
+        "cnc_msgs/msg/MotionBlock",
+        qos::commands(),
+    )?;
+    let commands = ros.subscription::<ProgramCommand>(
+        "_internal/program_command",
+        "cnc_msgs/msg/ProgramCommand",
+        qos::commands(),
+    )?;
+    let status_pub = ros.publisher::<MotionStatus>(
+        "_internal/motion_status",
+        "cnc_msgs/msg/MotionStatus",
+        qos::state(),
+    )?;
     let axes_pub = ros.publisher::<AxisState>("axes", "cnc_msgs/msg/AxisState", qos::state())?;
-    let stats_pub = ros.publisher::<ServoStats>("servo_stats", "cnc_msgs/msg/ServoStats", qos::state())?;
+    let stats_pub =
+        ros.publisher::<ServoStats>("servo_stats", "cnc_msgs/msg/ServoStats", qos::state())?;
     let alarms = AlarmReporter::new(&mut ros, "motion")?;
     while !shutdown.requested() {
         let mut idle = true;
@@ -108,7 +146,13 @@ fn dds_loop(cfg: &LaunchConfig, to_servo: Sender<Input>, from_servo: Receiver<Re
                 Some(b) => {
                     let _ = to_servo.send(Input::Block(b));
                 }
-                None => alarms.raise(alarms.alarm(33, Alarm::SEVERITY_ERROR, "unknown internal interpolation function", &m.program, m.line)),
+                None => alarms.raise(alarms.alarm(
+                    33,
+                    Alarm::SEVERITY_ERROR,
+                    "unknown internal interpolation function",
+                    &m.program,
+                    m.line,
+                )),
             }
         }
         while let Ok(Some((c, _))) = commands.take() {
@@ -120,7 +164,9 @@ fn dds_loop(cfg: &LaunchConfig, to_servo: Sender<Input>, from_servo: Receiver<Re
                 Ok(Report::Status(s)) => publish(&status_pub, s),
                 Ok(Report::Axes(a)) => publish(&axes_pub, a),
                 Ok(Report::Stats(s)) => publish(&stats_pub, s),
-                Ok(Report::Alarm(number, text, line)) => alarms.raise(alarms.alarm(number, Alarm::SEVERITY_ERROR, &text, "", line)),
+                Ok(Report::Alarm(number, text, line)) => {
+                    alarms.raise(alarms.alarm(number, Alarm::SEVERITY_ERROR, &text, "", line))
+                }
                 Err(TryRecvError::Empty) => break,
                 Err(TryRecvError::Disconnected) => return Ok(()),
             }
@@ -139,7 +185,14 @@ fn publish<M: ros2_client::Message + std::fmt::Debug>(p: &ros2_client::dds::Publ
     }
 }
 
-fn servo_loop(mcfg: MotionConfig, names: Vec<String>, instance: String, inputs: Receiver<Input>, reports: Sender<Report>, shutdown: Shutdown) -> Result<String, String> {
+fn servo_loop(
+    mcfg: MotionConfig,
+    names: Vec<String>,
+    instance: String,
+    inputs: Receiver<Input>,
+    reports: Sender<Report>,
+    shutdown: Shutdown,
+) -> Result<String, String> {
     let shm = ShmNode::new(&instance, "motion")?;
     let setpoints = shm.sender::<ServoSetpoint>(channel::SETPOINT, true)?;
     let feedback = shm.receiver::<ServoFeedback>(channel::FEEDBACK, true)?;
@@ -148,7 +201,9 @@ fn servo_loop(mcfg: MotionConfig, names: Vec<String>, instance: String, inputs: 
     let n = mcfg.axes.len();
     let period_ns = (mcfg.period * 1e9) as u64;
     // Start from where the drives are.
-    let first = feedback.wait(Duration::from_secs(2))?.ok_or("no feedback from the drives (is io running?)")?;
+    let first = feedback
+        .wait(Duration::from_secs(2))?
+        .ok_or("no feedback from the drives (is io running?)")?;
     let mut actual = first.position;
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     let mut g = GImage::default();
@@ -196,11 +251,19 @@ fn servo_loop(mcfg: MotionConfig, names: Vec<String>, instance: String, inputs: 
         f_out.send(*motion.f_image())?;
         seq += 1;
         let sent = monotonic_ns();
-        setpoints.send(ServoSetpoint { seq, sent_ns: sent, position: commanded, axis_count: n as u32, enable: 1 })?;
+        setpoints.send(ServoSetpoint {
+            seq,
+            sent_ns: sent,
+            position: commanded,
+            axis_count: n as u32,
+            enable: 1,
+        })?;
         have_feedback = false;
         if let Some(fb) = feedback.wait(Duration::from_nanos(period_ns / 2))? {
             if fb.seq == seq {
-                stats.round_trip.record((monotonic_ns() - fb.setpoint_sent_ns) as f64 / 1000.0);
+                stats
+                    .round_trip
+                    .record((monotonic_ns() - fb.setpoint_sent_ns) as f64 / 1000.0);
             }
             actual = fb.position;
             have_feedback = true;
@@ -209,8 +272,14 @@ fn servo_loop(mcfg: MotionConfig, names: Vec<String>, instance: String, inputs: 
             let MotionEvent::Alarm { number, text, line } = e;
             let _ = reports.send(Report::Alarm(number, text, line));
         }
-        let status = (motion.run_id(), motion.accepted_seq(), motion.done_seq(), motion.state(), motion.line());
-        if status != last_status || seq % 25 == 0 {
+        let status = (
+            motion.run_id(),
+            motion.accepted_seq(),
+            motion.done_seq(),
+            motion.state(),
+            motion.line(),
+        );
+        if status != last_status || seq.is_multiple_of(25) {
             last_status = status;
             let state = match motion.state() {
                 RunState::Idle => MotionStatus::STATE_IDLE,
@@ -227,7 +296,7 @@ fn servo_loop(mcfg: MotionConfig, names: Vec<String>, instance: String, inputs: 
                 state,
             }));
         }
-        if seq % 10 == 0 {
+        if seq.is_multiple_of(10) {
             let cmd = motion.commanded_display();
             let axes = mcfg
                 .axes
@@ -235,12 +304,21 @@ fn servo_loop(mcfg: MotionConfig, names: Vec<String>, instance: String, inputs: 
                 .enumerate()
                 .map(|(i, a)| {
                     let act = actual[i] / a.scale();
-                    Axis { name: names[i].clone(), commanded_position: cmd[i], actual_position: act, following_error: cmd[i] - act, homed: true }
+                    Axis {
+                        name: names[i].clone(),
+                        commanded_position: cmd[i],
+                        actual_position: act,
+                        following_error: cmd[i] - act,
+                        homed: true,
+                    }
                 })
                 .collect();
-            let _ = reports.send(Report::Axes(AxisState { stamp: stamp(), axes }));
+            let _ = reports.send(Report::Axes(AxisState {
+                stamp: stamp(),
+                axes,
+            }));
         }
-        if seq % 250 == 0 {
+        if seq.is_multiple_of(250) {
             let _ = reports.send(Report::Stats(stats_msg(&stats, mcfg.period)));
         }
     }

@@ -16,7 +16,13 @@ pub struct Profile {
 
 impl Profile {
     pub fn new(length: f64, max_velocity: f64, acceleration: f64) -> Self {
-        Profile { length, position: 0.0, velocity: 0.0, max_velocity, acceleration }
+        Profile {
+            length,
+            position: 0.0,
+            velocity: 0.0,
+            max_velocity,
+            acceleration,
+        }
     }
 
     pub fn done(&self) -> bool {
@@ -35,10 +41,22 @@ impl Profile {
         // still stops at the end: v²/2a + v·dt/2 ≤ remaining − v₀·dt/2.
         let room = remaining - 0.5 * self.velocity * dt;
         let half = 0.5 * a * dt;
-        let braking = if room <= 0.0 { 0.0 } else { -half + (half * half + 2.0 * a * room).sqrt() };
-        let target = if hold { 0.0 } else { self.max_velocity.min(braking) };
+        let braking = if room <= 0.0 {
+            0.0
+        } else {
+            -half + (half * half + 2.0 * a * room).sqrt()
+        };
+        let target = if hold {
+            0.0
+        } else {
+            self.max_velocity.min(braking)
+        };
         let dv = a * dt;
-        let mut v = if target > self.velocity { (self.velocity + dv).min(target) } else { (self.velocity - dv).max(target) };
+        let mut v = if target > self.velocity {
+            (self.velocity + dv).min(target)
+        } else {
+            (self.velocity - dv).max(target)
+        };
         if !hold {
             v = v.min(braking);
         }
@@ -66,7 +84,12 @@ mod tests {
         while !p.done() {
             p.step(dt, false);
             assert!(p.velocity <= 50.0 + 1e-9);
-            assert!((p.velocity - last_v).abs() <= 500.0 * dt * (1.0 + 1e-9), "accel limit: {} -> {}", last_v, p.velocity);
+            assert!(
+                (p.velocity - last_v).abs() <= 500.0 * dt * (1.0 + 1e-9),
+                "accel limit: {} -> {}",
+                last_v,
+                p.velocity
+            );
             last_v = p.velocity;
             ticks += 1;
             assert!(ticks < 10_000);

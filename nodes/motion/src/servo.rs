@@ -13,7 +13,12 @@ pub struct Histogram {
 
 impl Default for Histogram {
     fn default() -> Self {
-        Histogram { bins: vec![0; BINS], count: 0, min_us: f64::INFINITY, max_us: 0.0 }
+        Histogram {
+            bins: vec![0; BINS],
+            count: 0,
+            min_us: f64::INFINITY,
+            max_us: 0.0,
+        }
     }
 }
 

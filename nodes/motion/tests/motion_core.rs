@@ -1,7 +1,10 @@
 //! Motion core on a perfect drive. `Motion::new` takes slide positions (X as radius): X50 is 25.
 //! (actual = commanded) and a simple PLC that answers strobes.
 
-use cnc_motion::{motion::alarm, AuxCode, AxisConfig, Block, BlockKind, Motion, MotionConfig, MotionEvent, RunState};
+use cnc_motion::{
+    motion::alarm, AuxCode, AxisConfig, Block, BlockKind, Motion, MotionConfig, MotionEvent,
+    RunState,
+};
 use cnc_msgs::signals::GImage;
 
 fn lathe() -> MotionConfig {
@@ -15,11 +18,24 @@ fn lathe() -> MotionConfig {
         in_position: 0.0005,
         drive_lag: 0.008,
     };
-    MotionConfig { axes: vec![axis("X", true, -10.0, 300.0), axis("Z", false, -400.0, 100.0)], period: 0.004, queue_capacity: 16, arc_plane: (1, 0) }
+    MotionConfig {
+        axes: vec![
+            axis("X", true, -10.0, 300.0),
+            axis("Z", false, -400.0, 100.0),
+        ],
+        period: 0.004,
+        queue_capacity: 16,
+        arc_plane: (1, 0),
+    }
 }
 
 fn block(seq: u64, line: u32, kind: BlockKind) -> Block {
-    Block { run_id: 1, seq, line, kind }
+    Block {
+        run_id: 1,
+        seq,
+        line,
+        kind,
+    }
 }
 
 /// Runs until idle or alarm; answers every strobe with FIN after `fin_delay` ticks.
@@ -47,9 +63,31 @@ fn run(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(u64, i32)>) {
 fn program_runs_to_its_end_point_with_fin_handshake() {
     let mut m = Motion::new(lathe(), &[25.0, 50.0]);
     m.push(block(1, 1, BlockKind::Aux(AuxCode::M(3))));
-    m.push(block(2, 2, BlockKind::Rapid { end: vec![50.0, 2.0] }));
-    m.push(block(3, 3, BlockKind::Linear { end: vec![50.0, -30.0], feed: 600.0 }));
-    m.push(block(4, 4, BlockKind::Arc { end: vec![70.0, -40.0], center: vec![50.0, -40.0], clockwise: false, feed: 600.0 }));
+    m.push(block(
+        2,
+        2,
+        BlockKind::Rapid {
+            end: vec![50.0, 2.0],
+        },
+    ));
+    m.push(block(
+        3,
+        3,
+        BlockKind::Linear {
+            end: vec![50.0, -30.0],
+            feed: 600.0,
+        },
+    ));
+    m.push(block(
+        4,
+        4,
+        BlockKind::Arc {
+            end: vec![70.0, -40.0],
+            center: vec![50.0, -40.0],
+            clockwise: false,
+            feed: 600.0,
+        },
+    ));
     m.push(block(5, 5, BlockKind::Aux(AuxCode::M(30))));
     m.push(block(6, 5, BlockKind::ProgramEnd));
     let (trace, strobes) = run(&mut m, 100_000);
@@ -64,7 +102,10 @@ fn program_runs_to_its_end_point_with_fin_handshake() {
         assert!((r - 10.0).abs() < 1e-9, "{p:?} off the arc (r={r})");
     }
     // Feed 600 mm/min = 10 mm/s: no tick moves more than 10 mm/s * 4 ms along the line.
-    for w in trace.windows(2).filter(|w| w[0][1] <= 2.0 && w[1][1] >= -30.0 && w[0][0] == 50.0) {
+    for w in trace
+        .windows(2)
+        .filter(|w| w[0][1] <= 2.0 && w[1][1] >= -30.0 && w[0][0] == 50.0)
+    {
         assert!((w[1][1] - w[0][1]).abs() <= 0.04 + 1e-9);
     }
 }
@@ -72,24 +113,55 @@ fn program_runs_to_its_end_point_with_fin_handshake() {
 #[test]
 fn soft_limit_is_refused_before_any_motion() {
     let mut m = Motion::new(lathe(), &[25.0, 50.0]);
-    m.push(block(1, 7, BlockKind::Linear { end: vec![50.0, -500.0], feed: 600.0 }));
-    m.push(block(2, 8, BlockKind::Rapid { end: vec![0.0, 0.0] }));
+    m.push(block(
+        1,
+        7,
+        BlockKind::Linear {
+            end: vec![50.0, -500.0],
+            feed: 600.0,
+        },
+    ));
+    m.push(block(
+        2,
+        8,
+        BlockKind::Rapid {
+            end: vec![0.0, 0.0],
+        },
+    ));
     let (trace, _) = run(&mut m, 100);
     assert_eq!(m.state(), RunState::Alarm);
     assert!(trace.iter().all(|p| p == &vec![50.0, 50.0]), "axes moved");
     let events = m.take_events();
-    assert!(matches!(&events[..], [MotionEvent::Alarm { number, line: 7, .. }] if *number == alarm::SOFT_LIMIT), "{events:?}");
+    assert!(
+        matches!(&events[..], [MotionEvent::Alarm { number, line: 7, .. }] if *number == alarm::SOFT_LIMIT),
+        "{events:?}"
+    );
     // An arc whose end is inside but whose bulge leaves the limits is refused too.
     // From X20 Z50 counter-clockwise around Z70 (radius 20) the arc dips to X-20, below -10.
     let mut m = Motion::new(lathe(), &[10.0, 50.0]);
-    let arc = |clockwise| BlockKind::Arc { end: vec![20.0, 90.0], center: vec![20.0, 70.0], clockwise, feed: 100.0 };
-    m.push(Block { run_id: 2, seq: 1, line: 3, kind: arc(false) });
+    let arc = |clockwise| BlockKind::Arc {
+        end: vec![20.0, 90.0],
+        center: vec![20.0, 70.0],
+        clockwise,
+        feed: 100.0,
+    };
+    m.push(Block {
+        run_id: 2,
+        seq: 1,
+        line: 3,
+        kind: arc(false),
+    });
     run(&mut m, 100);
     assert_eq!(m.state(), RunState::Alarm);
     assert_eq!(m.commanded_display(), vec![20.0, 50.0]);
     // The same arc clockwise goes over the top (X60) and is allowed.
     let mut m = Motion::new(lathe(), &[10.0, 50.0]);
-    m.push(Block { run_id: 2, seq: 1, line: 3, kind: arc(true) });
+    m.push(Block {
+        run_id: 2,
+        seq: 1,
+        line: 3,
+        kind: arc(true),
+    });
     run(&mut m, 100_000);
     assert_eq!(m.state(), RunState::Idle);
     assert_eq!(m.commanded_display(), vec![20.0, 90.0]);
@@ -98,7 +170,14 @@ fn soft_limit_is_refused_before_any_motion() {
 #[test]
 fn feed_hold_stops_on_the_path_and_cycle_start_resumes() {
     let mut m = Motion::new(lathe(), &[25.0, 0.0]);
-    m.push(block(1, 1, BlockKind::Linear { end: vec![50.0, -50.0], feed: 1200.0 }));
+    m.push(block(
+        1,
+        1,
+        BlockKind::Linear {
+            end: vec![50.0, -50.0],
+            feed: 1200.0,
+        },
+    ));
     m.push(block(2, 2, BlockKind::ProgramEnd));
     let g = GImage::default();
     for _ in 0..200 {
@@ -125,7 +204,14 @@ fn feed_hold_stops_on_the_path_and_cycle_start_resumes() {
 #[test]
 fn emergency_stop_drops_the_run_and_holds_position() {
     let mut m = Motion::new(lathe(), &[25.0, 0.0]);
-    m.push(block(1, 1, BlockKind::Linear { end: vec![50.0, -50.0], feed: 1200.0 }));
+    m.push(block(
+        1,
+        1,
+        BlockKind::Linear {
+            end: vec![50.0, -50.0],
+            feed: 1200.0,
+        },
+    ));
     let mut g = GImage::default();
     for _ in 0..50 {
         let a = m.commanded().to_vec();
@@ -146,8 +232,22 @@ fn emergency_stop_drops_the_run_and_holds_position() {
 #[test]
 fn blocks_of_an_old_run_are_ignored() {
     let mut m = Motion::new(lathe(), &[0.0, 0.0]);
-    m.push(Block { run_id: 2, seq: 1, line: 1, kind: BlockKind::Rapid { end: vec![10.0, 0.0] } });
-    m.push(Block { run_id: 1, seq: 2, line: 1, kind: BlockKind::Rapid { end: vec![99.0, 0.0] } });
+    m.push(Block {
+        run_id: 2,
+        seq: 1,
+        line: 1,
+        kind: BlockKind::Rapid {
+            end: vec![10.0, 0.0],
+        },
+    });
+    m.push(Block {
+        run_id: 1,
+        seq: 2,
+        line: 1,
+        kind: BlockKind::Rapid {
+            end: vec![99.0, 0.0],
+        },
+    });
     run(&mut m, 10_000);
     assert_eq!(m.commanded_display(), vec![10.0, 0.0]);
 }

@@ -91,7 +91,10 @@ impl Plc {
         if x.emergency_stop != 0 {
             if !self.emergency_stop {
                 self.emergency_stop = true;
-                self.events.push(PlcEvent::AlarmRaised { number: alarm::EMERGENCY_STOP, text: "emergency stop".into() });
+                self.events.push(PlcEvent::AlarmRaised {
+                    number: alarm::EMERGENCY_STOP,
+                    text: "emergency stop".into(),
+                });
             }
             self.y = YImage::default();
             self.g.emergency_stop = 1;
@@ -103,7 +106,9 @@ impl Plc {
             // Released: the alarm goes, the machine stays stopped until reset and cycle start.
             self.emergency_stop = false;
             self.g.emergency_stop = 0;
-            self.events.push(PlcEvent::AlarmCleared { number: alarm::EMERGENCY_STOP });
+            self.events.push(PlcEvent::AlarmCleared {
+                number: alarm::EMERGENCY_STOP,
+            });
         }
         if f.op != 0 && self.cycle_started_at.is_none() {
             self.cycle_started_at = Some(now);
@@ -137,7 +142,11 @@ impl Plc {
             self.speed = f.s_value;
             if self.y.spindle_direction != 0 {
                 self.y.spindle_rpm = self.speed;
-                return if self.speed > 0.0 { Waiting::SpindleAtSpeed } else { Waiting::SpindleStopped };
+                return if self.speed > 0.0 {
+                    Waiting::SpindleAtSpeed
+                } else {
+                    Waiting::SpindleStopped
+                };
             }
             return Waiting::Nothing;
         }
@@ -182,7 +191,10 @@ impl Plc {
                 if f.m_code == 30 {
                     self.part_count += 1;
                     let cycle_time = self.cycle_started_at.map(|t| now - t).unwrap_or(0.0);
-                    self.events.push(PlcEvent::PartCounted { count: self.part_count, cycle_time });
+                    self.events.push(PlcEvent::PartCounted {
+                        count: self.part_count,
+                        cycle_time,
+                    });
                 }
                 Waiting::Nothing
             }
@@ -196,15 +208,35 @@ mod tests {
     use super::*;
 
     fn strobe_m(seq: u64, m: i32) -> FImage {
-        FImage { strobe_seq: seq, mf: 1, m_code: m, op: 1, ..Default::default() }
+        FImage {
+            strobe_seq: seq,
+            mf: 1,
+            m_code: m,
+            op: 1,
+            ..Default::default()
+        }
     }
 
     #[test]
     fn m03_fins_only_at_speed() {
         let mut plc = Plc::new(0);
         let mut x = XImage::default();
-        plc.scan(&FImage { strobe_seq: 1, sf: 1, s_value: 1200.0, op: 1, ..Default::default() }, &x, 0.0);
-        assert_eq!(plc.to_nc().fin_seq, 1, "S with the spindle stopped only latches the speed");
+        plc.scan(
+            &FImage {
+                strobe_seq: 1,
+                sf: 1,
+                s_value: 1200.0,
+                op: 1,
+                ..Default::default()
+            },
+            &x,
+            0.0,
+        );
+        assert_eq!(
+            plc.to_nc().fin_seq,
+            1,
+            "S with the spindle stopped only latches the speed"
+        );
         plc.scan(&strobe_m(2, 3), &x, 0.01);
         assert_eq!(plc.outputs().spindle_direction, 1);
         assert_eq!(plc.outputs().spindle_rpm, 1200.0);
@@ -218,18 +250,44 @@ mod tests {
     fn m30_counts_the_part_with_cycle_time() {
         let mut plc = Plc::new(4);
         let x = XImage::default();
-        plc.scan(&FImage { op: 1, ..Default::default() }, &x, 10.0);
+        plc.scan(
+            &FImage {
+                op: 1,
+                ..Default::default()
+            },
+            &x,
+            10.0,
+        );
         plc.scan(&strobe_m(1, 30), &x, 12.5);
         assert_eq!(plc.part_count(), 5);
-        assert_eq!(plc.take_events(), vec![PlcEvent::PartCounted { count: 5, cycle_time: 2.5 }]);
+        assert_eq!(
+            plc.take_events(),
+            vec![PlcEvent::PartCounted {
+                count: 5,
+                cycle_time: 2.5
+            }]
+        );
         assert_eq!(plc.to_nc().fin_seq, 1);
     }
 
     #[test]
     fn emergency_stop_turns_every_output_off_in_one_scan() {
         let mut plc = Plc::new(0);
-        let mut x = XImage { spindle_at_speed: 1, coolant_pressure: 1, ..Default::default() };
-        plc.scan(&FImage { strobe_seq: 1, sf: 1, s_value: 500.0, ..Default::default() }, &x, 0.0);
+        let mut x = XImage {
+            spindle_at_speed: 1,
+            coolant_pressure: 1,
+            ..Default::default()
+        };
+        plc.scan(
+            &FImage {
+                strobe_seq: 1,
+                sf: 1,
+                s_value: 500.0,
+                ..Default::default()
+            },
+            &x,
+            0.0,
+        );
         plc.scan(&strobe_m(2, 3), &x, 0.0);
         plc.scan(&strobe_m(3, 8), &x, 0.0);
         assert_ne!(plc.outputs(), &YImage::default());
@@ -237,6 +295,12 @@ mod tests {
         plc.scan(&FImage::default(), &x, 0.1);
         assert_eq!(plc.outputs(), &YImage::default());
         assert_eq!(plc.to_nc().emergency_stop, 1);
-        assert!(matches!(plc.take_events()[..], [PlcEvent::AlarmRaised { number: alarm::EMERGENCY_STOP, .. }]));
+        assert!(matches!(
+            plc.take_events()[..],
+            [PlcEvent::AlarmRaised {
+                number: alarm::EMERGENCY_STOP,
+                ..
+            }]
+        ));
     }
 }

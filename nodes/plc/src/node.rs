@@ -13,8 +13,10 @@ use crate::logic::{Plc, PlcEvent};
 
 pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "plc")?;
-    let spindle_pub = ros.publisher::<SpindleState>("spindle", "cnc_msgs/msg/SpindleState", qos::state())?;
-    let parts_pub = ros.publisher::<PartCount>("part_count", "cnc_msgs/msg/PartCount", qos::state())?;
+    let spindle_pub =
+        ros.publisher::<SpindleState>("spindle", "cnc_msgs/msg/SpindleState", qos::state())?;
+    let parts_pub =
+        ros.publisher::<PartCount>("part_count", "cnc_msgs/msg/PartCount", qos::state())?;
     let alarms = AlarmReporter::new(&mut ros, "plc")?;
     let shm = ShmNode::new(&instance, "plc")?;
     let f_in = shm.receiver::<FImage>(channel::F_IMAGE, false)?;
@@ -29,7 +31,12 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut scans = 0u64;
     let mut last_cycle_time = 0.0;
     let publish_parts = |count: u32, last: f64| {
-        let _ = parts_pub.publish(PartCount { stamp: stamp(), count, target: 0, last_cycle_time: last });
+        let _ = parts_pub.publish(PartCount {
+            stamp: stamp(),
+            count,
+            target: 0,
+            last_cycle_time: last,
+        });
     };
     publish_parts(0, 0.0);
     let mut last_spindle: Option<(f64, u32, bool, i64)> = None;
@@ -50,7 +57,9 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         y_out.send(*plc.outputs())?;
         for e in plc.take_events() {
             match e {
-                PlcEvent::AlarmRaised { number, text } => alarms.raise(alarms.alarm(number, Alarm::SEVERITY_FATAL, &text, "", 0)),
+                PlcEvent::AlarmRaised { number, text } => {
+                    alarms.raise(alarms.alarm(number, Alarm::SEVERITY_FATAL, &text, "", 0))
+                }
                 PlcEvent::AlarmCleared { number } => alarms.clear(number),
                 PlcEvent::PartCounted { count, cycle_time } => {
                     last_cycle_time = cycle_time;
@@ -61,8 +70,13 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         scans += 1;
         // Spindle state on change (to the rpm) and at least every 100 ms.
         let y = plc.outputs();
-        let key = (plc.commanded_rpm(), y.spindle_direction, x.spindle_at_speed != 0, x.spindle_actual_rpm.round() as i64);
-        if last_spindle != Some(key) || scans % 10 == 0 {
+        let key = (
+            plc.commanded_rpm(),
+            y.spindle_direction,
+            x.spindle_at_speed != 0,
+            x.spindle_actual_rpm.round() as i64,
+        );
+        if last_spindle != Some(key) || scans.is_multiple_of(10) {
             last_spindle = Some(key);
             let direction = match y.spindle_direction {
                 1 => SpindleState::DIRECTION_CW,
@@ -80,7 +94,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 at_speed: x.spindle_at_speed != 0 && direction != SpindleState::DIRECTION_STOP,
             });
         }
-        if scans % 500 == 0 {
+        if scans.is_multiple_of(500) {
             publish_parts(plc.part_count(), last_cycle_time);
         }
     }

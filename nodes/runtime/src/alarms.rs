@@ -16,23 +16,47 @@ pub struct AlarmReporter {
 
 impl AlarmReporter {
     pub fn new(node: &mut RosNode, source: &str) -> Result<Self, String> {
-        Ok(AlarmReporter { source: source.into(), publisher: node.publisher(EVENTS_TOPIC, EVENTS_TYPE, qos::events(100))? })
+        Ok(AlarmReporter {
+            source: source.into(),
+            publisher: node.publisher(EVENTS_TOPIC, EVENTS_TYPE, qos::events(100))?,
+        })
     }
 
     pub fn alarm(&self, number: u32, severity: u8, text: &str, program: &str, line: u32) -> Alarm {
-        Alarm { number, severity, text: text.into(), source: self.source.clone(), program: program.into(), line, stamp: stamp() }
+        Alarm {
+            number,
+            severity,
+            text: text.into(),
+            source: self.source.clone(),
+            program: program.into(),
+            line,
+            stamp: stamp(),
+        }
     }
 
     pub fn raise(&self, alarm: Alarm) {
-        log::error!("alarm {} ({}): {} [{} line {}]", alarm.number, alarm.source, alarm.text, alarm.program, alarm.line);
-        if let Err(e) = self.publisher.publish(AlarmEvent { kind: AlarmEvent::RAISED, alarm }) {
+        log::error!(
+            "alarm {} ({}): {} [{} line {}]",
+            alarm.number,
+            alarm.source,
+            alarm.text,
+            alarm.program,
+            alarm.line
+        );
+        if let Err(e) = self.publisher.publish(AlarmEvent {
+            kind: AlarmEvent::RAISED,
+            alarm,
+        }) {
             log::error!("{}: alarm event not published: {e:?}", self.source);
         }
     }
 
     pub fn clear(&self, number: u32) {
         let alarm = self.alarm(number, Alarm::SEVERITY_INFO, "", "", 0);
-        if let Err(e) = self.publisher.publish(AlarmEvent { kind: AlarmEvent::CLEARED, alarm }) {
+        if let Err(e) = self.publisher.publish(AlarmEvent {
+            kind: AlarmEvent::CLEARED,
+            alarm,
+        }) {
             log::error!("{}: alarm event not published: {e:?}", self.source);
         }
     }

@@ -83,7 +83,10 @@ fn default_interfaces() -> Vec<IpAddr> {
 
 impl Default for NetworkConfig {
     fn default() -> Self {
-        NetworkConfig { domain_id: None, interfaces: default_interfaces() }
+        NetworkConfig {
+            domain_id: None,
+            interfaces: default_interfaces(),
+        }
     }
 }
 
@@ -95,7 +98,10 @@ impl NetworkConfig {
         }
         match std::env::var("ROS_DOMAIN_ID") {
             Ok(v) if !v.trim().is_empty() => {
-                let d: u16 = v.trim().parse().map_err(|_| format!("ROS_DOMAIN_ID={v:?} is not a number"))?;
+                let d: u16 = v
+                    .trim()
+                    .parse()
+                    .map_err(|_| format!("ROS_DOMAIN_ID={v:?} is not a number"))?;
                 valid_domain(d)
             }
             _ => Ok(0),
@@ -132,7 +138,10 @@ fn default_queue() -> usize {
 
 impl Default for ServoConfig {
     fn default() -> Self {
-        ServoConfig { period_ms: default_period(), queue_capacity: default_queue() }
+        ServoConfig {
+            period_ms: default_period(),
+            queue_capacity: default_queue(),
+        }
     }
 }
 
@@ -159,7 +168,11 @@ fn default_coolant_delay() -> f64 {
 
 impl Default for SimConfig {
     fn default() -> Self {
-        SimConfig { spindle_acceleration: default_spindle_acc(), at_speed_tolerance: default_at_speed(), coolant_delay: default_coolant_delay() }
+        SimConfig {
+            spindle_acceleration: default_spindle_acc(),
+            at_speed_tolerance: default_at_speed(),
+            coolant_delay: default_coolant_delay(),
+        }
     }
 }
 
@@ -177,13 +190,16 @@ fn default_scan() -> f64 {
 
 impl Default for PlcConfig {
     fn default() -> Self {
-        PlcConfig { scan_ms: default_scan() }
+        PlcConfig {
+            scan_ms: default_scan(),
+        }
     }
 }
 
 impl LaunchConfig {
     pub fn from_yaml(text: &str) -> Result<Self, String> {
-        let cfg: LaunchConfig = serde_yaml::from_str(text).map_err(|e| format!("launch config: {e}"))?;
+        let cfg: LaunchConfig =
+            serde_yaml::from_str(text).map_err(|e| format!("launch config: {e}"))?;
         cfg.validate()?;
         Ok(cfg)
     }
@@ -195,26 +211,43 @@ impl LaunchConfig {
 
     fn validate(&self) -> Result<(), String> {
         let ns = &self.machine.namespace;
-        if ns.is_empty() || !ns.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') || ns.starts_with(|c: char| c.is_ascii_digit()) {
-            return Err(format!("machine.namespace {ns:?}: letters, digits and _ only, not starting with a digit"));
+        if ns.is_empty()
+            || !ns.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+            || ns.starts_with(|c: char| c.is_ascii_digit())
+        {
+            return Err(format!(
+                "machine.namespace {ns:?}: letters, digits and _ only, not starting with a digit"
+            ));
         }
         let n = self.machine.axes.len();
         if n == 0 || n > cnc_msgs::servo::MAX_AXES {
-            return Err(format!("machine.axes: 1..{} axes, found {n}", cnc_msgs::servo::MAX_AXES));
+            return Err(format!(
+                "machine.axes: 1..{} axes, found {n}",
+                cnc_msgs::servo::MAX_AXES
+            ));
         }
         for a in &self.machine.axes {
-            let ok = a.min < a.max && a.max_velocity > 0.0 && a.max_acceleration > 0.0 && a.in_position > 0.0 && a.drive_lag >= 0.0;
+            let ok = a.min < a.max
+                && a.max_velocity > 0.0
+                && a.max_acceleration > 0.0
+                && a.in_position > 0.0
+                && a.drive_lag >= 0.0;
             if !ok || a.home < a.min || a.home > a.max {
                 return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, in_position", a.name));
             }
         }
         for p in &self.machine.arc_plane {
             if !self.machine.axes.iter().any(|a| &a.name == p) {
-                return Err(format!("machine.arc_plane names axis {p}, which is not configured"));
+                return Err(format!(
+                    "machine.arc_plane names axis {p}, which is not configured"
+                ));
             }
         }
         if !(1.0..=8.0).contains(&self.servo.period_ms) {
-            return Err(format!("servo.period_ms {} outside 1..8", self.servo.period_ms));
+            return Err(format!(
+                "servo.period_ms {} outside 1..8",
+                self.servo.period_ms
+            ));
         }
         if self.servo.queue_capacity < 2 || self.servo.queue_capacity > 10_000 {
             return Err("servo.queue_capacity must be 2..10000".into());
@@ -235,6 +268,10 @@ impl LaunchConfig {
 
     /// Power-on slide positions (X as radius).
     pub fn home_slide(&self) -> Vec<f64> {
-        self.machine.axes.iter().map(|a| if a.diameter { a.home / 2.0 } else { a.home }).collect()
+        self.machine
+            .axes
+            .iter()
+            .map(|a| if a.diameter { a.home / 2.0 } else { a.home })
+            .collect()
     }
 }

@@ -32,17 +32,26 @@ impl RosNode {
     /// Node `name` in namespace `/namespace`, with its spinner (discovery, parameters) running.
     pub fn new(net: &NetworkConfig, namespace: &str, name: &str) -> Result<Self, String> {
         let context = context(net)?;
-        let node_name = NodeName::new(&format!("/{namespace}"), name).map_err(|e| format!("node name {name}: {e:?}"))?;
-        let mut node = context.new_node(node_name, NodeOptions::new().enable_rosout(true)).map_err(|e| format!("node {name}: {e:?}"))?;
+        let node_name = NodeName::new(&format!("/{namespace}"), name)
+            .map_err(|e| format!("node name {name}: {e:?}"))?;
+        let mut node = context
+            .new_node(node_name, NodeOptions::new().enable_rosout(true))
+            .map_err(|e| format!("node {name}: {e:?}"))?;
         match node.spinner() {
             Ok(spinner) => {
-                let _ = std::thread::Builder::new().name(format!("{name}-spin")).spawn(move || {
-                    let _ = smol::block_on(spinner.spin());
-                });
+                let _ = std::thread::Builder::new()
+                    .name(format!("{name}-spin"))
+                    .spawn(move || {
+                        let _ = smol::block_on(spinner.spin());
+                    });
             }
             Err(e) => log::warn!("{name}: no spinner: {e:?}"),
         }
-        Ok(RosNode { node, namespace: namespace.to_string(), context })
+        Ok(RosNode {
+            node,
+            namespace: namespace.to_string(),
+            context,
+        })
     }
 
     /// The node's DDS participant, for entities ros2-client does not offer.
@@ -50,21 +59,42 @@ impl RosNode {
         self.context.domain_participant()
     }
 
-    fn topic(&mut self, topic: &str, type_name: &str, qos: &QosProfile) -> Result<ros2_client::dds::rustdds::Topic, String> {
+    fn topic(
+        &mut self,
+        topic: &str,
+        type_name: &str,
+        qos: &QosProfile,
+    ) -> Result<ros2_client::dds::rustdds::Topic, String> {
         let name = ros_name(&self.namespace, topic)?;
         let (pkg, ty) = split_type(type_name);
-        self.node.create_topic(&name, MessageTypeName::new(pkg, ty), qos).map_err(|e| format!("topic {topic}: {e:?}"))
+        self.node
+            .create_topic(&name, MessageTypeName::new(pkg, ty), qos)
+            .map_err(|e| format!("topic {topic}: {e:?}"))
     }
 
     /// Publisher on `/<namespace>/<topic>`; `type_name` like `cnc_msgs/msg/SpindleState`.
-    pub fn publisher<M: Message>(&mut self, topic: &str, type_name: &str, qos: QosProfile) -> Result<ros2_client::dds::Publisher<M>, String> {
+    pub fn publisher<M: Message>(
+        &mut self,
+        topic: &str,
+        type_name: &str,
+        qos: QosProfile,
+    ) -> Result<ros2_client::dds::Publisher<M>, String> {
         let t = self.topic(topic, type_name, &qos)?;
-        self.node.create_publisher::<M>(&t, Some(qos)).map_err(|e| format!("publisher {topic}: {e:?}"))
+        self.node
+            .create_publisher::<M>(&t, Some(qos))
+            .map_err(|e| format!("publisher {topic}: {e:?}"))
     }
 
-    pub fn subscription<M: Message + 'static>(&mut self, topic: &str, type_name: &str, qos: QosProfile) -> Result<ros2_client::dds::Subscription<M>, String> {
+    pub fn subscription<M: Message + 'static>(
+        &mut self,
+        topic: &str,
+        type_name: &str,
+        qos: QosProfile,
+    ) -> Result<ros2_client::dds::Subscription<M>, String> {
         let t = self.topic(topic, type_name, &qos)?;
-        self.node.create_subscription::<M>(&t, Some(qos)).map_err(|e| format!("subscription {topic}: {e:?}"))
+        self.node
+            .create_subscription::<M>(&t, Some(qos))
+            .map_err(|e| format!("subscription {topic}: {e:?}"))
     }
 }
 

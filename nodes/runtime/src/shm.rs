@@ -37,16 +37,29 @@ fn err(what: &str, e: impl Debug) -> String {
 impl ShmNode {
     pub fn new(instance: &str, node_name: &str) -> Result<Self, String> {
         let name: NodeName = node_name.try_into().map_err(|e| err("node name", e))?;
-        let node = NodeBuilder::new().name(&name).create::<ipc::Service>().map_err(|e| err("node", e))?;
-        Ok(ShmNode { node, instance: instance.to_string() })
+        let node = NodeBuilder::new()
+            .name(&name)
+            .create::<ipc::Service>()
+            .map_err(|e| err("node", e))?;
+        Ok(ShmNode {
+            node,
+            instance: instance.to_string(),
+        })
     }
 
     fn service_name(&self, channel: &str) -> Result<ServiceName, String> {
-        format!("cnc/{}/{}", self.instance, channel).as_str().try_into().map_err(|e| err("service name", e))
+        format!("cnc/{}/{}", self.instance, channel)
+            .as_str()
+            .try_into()
+            .map_err(|e| err("service name", e))
     }
 
     /// Sender on `channel`; with `wake`, it also notifies the receiver's listener on each send.
-    pub fn sender<T: Debug + ZeroCopySend + Copy + 'static>(&self, channel: &str, wake: bool) -> Result<Sender<T>, String> {
+    pub fn sender<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        channel: &str,
+        wake: bool,
+    ) -> Result<Sender<T>, String> {
         let service = self
             .node
             .service_builder(&self.service_name(channel)?)
@@ -55,17 +68,36 @@ impl ShmNode {
             .history_size(1)
             .open_or_create()
             .map_err(|e| err(channel, e))?;
-        let publisher = service.publisher_builder().create().map_err(|e| err(channel, e))?;
+        let publisher = service
+            .publisher_builder()
+            .create()
+            .map_err(|e| err(channel, e))?;
         let notifier = if wake {
-            let ev = self.node.service_builder(&self.service_name(&format!("{channel}/wake"))?).event().open_or_create().map_err(|e| err(channel, e))?;
-            Some(ev.notifier_builder().create().map_err(|e| err(channel, e))?)
+            let ev = self
+                .node
+                .service_builder(&self.service_name(&format!("{channel}/wake"))?)
+                .event()
+                .open_or_create()
+                .map_err(|e| err(channel, e))?;
+            Some(
+                ev.notifier_builder()
+                    .create()
+                    .map_err(|e| err(channel, e))?,
+            )
         } else {
             None
         };
-        Ok(Sender { publisher, notifier })
+        Ok(Sender {
+            publisher,
+            notifier,
+        })
     }
 
-    pub fn receiver<T: Debug + ZeroCopySend + Copy + 'static>(&self, channel: &str, wake: bool) -> Result<Receiver<T>, String> {
+    pub fn receiver<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        channel: &str,
+        wake: bool,
+    ) -> Result<Receiver<T>, String> {
         let service = self
             .node
             .service_builder(&self.service_name(channel)?)
@@ -74,20 +106,37 @@ impl ShmNode {
             .history_size(1)
             .open_or_create()
             .map_err(|e| err(channel, e))?;
-        let subscriber = service.subscriber_builder().create().map_err(|e| err(channel, e))?;
+        let subscriber = service
+            .subscriber_builder()
+            .create()
+            .map_err(|e| err(channel, e))?;
         let listener = if wake {
-            let ev = self.node.service_builder(&self.service_name(&format!("{channel}/wake"))?).event().open_or_create().map_err(|e| err(channel, e))?;
-            Some(ev.listener_builder().create().map_err(|e| err(channel, e))?)
+            let ev = self
+                .node
+                .service_builder(&self.service_name(&format!("{channel}/wake"))?)
+                .event()
+                .open_or_create()
+                .map_err(|e| err(channel, e))?;
+            Some(
+                ev.listener_builder()
+                    .create()
+                    .map_err(|e| err(channel, e))?,
+            )
         } else {
             None
         };
-        Ok(Receiver { subscriber, listener })
+        Ok(Receiver {
+            subscriber,
+            listener,
+        })
     }
 }
 
 impl<T: Debug + ZeroCopySend + Copy + 'static> Sender<T> {
     pub fn send(&self, value: T) -> Result<(), String> {
-        self.publisher.send_copy(value).map_err(|e| err("send", e))?;
+        self.publisher
+            .send_copy(value)
+            .map_err(|e| err("send", e))?;
         if let Some(n) = &self.notifier {
             n.notify().map_err(|e| err("notify", e))?;
         }
@@ -141,8 +190,12 @@ mod tests {
     fn values_cross_shared_memory_with_wake_up() {
         let instance = format!("test_shm_{}", std::process::id());
         let node = ShmNode::new(&instance, "test_node").unwrap();
-        let tx = node.sender::<ServoSetpoint>(channel::SETPOINT, true).unwrap();
-        let rx = node.receiver::<ServoSetpoint>(channel::SETPOINT, true).unwrap();
+        let tx = node
+            .sender::<ServoSetpoint>(channel::SETPOINT, true)
+            .unwrap();
+        let rx = node
+            .receiver::<ServoSetpoint>(channel::SETPOINT, true)
+            .unwrap();
         let handle = std::thread::spawn(move || {
             let node = ShmNode::new(&instance, "test_node2").unwrap();
             let rx2 = node.receiver::<ServoSetpoint>("other", false).unwrap();
@@ -150,7 +203,11 @@ mod tests {
         });
         assert_eq!(handle.join().unwrap(), None);
         for seq in 1..=3 {
-            tx.send(ServoSetpoint { seq, ..Default::default() }).unwrap();
+            tx.send(ServoSetpoint {
+                seq,
+                ..Default::default()
+            })
+            .unwrap();
         }
         let got = rx.wait(Duration::from_millis(100)).unwrap().unwrap();
         assert_eq!(got.seq, 3, "latest wins");

@@ -38,7 +38,16 @@ impl SimLathe {
         for (p, s) in position.iter_mut().zip(start) {
             *p = *s;
         }
-        SimLathe { cfg, position, spindle_rpm: 0.0, spindle_angle: 0.0, coolant_time: 0.0, chuck_clamped: false, emergency_stop: false, x_seq: 0 }
+        SimLathe {
+            cfg,
+            position,
+            spindle_rpm: 0.0,
+            spindle_angle: 0.0,
+            coolant_time: 0.0,
+            chuck_clamped: false,
+            emergency_stop: false,
+            x_seq: 0,
+        }
     }
 
     pub fn set_emergency_stop(&mut self, pressed: bool) {
@@ -63,7 +72,11 @@ impl SimLathe {
                     continue;
                 }
                 let tau = self.cfg.drive_lag[i];
-                let k = if tau > 0.0 { 1.0 - (-dt / tau).exp() } else { 1.0 };
+                let k = if tau > 0.0 {
+                    1.0 - (-dt / tau).exp()
+                } else {
+                    1.0
+                };
                 self.position[i] += (target - self.position[i]) * k;
             }
         }
@@ -79,8 +92,13 @@ impl SimLathe {
         };
         let step = self.cfg.spindle_acceleration * dt;
         self.spindle_rpm += (command - self.spindle_rpm).clamp(-step, step);
-        self.spindle_angle = (self.spindle_angle + self.spindle_rpm / 60.0 * 360.0 * dt).rem_euclid(360.0);
-        self.coolant_time = if y.coolant != 0 && !self.emergency_stop { self.coolant_time + dt } else { 0.0 };
+        self.spindle_angle =
+            (self.spindle_angle + self.spindle_rpm / 60.0 * 360.0 * dt).rem_euclid(360.0);
+        self.coolant_time = if y.coolant != 0 && !self.emergency_stop {
+            self.coolant_time + dt
+        } else {
+            0.0
+        };
         self.chuck_clamped = y.chuck_clamp != 0;
         ServoFeedback {
             seq: setpoint.seq,
@@ -118,13 +136,25 @@ mod tests {
     use super::*;
 
     fn sim() -> SimLathe {
-        SimLathe::new(SimConfig { drive_lag: vec![0.008, 0.008], spindle_acceleration: 2000.0, at_speed_tolerance: 0.02, coolant_delay: 0.2 }, &[10.0, 20.0])
+        SimLathe::new(
+            SimConfig {
+                drive_lag: vec![0.008, 0.008],
+                spindle_acceleration: 2000.0,
+                at_speed_tolerance: 0.02,
+                coolant_delay: 0.2,
+            },
+            &[10.0, 20.0],
+        )
     }
 
     #[test]
     fn axes_follow_with_first_order_lag() {
         let mut m = sim();
-        let mut sp = ServoSetpoint { enable: 1, axis_count: 2, ..Default::default() };
+        let mut sp = ServoSetpoint {
+            enable: 1,
+            axis_count: 2,
+            ..Default::default()
+        };
         sp.position[0] = 11.0;
         sp.position[1] = 20.0;
         let fb = m.step(&sp, &YImage::default(), 0.008);
@@ -144,7 +174,11 @@ mod tests {
     #[test]
     fn spindle_ramps_and_reports_at_speed() {
         let mut m = sim();
-        let y = YImage { spindle_direction: 1, spindle_rpm: 1000.0, ..Default::default() };
+        let y = YImage {
+            spindle_direction: 1,
+            spindle_rpm: 1000.0,
+            ..Default::default()
+        };
         let sp = ServoSetpoint::default();
         for _ in 0..100 {
             m.step(&sp, &y, 0.004); // 0.4 s at 2000 rpm/s = 800 rpm
