@@ -131,25 +131,17 @@ impl CellClient {
     }
 }
 
-/// Calls a service; until the server is discovered the request is repeated every second, and
-/// the first reply to any of the copies is taken. Gives up after 20 s.
+/// Calls a service. A request sent before discovery has matched the server is lost, so it is
+/// repeated every second (at most 3 copies); the first reply to any copy is the answer.
 fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
     client: &Client<Req, Resp>,
     req: Req,
 ) -> Result<Resp, String> {
     let deadline = Instant::now() + Duration::from_secs(20);
     let mut ids = Vec::new();
-    let mut last_send = None::<Instant>;
+    let mut last_send: Option<Instant> = None;
     while Instant::now() < deadline {
-        if last_send.is_none_or(|t| t.elapsed() > Duration::from_secs(1)) && ids.is_empty() {
-            ids.push(
-                client
-                    .send_request(req.clone())
-                    .map_err(|e| format!("request not sent: {e:?}"))?,
-            );
-            last_send = Some(Instant::now());
-        } else if last_send.is_some_and(|t| t.elapsed() > Duration::from_secs(1)) && ids.len() < 3 {
-            // Nothing yet: the reply reader may not have been matched when the server answered.
+        if ids.len() < 3 && last_send.is_none_or(|t| t.elapsed() > Duration::from_secs(1)) {
             ids.push(
                 client
                     .send_request(req.clone())

@@ -81,16 +81,14 @@ fn check(program: &Path, config: &Path) -> Result<(), String> {
     let text = read_program(program)?;
     let dialect =
         cnc_interpreter::Dialect::from_name(&cfg.machine.dialect).ok_or("unknown dialect")?;
-    let axes: Vec<char> = cfg
-        .machine
-        .axes
-        .iter()
-        .map(|a| a.name.chars().next().unwrap_or('?'))
-        .collect();
-    let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
-    let home: Vec<f64> = cfg.machine.axes.iter().map(|a| a.home).collect();
-    let cmds = cnc_interpreter::check(dialect, &text, &axes, &diameter, &home)
-        .map_err(|e| format!("{}: {e}", program.display()))?;
+    let cmds = cnc_interpreter::check(
+        dialect,
+        &text,
+        &cfg.axis_letters(),
+        &cfg.diameter_axes(),
+        &cfg.home(),
+    )
+    .map_err(|e| format!("{}: {e}", program.display()))?;
     println!(
         "{}: {} canonical commands, no alarm",
         program.display(),
@@ -128,7 +126,7 @@ fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String>
         "cell '{ns}' running: DDS domain {domain} on {:?}; services /{ns}/load_program, /{ns}/start_program, /{ns}/stop, /{ns}/reset; topics /{ns}/machine_state, /{ns}/spindle, /{ns}/axes, /{ns}/part_count, /{ns}/alarms, /{ns}/alarm_events",
         cfg.network.interfaces
     );
-    let outcome = supervise(&cfg, program, text.as_deref(), cycles);
+    let outcome = supervise(&cfg, &cell, program, text.as_deref(), cycles);
     let (summary, errors) = cell.stop();
     if !summary.is_empty() {
         println!("{summary}");
@@ -147,90 +145,90 @@ fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String>
 /// Loads and runs the program for the requested cycles, printing progress; or just waits.
 fn supervise(
     cfg: &LaunchConfig,
+    cell: &Cell,
     program: Option<&Path>,
     text: Option<&str>,
     cycles: u32,
 ) -> Result<(), String> {
-    let ns = &cfg.machine.namespace;
-    let mut client = CellClient::new(&cfg.network, ns, "cnc_cli", ServiceMapping::Enhanced)?;
-    let (Some(path), Some(text)) = (program, text) else {
-        while !STOP.load(Ordering::SeqCst) {
-            client.poll();
-            std::thread::sleep(Duration::from_millis(200));
+    let mut client = CellClient::new(
+        &cfg.network,
+        &cfg.machine.namespace,
+        "cnc_cli",
+        ServiceMapping::Enhanced,
+    )?;
+    let name = program.map(program_name);
+    if let (Some(name), Some(text)) = (&name, text) {
+        let r = client.load_program(name, text)?;
+        if !r.accepted {
+            return Err(format!("load refused: {}", r.message));
         }
-        return Ok(());
-    };
-    let name = program_name(path);
-    let r = client.load_program(&name, text)?;
-    if !r.accepted {
-        return Err(format!("load refused: {}", r.message));
     }
     let mut done = 0u32;
-    let mut last_print = Instant::now() - Duration::from_secs(1);
-    while !STOP.load(Ordering::SeqCst) && (cycles == 0 || done < cycles) {
-        let r = client.start_program(&name)?;
-        if !r.accepted {
-            return Err(format!("start refused: {}", r.message));
+    // A cycle is complete when PROGRAM_COMPLETED follows the ACTIVE of this start.
+    let mut seen_active = false;
+    let mut cycle_running = false;
+    let mut last_print = Instant::now();
+    while !STOP.load(Ordering::SeqCst) {
+        if let Some(node) = cell.failed_node() {
+            return Err(format!("node {node} stopped"));
         }
-        let started = Instant::now();
-        let mut seen_active = false;
-        loop {
-            if STOP.load(Ordering::SeqCst) {
-                return Ok(());
+        if let Some(name) = &name {
+            if !cycle_running {
+                if cycles != 0 && done >= cycles {
+                    return Ok(());
+                }
+                let r = client.start_program(name)?;
+                if !r.accepted {
+                    return Err(format!("start refused: {}", r.message));
+                }
+                (cycle_running, seen_active) = (true, false);
             }
             for s in client.poll() {
                 match s.execution {
                     MachineState::ACTIVE => seen_active = true,
                     MachineState::PROGRAM_COMPLETED if seen_active => {
                         done += 1;
+                        cycle_running = false;
                         print_progress(&client, done);
-                        seen_active = false;
-                        break;
                     }
-                    MachineState::STOPPED | MachineState::READY
-                        if seen_active || s.alarm_active =>
-                    {
-                        let alarms = client
-                            .alarms
-                            .as_ref()
-                            .map(|a| {
-                                a.alarms
-                                    .iter()
-                                    .map(|a| {
-                                        format!(
-                                            "alarm {} ({}): {} [line {}]",
-                                            a.number, a.source, a.text, a.line
-                                        )
-                                    })
-                                    .collect::<Vec<_>>()
-                                    .join("; ")
-                            })
-                            .unwrap_or_default();
-                        return Err(format!("cycle {} stopped: {alarms}", done + 1));
+                    MachineState::STOPPED if seen_active => {
+                        return Err(format!(
+                            "cycle {} stopped: {}",
+                            done + 1,
+                            alarm_list(&client)
+                        ))
                     }
                     _ => {}
                 }
             }
-            if client
-                .state
-                .as_ref()
-                .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
-                && !seen_active
-                && started.elapsed() > Duration::from_millis(100)
-            {
-                break;
-            }
-            if last_print.elapsed() > Duration::from_millis(500) {
-                last_print = Instant::now();
-                print_progress(&client, done);
-            }
-            if started.elapsed() > Duration::from_secs(3600) {
-                return Err("cycle did not complete within an hour".into());
-            }
-            std::thread::sleep(Duration::from_millis(5));
+        } else {
+            client.poll();
         }
+        if last_print.elapsed() > Duration::from_millis(500) {
+            last_print = Instant::now();
+            print_progress(&client, done);
+        }
+        std::thread::sleep(Duration::from_millis(5));
     }
     Ok(())
+}
+
+fn alarm_list(c: &CellClient) -> String {
+    let alarms = c
+        .alarms
+        .as_ref()
+        .map(|a| a.alarms.as_slice())
+        .unwrap_or_default();
+    alarms
+        .iter()
+        .map(|a| {
+            format!(
+                "alarm {} ({}): {} [{} line {}]",
+                a.number, a.source, a.text, a.program, a.line
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 fn print_progress(c: &CellClient, done: u32) {

@@ -74,7 +74,10 @@ impl Interpreter {
             line: 0,
             axes: axes.to_vec(),
             diameter: diameter.to_vec(),
-            position: start.to_vec(),
+            // One value per axis whatever the caller passed: a missing one starts at 0.
+            position: (0..axes.len())
+                .map(|i| start.get(i).copied().unwrap_or(0.0))
+                .collect(),
             motion_mode: GMeaning::Rapid,
             incremental: false,
             feed: 0.0,
@@ -102,11 +105,6 @@ impl Interpreter {
                 return Err(e);
             }
         }
-    }
-
-    /// Line number of the block read last.
-    pub fn line(&self) -> u32 {
-        self.line
     }
 
     /// Reads one line and queues its commands.

@@ -17,7 +17,9 @@ use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{qos, stamp, RosNode};
 use cnc_runtime::{LaunchConfig, Shutdown};
 
-use crate::{Aux, Command, Dialect, Interpreter};
+use cnc_msgs::canon::to_motion_block;
+
+use crate::{Command, Dialect, Interpreter};
 
 /// Largest program text accepted, bytes.
 pub const MAX_PROGRAM_BYTES: usize = 4 * 1024 * 1024;
@@ -46,13 +48,7 @@ struct Run {
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let dialect = Dialect::from_name(&cfg.machine.dialect)
         .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
-    let axes: Vec<char> = cfg
-        .machine
-        .axes
-        .iter()
-        .map(|a| a.name.chars().next().unwrap_or('?'))
-        .collect();
-    let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
+    let (axes, diameter) = (cfg.axis_letters(), cfg.diameter_axes());
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
     let commands = ros.subscription::<ProgramCommand>(
         "_internal/program_command",
@@ -107,7 +103,11 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             status = s;
         }
         while let Ok(Some((a, _))) = axes_sub.take() {
-            position = Some(a.axes.iter().map(|x| x.commanded_position).collect());
+            // Only a report of this machine's axes is a start position.
+            if a.axes.len() == axes.len() && a.axes.iter().all(|x| x.commanded_position.is_finite())
+            {
+                position = Some(a.axes.iter().map(|x| x.commanded_position).collect());
+            }
         }
         while let Ok(Some((e, _))) = alarm_sub.take() {
             let key = (e.alarm.source.clone(), e.alarm.number);
@@ -257,8 +257,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     Ok(Some(canon)) => {
                         busy = true;
                         r.sent_seq += 1;
-                        let msg =
-                            to_block(r.id, r.sent_seq, &r.program, canon.line, &canon.command);
+                        let msg = to_motion_block(
+                            r.id,
+                            r.sent_seq,
+                            &r.program,
+                            canon.line,
+                            &canon.command,
+                        );
                         if canon.command == Command::ProgramEnd {
                             r.end_seq = Some(r.sent_seq);
                         }
@@ -337,63 +342,4 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-fn to_block(run_id: u64, seq: u64, program: &str, line: u32, c: &Command) -> MotionBlock {
-    let mut m = MotionBlock {
-        run_id,
-        seq,
-        program: program.into(),
-        line,
-        ..MotionBlock::default()
-    };
-    match c {
-        Command::Rapid { end } => {
-            m.kind = MotionBlock::KIND_RAPID;
-            m.end = end.clone();
-        }
-        Command::Linear { end, feed } => {
-            m.kind = MotionBlock::KIND_LINEAR;
-            m.end = end.clone();
-            m.feed = *feed;
-        }
-        Command::Arc {
-            end,
-            center,
-            clockwise,
-            feed,
-        } => {
-            m.kind = if *clockwise {
-                MotionBlock::KIND_ARC_CW
-            } else {
-                MotionBlock::KIND_ARC_CCW
-            };
-            m.end = end.clone();
-            m.center = center.clone();
-            m.feed = *feed;
-        }
-        Command::Dwell { seconds } => {
-            m.kind = MotionBlock::KIND_DWELL;
-            m.dwell_seconds = *seconds;
-        }
-        Command::Aux(a) => {
-            m.kind = MotionBlock::KIND_AUX;
-            match *a {
-                Aux::M(code) => {
-                    m.aux_kind = MotionBlock::AUX_M;
-                    m.aux_code = code;
-                }
-                Aux::S(v) => {
-                    m.aux_kind = MotionBlock::AUX_S;
-                    m.aux_value = v;
-                }
-                Aux::T(code) => {
-                    m.aux_kind = MotionBlock::AUX_T;
-                    m.aux_code = code;
-                }
-            }
-        }
-        Command::ProgramEnd => m.kind = MotionBlock::KIND_PROGRAM_END,
-    }
-    m
 }

@@ -57,11 +57,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 let fb = sim.step(&sp, &y, period);
                 feedback.send(fb)?;
             }
+            // No setpoint for 50 ms (no motion node): the drives are off and stay where they
+            // are (`enable` 0); the spindle and devices go on in real time.
             None => {
-                // No motion node: keep the spindle and devices alive in real time.
-                let mut hold = idle;
-                hold.position = sim.step(&idle, &y, 0.0).position;
-                sim.step(&hold, &y, 0.05);
+                sim.step(&idle, &y, 0.05);
             }
         }
         x_out.send(sim.x_image(&y))?;

@@ -1,35 +1,9 @@
-//! Machine parameters motion needs, from the launch config.
+//! Machine parameters motion needs, taken from the launch config.
 
-use serde::Deserialize;
+use cnc_runtime::LaunchConfig;
 
-/// One axis. Positions in the units the operator sees (X in diameter when `diameter`).
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-pub struct AxisConfig {
-    pub name: String,
-    /// Programmed and displayed in diameter; the slide moves half of it.
-    #[serde(default)]
-    pub diameter: bool,
-    /// Soft limits, in display units.
-    pub min: f64,
-    pub max: f64,
-    /// Rapid rate, mm/min of slide travel.
-    pub max_velocity: f64,
-    /// mm/s² of slide travel.
-    pub max_acceleration: f64,
-    /// In-position window, mm of slide travel, checked before M/S/T codes and program end.
-    #[serde(default = "default_in_position")]
-    pub in_position: f64,
-    /// Drive time constant of the simulated axis, s (io only).
-    #[serde(default = "default_drive_lag")]
-    pub drive_lag: f64,
-}
-
-fn default_in_position() -> f64 {
-    0.0005
-}
-fn default_drive_lag() -> f64 {
-    0.008
-}
+/// One axis, as the launch config describes it (limits in display units, X in diameter).
+pub use cnc_runtime::config::AxisEntry as AxisConfig;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct MotionConfig {
@@ -42,13 +16,17 @@ pub struct MotionConfig {
     pub arc_plane: (usize, usize),
 }
 
-impl AxisConfig {
-    /// Display units → slide travel.
-    pub fn scale(&self) -> f64 {
-        if self.diameter {
-            0.5
-        } else {
-            1.0
+impl MotionConfig {
+    pub fn from_launch(cfg: &LaunchConfig) -> Self {
+        let idx = |n: &str| cfg.axis_index(n).unwrap_or(0);
+        MotionConfig {
+            axes: cfg.machine.axes.clone(),
+            period: cfg.servo.period_ms / 1000.0,
+            queue_capacity: cfg.servo.queue_capacity,
+            arc_plane: (
+                idx(&cfg.machine.arc_plane[0]),
+                idx(&cfg.machine.arc_plane[1]),
+            ),
         }
     }
 }

@@ -11,6 +11,6 @@ pub mod node;
 pub mod profile;
 pub mod servo;
 
-pub use block::{AuxCode, Block, BlockKind};
+pub use block::{Aux, Block, Command};
 pub use config::{AxisConfig, MotionConfig};
 pub use motion::{Motion, MotionEvent, RunState};

@@ -9,15 +9,16 @@ use std::f64::consts::TAU;
 
 use cnc_msgs::signals::{FImage, GImage};
 
-use crate::block::{AuxCode, Block, BlockKind};
+use crate::block::{Aux, Block, Command};
 use crate::config::MotionConfig;
 use crate::profile::Profile;
 
 /// Alarm numbers raised by motion (`000` Appendix 1, inventory §11.2).
 pub mod alarm {
     pub const SOFT_LIMIT: u32 = 38;
-    /// A block arrived that the queue could not take (protocol fault of the sender).
-    pub const QUEUE_OVERFLOW: u32 = 111;
+    /// The block stream from the interpreter is out of step: queue overflow, a block with the
+    /// wrong number of axes, or one that could not run (`000` alarm 111, pre-read/execution sync).
+    pub const BAD_BLOCK: u32 = 111;
 }
 
 /// Something the shell must publish.
@@ -57,7 +58,7 @@ enum Active {
     },
     /// Waits for the axes to settle, then sends the strobe and waits for FIN.
     Aux {
-        code: AuxCode,
+        code: Aux,
         strobe: Option<u64>,
     },
     End,
@@ -146,7 +147,7 @@ impl Motion {
         }
         if self.queue.len() >= self.cfg.queue_capacity {
             self.raise(
-                alarm::QUEUE_OVERFLOW,
+                alarm::BAD_BLOCK,
                 format!(
                     "motion queue full ({} blocks): block {} dropped",
                     self.cfg.queue_capacity, block.seq
@@ -260,10 +261,8 @@ impl Motion {
         while budget > 0 && !self.alarm {
             budget -= 1;
             if self.active.is_none() {
-                if self.feed_hold && self.cycle_stop {
-                    self.queue.clear();
-                    self.cycle_stop = false;
-                    self.feed_hold = false;
+                // A cycle stop starts nothing new; it ends below once the axes stand.
+                if self.cycle_stop {
                     break;
                 }
                 let Some(block) = self.queue.pop_front() else {
@@ -295,6 +294,7 @@ impl Motion {
             }
             break;
         }
+        // Cycle stop: once the axes stand on the path, the rest of the run is dropped.
         if self.cycle_stop && self.stopped_on_path() {
             self.queue.clear();
             self.active = None;
@@ -365,17 +365,15 @@ impl Motion {
         let n = self.cfg.axes.len();
         let bad_len = |v: &Vec<f64>| v.len() != n || v.iter().any(|x| !x.is_finite());
         match &block.kind {
-            BlockKind::Rapid { end }
-            | BlockKind::Linear { end, .. }
-            | BlockKind::Arc { end, .. }
+            Command::Rapid { end } | Command::Linear { end, .. } | Command::Arc { end, .. }
                 if bad_len(end) =>
             {
                 Err((
-                    alarm::QUEUE_OVERFLOW,
+                    alarm::BAD_BLOCK,
                     format!("block has {} axis values, machine has {n}", end.len()),
                 ))
             }
-            BlockKind::Rapid { end } => {
+            Command::Rapid { end } => {
                 self.check_limits(end)?;
                 let end = self.to_slide(end);
                 let start = self.commanded.clone();
@@ -395,7 +393,7 @@ impl Motion {
                     profiles,
                 })
             }
-            BlockKind::Linear { end, feed } => {
+            Command::Linear { end, feed } => {
                 self.check_limits(end)?;
                 let end = self.to_slide(end);
                 let start = self.commanded.clone();
@@ -415,7 +413,7 @@ impl Motion {
                     profile: Profile::new(length, vmax, acc),
                 })
             }
-            BlockKind::Arc {
+            Command::Arc {
                 end,
                 center,
                 clockwise,
@@ -423,7 +421,7 @@ impl Motion {
             } => {
                 if bad_len(center) {
                     return Err((
-                        alarm::QUEUE_OVERFLOW,
+                        alarm::BAD_BLOCK,
                         "arc centre has the wrong number of axes".into(),
                     ));
                 }
@@ -504,14 +502,14 @@ impl Motion {
                     profile: Profile::new(length, vmax, 0.5 * amin),
                 })
             }
-            BlockKind::Dwell { seconds } => Ok(Active::Dwell {
+            Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),
-            BlockKind::Aux(code) => Ok(Active::Aux {
+            Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
                 strobe: None,
             }),
-            BlockKind::ProgramEnd => Ok(Active::End),
+            Command::ProgramEnd => Ok(Active::End),
         }
     }
 
@@ -602,15 +600,15 @@ impl Motion {
                     *strobe = Some(seq);
                     self.f.strobe_seq = seq;
                     match *code {
-                        AuxCode::M(m) => {
+                        Aux::M(m) => {
                             self.f.m_code = m;
                             self.f.mf = 1;
                         }
-                        AuxCode::S(s) => {
+                        Aux::S(s) => {
                             self.f.s_value = s;
                             self.f.sf = 1;
                         }
-                        AuxCode::T(t) => {
+                        Aux::T(t) => {
                             self.f.t_code = t;
                             self.f.tf = 1;
                         }

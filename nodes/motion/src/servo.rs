@@ -1,8 +1,8 @@
 //! Servo loop statistics: tick interval and iceoryx2 round trip, kept as fixed histograms so
 //! the loop allocates nothing after start-up.
 
-/// 1 µs bins up to 100 ms; slower values land in the last bin.
-const BINS: usize = 100_000;
+/// 1 µs bins up to 20 ms; slower values land in the last bin (the maximum is kept exactly).
+const BINS: usize = 20_000;
 
 pub struct Histogram {
     bins: Vec<u32>,
@@ -66,6 +66,8 @@ impl Histogram {
     }
 }
 
+use cnc_msgs::msg::ServoStats;
+
 #[derive(Default)]
 pub struct ServoStatistics {
     pub interval: Histogram,
@@ -75,6 +77,25 @@ pub struct ServoStatistics {
 }
 
 impl ServoStatistics {
+    /// The statistics as published on `servo_stats`.
+    pub fn message(&self, period: f64) -> ServoStats {
+        ServoStats {
+            stamp: cnc_runtime::dds::stamp(),
+            period_us: period * 1e6,
+            ticks: self.ticks,
+            late_ticks: self.late_ticks,
+            interval_min_us: self.interval.min(),
+            interval_p50_us: self.interval.quantile(0.5),
+            interval_p99_us: self.interval.quantile(0.99),
+            interval_max_us: self.interval.max(),
+            round_trips: self.round_trip.count(),
+            round_trip_min_us: self.round_trip.min(),
+            round_trip_p50_us: self.round_trip.quantile(0.5),
+            round_trip_p99_us: self.round_trip.quantile(0.99),
+            round_trip_max_us: self.round_trip.max(),
+        }
+    }
+
     pub fn summary(&self, period_us: f64) -> String {
         format!(
             "servo loop: {} ticks of {:.0} us, {} late; interval us min/p50/p99/max {:.0}/{:.0}/{:.0}/{:.0}; iceoryx2 round trip us min/p50/p99/max {:.1}/{:.0}/{:.0}/{:.0} ({} samples)",

@@ -2,8 +2,7 @@
 //! (actual = commanded) and a simple PLC that answers strobes.
 
 use cnc_motion::{
-    motion::alarm, AuxCode, AxisConfig, Block, BlockKind, Motion, MotionConfig, MotionEvent,
-    RunState,
+    motion::alarm, Aux, AxisConfig, Block, Command, Motion, MotionConfig, MotionEvent, RunState,
 };
 use cnc_msgs::signals::GImage;
 
@@ -17,6 +16,7 @@ fn lathe() -> MotionConfig {
         max_acceleration: 1000.0,
         in_position: 0.0005,
         drive_lag: 0.008,
+        home: 0.0,
     };
     MotionConfig {
         axes: vec![
@@ -29,12 +29,20 @@ fn lathe() -> MotionConfig {
     }
 }
 
-fn block(seq: u64, line: u32, kind: BlockKind) -> Block {
+fn block(seq: u64, line: u32, kind: Command) -> Block {
     Block {
         run_id: 1,
         seq,
         line,
         kind,
+    }
+}
+
+/// `n` ticks on a perfect drive, with the PLC image `g`.
+fn ticks(m: &mut Motion, g: &GImage, n: usize) {
+    for _ in 0..n {
+        let actual = m.commanded().to_vec();
+        m.tick(Some(&actual), g);
     }
 }
 
@@ -62,18 +70,18 @@ fn run(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(u64, i32)>) {
 #[test]
 fn program_runs_to_its_end_point_with_fin_handshake() {
     let mut m = Motion::new(lathe(), &[25.0, 50.0]);
-    m.push(block(1, 1, BlockKind::Aux(AuxCode::M(3))));
+    m.push(block(1, 1, Command::Aux(Aux::M(3))));
     m.push(block(
         2,
         2,
-        BlockKind::Rapid {
+        Command::Rapid {
             end: vec![50.0, 2.0],
         },
     ));
     m.push(block(
         3,
         3,
-        BlockKind::Linear {
+        Command::Linear {
             end: vec![50.0, -30.0],
             feed: 600.0,
         },
@@ -81,15 +89,15 @@ fn program_runs_to_its_end_point_with_fin_handshake() {
     m.push(block(
         4,
         4,
-        BlockKind::Arc {
+        Command::Arc {
             end: vec![70.0, -40.0],
             center: vec![50.0, -40.0],
             clockwise: false,
             feed: 600.0,
         },
     ));
-    m.push(block(5, 5, BlockKind::Aux(AuxCode::M(30))));
-    m.push(block(6, 5, BlockKind::ProgramEnd));
+    m.push(block(5, 5, Command::Aux(Aux::M(30))));
+    m.push(block(6, 5, Command::ProgramEnd));
     let (trace, strobes) = run(&mut m, 100_000);
     assert_eq!(m.state(), RunState::Idle);
     assert_eq!(m.done_seq(), 6);
@@ -116,7 +124,7 @@ fn soft_limit_is_refused_before_any_motion() {
     m.push(block(
         1,
         7,
-        BlockKind::Linear {
+        Command::Linear {
             end: vec![50.0, -500.0],
             feed: 600.0,
         },
@@ -124,7 +132,7 @@ fn soft_limit_is_refused_before_any_motion() {
     m.push(block(
         2,
         8,
-        BlockKind::Rapid {
+        Command::Rapid {
             end: vec![0.0, 0.0],
         },
     ));
@@ -139,7 +147,7 @@ fn soft_limit_is_refused_before_any_motion() {
     // An arc whose end is inside but whose bulge leaves the limits is refused too.
     // From X20 Z50 counter-clockwise around Z70 (radius 20) the arc dips to X-20, below -10.
     let mut m = Motion::new(lathe(), &[10.0, 50.0]);
-    let arc = |clockwise| BlockKind::Arc {
+    let arc = |clockwise| Command::Arc {
         end: vec![20.0, 90.0],
         center: vec![20.0, 70.0],
         clockwise,
@@ -173,26 +181,19 @@ fn feed_hold_stops_on_the_path_and_cycle_start_resumes() {
     m.push(block(
         1,
         1,
-        BlockKind::Linear {
+        Command::Linear {
             end: vec![50.0, -50.0],
             feed: 1200.0,
         },
     ));
-    m.push(block(2, 2, BlockKind::ProgramEnd));
+    m.push(block(2, 2, Command::ProgramEnd));
     let g = GImage::default();
-    for _ in 0..200 {
-        let a = m.commanded().to_vec();
-        m.tick(Some(&a), &g);
-    }
+    ticks(&mut m, &g, 200);
     m.feed_hold();
-    for _ in 0..200 {
-        let a = m.commanded().to_vec();
-        m.tick(Some(&a), &g);
-    }
+    ticks(&mut m, &g, 200);
     assert_eq!(m.state(), RunState::Hold);
     let held = m.commanded_display();
-    let a = m.commanded().to_vec();
-    m.tick(Some(&a), &g);
+    ticks(&mut m, &g, 1);
     assert_eq!(m.commanded_display(), held, "still moving in hold");
     assert_eq!(held[0], 50.0);
     m.cycle_start();
@@ -207,24 +208,17 @@ fn emergency_stop_drops_the_run_and_holds_position() {
     m.push(block(
         1,
         1,
-        BlockKind::Linear {
+        Command::Linear {
             end: vec![50.0, -50.0],
             feed: 1200.0,
         },
     ));
     let mut g = GImage::default();
-    for _ in 0..50 {
-        let a = m.commanded().to_vec();
-        m.tick(Some(&a), &g);
-    }
+    ticks(&mut m, &g, 50);
     g.emergency_stop = 1;
-    let a = m.commanded().to_vec();
-    m.tick(Some(&a), &g);
+    ticks(&mut m, &g, 1);
     let stopped = m.commanded_display();
-    for _ in 0..10 {
-        let a = m.commanded().to_vec();
-        m.tick(Some(&a), &g);
-    }
+    ticks(&mut m, &g, 10);
     assert_eq!(m.commanded_display(), stopped);
     assert_eq!(m.state(), RunState::Alarm);
 }
@@ -236,7 +230,7 @@ fn blocks_of_an_old_run_are_ignored() {
         run_id: 2,
         seq: 1,
         line: 1,
-        kind: BlockKind::Rapid {
+        kind: Command::Rapid {
             end: vec![10.0, 0.0],
         },
     });
@@ -244,10 +238,70 @@ fn blocks_of_an_old_run_are_ignored() {
         run_id: 1,
         seq: 2,
         line: 1,
-        kind: BlockKind::Rapid {
+        kind: Command::Rapid {
             end: vec![99.0, 0.0],
         },
     });
     run(&mut m, 10_000);
     assert_eq!(m.commanded_display(), vec![10.0, 0.0]);
+}
+
+#[test]
+fn cycle_stop_stops_on_the_path_and_drops_the_rest_of_the_run() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(
+        1,
+        1,
+        Command::Linear {
+            end: vec![50.0, -50.0],
+            feed: 1200.0,
+        },
+    ));
+    m.push(block(
+        2,
+        2,
+        Command::Rapid {
+            end: vec![80.0, 0.0],
+        },
+    ));
+    let g = GImage::default();
+    ticks(&mut m, &g, 100);
+    m.cycle_stop();
+    ticks(&mut m, &g, 200);
+    assert_eq!(m.state(), RunState::Idle);
+    let stopped = m.commanded_display();
+    assert!(
+        stopped[1] < 0.0 && stopped[1] > -50.0,
+        "stopped at {stopped:?}"
+    );
+    assert_eq!(stopped[0], 50.0, "the rapid after the stop never started");
+    // The next run starts from where the axes stand.
+    m.push(Block {
+        run_id: 2,
+        seq: 1,
+        line: 1,
+        kind: Command::Rapid {
+            end: vec![60.0, 10.0],
+        },
+    });
+    run(&mut m, 10_000);
+    assert_eq!(m.commanded_display(), vec![60.0, 10.0]);
+}
+
+#[test]
+fn a_block_for_another_axis_set_is_refused_with_an_alarm() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(
+        1,
+        4,
+        Command::Rapid {
+            end: vec![10.0, 0.0, 5.0],
+        },
+    ));
+    run(&mut m, 10);
+    assert_eq!(m.state(), RunState::Alarm);
+    assert_eq!(m.commanded_display(), vec![50.0, 0.0]);
+    assert!(
+        matches!(&m.take_events()[..], [MotionEvent::Alarm { number, line: 4, .. }] if *number == alarm::BAD_BLOCK)
+    );
 }

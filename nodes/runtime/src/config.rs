@@ -36,7 +36,7 @@ fn default_arc_plane() -> [String; 2] {
 }
 
 /// One axis: limits in display units (X as diameter when `diameter`).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxisEntry {
     pub name: String,
@@ -56,6 +56,22 @@ pub struct AxisEntry {
     /// Simulated power-on position, display units.
     #[serde(default)]
     pub home: f64,
+}
+
+impl AxisEntry {
+    /// Display units → slide travel: a diameter axis moves half of what it shows.
+    pub fn scale(&self) -> f64 {
+        if self.diameter {
+            0.5
+        } else {
+            1.0
+        }
+    }
+
+    /// The axis's address letter (names are validated to be one letter).
+    pub fn letter(&self) -> char {
+        self.name.chars().next().unwrap_or('?')
+    }
 }
 
 fn default_in_position() -> f64 {
@@ -226,7 +242,16 @@ impl LaunchConfig {
                 cnc_msgs::servo::MAX_AXES
             ));
         }
-        for a in &self.machine.axes {
+        for (i, a) in self.machine.axes.iter().enumerate() {
+            if a.name.len() != 1
+                || !a.name.chars().all(|c| c.is_ascii_uppercase())
+                || self.machine.axes[..i].iter().any(|b| b.name == a.name)
+            {
+                return Err(format!(
+                    "axis name {:?}: one upper-case letter, each axis once",
+                    a.name
+                ));
+            }
             let ok = a.min < a.max
                 && a.max_velocity > 0.0
                 && a.max_acceleration > 0.0
@@ -271,7 +296,22 @@ impl LaunchConfig {
         self.machine
             .axes
             .iter()
-            .map(|a| if a.diameter { a.home / 2.0 } else { a.home })
+            .map(|a| a.home * a.scale())
             .collect()
+    }
+
+    /// The axis address letters in machine order, e.g. `['X', 'Z']`.
+    pub fn axis_letters(&self) -> Vec<char> {
+        self.machine.axes.iter().map(AxisEntry::letter).collect()
+    }
+
+    /// Per axis: programmed and displayed in diameter.
+    pub fn diameter_axes(&self) -> Vec<bool> {
+        self.machine.axes.iter().map(|a| a.diameter).collect()
+    }
+
+    /// Power-on position in display units.
+    pub fn home(&self) -> Vec<f64> {
+        self.machine.axes.iter().map(|a| a.home).collect()
     }
 }

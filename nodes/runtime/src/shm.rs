@@ -11,6 +11,8 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory;
 
 /// One iceoryx2 node per thread (iceoryx2 nodes are not shared across threads).
 pub struct ShmNode {
@@ -54,38 +56,48 @@ impl ShmNode {
             .map_err(|e| err("service name", e))
     }
 
+    /// The publish-subscribe service of `channel`: newest value kept for late subscribers.
+    fn service<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        channel: &str,
+    ) -> Result<PortFactory<ipc::Service, T, ()>, String> {
+        self.node
+            .service_builder(&self.service_name(channel)?)
+            .publish_subscribe::<T>()
+            .subscriber_max_buffer_size(4)
+            .history_size(1)
+            .open_or_create()
+            .map_err(|e| err(channel, e))
+    }
+
+    /// The event service that wakes the receiver of `channel`.
+    fn wake_event(&self, channel: &str) -> Result<EventFactory<ipc::Service>, String> {
+        self.node
+            .service_builder(&self.service_name(&format!("{channel}/wake"))?)
+            .event()
+            .open_or_create()
+            .map_err(|e| err(channel, e))
+    }
+
     /// Sender on `channel`; with `wake`, it also notifies the receiver's listener on each send.
     pub fn sender<T: Debug + ZeroCopySend + Copy + 'static>(
         &self,
         channel: &str,
         wake: bool,
     ) -> Result<Sender<T>, String> {
-        let service = self
-            .node
-            .service_builder(&self.service_name(channel)?)
-            .publish_subscribe::<T>()
-            .subscriber_max_buffer_size(4)
-            .history_size(1)
-            .open_or_create()
-            .map_err(|e| err(channel, e))?;
-        let publisher = service
+        let publisher = self
+            .service::<T>(channel)?
             .publisher_builder()
             .create()
             .map_err(|e| err(channel, e))?;
-        let notifier = if wake {
-            let ev = self
-                .node
-                .service_builder(&self.service_name(&format!("{channel}/wake"))?)
-                .event()
-                .open_or_create()
-                .map_err(|e| err(channel, e))?;
-            Some(
-                ev.notifier_builder()
+        let notifier = match wake {
+            true => Some(
+                self.wake_event(channel)?
+                    .notifier_builder()
                     .create()
                     .map_err(|e| err(channel, e))?,
-            )
-        } else {
-            None
+            ),
+            false => None,
         };
         Ok(Sender {
             publisher,
@@ -98,32 +110,19 @@ impl ShmNode {
         channel: &str,
         wake: bool,
     ) -> Result<Receiver<T>, String> {
-        let service = self
-            .node
-            .service_builder(&self.service_name(channel)?)
-            .publish_subscribe::<T>()
-            .subscriber_max_buffer_size(4)
-            .history_size(1)
-            .open_or_create()
-            .map_err(|e| err(channel, e))?;
-        let subscriber = service
+        let subscriber = self
+            .service::<T>(channel)?
             .subscriber_builder()
             .create()
             .map_err(|e| err(channel, e))?;
-        let listener = if wake {
-            let ev = self
-                .node
-                .service_builder(&self.service_name(&format!("{channel}/wake"))?)
-                .event()
-                .open_or_create()
-                .map_err(|e| err(channel, e))?;
-            Some(
-                ev.listener_builder()
+        let listener = match wake {
+            true => Some(
+                self.wake_event(channel)?
+                    .listener_builder()
                     .create()
                     .map_err(|e| err(channel, e))?,
-            )
-        } else {
-            None
+            ),
+            false => None,
         };
         Ok(Receiver {
             subscriber,
@@ -154,15 +153,22 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Receiver<T> {
         Ok(last)
     }
 
-    /// Waits up to `timeout` for a wake-up (needs `wake`), then returns the newest value.
+    /// Waits up to `timeout` for a value (needs `wake`) and returns the newest. A wake-up whose
+    /// value was already taken by [`Receiver::latest`] does not end the wait.
     pub fn wait(&self, timeout: Duration) -> Result<Option<T>, String> {
-        if let Some(value) = self.latest()? {
-            return Ok(Some(value));
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            if let Some(value) = self.latest()? {
+                return Ok(Some(value));
+            }
+            let left = deadline.saturating_duration_since(std::time::Instant::now());
+            match &self.listener {
+                Some(l) if !left.is_zero() => {
+                    l.timed_wait(|_| {}, left).map_err(|e| err("wait", e))?;
+                }
+                _ => return Ok(None),
+            }
         }
-        if let Some(l) = &self.listener {
-            l.timed_wait(|_| {}, timeout).map_err(|e| err("wait", e))?;
-        }
-        self.latest()
     }
 }
 
@@ -196,12 +202,7 @@ mod tests {
         let rx = node
             .receiver::<ServoSetpoint>(channel::SETPOINT, true)
             .unwrap();
-        let handle = std::thread::spawn(move || {
-            let node = ShmNode::new(&instance, "test_node2").unwrap();
-            let rx2 = node.receiver::<ServoSetpoint>("other", false).unwrap();
-            rx2.latest().unwrap()
-        });
-        assert_eq!(handle.join().unwrap(), None);
+        let other = node.receiver::<ServoSetpoint>("other", false).unwrap();
         for seq in 1..=3 {
             tx.send(ServoSetpoint {
                 seq,
@@ -209,8 +210,41 @@ mod tests {
             })
             .unwrap();
         }
+        assert_eq!(other.latest().unwrap(), None, "channels are separate");
         let got = rx.wait(Duration::from_millis(100)).unwrap().unwrap();
         assert_eq!(got.seq, 3, "latest wins");
-        assert_eq!(rx.latest().unwrap(), None);
+        // The three wake-ups are still pending but their values are taken: wait must not return
+        // early with nothing.
+        let t0 = std::time::Instant::now();
+        assert_eq!(rx.wait(Duration::from_millis(30)).unwrap(), None);
+        assert!(
+            t0.elapsed() >= Duration::from_millis(30),
+            "returned after {:?}",
+            t0.elapsed()
+        );
+        // Values sent periodically from another thread end the wait early. (A publisher that
+        // sends once right after it is created can lose that sample before the subscriber has
+        // connected to it; the real senders send every period.)
+        let sender = std::thread::spawn(move || {
+            let node = ShmNode::new(&instance, "test_sender").unwrap();
+            let tx = node
+                .sender::<ServoSetpoint>(channel::SETPOINT, true)
+                .unwrap();
+            for _ in 0..100 {
+                std::thread::sleep(Duration::from_millis(5));
+                tx.send(ServoSetpoint {
+                    seq: 9,
+                    ..Default::default()
+                })
+                .unwrap();
+            }
+        });
+        let t0 = std::time::Instant::now();
+        assert_eq!(
+            rx.wait(Duration::from_secs(5)).unwrap().map(|s| s.seq),
+            Some(9)
+        );
+        assert!(t0.elapsed() < Duration::from_secs(4));
+        sender.join().unwrap();
     }
 }

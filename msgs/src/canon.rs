@@ -1,0 +1,220 @@
+//! Canonical commands: the dialect-free language between interpreter and motion, in machine
+//! coordinates (mm; lathe X as diameter, as the position display shows it), and their wire form
+//! [`MotionBlock`]. The interpreter produces them, motion consumes them; the conversion both ways
+//! lives here once.
+
+use crate::msg::MotionBlock;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// Each axis at its own rapid rate (dog-leg path).
+    Rapid {
+        end: Vec<f64>,
+    },
+    /// Straight line at `feed` mm/min along the path.
+    Linear {
+        end: Vec<f64>,
+        feed: f64,
+    },
+    /// Circular arc around `center` in the machine's arc plane; `end == start` is a full circle.
+    Arc {
+        end: Vec<f64>,
+        center: Vec<f64>,
+        clockwise: bool,
+        feed: f64,
+    },
+    Dwell {
+        seconds: f64,
+    },
+    /// An M, S or T function for the PLC, which answers with FIN.
+    Aux(Aux),
+    /// M02/M30: the program is finished; motion completes everything before it.
+    ProgramEnd,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Aux {
+    M(i32),
+    S(f64),
+    T(i32),
+}
+
+/// The wire form of `command`, block `seq` of run `run_id`, from `program` line `line`.
+pub fn to_motion_block(
+    run_id: u64,
+    seq: u64,
+    program: &str,
+    line: u32,
+    command: &Command,
+) -> MotionBlock {
+    let mut m = MotionBlock {
+        run_id,
+        seq,
+        program: program.into(),
+        line,
+        ..MotionBlock::default()
+    };
+    match command {
+        Command::Rapid { end } => {
+            m.kind = MotionBlock::KIND_RAPID;
+            m.end.clone_from(end);
+        }
+        Command::Linear { end, feed } => {
+            m.kind = MotionBlock::KIND_LINEAR;
+            m.end.clone_from(end);
+            m.feed = *feed;
+        }
+        Command::Arc {
+            end,
+            center,
+            clockwise,
+            feed,
+        } => {
+            m.kind = if *clockwise {
+                MotionBlock::KIND_ARC_CW
+            } else {
+                MotionBlock::KIND_ARC_CCW
+            };
+            m.end.clone_from(end);
+            m.center.clone_from(center);
+            m.feed = *feed;
+        }
+        Command::Dwell { seconds } => {
+            m.kind = MotionBlock::KIND_DWELL;
+            m.dwell_seconds = *seconds;
+        }
+        Command::Aux(aux) => {
+            m.kind = MotionBlock::KIND_AUX;
+            (m.aux_kind, m.aux_code, m.aux_value) = match *aux {
+                Aux::M(code) => (MotionBlock::AUX_M, code, 0.0),
+                Aux::S(value) => (MotionBlock::AUX_S, 0, value),
+                Aux::T(code) => (MotionBlock::AUX_T, code, 0.0),
+            };
+        }
+        Command::ProgramEnd => m.kind = MotionBlock::KIND_PROGRAM_END,
+    }
+    m
+}
+
+/// The command a block carries. Anyone on the DDS domain can publish blocks, so every value is
+/// checked: a block that could not run to its end (non-finite numbers, no feed) is refused with
+/// the reason.
+pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    let feed = || {
+        if m.feed.is_finite() && m.feed > 0.0 {
+            Ok(m.feed)
+        } else {
+            Err(format!("feed {} is not a positive number", m.feed))
+        }
+    };
+    if !finite(&m.end) || !finite(&m.center) {
+        return Err("end point or centre is not a finite number".into());
+    }
+    Ok(match m.kind {
+        MotionBlock::KIND_RAPID => Command::Rapid { end: m.end.clone() },
+        MotionBlock::KIND_LINEAR => Command::Linear {
+            end: m.end.clone(),
+            feed: feed()?,
+        },
+        MotionBlock::KIND_ARC_CW | MotionBlock::KIND_ARC_CCW => Command::Arc {
+            end: m.end.clone(),
+            center: m.center.clone(),
+            clockwise: m.kind == MotionBlock::KIND_ARC_CW,
+            feed: feed()?,
+        },
+        MotionBlock::KIND_DWELL if m.dwell_seconds.is_finite() && m.dwell_seconds >= 0.0 => {
+            Command::Dwell {
+                seconds: m.dwell_seconds,
+            }
+        }
+        MotionBlock::KIND_DWELL => {
+            return Err(format!("dwell {} s is not a time", m.dwell_seconds))
+        }
+        MotionBlock::KIND_AUX => Command::Aux(match m.aux_kind {
+            MotionBlock::AUX_M => Aux::M(m.aux_code),
+            MotionBlock::AUX_S if m.aux_value.is_finite() && m.aux_value >= 0.0 => {
+                Aux::S(m.aux_value)
+            }
+            MotionBlock::AUX_T => Aux::T(m.aux_code),
+            other => {
+                return Err(format!(
+                    "aux kind {other} with value {} is not an M, S or T function",
+                    m.aux_value
+                ))
+            }
+        }),
+        MotionBlock::KIND_PROGRAM_END => Command::ProgramEnd,
+        other => return Err(format!("unknown block kind {other}")),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_command_survives_the_wire_form() {
+        let commands = [
+            Command::Rapid {
+                end: vec![1.0, 2.0],
+            },
+            Command::Linear {
+                end: vec![3.0, -4.0],
+                feed: 200.0,
+            },
+            Command::Arc {
+                end: vec![5.0, 6.0],
+                center: vec![5.0, 0.0],
+                clockwise: true,
+                feed: 90.0,
+            },
+            Command::Arc {
+                end: vec![5.0, 6.0],
+                center: vec![5.0, 0.0],
+                clockwise: false,
+                feed: 90.0,
+            },
+            Command::Dwell { seconds: 1.5 },
+            Command::Aux(Aux::M(3)),
+            Command::Aux(Aux::S(1200.0)),
+            Command::Aux(Aux::T(101)),
+            Command::ProgramEnd,
+        ];
+        for c in commands {
+            let m = to_motion_block(7, 3, "p.nc", 12, &c);
+            assert_eq!(
+                (m.run_id, m.seq, m.line, m.program.as_str()),
+                (7, 3, 12, "p.nc")
+            );
+            assert_eq!(from_motion_block(&m), Ok(c));
+        }
+    }
+
+    #[test]
+    fn blocks_that_could_never_finish_are_refused() {
+        let mut m = to_motion_block(
+            1,
+            1,
+            "",
+            1,
+            &Command::Linear {
+                end: vec![1.0],
+                feed: 100.0,
+            },
+        );
+        for bad_feed in [0.0, -5.0, f64::NAN, f64::INFINITY] {
+            m.feed = bad_feed;
+            assert!(from_motion_block(&m).is_err(), "feed {bad_feed}");
+        }
+        m.feed = 100.0;
+        m.end = vec![f64::NAN];
+        assert!(from_motion_block(&m).is_err());
+        let mut d = to_motion_block(1, 1, "", 1, &Command::Dwell { seconds: 1.0 });
+        d.dwell_seconds = f64::NAN;
+        assert!(from_motion_block(&d).is_err());
+        let mut k = d.clone();
+        k.kind = 99;
+        assert!(from_motion_block(&k).is_err());
+    }
+}
