@@ -1,8 +1,14 @@
 #!/usr/bin/env bash
-# Runs every test. DDS tests run inside a network namespace that has only loopback, so no
+# The project's test command (README): sets up what the tests need, then runs
+# `cargo test --workspace` inside a network namespace that has only loopback, so no DDS
 # discovery traffic leaves the machine. Needs root (ip netns); CI runs as root.
+#   - target/venv: Python with cyclonedds (the interop peer of tests/cyclonedds_interop.rs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+if ! target/venv/bin/python -c "import cyclonedds" 2>/dev/null; then
+    python3 -m venv target/venv
+    target/venv/bin/pip install --quiet --disable-pip-version-check cyclonedds==11.0.1
+fi
 NS="cnc_test_$$"
 cleanup() { ip netns del "$NS" 2>/dev/null || true; }
 trap cleanup EXIT
