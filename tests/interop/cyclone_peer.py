@@ -140,7 +140,8 @@ def main():
     peer = Peer(args.domain, args.namespace, Interfaces(pathlib.Path(args.msgs)))
     readers = {"spindle": peer.subscribe("spindle", "SpindleState"),
                "part_count": peer.subscribe("part_count", "PartCount"),
-               "alarms": peer.subscribe("alarms", "ActiveAlarms")}
+               "alarms": peer.subscribe("alarms", "ActiveAlarms"),
+               "machine_state": peer.subscribe("machine_state", "MachineState")}
     failures = []
 
     def check(ok, what):
@@ -168,7 +169,7 @@ def main():
         return False
 
     check(wait(lambda: all(v is not None for v in peer.latest.values()), 30),
-          "transient-local spindle, part_count and alarms arrive on joining")
+          "transient-local spindle, part_count, alarms and machine_state arrive on joining")
     start_count = peer.latest["part_count"].count if peer.latest["part_count"] else None
     check(peer.latest["alarms"] is not None and len(peer.latest["alarms"].alarms) == 0, "no active alarms at start")
 
@@ -178,6 +179,9 @@ def main():
     check(r.accepted, f"StartProgram (Cyclone mapping) accepted: {r.message}")
     check(wait(lambda: peer.latest["part_count"].count == start_count + 1, 60),
           f"part_count {start_count} -> {peer.latest['part_count'].count}")
+    # The part is counted at M30; the cycle is complete once motion has finished the program end.
+    check(wait(lambda: peer.latest["machine_state"].execution_name == "PROGRAM_COMPLETED", 20),
+          f"machine_state {peer.latest['machine_state'].execution_name} after the cycle")
     check(abs(max_rpm - 700.0) <= 14.0, f"spindle reached the programmed 700 rpm: max actual {max_rpm:.1f}")
 
     r = peer.call("start_program", "StartProgram", name="missing.nc")
