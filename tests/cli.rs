@@ -1,0 +1,57 @@
+//! The `cnc` binary as a user runs it: `run --program --cycles` exits 0 when the cycles complete
+//! and non-zero on an alarm. The domain comes from `ROS_DOMAIN_ID` (the launch config names none).
+
+use std::process::Command;
+
+fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, String) {
+    let dir = std::env::temp_dir().join(format!("cnc_cli_{}_{domain}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["run", "launch_configs/sim_lathe.yaml", "--program"])
+        .arg(&path)
+        .args(["--cycles", cycles])
+        .env("ROS_DOMAIN_ID", domain)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), text)
+}
+
+#[test]
+fn run_exits_zero_after_its_cycles() {
+    let (ok, out) = run_program(
+        "45",
+        "two.nc",
+        "G00 X100 Z20\nS500 M03\nG01 Z10 F3000\nM05\nM30\n",
+        "2",
+    );
+    assert!(ok, "{out}");
+    assert!(
+        out.contains("DDS domain 45"),
+        "ROS_DOMAIN_ID not honoured:\n{out}"
+    );
+    assert!(out.contains("cycles done 2"), "{out}");
+    assert!(
+        out.contains("servo loop:") && out.contains("round trip"),
+        "no servo statistics at exit:\n{out}"
+    );
+}
+
+#[test]
+fn run_exits_nonzero_on_an_alarm_with_number_and_line() {
+    let (ok, out) = run_program(
+        "46",
+        "bad.nc",
+        "G00 X100 Z20\nG01 Z10 F3000\nG02 X120 Z-20 R5\nM30\n",
+        "1",
+    );
+    assert!(!ok, "{out}");
+    assert!(out.contains("alarm 11") && out.contains("line 3"), "{out}");
+}
