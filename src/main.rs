@@ -38,11 +38,21 @@ enum Verb {
         #[arg(long, default_value_t = 1)]
         cycles: u32,
     },
-    /// Interpret a program without running it; report the first error with line and alarm number.
+    /// Interpret a program without running it; report every error with line and alarm number.
     Check {
         program: PathBuf,
         #[arg(long, default_value = DEFAULT_CONFIG)]
         config: PathBuf,
+        /// Dialect (huaxing-lathe, gtc2e-lathe, iso-lathe); default: the config's.
+        #[arg(long)]
+        dialect: Option<String>,
+        /// Folder of subprograms (O number on the first line or file name O1234.nc);
+        /// default: the program's folder.
+        #[arg(long)]
+        library: Option<PathBuf>,
+        /// Print the canonical block stream, one command per line.
+        #[arg(long)]
+        trace: bool,
     },
 }
 
@@ -64,7 +74,19 @@ fn main() -> ExitCode {
             program,
             cycles,
         }) => run(&config, program.as_deref(), cycles),
-        Some(Verb::Check { program, config }) => check(&program, &config),
+        Some(Verb::Check {
+            program,
+            config,
+            dialect,
+            library,
+            trace,
+        }) => check(
+            &program,
+            &config,
+            dialect.as_deref(),
+            library.as_deref(),
+            trace,
+        ),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
     match result {
@@ -76,25 +98,53 @@ fn main() -> ExitCode {
     }
 }
 
-fn check(program: &Path, config: &Path) -> Result<(), String> {
+fn check(
+    program: &Path,
+    config: &Path,
+    dialect: Option<&str>,
+    library: Option<&Path>,
+    trace: bool,
+) -> Result<(), String> {
+    use cnc_interpreter::{diagnose, Dialect, Library, Setup};
     let cfg = LaunchConfig::load(config)?;
     let text = read_program(program)?;
-    let dialect =
-        cnc_interpreter::Dialect::from_name(&cfg.machine.dialect).ok_or("unknown dialect")?;
-    let cmds = cnc_interpreter::check(
-        dialect,
-        &text,
-        &cfg.axis_letters(),
-        &cfg.diameter_axes(),
-        &cfg.home(),
-    )
-    .map_err(|e| format!("{}: {e}", program.display()))?;
-    println!(
-        "{}: {} canonical commands, no alarm",
-        program.display(),
-        cmds.len()
-    );
-    Ok(())
+    let name = dialect.unwrap_or(&cfg.machine.dialect);
+    let dialect = Dialect::from_name(name).ok_or_else(|| {
+        let known: Vec<&str> = Dialect::ALL.iter().map(|d| d.name()).collect();
+        format!("unknown dialect {name:?}; known: {}", known.join(", "))
+    })?;
+    let dir = match library {
+        Some(d) => d.to_path_buf(),
+        None => program
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_path_buf(),
+    };
+    // Files that are not programs or repeat a number are left out of the library.
+    let (lib, _skipped) =
+        Library::load_dir(&dir).map_err(|e| format!("library {}: {e}", dir.display()))?;
+    let letters = cfg.axis_letters();
+    let mut setup = Setup::new(&letters, &cfg.diameter_axes(), &cfg.home());
+    setup.reference = cfg.home();
+    let errors = diagnose(dialect, &text, setup.clone(), lib.clone());
+    if trace {
+        let mut interp = cnc_interpreter::Interpreter::with_library(dialect, &text, setup, lib);
+        let mut out = String::new();
+        while let Ok(Some(c)) = interp.next_command() {
+            out.push_str(&cnc_interpreter::trace::line(&letters, &c));
+            out.push('\n');
+        }
+        print!("{out}");
+    }
+    if errors.is_empty() {
+        eprintln!("{}: no alarm ({})", program.display(), dialect.name());
+        return Ok(());
+    }
+    for e in &errors {
+        eprintln!("{}: {e}", program.display());
+    }
+    Err(format!("{} alarm(s)", errors.len()))
 }
 
 fn read_program(path: &Path) -> Result<String, String> {

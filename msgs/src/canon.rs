@@ -23,8 +23,24 @@ pub enum Command {
         clockwise: bool,
         feed: f64,
     },
+    /// Thread cutting: a straight move whose long axis advances `lead` mm per spindle
+    /// revolution, starting `start_angle` degrees after the spindle's index pulse. Feed
+    /// override does not apply.
+    Thread {
+        end: Vec<f64>,
+        lead: f64,
+        start_angle: f64,
+    },
     Dwell {
         seconds: f64,
+    },
+    /// Feed words of the following moves are mm/min (`false`, G98) or mm/rev (`true`, G99).
+    FeedMode {
+        per_rev: bool,
+    },
+    /// Exact stop (`true`: G09/G61, each block ends at rest) or blending (`false`, G64).
+    PathMode {
+        exact_stop: bool,
     },
     /// An M, S or T function for the PLC, which answers with FIN.
     Aux(Aux),
@@ -79,9 +95,27 @@ pub fn to_motion_block(
             m.center.clone_from(center);
             m.feed = *feed;
         }
+        Command::Thread {
+            end,
+            lead,
+            start_angle,
+        } => {
+            m.kind = MotionBlock::KIND_THREAD;
+            m.end.clone_from(end);
+            m.lead = *lead;
+            m.start_angle = *start_angle;
+        }
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
+        }
+        Command::FeedMode { per_rev } => {
+            m.kind = MotionBlock::KIND_FEED_MODE;
+            m.flag = *per_rev;
+        }
+        Command::PathMode { exact_stop } => {
+            m.kind = MotionBlock::KIND_PATH_MODE;
+            m.flag = *exact_stop;
         }
         Command::Aux(aux) => {
             m.kind = MotionBlock::KIND_AUX;
@@ -123,6 +157,21 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
             clockwise: m.kind == MotionBlock::KIND_ARC_CW,
             feed: feed()?,
         },
+        MotionBlock::KIND_THREAD => {
+            if !(m.lead.is_finite() && m.lead > 0.0 && m.start_angle.is_finite()) {
+                return Err(format!(
+                    "thread lead {} or start angle {} is not valid",
+                    m.lead, m.start_angle
+                ));
+            }
+            Command::Thread {
+                end: m.end.clone(),
+                lead: m.lead,
+                start_angle: m.start_angle,
+            }
+        }
+        MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
+        MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_DWELL if m.dwell_seconds.is_finite() && m.dwell_seconds >= 0.0 => {
             Command::Dwell {
                 seconds: m.dwell_seconds,

@@ -1,87 +1,462 @@
 //! Dialect tables: which G and M codes a control knows, their modal groups and meanings.
 //!
-//! The shared interpreter core works on [`GMeaning`]s; a dialect only maps its numbers onto them.
-//! For now there is one table, `iso-lathe` (FANUC-style lathe, G-code system B: G90/G91 select
-//! absolute/incremental). The Huaxing and GTC2E tables, where G90 is a turning cycle, come with
-//! their own names (decision D1 in docs/decisions.md).
+//! The shared interpreter core works on [`G`] meanings; a dialect maps its numbers onto them.
+//! Three tables:
+//! - `huaxing-lathe`: the Huaxing WA-N7xx lathe (`000` §5.1, FANUC "G-code system A" style:
+//!   G50 sets coordinates, G90/G92/G94 are cycles, U/W incremental).
+//! - `gtc2e-lathe`: the GTC2E lathe (`002` §4.2.2): the same numbers often mean other things
+//!   (G50/G51 turret mode, G22/G80 loops, G24/G77 cycles, G54–G57 cumulative shifts).
+//! - `iso-lathe`: the skeleton's FANUC lathe "system B" subset with G90/G91 absolute/incremental
+//!   (decision D1), kept for programs written for it.
+
+use crate::error::{gtc2e_number, huaxing_number, Fault};
 
 /// What a G code does in the shared core.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum GMeaning {
+pub enum G {
     Rapid,
     Linear,
     ArcCw,
     ArcCcw,
+    /// G05 (`absolute` false: mid point relative to start) / G05.1 (absolute).
+    ThreePointArc {
+        absolute: bool,
+    },
     Dwell,
+    ExactStopBlock,
+    ExactStopMode,
+    ContinuousMode,
+    ReferenceReturn,
+    /// G50: set the work coordinate of the current point (or with S: max spindle speed).
+    SetCoordinate,
+    /// G50.1: assign work coordinate, remember the difference as local coordinate.
+    AssignCoordinate,
+    /// G50.2: assign work coordinate and clear the local coordinate.
+    AssignClearLocal,
+    /// G50.3: shift the work coordinate by U/W and clear the local coordinate.
+    ShiftCoordinate,
+    LocalCoordinate,
+    /// G54–G59 (index 0–5).
+    WorkSystem(u8),
+    FeedPerMinute,
+    FeedPerRevolution,
+    ConstantSurfaceSpeed,
+    ConstantRpm,
+    PlaneXy,
+    PlaneZx,
+    PlaneYz,
+    NoseCancel,
+    NoseLeft,
+    NoseRight,
     Absolute,
     Incremental,
+    // Huaxing single and compound cycles (`000` §5.21–5.23).
+    TurningCycle,
+    FacingCycle,
+    ThreadCycle,
+    Thread,
+    VariableLeadThread,
+    TappingCycle,
+    MultiThreadCycle,
+    RoughTurning,
+    RoughFacing,
+    PatternRepeat,
+    Finishing,
+    FaceGrooving,
+    RadialGrooving,
+    // Huaxing program flow (`000` §5.12, §5.13).
+    /// G21 (`high` false) / G23 (`high` true): input-conditioned range repeat.
+    ConditionalRepeat {
+        high: bool,
+    },
+    JumpRange,
+    CallRange,
+    LoopRange,
+    // GTC2E codes (`002` §4.3.2).
+    GtcThread,
+    GtcThreadCycle,
+    GtcTapping,
+    GtcTaperCycle,
+    GtcCylinderCycle,
+    GtcDrillCycle,
+    GtcGroovingCycle,
+    LoopStart,
+    LoopEnd,
+    /// G26 (X and Z), G27 (X), G29 (Z) return to the program start point.
+    ReturnToStart {
+        x: bool,
+        z: bool,
+    },
+    ReturnToPreviousStart,
+    ReturnToStored,
+    StorePosition,
+    ThreadRetract,
+    /// G54–G57 on GTC2E: add offset group n (0–3) to the coordinates, cumulatively.
+    OffsetShift(u8),
+    TurretMode {
+        gang: bool,
+    },
+    /// Defined by the manual but not implemented by this controller: alarm with the reason.
+    Unsupported(&'static str),
 }
 
-/// Modal group of a G code; group 0 is one-shot.
+/// A G code's modal group; group 0 is one-shot (non-modal).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct GCode {
     pub group: u8,
-    pub meaning: GMeaning,
+    pub meaning: G,
 }
 
 /// What the interpreter does with an M code.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MMeaning {
+pub enum M {
     /// Sent to the PLC before the block's motion (spindle on, coolant on, clamp).
     AuxBefore,
     /// Sent to the PLC after the block's motion (spindle off, coolant off).
     AuxAfter,
-    /// Program end (M02, M30): sent to the PLC after motion, then the program ends.
+    /// Program stop M00 (sent to the PLC after motion; cycle start resumes).
+    Stop,
+    /// Optional stop M01.
+    OptionalStop,
+    /// M02/M30: sent to the PLC after motion, then the program ends.
     ProgramEnd,
+    /// GTC2E M20: spindle and coolant off, then the program restarts from the top.
+    EndAndRestart,
+    SubprogramCall,
+    SubprogramReturn,
+    /// GTC2E M97: jump to line P.
+    Jump,
+    /// Huaxing M48: count a part (sent to the PLC).
+    CountPart,
+    /// GTC2E M52/M53/M65: order of axes in returns.
+    ReturnOrder(ReturnOrder),
+    /// Defined by the manual but not implemented by this controller.
+    Unsupported(&'static str),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ReturnOrder {
+    #[default]
+    XThenZ,
+    ZThenX,
+    Together,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Dialect {
+    HuaxingLathe,
+    Gtc2eLathe,
     IsoLathe,
 }
 
+/// Dialect properties the core needs besides the code tables.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rules {
+    /// Macro statements (`#`, IF, GOTO) exist.
+    pub macros: bool,
+    /// Least input increment, mm (`000` 0.0001 §1.2; `002` 0.001 §2.2).
+    pub increment: f64,
+    /// Largest coordinate value, mm.
+    pub max_coordinate: f64,
+    /// Largest programmable feed, mm/min.
+    pub max_feed: f64,
+    /// Power-on group-01 code (decision D14).
+    pub initial_motion: G,
+    /// Power-on feed, mm/min (`000` §5.25: F 50).
+    pub initial_feed: f64,
+    /// The program must end with M02/M20/M30 (`002` §4.1 rule 9).
+    pub needs_end: bool,
+}
+
 impl Dialect {
+    pub const ALL: [Dialect; 3] = [
+        Dialect::HuaxingLathe,
+        Dialect::Gtc2eLathe,
+        Dialect::IsoLathe,
+    ];
+
     pub fn from_name(name: &str) -> Option<Dialect> {
-        match name {
-            "iso-lathe" => Some(Dialect::IsoLathe),
-            _ => None,
-        }
+        Dialect::ALL.into_iter().find(|d| d.name() == name)
     }
 
     pub fn name(self) -> &'static str {
         match self {
+            Dialect::HuaxingLathe => "huaxing-lathe",
+            Dialect::Gtc2eLathe => "gtc2e-lathe",
             Dialect::IsoLathe => "iso-lathe",
         }
     }
 
-    /// Looks up `G<number>`; `number` is ×10 so G50.1 is 501.
-    pub fn g_code(self, number_x10: u32) -> Option<GCode> {
-        use GMeaning::*;
-        let (group, meaning) = match number_x10 {
-            0 => (1, Rapid),
-            10 => (1, Linear),
-            20 => (1, ArcCw),
-            30 => (1, ArcCcw),
-            40 => (0, Dwell),
-            900 => (3, Absolute),
-            910 => (3, Incremental),
-            _ => return None,
-        };
-        Some(GCode { group, meaning })
-    }
-
-    pub fn m_code(self, number: u32) -> Option<MMeaning> {
-        match number {
-            2 | 30 => Some(MMeaning::ProgramEnd),
-            3 | 4 | 8 | 10 => Some(MMeaning::AuxBefore),
-            5 | 9 | 11 => Some(MMeaning::AuxAfter),
-            _ => None,
+    pub fn rules(self) -> Rules {
+        match self {
+            Dialect::HuaxingLathe => Rules {
+                macros: true,
+                increment: 0.0001,
+                max_coordinate: 99999.9999,
+                max_feed: 15000.0,
+                initial_motion: G::Linear,
+                initial_feed: 50.0,
+                needs_end: false,
+            },
+            // The skeleton's table: G00 at power-on and no feed until F is given.
+            Dialect::IsoLathe => Rules {
+                macros: false,
+                increment: 0.001,
+                max_coordinate: 99999.999,
+                max_feed: 15000.0,
+                initial_motion: G::Rapid,
+                initial_feed: 0.0,
+                needs_end: false,
+            },
+            Dialect::Gtc2eLathe => Rules {
+                macros: false,
+                increment: 0.001,
+                max_coordinate: 7999.999,
+                max_feed: 3000.0,
+                initial_motion: G::Rapid,
+                initial_feed: 0.0,
+                needs_end: true,
+            },
         }
     }
 
-    /// Axis words: absolute letter, incremental letter, and whether the axis is programmed in
-    /// diameter (lathe X).
-    pub fn axis_words(self) -> &'static [(char, char)] {
-        &[('X', 'U'), ('Z', 'W')]
+    /// The alarm number of a fault in this dialect's manual.
+    pub fn alarm(self, f: Fault) -> u32 {
+        match self {
+            Dialect::Gtc2eLathe => gtc2e_number(f),
+            _ => huaxing_number(f),
+        }
     }
+
+    /// Looks up `G<number>`; `number_x10` is ×10 so G50.1 is 501.
+    pub fn g_code(self, number_x10: u32) -> Option<GCode> {
+        match self {
+            Dialect::HuaxingLathe => huaxing_g(number_x10),
+            Dialect::Gtc2eLathe => gtc2e_g(number_x10),
+            Dialect::IsoLathe => iso_g(number_x10),
+        }
+    }
+
+    /// Looks up `M<number>`; `number_x10` is ×10 so M14.6 is 146.
+    pub fn m_code(self, number_x10: u32) -> Option<M> {
+        match self {
+            Dialect::Gtc2eLathe => gtc2e_m(number_x10),
+            _ => huaxing_m(number_x10),
+        }
+    }
+
+    /// Every G code of the table, as `(number ×10, code)`, for the code table document.
+    pub fn all_g(self) -> Vec<(u32, GCode)> {
+        (0..1000)
+            .filter_map(|n| Some((n, self.g_code(n)?)))
+            .collect()
+    }
+
+    pub fn all_m(self) -> Vec<(u32, M)> {
+        (0..1000)
+            .filter_map(|n| Some((n, self.m_code(n)?)))
+            .collect()
+    }
+}
+
+fn huaxing_g(n: u32) -> Option<GCode> {
+    use G::*;
+    let (group, meaning) = match n {
+        0 => (1, Rapid),
+        10 => (1, Linear),
+        20 => (1, ArcCw),
+        30 => (1, ArcCcw),
+        40 => (0, Dwell),
+        50 => (1, ThreePointArc { absolute: false }),
+        51 => (1, ThreePointArc { absolute: true }),
+        70 => (
+            0,
+            Unsupported("G07 chip breaking needs feed interruption in motion"),
+        ),
+        71 => (
+            0,
+            Unsupported("G07.1 thread chip breaking needs oscillation in motion"),
+        ),
+        80..=86 => (
+            1,
+            Unsupported("G08 rotary-axis interpolation needs a rotary axis"),
+        ),
+        90 => (15, ExactStopBlock),
+        121 => (16, Unsupported("G12.1 polar interpolation needs a C axis")),
+        131 => (16, Unsupported("G13.1 polar interpolation needs a C axis")),
+        141..=146 => (
+            1,
+            Unsupported("G14.n live-tool tapping needs a live tool axis"),
+        ),
+        170 => (16, PlaneXy),
+        180 => (16, PlaneZx),
+        190 => (16, PlaneYz),
+        210 => (0, ConditionalRepeat { high: false }),
+        230 => (0, ConditionalRepeat { high: true }),
+        250 => (0, JumpRange),
+        260 => (0, CallRange),
+        270 => (0, LoopRange),
+        280 => (0, ReferenceReturn),
+        310 => (1, Unsupported("G31 skip needs a skip input in motion")),
+        320 => (1, Thread),
+        330 => (1, TappingCycle),
+        340 => (1, VariableLeadThread),
+        400 => (7, NoseCancel),
+        410 => (7, NoseLeft),
+        420 => (7, NoseRight),
+        430 | 440 | 490 => (
+            8,
+            Unsupported("G43/G44/G49 tool length compensation is milling"),
+        ),
+        500 => (0, SetCoordinate),
+        501 => (0, AssignCoordinate),
+        502 => (0, AssignClearLocal),
+        503 => (0, ShiftCoordinate),
+        520 => (0, LocalCoordinate),
+        540..=590 if n.is_multiple_of(10) => (14, WorkSystem(((n - 540) / 10) as u8)),
+        610 => (15, ExactStopMode),
+        640 => (15, ContinuousMode),
+        650 => (
+            0,
+            Unsupported("G65 macro call: format not documented in the manual"),
+        ),
+        660 => (
+            0,
+            Unsupported("G66 modal macro call: format not documented in the manual"),
+        ),
+        700 => (0, Finishing),
+        710 => (0, RoughTurning),
+        720 => (0, RoughFacing),
+        730 => (0, PatternRepeat),
+        740 => (0, FaceGrooving),
+        750 => (0, RadialGrooving),
+        760 => (0, MultiThreadCycle),
+        770 => (
+            0,
+            Unsupported("G77 clears an absolute encoder's multi-turn count"),
+        ),
+        800 => (
+            1,
+            Unsupported("G80 cancels rigid tapping, which needs a position spindle"),
+        ),
+        830 | 870 => (
+            1,
+            Unsupported("G83/G87 drilling needs a C axis for hole positions"),
+        ),
+        840 | 880 => (
+            1,
+            Unsupported("G84/G88 rigid tapping needs a position spindle"),
+        ),
+        850 | 860 | 890 => (1, Unsupported("not described in the manual")),
+        900 => (1, TurningCycle),
+        920 => (1, ThreadCycle),
+        921 => (1, Unsupported("G92.1 rigid thread cycle is only listed")),
+        940 => (1, FacingCycle),
+        960 => (2, ConstantSurfaceSpeed),
+        970 => (2, ConstantRpm),
+        980 => (5, FeedPerMinute),
+        990 => (5, FeedPerRevolution),
+        991 => (5, Unsupported("G99.1 needs the encoder Z pulse in motion")),
+        _ => return None,
+    };
+    Some(GCode { group, meaning })
+}
+
+fn gtc2e_g(n: u32) -> Option<GCode> {
+    use G::*;
+    // Group 1 holds motion, cycles, returns, G25/G31 and the offsets (`002` §4.2.2 as
+    // reconstructed in the inventory §3.1): no two of them in one block.
+    let (group, meaning) = match n {
+        0 => (1, Rapid),
+        10 => (1, Linear),
+        20 => (1, ArcCw),
+        30 => (1, ArcCcw),
+        330 => (1, GtcThread),
+        960 => (1, ConstantSurfaceSpeed),
+        970 => (1, ConstantRpm),
+        770 => (1, GtcCylinderCycle),
+        240 => (1, GtcTaperCycle),
+        740 => (1, GtcTapping),
+        760 => (1, GtcThreadCycle),
+        830 => (1, GtcDrillCycle),
+        750 => (1, GtcGroovingCycle),
+        220 => (1, LoopStart),
+        800 => (1, LoopEnd),
+        260 => (1, ReturnToStart { x: true, z: true }),
+        270 => (1, ReturnToStart { x: true, z: false }),
+        290 => (1, ReturnToStart { x: false, z: true }),
+        600 => (1, ReturnToPreviousStart),
+        610 => (1, ReturnToStored),
+        250 => (1, StorePosition),
+        310 => (1, ThreadRetract),
+        540..=570 if n.is_multiple_of(10) => (1, OffsetShift(((n - 540) / 10) as u8)),
+        40 => (2, Dwell),
+        500 => (3, TurretMode { gang: false }),
+        510 => (3, TurretMode { gang: true }),
+        400 => (15, NoseCancel),
+        410 => (15, NoseLeft),
+        420 => (15, NoseRight),
+        _ => return None,
+    };
+    Some(GCode { group, meaning })
+}
+
+fn iso_g(n: u32) -> Option<GCode> {
+    use G::*;
+    let (group, meaning) = match n {
+        0 => (1, Rapid),
+        10 => (1, Linear),
+        20 => (1, ArcCw),
+        30 => (1, ArcCcw),
+        40 => (0, Dwell),
+        900 => (3, Absolute),
+        910 => (3, Incremental),
+        _ => return None,
+    };
+    Some(GCode { group, meaning })
+}
+
+fn huaxing_m(n: u32) -> Option<M> {
+    use M::*;
+    Some(match n {
+        0 => Stop,
+        10 => OptionalStop,
+        20 | 300 => ProgramEnd,
+        // Codes that start something go out before the block's motion (decision D6).
+        30 | 40 | 60 | 80 | 100 | 120 | 140 | 170 | 180 | 190 | 200 | 220 | 320 | 410 | 420
+        | 430 | 440 | 630 | 640 => AuxBefore,
+        // Codes that stop something go out after it.
+        50 | 90 | 110 | 130 | 150 | 210 | 230 | 330 | 650 => AuxAfter,
+        480 => CountPart,
+        980 => SubprogramCall,
+        990 => SubprogramReturn,
+        141..=146 => Unsupported("M14.n assigns the spindle angle to a rotary axis"),
+        290 => Unsupported("M29 rigid tapping needs a position spindle"),
+        500 => Unsupported("M50 bar feed drives outputs directly, not through the PLC"),
+        510 => Unsupported("M51 sets the start block in MDI"),
+        520..=580 => Unsupported("M52–M58 belong to tool-change macros"),
+        590 | 600 | 660 | 850 | 860 | 870 | 880 | 890 => {
+            Unsupported("NC-internal M code of multi-channel or live-tool machines")
+        }
+        _ => return None,
+    })
+}
+
+fn gtc2e_m(n: u32) -> Option<M> {
+    use M::*;
+    Some(match n {
+        0 => Stop,
+        20 | 300 => ProgramEnd,
+        200 => EndAndRestart,
+        30 | 40 | 80 | 100 | 230 | 250 | 550 => AuxBefore,
+        50 | 90 | 110 | 220 | 240 | 540 => AuxAfter,
+        120 | 130 => AuxBefore,
+        520 => ReturnOrder(self::ReturnOrder::XThenZ),
+        530 => ReturnOrder(self::ReturnOrder::ZThenX),
+        650 => ReturnOrder(self::ReturnOrder::Together),
+        970 => Jump,
+        980 => SubprogramCall,
+        990 => SubprogramReturn,
+        _ => return None,
+    })
 }

@@ -1,7 +1,9 @@
 //! Program errors: every rejection is an alarm with the manual's number, a text and the line.
 //!
-//! Numbers and texts follow the Huaxing alarm list (`000` Appendix 1, inventory §11.1), the
-//! table the lathe dialects share until each dialect gets its own (see docs/decisions.md).
+//! The interpreter raises a [`Fault`] (what went wrong, in the controller's own terms); the
+//! dialect turns it into the number of its manual's alarm table: the Huaxing list (`000`
+//! Appendix 1, inventory §11.1) or the GTC2E list (`002` §6.3, inventory §10, numbered 1–28 in
+//! the order printed, decision D13).
 
 use std::fmt;
 
@@ -12,35 +14,29 @@ pub struct ProgramError {
     pub text: String,
     /// 1-based source line; 0 when the error is not tied to a line.
     pub line: u32,
+    /// The program the line belongs to (empty for the main program).
+    pub program: String,
 }
 
 impl fmt::Display for ProgramError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "alarm {} at line {}: {}",
-            self.number, self.line, self.text
-        )
+        if self.program.is_empty() {
+            write!(
+                f,
+                "alarm {} at line {}: {}",
+                self.number, self.line, self.text
+            )
+        } else {
+            write!(
+                f,
+                "alarm {} at line {} of {}: {}",
+                self.number, self.line, self.program, self.text
+            )
+        }
     }
 }
 
 impl std::error::Error for ProgramError {}
-
-/// Alarm numbers used by the interpreter.
-pub mod alarm {
-    pub const DWELL_TIME: u32 = 1;
-    pub const UNDEFINED_CODE: u32 = 7;
-    pub const GROUP_00_WITH_01: u32 = 8;
-    pub const ABS_AND_INC_SAME_AXIS: u32 = 9;
-    pub const TOO_MANY_M: u32 = 10;
-    pub const ARC_RADIUS_TOO_SMALL: u32 = 11;
-    pub const DATA_FORMAT: u32 = 13;
-    pub const AXIS_ADDRESS: u32 = 14;
-    pub const ARC_R_AND_IJK: u32 = 15;
-    pub const FEED_OUT_OF_RANGE: u32 = 16;
-    pub const PROGRAM_NOT_FOUND: u32 = 22;
-    pub const ARC_END_NOT_ON_CIRCLE: u32 = 50;
-}
 
 impl ProgramError {
     pub fn new(number: u32, line: u32, text: impl Into<String>) -> Self {
@@ -48,6 +44,184 @@ impl ProgramError {
             number,
             text: text.into(),
             line,
+            program: String::new(),
         }
+    }
+}
+
+/// What went wrong, independent of the dialect's numbering.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// G04 time out of range (`000` 1).
+    DwellTime,
+    /// Thread lead wrong, F and I together, lead 0 (`000` 2).
+    ThreadLead,
+    /// G90/G92 taper R larger than half of U with opposite sign (`000` 3).
+    TaperTooLarge,
+    /// G96/G97 without S (`000` 4).
+    CssWithoutS,
+    /// Tool or offset number out of range (`000` 6).
+    ToolNumber,
+    /// Unknown G or M code, or a word that does not exist (`000` 7, `002` 15).
+    UndefinedCode,
+    /// G codes of groups 00 and 01 in one block (`000` 8).
+    Group00With01,
+    /// Absolute and incremental word for one axis (`000` 9).
+    AbsAndInc,
+    /// More than three M codes (`000` 10).
+    TooManyM,
+    /// Arc radius too small, or full circle with R (`000` 11).
+    ArcRadius,
+    /// Chamfer or corner rounding impossible (`000` 12).
+    Chamfer,
+    /// Malformed number or text (`000` 13, `002` 15).
+    DataFormat,
+    /// Axis address error (`000` 14).
+    AxisAddress,
+    /// R and I/K in one arc (`000` 15).
+    ArcRAndIk,
+    /// Feed out of range (`000` 16, `002` 23).
+    FeedRange,
+    /// Macro statement or variable error (`000` 20).
+    Macro,
+    /// Subprogram or macro call error, or nose radius 0 (`000` 21).
+    Call,
+    /// Program not found (`000` 22, `002` 10).
+    ProgramNotFound,
+    /// Cycle words missing (`000` 23, `002` 18).
+    MissingWord,
+    /// Jump or cycle target block not found (`000` 24, `002` 20).
+    TargetNotFound,
+    /// G25/G26/G27 range error (`000` 25).
+    RangeError,
+    /// M98 of an undefined program (`000` 26, `002` 20).
+    UndefinedSubprogram,
+    /// M99 without a call (`000` 27, `002` 22).
+    ReturnWithoutCall,
+    /// Two codes of one group in a block (`002` 16; `000` has no own number: 13).
+    SameGroup,
+    /// Address repeated in a block (`002` 17; `000` 13).
+    RepeatedWord,
+    /// A word the block's command does not take (`002` 19; `000` 7).
+    IllegalWord,
+    /// Value out of the address's range (`002` 23; `000` 13).
+    OutOfRange,
+    /// G80 without G22 (`002` 21).
+    LoopWithoutStart,
+    /// No program end M02/M20/M30 (`002` 14).
+    NoProgramEnd,
+    /// Tool-nose compensation active on entering a roughing cycle (`000` 42).
+    CompInCycle,
+    /// G71/G72 allowance or depth zero (`000` 43).
+    CycleZero,
+    /// G71 format error (`000` 44).
+    CycleFormat,
+    /// Contour too long (`000` 45/56).
+    ContourTooLong,
+    /// Contour data error: not monotonic, not closed (`000` 47).
+    ContourData,
+    /// Type I/II ns block rule (`000` 48).
+    ContourStart,
+    /// Arc end not on the circle (`000` 50).
+    ArcEnd,
+    /// Contour point beyond the start point (`000` 57).
+    ContourBeyondStart,
+    /// G76 P(k)/Q(Δd) missing (`000` 58).
+    ThreadDepthMissing,
+    /// G73 relief 0 (`000` 59).
+    PatternReliefZero,
+    /// Work offset number wrong (`000` 62).
+    WorkOffset,
+    /// Unknown axis for reference return (`000` 75).
+    NoSuchAxis,
+    /// Three-point arc points collinear (`000` 80 covers G05).
+    ThreePointArc,
+    /// Too few blocks between G41/G42 and G40, or G40 without G41/G42 (`000` 82).
+    CompBlocks,
+    /// Compensation start or cancel not on a G01 line (`000` 85).
+    CompStartNotLine,
+    /// Compensated path has no intersection (`000` 88/97; `002` inner corner).
+    CompNoIntersection,
+    /// Compensation direction changed at start/cancel (`000` 89).
+    CompDirection,
+    /// Code must start the block (`000` 103, 92).
+    MustStartBlock,
+    /// Chamfer line too short (`000` 119).
+    ChamferTooShort,
+    /// G50 S format (`000` 112).
+    G50S,
+    /// A function this controller does not implement yet: alarm 7 with the reason.
+    NotSupported,
+}
+
+/// The alarm number a fault has in the Huaxing table (`000` Appendix 1).
+pub fn huaxing_number(f: Fault) -> u32 {
+    use Fault::*;
+    match f {
+        DwellTime => 1,
+        ThreadLead => 2,
+        TaperTooLarge => 3,
+        CssWithoutS => 4,
+        ToolNumber => 6,
+        UndefinedCode | IllegalWord | NotSupported => 7,
+        Group00With01 => 8,
+        AbsAndInc => 9,
+        TooManyM => 10,
+        ArcRadius => 11,
+        Chamfer => 12,
+        DataFormat | SameGroup | RepeatedWord | OutOfRange => 13,
+        AxisAddress => 14,
+        ArcRAndIk => 15,
+        FeedRange => 16,
+        Macro => 20,
+        Call => 21,
+        ProgramNotFound => 22,
+        MissingWord => 23,
+        TargetNotFound => 24,
+        RangeError | LoopWithoutStart => 25,
+        UndefinedSubprogram => 26,
+        ReturnWithoutCall => 27,
+        NoProgramEnd => 22,
+        CompInCycle => 42,
+        CycleZero => 43,
+        CycleFormat => 44,
+        ContourTooLong => 45,
+        ContourData => 47,
+        ContourStart => 48,
+        ArcEnd => 50,
+        ContourBeyondStart => 57,
+        ThreadDepthMissing => 58,
+        PatternReliefZero => 59,
+        WorkOffset => 62,
+        NoSuchAxis => 75,
+        ThreePointArc => 80,
+        CompBlocks => 82,
+        CompStartNotLine => 85,
+        CompNoIntersection => 88,
+        CompDirection => 89,
+        MustStartBlock => 103,
+        ChamferTooShort => 119,
+        G50S => 112,
+    }
+}
+
+/// The message number a fault has in the GTC2E list (`002` §6.3: 15 illegal command, 16
+/// multiple commands, 17 multiple operands, 18 missing operand, 19 illegal operand, 20 P line
+/// undefined, 21 G22 undefined, 22 M98 undefined, 23 data overflow, 14 no M02, 10 no such program).
+pub fn gtc2e_number(f: Fault) -> u32 {
+    use Fault::*;
+    match f {
+        UndefinedCode | DataFormat | NotSupported | Macro | MustStartBlock => 15,
+        SameGroup | Group00With01 | TooManyM => 16,
+        RepeatedWord | AbsAndInc => 17,
+        MissingWord | ThreadDepthMissing | CssWithoutS => 18,
+        IllegalWord | AxisAddress | ArcRAndIk | CycleFormat | ContourStart | Call => 19,
+        TargetNotFound | RangeError => 20,
+        LoopWithoutStart => 21,
+        ReturnWithoutCall => 22,
+        NoProgramEnd => 14,
+        ProgramNotFound | UndefinedSubprogram => 10,
+        // Geometry that cannot be made is an operand error on this control.
+        _ => 23,
     }
 }

@@ -2,89 +2,271 @@
 //!
 //! Pure and streaming: it holds the program text and a cursor, and produces commands only as
 //! they are asked for, so the motion queue's credit decides how far ahead it reads. An error
-//! stops it for good: nothing after the bad line is produced.
+//! stops it for good: nothing after the bad line is produced, and nothing of the bad block.
+//!
+//! A block's path: [`crate::syntax`] parses the line, [`Interpreter::decode`] checks its words
+//! against the dialect's tables, [`Interpreter::execute`] applies modal state, offsets and
+//! program flow, and motion-producing blocks end in [`Interpreter::emit`], which turns work
+//! coordinates into machine coordinates.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::sync::Arc;
 
 use crate::canon::{Aux, Canon, Command};
-use crate::dialect::{Dialect, GMeaning, MMeaning};
-use crate::error::{alarm, ProgramError};
-use crate::lexer::{lex_line, Word};
+use crate::dialect::{Dialect, ReturnOrder, Rules, G, M};
+use crate::error::{Fault, ProgramError};
+use crate::expr::{truth, variable_number, EvalError, Expr, Value, Variables};
+use crate::geometry::{self, ArcError, Elem, Pt};
+use crate::program::{find_number, line_number, read_line, Library, Pos};
+use crate::rough::{Move, Rough};
+use crate::setup::{Setup, MAX_OFFSET};
+use crate::syntax::{parse_line, Line, Stmt};
 
-/// Tolerance for "the end point lies on the arc" and for "start equals end", mm.
-const ARC_TOLERANCE: f64 = 0.005;
-/// Most M codes in one block (`000` alarm 10).
+/// Most M codes in one block (`000` alarm 10; decision D6).
 const MAX_M_PER_BLOCK: usize = 3;
-/// Largest feed accepted, mm/min (`000` alarm 113 names 15000 mm/min as the interpolation limit).
-const MAX_FEED: f64 = 15000.0;
+/// Deepest subprogram nesting (`000` §4.1.3: four levels).
+const MAX_CALL_DEPTH: usize = 4;
+/// Most blocks in a G70–G73 contour (`000` alarm 45).
+const MAX_CONTOUR_BLOCKS: usize = 100;
+/// Most blocks read without producing a command before the program is judged stuck in a
+/// loop that never moves (macro `GOTO` loops): alarm instead of hanging.
+const MAX_SILENT_BLOCKS: u32 = 1_000_000;
+/// Number of local variables per program level (`000` §5.27.2: #1–#40).
+const LOCALS: usize = 41;
 
-/// Words of one block after validation, before execution.
+/// A block's words after evaluation, sorted by meaning.
 #[derive(Debug, Default)]
 struct Block {
-    motion: Option<GMeaning>,
-    dwell: bool,
-    distance: Option<GMeaning>,
-    /// Per machine axis: absolute value, or incremental amount.
-    absolute: Vec<Option<f64>>,
-    incremental: Vec<Option<f64>>,
-    r: Option<f64>,
-    i: Option<f64>,
+    number: Option<u32>,
+    /// G codes in the order written, with their group.
+    g: Vec<(u8, G, u32)>,
+    m: Vec<(M, u32)>,
+    /// Address values other than G, M, N, O: letter → (value, written with a decimal point).
+    words: BTreeMap<char, (f64, bool)>,
+}
+
+impl Block {
+    fn get(&self, c: char) -> Option<f64> {
+        self.words.get(&c).map(|w| w.0)
+    }
+    fn has(&self, c: char) -> bool {
+        self.words.contains_key(&c)
+    }
+    fn group(&self, group: u8) -> Option<G> {
+        self.g.iter().rev().find(|g| g.0 == group).map(|g| g.1)
+    }
+    fn has_g(&self, meaning: G) -> bool {
+        self.g.iter().any(|g| g.1 == meaning)
+    }
+}
+
+/// A loop or block-range repetition inside one program text.
+#[derive(Debug, Clone)]
+enum Repeat {
+    /// Run lines up to and including the one numbered `last`, `remaining` more times (None:
+    /// forever), then continue at `then` (None: after `last`), optionally returning to `home`.
+    Range {
+        first: Pos,
+        last: u32,
+        remaining: Option<u32>,
+        then: Option<Pos>,
+        home: Option<Vec<f64>>,
+    },
+    /// GTC2E `M98 P L`: a subroutine by line number, ended by M99.
+    LineCall {
+        first: Pos,
+        remaining: u32,
+        ret: Pos,
+    },
+    /// GTC2E `G22 L` … `G80`.
+    Loop { first: Pos, remaining: u32 },
+}
+
+/// One program level: the main program or a called subprogram.
+#[derive(Debug, Clone)]
+struct Frame {
+    text: Arc<str>,
+    name: String,
+    pos: Pos,
+    /// Times the subprogram still runs after this pass (M98 repeat count).
+    remaining: u32,
+    repeats: Vec<Repeat>,
+    locals: Vec<Value>,
+}
+
+/// Retained words of a Huaxing single cycle (G90/G92/G94, `000` §5.21.3).
+#[derive(Debug, Clone, Copy, Default)]
+struct CycleWords {
+    x: Option<f64>,
+    z: Option<f64>,
+    r: f64,
+}
+
+/// Retained definition of a GTC2E cycle: the shape relative to the start point, repeated by
+/// follow-on blocks that move the start point (`002` §4.3.2-5..10).
+#[derive(Debug, Clone, Copy)]
+struct GtcCycle {
+    kind: G,
+    dx: f64,
+    dz: f64,
+    lead: f64,
+    starts: u32,
+    dwell: f64,
+}
+
+/// Thread modal words (`000` §5.23.1: F/I lead, J/K run-out).
+#[derive(Debug, Clone, Copy, Default)]
+struct ThreadWords {
+    lead: f64,
+    j: Option<f64>,
     k: Option<f64>,
-    f: Option<f64>,
-    s: Option<f64>,
-    t: Option<i32>,
-    p: Option<f64>,
-    /// G04 X/U time in seconds (X wins over U).
-    dwell_seconds: Option<f64>,
-    m: Vec<(i32, MMeaning)>,
+}
+
+/// GTC2E G31 settings: X retract length, early-retract distance, retract speed 1–7.
+#[derive(Debug, Clone, Copy, Default)]
+struct GtcRetract {
+    u: Option<f64>,
+    w: f64,
+    speed: u32,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SpindleDir {
+    Stopped,
+    Cw,
+    Ccw,
 }
 
 /// Streaming interpreter for one program run.
 pub struct Interpreter {
     dialect: Dialect,
-    text: String,
-    cursor: usize,
-    line: u32,
-    /// Machine axis letters in machine order, e.g. `['X', 'Z']`.
-    axes: Vec<char>,
-    /// Axes programmed in diameter (lathe X).
-    diameter: Vec<bool>,
-    position: Vec<f64>,
-    motion_mode: GMeaning,
+    rules: Rules,
+    setup: Setup,
+    library: Library,
+    frames: Vec<Frame>,
+    /// Commanded machine position per axis (X as diameter).
+    pos: Vec<f64>,
+    /// Work position at the program start (GTC2E G26/G27/G29 return there).
+    program_start: Vec<f64>,
+    /// Work position at the start of the previous block (GTC2E G60).
+    previous_start: Vec<f64>,
+    /// GTC2E G25 memory.
+    stored: Option<Vec<f64>>,
+    motion: G,
     incremental: bool,
     feed: f64,
+    feed_per_rev: bool,
+    exact_stop_mode: bool,
+    css: bool,
+    css_speed: f64,
+    /// Last programmed spindle speed in rpm.
+    rpm: f64,
+    /// Last spindle speed sent to the PLC.
+    sent_rpm: Option<f64>,
+    /// G50 S clamp.
+    max_rpm: Option<f64>,
+    /// GTC2E G96: the rpm and |X| where G96 was given (linear rpm rule, decision D18).
+    gtc_css_from: (f64, f64),
+    spindle: SpindleDir,
+    nose: G,
+    work_system: u8,
+    /// G50 floating shift, G52 local shift and GTC2E cumulative shifts, per axis.
+    shift: Vec<f64>,
+    tool_offset: Vec<f64>,
+    /// Active offset number (0 = none).
+    offset_number: u32,
+    gang_mode: bool,
+    return_order: ReturnOrder,
+    thread: ThreadWords,
+    cycle: CycleWords,
+    gtc_cycle: Option<GtcCycle>,
+    gtc_retract: GtcRetract,
+    compound: compound::CompoundWords,
+    /// G74/G75 retract per peck (`000` GS#43 default 1 mm).
+    groove_retract: f64,
+    /// G92 number of starts (`000` §5.23.5, modal).
+    cycle_starts: u32,
+    /// The sign of the approach move before a GTC2E thread cycle (its retract goes the other way).
+    last_x_direction: f64,
+    common: HashMap<i64, f64>,
     pending: VecDeque<Canon>,
+    line: u32,
     done: bool,
     error: Option<ProgramError>,
+    silent_blocks: u32,
+    saw_end: bool,
 }
 
 impl Interpreter {
-    /// `axes` are the machine's axis letters; `start` its commanded position (X as diameter).
-    pub fn new(
-        dialect: Dialect,
-        text: &str,
-        axes: &[char],
-        diameter: &[bool],
-        start: &[f64],
-    ) -> Self {
-        Interpreter {
+    pub fn new(dialect: Dialect, text: &str, setup: Setup) -> Self {
+        Interpreter::with_library(dialect, text, setup, Library::new())
+    }
+
+    pub fn with_library(dialect: Dialect, text: &str, setup: Setup, library: Library) -> Self {
+        let rules = dialect.rules();
+        let n = setup.axes.len();
+        let mut common = HashMap::new();
+        for (&k, &v) in &setup.kept {
+            common.insert(k, v);
+        }
+        let mut it = Interpreter {
             dialect,
-            text: text.to_string(),
-            cursor: 0,
-            line: 0,
-            axes: axes.to_vec(),
-            diameter: diameter.to_vec(),
-            // One value per axis whatever the caller passed: a missing one starts at 0.
-            position: (0..axes.len())
-                .map(|i| start.get(i).copied().unwrap_or(0.0))
-                .collect(),
-            motion_mode: GMeaning::Rapid,
+            rules,
+            library,
+            frames: vec![Frame {
+                text: Arc::from(text),
+                name: String::new(),
+                pos: Pos::default(),
+                remaining: 0,
+                repeats: Vec::new(),
+                locals: vec![None; LOCALS],
+            }],
+            pos: setup.start.clone(),
+            program_start: Vec::new(),
+            previous_start: Vec::new(),
+            stored: None,
+            motion: rules.initial_motion,
             incremental: false,
-            feed: 0.0,
+            feed: rules.initial_feed,
+            feed_per_rev: false,
+            exact_stop_mode: false,
+            css: false,
+            css_speed: 0.0,
+            rpm: 0.0,
+            sent_rpm: None,
+            max_rpm: None,
+            gtc_css_from: (0.0, 0.0),
+            spindle: SpindleDir::Stopped,
+            nose: G::NoseCancel,
+            work_system: setup.work_system.min(5),
+            shift: vec![0.0; n],
+            tool_offset: vec![0.0; n],
+            offset_number: 0,
+            gang_mode: false,
+            return_order: ReturnOrder::XThenZ,
+            thread: ThreadWords::default(),
+            cycle: CycleWords::default(),
+            gtc_cycle: None,
+            gtc_retract: GtcRetract {
+                speed: 3,
+                ..GtcRetract::default()
+            },
+            last_x_direction: -1.0,
+            cycle_starts: 1,
+            compound: compound::CompoundWords::default(),
+            groove_retract: 1.0,
+            common,
             pending: VecDeque::new(),
+            line: 0,
             done: false,
             error: None,
-        }
+            silent_blocks: 0,
+            saw_end: false,
+            setup,
+        };
+        it.program_start = it.work_position();
+        it.previous_start = it.program_start.clone();
+        it
     }
 
     /// The next canonical command; `Ok(None)` once the program has ended.
@@ -94,12 +276,19 @@ impl Interpreter {
                 return Err(e.clone());
             }
             if let Some(c) = self.pending.pop_front() {
+                self.silent_blocks = 0;
                 return Ok(Some(c));
             }
             if self.done {
                 return Ok(None);
             }
-            if let Err(e) = self.read_block() {
+            self.silent_blocks += 1;
+            let result = if self.silent_blocks > MAX_SILENT_BLOCKS {
+                Err(self.fault(Fault::Macro, "program loops without producing any command"))
+            } else {
+                self.read_block()
+            };
+            if let Err(e) = result {
                 self.error = Some(e.clone());
                 self.pending.clear();
                 return Err(e);
@@ -107,384 +296,1895 @@ impl Interpreter {
         }
     }
 
-    /// Reads one line and queues its commands.
-    fn read_block(&mut self) -> Result<(), ProgramError> {
-        if self.cursor >= self.text.len() {
-            // End of text without M02/M30: the program ends here.
-            self.finish(self.line);
-            return Ok(());
-        }
-        let rest = &self.text[self.cursor..];
-        let (raw, advance) = match rest.find('\n') {
-            Some(i) => (&rest[..i], i + 1),
-            None => (rest, rest.len()),
-        };
-        self.cursor += advance;
-        self.line += 1;
-        let line = lex_line(raw, self.line)?;
-        if line.end_of_text {
-            self.finish(self.line);
-            return Ok(());
-        }
-        if line.block_skip || line.words.is_empty() {
-            return Ok(());
-        }
-        let block = self.decode(&line.words)?;
-        self.execute(block)
+    /// Values of the kept macro variables now, for the shell to persist.
+    pub fn kept_variables(&self) -> BTreeMap<i64, f64> {
+        self.common
+            .iter()
+            .filter(|(k, _)| is_kept(**k))
+            .map(|(&k, &v)| (k, v))
+            .collect()
     }
 
-    fn finish(&mut self, line: u32) {
-        self.pending.push_back(Canon {
-            line,
-            command: Command::ProgramEnd,
-        });
+    // ---------------------------------------------------------------- errors
+
+    fn fault(&self, f: Fault, text: impl Into<String>) -> ProgramError {
+        let mut e = ProgramError::new(self.dialect.alarm(f), self.line, text);
+        if let Some(frame) = self.frames.last() {
+            e.program.clone_from(&frame.name);
+        }
+        e
+    }
+
+    fn eval_err(&self, e: EvalError) -> ProgramError {
+        self.fault(Fault::Macro, e.0)
+    }
+
+    // ---------------------------------------------------------------- reading
+
+    fn frame(&mut self) -> &mut Frame {
+        // There is always a main frame: the last one is popped only by ending the program.
+        let last = self.frames.len() - 1;
+        &mut self.frames[last]
+    }
+
+    /// Reads one line and queues its commands.
+    fn read_block(&mut self) -> Result<(), ProgramError> {
+        let frame = self.frame();
+        let text = frame.text.clone();
+        let pos = frame.pos;
+        let Some((raw, next)) = read_line(&text, pos) else {
+            return self.end_of_text();
+        };
+        self.frame().pos = next;
+        self.line = next.line;
+        let line = parse_line(raw, self.rules.macros).map_err(|e| self.fault(e.fault, e.text))?;
+        if line.percent && !self.saw_any_block() && line.stmt == Stmt::Empty {
+            return Ok(()); // `%` opening a tape
+        }
+        if line.percent {
+            return self.end_of_text();
+        }
+        if line.skip.is_some() && self.setup.block_skip {
+            return self.after_line(line_number(raw));
+        }
+        self.statement(&line, &line.stmt)?;
+        self.after_line(line.number)
+    }
+
+    fn saw_any_block(&self) -> bool {
+        self.line > 1 || self.frames.len() > 1
+    }
+
+    /// End of the text without M02/M30.
+    fn end_of_text(&mut self) -> Result<(), ProgramError> {
+        if self.frames.len() > 1 {
+            // A subprogram that runs off its end returns like M99.
+            return self.subprogram_return();
+        }
+        if self.rules.needs_end && !self.saw_end {
+            return Err(self.fault(Fault::NoProgramEnd, "program has no M02, M20 or M30"));
+        }
+        self.finish();
+        Ok(())
+    }
+
+    fn finish(&mut self) {
+        self.push(Command::ProgramEnd);
         self.done = true;
     }
 
-    fn err(&self, number: u32, text: impl Into<String>) -> ProgramError {
-        ProgramError::new(number, self.line, text)
+    /// Range repeats end after the line numbered `last` has run.
+    fn after_line(&mut self, number: Option<u32>) -> Result<(), ProgramError> {
+        let Some(n) = number else { return Ok(()) };
+        loop {
+            let frame = self.frame();
+            let Some(Repeat::Range {
+                first,
+                last,
+                remaining,
+                then,
+                home,
+            }) = frame.repeats.last().cloned()
+            else {
+                return Ok(());
+            };
+            if last != n {
+                return Ok(());
+            }
+            match remaining {
+                Some(r) if r <= 1 => {
+                    frame.repeats.pop();
+                    if let Some(t) = then {
+                        frame.pos = t;
+                    }
+                    if let Some(home) = home {
+                        self.rapid_to(&home);
+                    }
+                    // An enclosing range may end on the same line.
+                    continue;
+                }
+                Some(r) => {
+                    if let Some(Repeat::Range { remaining, .. }) = frame.repeats.last_mut() {
+                        *remaining = Some(r - 1);
+                    }
+                    frame.pos = first;
+                }
+                None => {
+                    if self.setup.single_pass {
+                        self.finish();
+                    } else {
+                        self.frame().pos = first;
+                    }
+                }
+            }
+            return Ok(());
+        }
     }
 
-    /// Checks every word of a block and sorts it into a [`Block`].
-    fn decode(&self, words: &[Word]) -> Result<Block, ProgramError> {
-        let n = self.axes.len();
-        let mut b = Block {
-            absolute: vec![None; n],
-            incremental: vec![None; n],
-            ..Block::default()
-        };
-        let mut group1_explicit = false;
-        let mut group0_explicit = false;
-        let mut seen = Vec::new();
-        // G04 takes X/U as its time: find it first.
-        let dwell_block = words
-            .iter()
-            .any(|w| w.letter == 'G' && (w.value * 10.0).round() == 40.0);
-        for w in words {
-            let letter = w.letter;
-            if letter != 'G' && letter != 'M' {
-                if seen.contains(&letter) {
-                    return Err(self.err(
-                        alarm::DATA_FORMAT,
-                        format!("address {letter} twice in one block"),
-                    ));
-                }
-                seen.push(letter);
+    fn statement(&mut self, line: &Line, stmt: &Stmt) -> Result<(), ProgramError> {
+        match stmt {
+            Stmt::Empty => Ok(()),
+            Stmt::Assign { var, value } => {
+                let n = self.var_number(var)?;
+                let v = value.eval(self).map_err(|e| self.eval_err(e))?;
+                self.write_var(n, v)
             }
-            match letter {
-                'O' | 'N' => {}
-                'G' => {
-                    let x10 = (w.value * 10.0).round();
-                    let code =
-                        if w.value >= 0.0 && (w.value * 10.0 - x10).abs() < 1e-6 && x10 < 10000.0 {
-                            self.dialect.g_code(x10 as u32)
-                        } else {
-                            None
-                        };
-                    let code = code.ok_or_else(|| {
-                        self.err(
-                            alarm::UNDEFINED_CODE,
-                            format!("undefined G code G{}", w.value),
-                        )
-                    })?;
-                    match code.group {
-                        0 => {
-                            group0_explicit = true;
-                            b.dwell = true;
-                        }
-                        1 => {
-                            group1_explicit = true;
-                            b.motion = Some(code.meaning); // same group twice: the last one wins
-                        }
-                        _ => b.distance = Some(code.meaning),
-                    }
-                }
-                'M' => {
-                    let m = integer(w).ok_or_else(|| {
-                        self.err(
-                            alarm::DATA_FORMAT,
-                            format!("M code must be an integer, found M{}", w.value),
-                        )
-                    })?;
-                    let meaning = u32::try_from(m)
-                        .ok()
-                        .and_then(|m| self.dialect.m_code(m))
-                        .ok_or_else(|| {
-                            self.err(alarm::UNDEFINED_CODE, format!("undefined M code M{m}"))
-                        })?;
-                    b.m.push((m, meaning));
-                    if b.m.len() > MAX_M_PER_BLOCK {
-                        return Err(self.err(alarm::TOO_MANY_M, "more than 3 M codes in one block"));
-                    }
-                }
-                'X' | 'U' if dwell_block => {
-                    if letter == 'X' || b.dwell_seconds.is_none() {
-                        b.dwell_seconds = Some(w.value);
-                    }
-                }
-                'P' => b.p = Some(w.value),
-                'R' => b.r = Some(w.value),
-                'I' => b.i = Some(w.value),
-                'K' => b.k = Some(w.value),
-                'F' => {
-                    if !(0.0..=MAX_FEED).contains(&w.value) {
-                        return Err(self.err(
-                            alarm::FEED_OUT_OF_RANGE,
-                            format!("feed F{} out of range 0..{MAX_FEED}", w.value),
-                        ));
-                    }
-                    b.f = Some(w.value);
-                }
-                'S' => {
-                    if !(0.0..=99999.0).contains(&w.value) {
-                        return Err(self.err(
-                            alarm::DATA_FORMAT,
-                            format!("spindle speed S{} out of range", w.value),
-                        ));
-                    }
-                    b.s = Some(w.value);
-                }
-                'T' => {
-                    b.t = Some(
-                        integer(w)
-                            .filter(|t| (0..=9999).contains(t))
-                            .ok_or_else(|| {
-                                self.err(
-                                    alarm::DATA_FORMAT,
-                                    format!("tool word T{} must be an integer 0..9999", w.value),
-                                )
-                            })?,
+            Stmt::Goto(target) => {
+                let v = target
+                    .eval(self)
+                    .map_err(|e| self.eval_err(e))?
+                    .ok_or_else(|| self.fault(Fault::Macro, "GOTO to a null value"))?;
+                let n = variable_number(v).map_err(|e| self.eval_err(e))?;
+                if !(0..=99999).contains(&n) {
+                    return Err(
+                        self.fault(Fault::TargetNotFound, format!("GOTO {n}: no such block"))
                     );
                 }
-                _ => {
-                    let axis = self.dialect.axis_words().iter().find_map(|&(abs, inc)| {
-                        let idx = self.axes.iter().position(|&a| a == abs)?;
-                        (letter == abs)
-                            .then_some((idx, true))
-                            .or((letter == inc).then_some((idx, false)))
-                    });
-                    match axis {
-                        Some((idx, true)) => b.absolute[idx] = Some(w.value),
-                        Some((idx, false)) => b.incremental[idx] = Some(w.value),
-                        None => {
-                            return Err(self
-                                .err(alarm::UNDEFINED_CODE, format!("undefined address {letter}")))
+                self.jump_to_number(n as u32)
+            }
+            Stmt::If { cond, then } => {
+                let c = cond.eval(self).map_err(|e| self.eval_err(e))?;
+                if truth(c) {
+                    self.statement(line, then)
+                } else {
+                    Ok(())
+                }
+            }
+            Stmt::Words(words) => {
+                let mut b = Block {
+                    number: line.number,
+                    ..Block::default()
+                };
+                self.decode(words, &mut b)?;
+                self.execute(b)
+            }
+        }
+    }
+
+    fn var_number(&self, var: &Expr) -> Result<i64, ProgramError> {
+        let v = var
+            .eval(self)
+            .map_err(|e| self.eval_err(e))?
+            .ok_or_else(|| self.fault(Fault::Macro, "variable number is null"))?;
+        variable_number(v).map_err(|e| self.eval_err(e))
+    }
+
+    fn jump_to_number(&mut self, n: u32) -> Result<(), ProgramError> {
+        let text = self.frame().text.clone();
+        let pos = find_number(&text, n)
+            .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("block N{n} not found")))?;
+        self.frame().pos = pos;
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- variables
+
+    fn write_var(&mut self, n: i64, v: Value) -> Result<(), ProgramError> {
+        match n {
+            1..=40 => {
+                self.frame().locals[n as usize] = v;
+                Ok(())
+            }
+            100..=289 => {
+                match v {
+                    Some(x) => self.common.insert(n, x),
+                    None => self.common.remove(&n),
+                };
+                Ok(())
+            }
+            4001..=4499 => {
+                let (table, num) = (n / 100 - 40, (n % 100) as u32);
+                let x = v.unwrap_or(0.0);
+                let t = self.setup.offsets.tools.entry(num).or_default();
+                match table {
+                    0 => t.x = x,
+                    2 => t.z = x,
+                    3 => t.radius = x,
+                    4 => t.tip = x.clamp(0.0, 9.0) as u8,
+                    _ => return Err(self.fault(Fault::Macro, format!("#{n}: no Y axis offsets"))),
+                }
+                Ok(())
+            }
+            _ => Err(self.fault(Fault::Macro, format!("#{n} cannot be written"))),
+        }
+    }
+
+    // ---------------------------------------------------------------- decoding
+
+    /// Evaluates and checks every word of a block.
+    fn decode(&self, words: &[crate::syntax::Word], b: &mut Block) -> Result<(), ProgramError> {
+        let mut groups: Vec<u8> = Vec::new();
+        let mut m_groups: Vec<u32> = Vec::new();
+        for w in words {
+            let value = w.value.eval(self).map_err(|e| self.eval_err(e))?;
+            // A null word disappears (`000` §5.27.3).
+            let Some(v) = value else { continue };
+            let point = w.value.has_point();
+            match w.letter {
+                'O' | 'N' => {}
+                'G' => {
+                    let x10 = code_x10(v).ok_or_else(|| {
+                        self.fault(Fault::UndefinedCode, format!("undefined G code G{v}"))
+                    })?;
+                    let code = self.dialect.g_code(x10).ok_or_else(|| {
+                        self.fault(
+                            Fault::UndefinedCode,
+                            format!("undefined G code G{}", show(v)),
+                        )
+                    })?;
+                    if let G::Unsupported(why) = code.meaning {
+                        return Err(self.fault(Fault::NotSupported, format!("G{}: {why}", show(v))));
+                    }
+                    if code.group != 0
+                        && groups.contains(&code.group)
+                        && self.dialect == Dialect::Gtc2eLathe
+                    {
+                        return Err(self.fault(
+                            Fault::SameGroup,
+                            format!(
+                                "G{} shares its group with another G code of the block",
+                                show(v)
+                            ),
+                        ));
+                    }
+                    groups.push(code.group);
+                    b.g.push((code.group, code.meaning, x10));
+                }
+                'M' => {
+                    let x10 = code_x10(v).ok_or_else(|| {
+                        self.fault(Fault::UndefinedCode, format!("undefined M code M{v}"))
+                    })?;
+                    let m = self.dialect.m_code(x10).ok_or_else(|| {
+                        self.fault(
+                            Fault::UndefinedCode,
+                            format!("undefined M code M{}", show(v)),
+                        )
+                    })?;
+                    if let M::Unsupported(why) = m {
+                        return Err(self.fault(Fault::NotSupported, format!("M{}: {why}", show(v))));
+                    }
+                    if self.dialect == Dialect::Gtc2eLathe {
+                        let g = gtc_m_group(x10);
+                        if m_groups.contains(&g) {
+                            return Err(self.fault(
+                                Fault::SameGroup,
+                                format!(
+                                    "M{} shares its group with another M code of the block",
+                                    show(v)
+                                ),
+                            ));
                         }
+                        m_groups.push(g);
+                    }
+                    b.m.push((m, x10));
+                    if b.m.len() > MAX_M_PER_BLOCK {
+                        return Err(self.fault(Fault::TooManyM, "more than 3 M codes in one block"));
+                    }
+                }
+                c => {
+                    if b.words.insert(c, (v, point)).is_some() {
+                        return Err(self.fault(
+                            Fault::RepeatedWord,
+                            format!("address {c} twice in one block"),
+                        ));
                     }
                 }
             }
         }
-        if group0_explicit && group1_explicit {
-            return Err(self.err(
-                alarm::GROUP_00_WITH_01,
-                "G codes of groups 00 and 01 in one block",
-            ));
-        }
-        for idx in 0..n {
-            if b.absolute[idx].is_some() && b.incremental[idx].is_some() {
-                return Err(self.err(
-                    alarm::ABS_AND_INC_SAME_AXIS,
-                    format!(
-                        "absolute and incremental word for axis {} in one block",
-                        self.axes[idx]
-                    ),
+        // Group 00 and group 01 in one block (`000` alarm 8). G04 and the coordinate codes
+        // are allowed with motion words only through their own meaning; G09 is group 15.
+        if self.dialect != Dialect::Gtc2eLathe {
+            let g0 = b.g.iter().any(|g| g.0 == 0);
+            let g1 = b.g.iter().any(|g| g.0 == 1);
+            if g0 && g1 {
+                return Err(self.fault(
+                    Fault::Group00With01,
+                    "G codes of groups 00 and 01 in one block",
                 ));
             }
         }
-        Ok(b)
-    }
-
-    /// Queues a decoded block's commands in execution order: F, S, T and the M codes that start
-    /// things, then the motion or dwell, then the M codes that stop things, then program end.
-    fn execute(&mut self, b: Block) -> Result<(), ProgramError> {
-        let line = self.line;
-        let mut out = Vec::new();
-        if let Some(f) = b.f {
-            self.feed = f;
-        }
-        if let Some(d) = b.distance {
-            self.incremental = d == GMeaning::Incremental;
-        }
-        if let Some(m) = b.motion {
-            self.motion_mode = m;
-        }
-        if let Some(s) = b.s {
-            out.push(Command::Aux(Aux::S(s)));
-        }
-        if let Some(t) = b.t {
-            out.push(Command::Aux(Aux::T(t)));
-        }
-        for &(m, meaning) in &b.m {
-            if meaning == MMeaning::AuxBefore {
-                out.push(Command::Aux(Aux::M(m)));
+        for (&c, &(v, _)) in &b.words {
+            let axis_word = self.setup.axes.contains(&c)
+                || self
+                    .setup
+                    .axes
+                    .iter()
+                    .any(|&a| incremental_letter(a) == Some(c));
+            let known = axis_word
+                || matches!(
+                    c,
+                    'F' | 'S' | 'T' | 'P' | 'Q' | 'R' | 'I' | 'J' | 'K' | 'L' | 'D' | 'E'
+                )
+                || (c == 'U' || c == 'W') && self.dialect != Dialect::IsoLathe;
+            if !known {
+                return Err(self.fault(
+                    Fault::UndefinedCode,
+                    format!("address {c}: no such word or axis on this machine"),
+                ));
             }
-        }
-        if b.dwell {
-            // Priority P (ms) > X (s) > U (s), `000` §5.15.
-            let ms = b.p.or(b.dwell_seconds.map(|s| s * 1000.0)).unwrap_or(0.0);
-            if ms.abs() > 99_999_999.0 {
-                return Err(self.err(alarm::DWELL_TIME, "G04 dwell time out of range"));
+            let limit = match c {
+                'F' => f64::MAX,
+                'P' | 'Q' | 'K' | 'H' | 'L' => 1e9,
+                _ => self.rules.max_coordinate,
+            };
+            if v.abs() > limit {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("{c}{} out of range ±{limit}", show(v)),
+                ));
             }
-            out.push(Command::Dwell {
-                seconds: ms.max(0.0) / 1000.0,
-            });
-        } else {
-            let has_axis = b.absolute.iter().chain(&b.incremental).any(Option::is_some);
-            let arc = matches!(self.motion_mode, GMeaning::ArcCw | GMeaning::ArcCcw);
-            if has_axis || (arc && (b.i.is_some() || b.k.is_some())) {
-                let end = self.end_point(&b);
-                out.push(self.motion(&b, end)?);
-            }
-        }
-        for &(m, meaning) in &b.m {
-            if meaning == MMeaning::AuxAfter {
-                out.push(Command::Aux(Aux::M(m)));
-            }
-        }
-        let ends = b.m.iter().find(|(_, m)| *m == MMeaning::ProgramEnd);
-        if let Some(&(m, _)) = ends {
-            out.push(Command::Aux(Aux::M(m)));
-        }
-        self.pending
-            .extend(out.into_iter().map(|command| Canon { line, command }));
-        if ends.is_some() {
-            self.finish(line);
         }
         Ok(())
     }
 
-    fn end_point(&self, b: &Block) -> Vec<f64> {
-        (0..self.axes.len())
-            .map(|i| match (b.absolute[i], b.incremental[i]) {
-                (Some(v), _) if self.incremental => self.position[i] + v,
-                (Some(v), _) => v,
-                (None, Some(d)) => self.position[i] + d,
-                (None, None) => self.position[i],
-            })
+    // ---------------------------------------------------------------- coordinates
+
+    fn axis(&self, letter: char) -> Option<usize> {
+        self.setup.axes.iter().position(|&a| a == letter)
+    }
+
+    fn origin(&self, i: usize) -> f64 {
+        let letter = self.setup.axes[i];
+        let work = if self.dialect == Dialect::Gtc2eLathe {
+            0.0
+        } else {
+            self.setup.offsets.work(self.work_system, letter)
+        };
+        work + self.shift[i] + self.tool_offset[i]
+    }
+
+    /// Current position in work coordinates (X as diameter).
+    fn work_position(&self) -> Vec<f64> {
+        (0..self.pos.len())
+            .map(|i| self.pos[i] - self.origin(i))
             .collect()
     }
 
-    fn motion(&mut self, b: &Block, end: Vec<f64>) -> Result<Command, ProgramError> {
-        let cmd = match self.motion_mode {
-            GMeaning::Rapid => Command::Rapid { end: end.clone() },
-            GMeaning::Linear => Command::Linear {
-                end: end.clone(),
-                feed: self.cutting_feed()?,
-            },
-            GMeaning::ArcCw | GMeaning::ArcCcw => {
-                let clockwise = self.motion_mode == GMeaning::ArcCw;
-                let feed = self.cutting_feed()?;
-                let center = self.arc_center(b, &end, clockwise)?;
-                Command::Arc {
-                    end: end.clone(),
-                    center,
-                    clockwise,
-                    feed,
-                }
-            }
-            other => {
-                return Err(self.err(alarm::UNDEFINED_CODE, format!("{other:?} is not a motion")))
-            }
-        };
-        self.position = end;
-        Ok(cmd)
+    fn to_machine(&self, work: &[f64]) -> Vec<f64> {
+        (0..work.len()).map(|i| work[i] + self.origin(i)).collect()
     }
 
-    fn cutting_feed(&self) -> Result<f64, ProgramError> {
-        if self.feed <= 0.0 {
-            return Err(self.err(
-                alarm::FEED_OUT_OF_RANGE,
+    /// The work-coordinate end point of a block's axis words.
+    fn end_point(&self, b: &Block) -> Result<Vec<f64>, ProgramError> {
+        let mut end = self.work_position();
+        for (i, &letter) in self.setup.axes.iter().enumerate() {
+            let inc = incremental_letter(letter);
+            let (abs, rel) = (b.get(letter), inc.and_then(|c| b.get(c)));
+            if abs.is_some() && rel.is_some() {
+                return Err(self.fault(
+                    Fault::AbsAndInc,
+                    format!("{letter} and {} in one block", inc.unwrap_or('?')),
+                ));
+            }
+            if let Some(v) = abs {
+                end[i] = if self.incremental { end[i] + v } else { v };
+            } else if let Some(d) = rel {
+                end[i] += d;
+            }
+        }
+        Ok(end)
+    }
+
+    fn has_axis_words(&self, b: &Block) -> bool {
+        self.setup
+            .axes
+            .iter()
+            .any(|&a| b.has(a) || incremental_letter(a).is_some_and(|c| b.has(c)))
+    }
+
+    fn xz(&self) -> Result<(usize, usize), ProgramError> {
+        match (self.axis('X'), self.axis('Z')) {
+            (Some(x), Some(z)) => Ok((x, z)),
+            _ => Err(self.fault(Fault::AxisAddress, "this function needs the X and Z axes")),
+        }
+    }
+
+    /// Work position as a plane point (radius).
+    fn plane_point(&self, work: &[f64]) -> Result<Pt, ProgramError> {
+        let (xi, zi) = self.xz()?;
+        Ok(Pt::new(work[zi], work[xi] * self.x_scale()))
+    }
+
+    fn x_scale(&self) -> f64 {
+        match self.axis('X') {
+            Some(i) if self.setup.diameter[i] => 0.5,
+            _ => 1.0,
+        }
+    }
+
+    fn with_point(&self, base: &[f64], p: Pt) -> Vec<f64> {
+        let mut w = base.to_vec();
+        if let Ok((xi, zi)) = self.xz() {
+            w[xi] = p.r / self.x_scale();
+            w[zi] = p.z;
+        }
+        w
+    }
+
+    // ---------------------------------------------------------------- emitting
+
+    fn push(&mut self, command: Command) {
+        self.pending.push_back(Canon {
+            line: self.line,
+            command,
+        });
+    }
+
+    fn aux(&mut self, a: Aux) {
+        self.push(Command::Aux(a));
+    }
+
+    /// Sends the spindle speed for a block ending at work position `end` (G96: the speed at
+    /// the end point, `000` §4.2.3; decision D17).
+    fn spindle_for(&mut self, end: &[f64]) {
+        if !self.css {
+            return;
+        }
+        let x = self.axis('X').map(|i| end[i].abs()).unwrap_or(0.0);
+        let rpm = if self.dialect == Dialect::Gtc2eLathe {
+            // GTC2E G96 S = rpm at X0, reached linearly from the rpm where G96 was given.
+            let (rpm0, x0) = self.gtc_css_from;
+            if x0 <= 0.0 {
+                self.css_speed
+            } else {
+                self.css_speed + (rpm0 - self.css_speed) * (x / x0).min(1.0)
+            }
+        } else {
+            let d = x.max(1e-3);
+            let mut rpm = self.css_speed * 1000.0 / (std::f64::consts::PI * d);
+            if let Some(m) = self.max_rpm {
+                rpm = rpm.min(m);
+            }
+            rpm.max(10.0)
+        };
+        let rpm = (rpm * 10.0).round() / 10.0;
+        if self.sent_rpm != Some(rpm) {
+            self.sent_rpm = Some(rpm);
+            self.aux(Aux::S(rpm));
+        }
+    }
+
+    /// Emits a move to work position `end` and makes it the current position.
+    fn emit(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        for (i, v) in end.iter().enumerate() {
+            if !v.is_finite() || v.abs() > 1e6 {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("{} end point {v} out of range", self.setup.axes[i]),
+                ));
+            }
+        }
+        self.spindle_for(end);
+        let m = self.to_machine(end);
+        let command = match kind {
+            MoveKind::Rapid => Command::Rapid { end: m.clone() },
+            MoveKind::Feed(feed) => Command::Linear {
+                end: m.clone(),
+                feed: self.check_feed(feed)?,
+            },
+            MoveKind::Arc { center, ccw, feed } => {
+                let mut c = self.to_machine(&self.with_point(end, center));
+                // Axes outside the plane keep the end's value.
+                if let Ok((xi, zi)) = self.xz() {
+                    for (i, v) in c.iter_mut().enumerate() {
+                        if i != xi && i != zi {
+                            *v = m[i];
+                        }
+                    }
+                }
+                Command::Arc {
+                    end: m.clone(),
+                    center: c,
+                    clockwise: !ccw,
+                    feed: self.check_feed(feed)?,
+                }
+            }
+            MoveKind::Thread { lead, angle } => {
+                if !(lead > 0.0 && lead.is_finite()) {
+                    return Err(self.fault(
+                        Fault::ThreadLead,
+                        format!("thread lead {lead} is not valid"),
+                    ));
+                }
+                Command::Thread {
+                    end: m.clone(),
+                    lead,
+                    start_angle: angle,
+                }
+            }
+        };
+        self.push(command);
+        self.pos = m;
+        Ok(())
+    }
+
+    fn check_feed(&self, feed: f64) -> Result<f64, ProgramError> {
+        if feed.is_nan() || feed <= 0.0 {
+            return Err(self.fault(
+                Fault::FeedRange,
                 "no feed programmed for a cutting move (F missing or 0)",
             ));
         }
-        Ok(self.feed)
+        let limit = if self.feed_per_rev {
+            500.0
+        } else {
+            self.rules.max_feed
+        };
+        if feed > limit {
+            return Err(self.fault(
+                Fault::FeedRange,
+                format!("feed F{} out of range (max {limit})", show(feed)),
+            ));
+        }
+        Ok(feed)
     }
 
-    /// Arc centre in machine coordinates. Geometry runs in the ZX plane with X as radius;
-    /// seen with Z to the right and X up, G02 turns clockwise (decision D3).
-    fn arc_center(
-        &self,
-        b: &Block,
-        end: &[f64],
-        clockwise: bool,
-    ) -> Result<Vec<f64>, ProgramError> {
-        let (xi, zi) = match (self.axis_index('X'), self.axis_index('Z')) {
-            (Some(x), Some(z)) => (x, z),
-            _ => return Err(self.err(alarm::AXIS_ADDRESS, "arcs need the X and Z axes")),
+    fn rapid_to(&mut self, work: &[f64]) {
+        // Only for points computed from known positions: cannot fail the range check.
+        let _ = self.emit(work, MoveKind::Rapid);
+    }
+
+    /// Emits cycle moves given in the plane (radius), starting from the current position.
+    fn emit_plane(&mut self, moves: &[Move], feed: f64) -> Result<(), ProgramError> {
+        for m in moves {
+            let base = self.work_position();
+            match *m {
+                Move::Rapid(p) => self.emit(&self.with_point(&base, p), MoveKind::Rapid)?,
+                Move::Feed(p) => self.emit(&self.with_point(&base, p), MoveKind::Feed(feed))?,
+                Move::Arc { to, c, ccw } => self.emit(
+                    &self.with_point(&base, to),
+                    MoveKind::Arc {
+                        center: c,
+                        ccw,
+                        feed,
+                    },
+                )?,
+            }
+        }
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- execution
+
+    /// Queues a decoded block's commands in execution order: F, S, T and the M codes that
+    /// start things, then the motion or dwell, then the M codes that stop things, then program
+    /// end or flow (decision D6).
+    fn execute(&mut self, b: Block) -> Result<(), ProgramError> {
+        let start_of_block = self.work_position();
+        let produced = self.pending.len();
+        // Modal settings first.
+        for &(_, g, _) in &b.g {
+            match g {
+                G::Absolute => self.incremental = false,
+                G::Incremental => self.incremental = true,
+                G::ExactStopMode => {
+                    self.exact_stop_mode = true;
+                    self.push(Command::PathMode { exact_stop: true });
+                }
+                G::ContinuousMode => {
+                    self.exact_stop_mode = false;
+                    self.push(Command::PathMode { exact_stop: false });
+                }
+                G::FeedPerMinute | G::FeedPerRevolution => {
+                    let per_rev = g == G::FeedPerRevolution;
+                    if per_rev != self.feed_per_rev {
+                        self.feed_per_rev = per_rev;
+                        self.push(Command::FeedMode { per_rev });
+                    }
+                }
+                G::WorkSystem(n) => {
+                    // Keep the machine position; the work coordinates change.
+                    self.work_system = n;
+                }
+                G::PlaneXy | G::PlaneYz => {
+                    return Err(self.fault(
+                        Fault::NotSupported,
+                        "G17/G19 need a Y axis; this lathe works in G18",
+                    ))
+                }
+                G::NoseLeft | G::NoseRight => {
+                    return Err(self.fault(
+                        Fault::NotSupported,
+                        "tool-nose radius compensation G41/G42 is not implemented yet",
+                    ))
+                }
+                G::TurretMode { gang } => self.gang_mode = gang,
+                G::OffsetShift(n) => self.gtc_offset_shift(n),
+                _ => {}
+            }
+        }
+        if let Some(f) = b.get('F') {
+            // GTC2E's F is a feed; in G32/G92/G76 blocks F is the lead (handled there).
+            if !self.is_thread_block(&b) {
+                if f < 0.0 {
+                    return Err(
+                        self.fault(Fault::FeedRange, format!("feed F{} is negative", show(f)))
+                    );
+                }
+                self.feed = f;
+            }
+        }
+        self.spindle_words(&b)?;
+        if let Some(t) = b.get('T') {
+            self.tool_word(t)?;
+        }
+        for &(m, code) in &b.m {
+            match m {
+                M::AuxBefore => {
+                    self.track_spindle(code);
+                    self.aux(Aux::M((code / 10) as i32));
+                }
+                M::ReturnOrder(o) => self.return_order = o,
+                _ => {}
+            }
+        }
+        self.block_body(&b)?;
+        for &(m, code) in &b.m {
+            match m {
+                M::AuxAfter | M::Stop | M::CountPart => {
+                    self.track_spindle(code);
+                    self.aux(Aux::M((code / 10) as i32));
+                }
+                M::OptionalStop if self.setup.optional_stop => self.aux(Aux::M(1)),
+                _ => {}
+            }
+        }
+        if b.has_g(G::ExactStopBlock) && self.pending.len() > produced && !self.exact_stop_mode {
+            // G09: this block ends at rest; the next blends again.
+            let at = self.pending.len();
+            let first = self.pending.iter().skip(produced).position(is_motion);
+            if let Some(i) = first {
+                self.pending.insert(
+                    produced + i,
+                    Canon {
+                        line: self.line,
+                        command: Command::PathMode { exact_stop: true },
+                    },
+                );
+                let _ = at;
+                self.push(Command::PathMode { exact_stop: false });
+            }
+        }
+        self.flow_m_codes(&b)?;
+        if self.has_axis_words(&b) || self.pending.len() > produced {
+            self.previous_start = start_of_block;
+        }
+        Ok(())
+    }
+
+    fn is_thread_block(&self, b: &Block) -> bool {
+        let motion = b.group(1).unwrap_or(self.motion);
+        matches!(
+            motion,
+            G::Thread | G::VariableLeadThread | G::ThreadCycle | G::TappingCycle
+        ) || b.has_g(G::MultiThreadCycle)
+    }
+
+    fn track_spindle(&mut self, code: u32) {
+        self.spindle = match code {
+            30 => SpindleDir::Cw,
+            40 => SpindleDir::Ccw,
+            50 | 200 | 300 => SpindleDir::Stopped,
+            _ => self.spindle,
         };
-        let scale = |i: usize| if self.diameter[i] { 0.5 } else { 1.0 };
-        let (sx, sz) = (self.position[xi] * scale(xi), self.position[zi]);
-        let (ex, ez) = (end[xi] * scale(xi), end[zi]);
-        let (dz, dx) = (ez - sz, ex - sx);
-        let chord = (dz * dz + dx * dx).sqrt();
-        let (cz, cx) = match (b.r, b.i.is_some() || b.k.is_some()) {
-            (Some(_), true) => {
-                return Err(self.err(alarm::ARC_R_AND_IJK, "arc with both R and I/K"))
+    }
+
+    fn spindle_words(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let s = b.get('S');
+        // G50 S is the clamp, not a speed (`000` §4.2.3).
+        if b.has_g(G::SetCoordinate) {
+            if let Some(s) = s {
+                if s <= 0.0 {
+                    return Err(
+                        self.fault(Fault::G50S, format!("G50 S{} must be positive", show(s)))
+                    );
+                }
+                self.max_rpm = Some(s);
             }
-            (Some(r), false) => {
-                if chord < ARC_TOLERANCE {
-                    return Err(self.err(
-                        alarm::ARC_RADIUS_TOO_SMALL,
-                        "a full circle cannot be programmed with R",
+            return Ok(());
+        }
+        if let Some(s) = s {
+            if !(0.0..=99999.0).contains(&s) {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("spindle speed S{} out of range", show(s)),
+                ));
+            }
+        }
+        match b.group(if self.dialect == Dialect::Gtc2eLathe {
+            1
+        } else {
+            2
+        }) {
+            Some(G::ConstantSurfaceSpeed) => {
+                let v = s.or(if self.css_speed > 0.0 {
+                    Some(self.css_speed)
+                } else {
+                    None
+                });
+                let v = v.ok_or_else(|| self.fault(Fault::CssWithoutS, "G96 without S"))?;
+                if self.dialect == Dialect::Gtc2eLathe {
+                    let x = self
+                        .axis('X')
+                        .map(|i| self.work_position()[i].abs())
+                        .unwrap_or(0.0);
+                    self.gtc_css_from = (self.rpm, x);
+                }
+                self.css = true;
+                self.css_speed = v;
+                let here = self.work_position();
+                self.spindle_for(&here);
+                return Ok(());
+            }
+            Some(G::ConstantRpm) => {
+                self.css = false;
+                // G96 → G97 without S: the last rpm under G96 becomes the G97 speed.
+                let rpm = s.or(self.sent_rpm).unwrap_or(self.rpm);
+                self.set_rpm(rpm);
+                return Ok(());
+            }
+            _ => {}
+        }
+        if let Some(s) = s {
+            if self.css {
+                self.css_speed = s;
+                let here = self.work_position();
+                self.spindle_for(&here);
+            } else {
+                self.set_rpm(s);
+            }
+        }
+        Ok(())
+    }
+
+    fn set_rpm(&mut self, rpm: f64) {
+        self.rpm = rpm;
+        if self.sent_rpm != Some(rpm) {
+            self.sent_rpm = Some(rpm);
+            self.aux(Aux::S(rpm));
+        }
+    }
+
+    /// T word: Huaxing `Tmmnn` (tool mm, offset nn; `T1` = tool 1 offset 1, decision D16);
+    /// GTC2E `T0x` (index station x and apply offset x) or `Tx0` (offset x only).
+    fn tool_word(&mut self, t: f64) -> Result<(), ProgramError> {
+        let code = code_x10(t)
+            .filter(|c| c % 10 == 0)
+            .map(|c| c / 10)
+            .ok_or_else(|| {
+                self.fault(
+                    Fault::ToolNumber,
+                    format!("tool word T{} must be an integer", show(t)),
+                )
+            })?;
+        let (tool, offset) = if self.dialect == Dialect::Gtc2eLathe {
+            match code {
+                1..=8 => (if self.gang_mode { None } else { Some(code) }, code),
+                10..=80 if code % 10 == 0 => (None, code / 10),
+                _ => {
+                    return Err(self.fault(
+                        Fault::ToolNumber,
+                        format!("T{code}: tools are T01–T08 and T10–T80"),
+                    ))
+                }
+            }
+        } else if code < 100 {
+            (Some(code), code)
+        } else if code <= 9999 {
+            (Some(code / 100), code % 100)
+        } else {
+            return Err(self.fault(Fault::ToolNumber, format!("T{code} out of range")));
+        };
+        if offset > MAX_OFFSET {
+            return Err(self.fault(
+                Fault::ToolNumber,
+                format!("offset number {offset} out of range"),
+            ));
+        }
+        if let Some(tool) = tool.filter(|&t| t > 0) {
+            self.aux(Aux::T(tool as i32));
+        }
+        // The offset takes effect with the next move (`000` §5.18): the work position shifts.
+        self.offset_number = offset;
+        let o = self.setup.offsets.tool(offset);
+        for (i, &a) in self.setup.axes.iter().enumerate() {
+            self.tool_offset[i] = if offset == 0 {
+                0.0
+            } else {
+                match a {
+                    'X' => o.x + o.wear_x,
+                    'Z' => o.z + o.wear_z,
+                    _ => 0.0,
+                }
+            };
+        }
+        Ok(())
+    }
+
+    fn gtc_offset_shift(&mut self, n: u8) {
+        // GTC2E G54–G57 add the group's offset, cumulatively (`002` §4.3.2-15, decision D19):
+        // the displayed coordinates change by −offset, nothing moves.
+        for (i, &a) in self.setup.axes.iter().enumerate() {
+            self.shift[i] += self.setup.offsets.work(n, a);
+        }
+    }
+
+    fn clear_gtc_shifts(&mut self) {
+        if self.dialect == Dialect::Gtc2eLathe {
+            for v in &mut self.shift {
+                *v = 0.0;
+            }
+        }
+    }
+
+    fn flow_m_codes(&mut self, b: &Block) -> Result<(), ProgramError> {
+        for &(m, code) in &b.m {
+            match m {
+                M::ProgramEnd => {
+                    self.saw_end = true;
+                    self.track_spindle(code);
+                    self.aux(Aux::M((code / 10) as i32));
+                    self.clear_gtc_shifts();
+                    self.finish();
+                    return Ok(());
+                }
+                M::EndAndRestart => {
+                    self.saw_end = true;
+                    self.aux(Aux::M(5));
+                    self.aux(Aux::M(9));
+                    self.spindle = SpindleDir::Stopped;
+                    self.clear_gtc_shifts();
+                    if self.setup.single_pass {
+                        self.finish();
+                    } else {
+                        let f = self.frame();
+                        f.pos = Pos::default();
+                        f.repeats.clear();
+                    }
+                    return Ok(());
+                }
+                M::SubprogramCall => return self.subprogram_call(b),
+                M::SubprogramReturn => return self.subprogram_return(),
+                M::Jump => {
+                    let p = self.line_target(b)?;
+                    self.frame().pos = p;
+                    return Ok(());
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// GTC2E `P____`: the line numbered P.
+    fn line_target(&self, b: &Block) -> Result<Pos, ProgramError> {
+        let p = b
+            .get('P')
+            .ok_or_else(|| self.fault(Fault::MissingWord, "P (line number) missing"))?;
+        let n = code_x10(p).filter(|c| c % 10 == 0).map(|c| c / 10);
+        let text = self
+            .frames
+            .last()
+            .map(|f| f.text.clone())
+            .unwrap_or_else(|| Arc::from(""));
+        n.and_then(|n| find_number(&text, n)).ok_or_else(|| {
+            self.fault(
+                Fault::TargetNotFound,
+                format!("line N{} not found", show(p)),
+            )
+        })
+    }
+
+    fn subprogram_call(&mut self, b: &Block) -> Result<(), ProgramError> {
+        if self.dialect == Dialect::Gtc2eLathe {
+            let first = self.line_target(b)?;
+            let count = b.get('L').unwrap_or(1.0);
+            let count = code_x10(count)
+                .map(|c| c / 10)
+                .filter(|&c| (1..=99).contains(&c))
+                .ok_or_else(|| self.fault(Fault::OutOfRange, format!("L{}: 1–99", show(count))))?;
+            let ret = self.frame().pos;
+            let f = self.frame();
+            f.repeats.push(Repeat::LineCall {
+                first,
+                remaining: count,
+                ret,
+            });
+            f.pos = first;
+            return Ok(());
+        }
+        let p = b
+            .get('P')
+            .ok_or_else(|| self.fault(Fault::MissingWord, "M98 needs P (program number)"))?;
+        let p = code_x10(p)
+            .filter(|c| c % 10 == 0)
+            .map(|c| c / 10)
+            .ok_or_else(|| {
+                self.fault(
+                    Fault::Call,
+                    format!("M98 P{}: not a program number", show(p)),
+                )
+            })?;
+        // P up to 4 digits: the program; 5–8 digits: repeat count then program (decision D20).
+        let (mut count, number) = if p > 9999 {
+            (p / 10000, p % 10000)
+        } else {
+            (1, p)
+        };
+        if let Some(l) = b.get('L') {
+            count = code_x10(l)
+                .map(|c| c / 10)
+                .ok_or_else(|| self.fault(Fault::Call, "L must be a count"))?;
+        }
+        if count == 0 || count > 9999 {
+            return Err(self.fault(Fault::Call, format!("repeat count {count} out of 1–9999")));
+        }
+        if self.frames.len() > MAX_CALL_DEPTH {
+            return Err(self.fault(Fault::Call, "subprograms nested deeper than 4 levels"));
+        }
+        let (name, text) = self.library.get(number).ok_or_else(|| {
+            self.fault(
+                Fault::UndefinedSubprogram,
+                format!("M98: program O{number:04} not in the library"),
+            )
+        })?;
+        let name = name.to_string();
+        self.frames.push(Frame {
+            text,
+            name,
+            pos: Pos::default(),
+            remaining: count - 1,
+            repeats: Vec::new(),
+            locals: vec![None; LOCALS],
+        });
+        Ok(())
+    }
+
+    fn subprogram_return(&mut self) -> Result<(), ProgramError> {
+        if self.dialect == Dialect::Gtc2eLathe {
+            let f = self.frame();
+            let Some(i) = f
+                .repeats
+                .iter()
+                .rposition(|r| matches!(r, Repeat::LineCall { .. }))
+            else {
+                return Err(self.fault(Fault::ReturnWithoutCall, "M99 without M98"));
+            };
+            f.repeats.truncate(i + 1);
+            if let Some(Repeat::LineCall {
+                first,
+                remaining,
+                ret,
+            }) = f.repeats.last_mut()
+            {
+                if *remaining > 1 {
+                    *remaining -= 1;
+                    f.pos = *first;
+                } else {
+                    f.pos = *ret;
+                    f.repeats.pop();
+                }
+            }
+            return Ok(());
+        }
+        if self.frames.len() == 1 {
+            // M99 in a main program: it starts over (`000` §4.1.4).
+            if self.setup.single_pass {
+                self.finish();
+            } else {
+                let f = self.frame();
+                f.pos = Pos::default();
+                f.repeats.clear();
+            }
+            return Ok(());
+        }
+        let f = self.frame();
+        if f.remaining > 0 {
+            f.remaining -= 1;
+            f.pos = Pos::default();
+            f.repeats.clear();
+        } else {
+            self.frames.pop();
+        }
+        Ok(())
+    }
+
+    /// The body of a block: one-shot codes, cycles, motion.
+    fn block_body(&mut self, b: &Block) -> Result<(), ProgramError> {
+        // One-shot (group 00, and GTC2E's non-motion group-1 codes) first.
+        for &(_, g, _) in &b.g {
+            match g {
+                G::Dwell => return self.dwell(b),
+                G::SetCoordinate => return self.set_coordinate(b, false),
+                G::AssignCoordinate | G::AssignClearLocal => {
+                    return self.set_coordinate(b, g == G::AssignClearLocal)
+                }
+                G::ShiftCoordinate => {
+                    let here = self.work_position();
+                    let end = self.end_point(b)?;
+                    for i in 0..here.len() {
+                        self.shift[i] -= end[i] - here[i];
+                    }
+                    return Ok(());
+                }
+                G::LocalCoordinate => {
+                    for (i, &a) in self.setup.axes.clone().iter().enumerate() {
+                        if let Some(v) = b.get(a) {
+                            self.shift[i] += v;
+                        }
+                    }
+                    return Ok(());
+                }
+                G::ReferenceReturn => return self.reference_return(b),
+                G::ConditionalRepeat { high } => return self.conditional_repeat(b, high),
+                G::JumpRange | G::CallRange | G::LoopRange => return self.range(b, g),
+                G::RoughTurning | G::RoughFacing | G::PatternRepeat => {
+                    return self.compound_cycle(b, g)
+                }
+                G::Finishing => return self.finishing(b),
+                G::FaceGrooving | G::RadialGrooving => {
+                    return self.grooving(b, g == G::RadialGrooving)
+                }
+                G::MultiThreadCycle => return self.g76(b),
+                G::LoopStart => return self.gtc_loop_start(b),
+                G::LoopEnd => return self.gtc_loop_end(),
+                G::ReturnToStart { x, z } => {
+                    self.clear_gtc_shifts();
+                    let target = self.program_start.clone();
+                    return self.gtc_return(&target, x, z);
+                }
+                G::ReturnToPreviousStart => {
+                    let target = self.previous_start.clone();
+                    return self.gtc_return(&target, true, true);
+                }
+                G::ReturnToStored => {
+                    let target = self
+                        .stored
+                        .clone()
+                        .unwrap_or_else(|| self.program_start.clone());
+                    return self.gtc_return(&target, true, true);
+                }
+                G::StorePosition => {
+                    self.stored = Some(self.work_position());
+                    return Ok(());
+                }
+                G::ThreadRetract => return self.gtc_g31(b),
+                _ => {}
+            }
+        }
+        if let Some(m) = b.group(1) {
+            if matches!(
+                m,
+                G::Rapid
+                    | G::Linear
+                    | G::ArcCw
+                    | G::ArcCcw
+                    | G::ThreePointArc { .. }
+                    | G::Thread
+                    | G::VariableLeadThread
+                    | G::TappingCycle
+                    | G::TurningCycle
+                    | G::FacingCycle
+                    | G::ThreadCycle
+                    | G::GtcThread
+                    | G::GtcThreadCycle
+                    | G::GtcTapping
+                    | G::GtcTaperCycle
+                    | G::GtcCylinderCycle
+                    | G::GtcDrillCycle
+                    | G::GtcGroovingCycle
+            ) {
+                if self.motion != m {
+                    // A new cycle or motion code drops the retained cycle words.
+                    self.cycle = CycleWords::default();
+                    if !matches!(
+                        m,
+                        G::GtcThreadCycle
+                            | G::GtcTapping
+                            | G::GtcTaperCycle
+                            | G::GtcCylinderCycle
+                            | G::GtcDrillCycle
+                            | G::GtcGroovingCycle
+                    ) {
+                        self.gtc_cycle = None;
+                    }
+                }
+                self.motion = m;
+                if matches!(
+                    m,
+                    G::GtcThreadCycle
+                        | G::GtcTapping
+                        | G::GtcTaperCycle
+                        | G::GtcCylinderCycle
+                        | G::GtcDrillCycle
+                        | G::GtcGroovingCycle
+                ) {
+                    return self.gtc_cycle_define(b, m);
+                }
+            }
+        }
+        if !self.has_axis_words(b) {
+            // A block of only modal words; arcs may still be full circles by I/K.
+            let arc_ik = matches!(self.motion, G::ArcCw | G::ArcCcw) && (b.has('I') || b.has('K'));
+            if !arc_ik {
+                return Ok(());
+            }
+        }
+        match self.motion {
+            G::Rapid => {
+                let end = self.end_point(b)?;
+                self.track_x_direction(&end);
+                self.emit(&end, MoveKind::Rapid)
+            }
+            G::Linear => {
+                if b.has('L') || b.has('D') {
+                    return Err(self.fault(
+                        Fault::NotSupported,
+                        "chamfer L / corner rounding D is not implemented yet",
                     ));
                 }
-                let half = chord / 2.0;
-                if r.abs() + 1e-9 < half {
-                    return Err(self.err(
-                        alarm::ARC_RADIUS_TOO_SMALL,
-                        format!("arc radius R{r} is smaller than half the chord ({half:.4})"),
-                    ));
-                }
-                let h = (r * r - half * half).max(0.0).sqrt();
-                // Left of the chord direction in the (Z right, X up) plane.
-                let (lz, lx) = (-dx / chord, dz / chord);
-                // CCW minor arc: centre on the left; CW: right; R < 0 (more than 180°) flips it.
-                let side = if clockwise { -1.0 } else { 1.0 } * r.signum();
-                (sz + dz / 2.0 + side * h * lz, sx + dx / 2.0 + side * h * lx)
+                let end = self.end_point(b)?;
+                self.track_x_direction(&end);
+                let f = self.feed;
+                self.emit(&end, MoveKind::Feed(f))
             }
+            G::ArcCw | G::ArcCcw => self.arc(b),
+            G::ThreePointArc { absolute } => self.three_point_arc(b, absolute),
+            G::Thread => self.g32(b),
+            G::VariableLeadThread => self.g34(b),
+            G::TappingCycle => self.g33(b),
+            G::TurningCycle | G::FacingCycle | G::ThreadCycle => self.single_cycle(b, self.motion),
+            G::GtcThread => self.gtc_thread(b),
+            G::GtcThreadCycle
+            | G::GtcTapping
+            | G::GtcTaperCycle
+            | G::GtcCylinderCycle
+            | G::GtcDrillCycle
+            | G::GtcGroovingCycle => self.gtc_cycle_follow_on(b),
+            other => Err(self.fault(Fault::UndefinedCode, format!("{other:?} is not a motion"))),
+        }
+    }
+
+    fn track_x_direction(&mut self, end: &[f64]) {
+        if let Some(i) = self.axis('X') {
+            let d = end[i] - self.work_position()[i];
+            if d.abs() > 1e-9 {
+                self.last_x_direction = d.signum();
+            }
+        }
+    }
+
+    fn dwell(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let seconds = if self.dialect == Dialect::Gtc2eLathe {
+            let d = b
+                .get('D')
+                .ok_or_else(|| self.fault(Fault::MissingWord, "G04 needs D (seconds)"))?;
+            if !(0.001..=65.0).contains(&d) {
+                return Err(self.fault(Fault::OutOfRange, format!("G04 D{}: 0.001–65 s", show(d))));
+            }
+            d
+        } else {
+            // Priority P (ms) > X (s) > U (s), `000` §5.15.
+            let s = b
+                .get('P')
+                .map(|p| p / 1000.0)
+                .or(b.get('X'))
+                .or(b.get('U'))
+                .unwrap_or(0.0);
+            if s.abs() > 99_999_999.0 / 1000.0 {
+                return Err(self.fault(Fault::DwellTime, "G04 dwell time out of range"));
+            }
+            s.max(0.0)
+        };
+        self.push(Command::Dwell { seconds });
+        Ok(())
+    }
+
+    fn set_coordinate(&mut self, b: &Block, clear_local: bool) -> Result<(), ProgramError> {
+        if clear_local {
+            for v in &mut self.shift {
+                *v = 0.0;
+            }
+        }
+        // G50 X Z: the current point gets these work coordinates.
+        let here = self.work_position();
+        let end = self.end_point(b)?;
+        for i in 0..here.len() {
+            self.shift[i] += here[i] - end[i];
+        }
+        Ok(())
+    }
+
+    fn reference_return(&mut self, b: &Block) -> Result<(), ProgramError> {
+        // G28: rapid to the intermediate point, then to the reference point; named axes only.
+        let here = self.work_position();
+        let mid = self.end_point(b)?;
+        let named: Vec<bool> = (0..here.len())
+            .map(|i| {
+                (mid[i] - here[i]).abs() > 0.0 || {
+                    let a = self.setup.axes[i];
+                    b.has(a) || incremental_letter(a).is_some_and(|c| b.has(c))
+                }
+            })
+            .collect();
+        if !named.iter().any(|&n| n) {
+            return Ok(());
+        }
+        self.emit(&mid, MoveKind::Rapid)?;
+        let mut target = self.pos.clone();
+        for i in 0..target.len() {
+            if named[i] {
+                target[i] = self.setup.reference[i];
+            }
+        }
+        self.push(Command::Rapid {
+            end: target.clone(),
+        });
+        self.pos = target;
+        Ok(())
+    }
+
+    fn range(&mut self, b: &Block, g: G) -> Result<(), ProgramError> {
+        let p = b
+            .get('P')
+            .ok_or_else(|| self.fault(Fault::RangeError, "P (first block) missing"))?;
+        let q = b
+            .get('Q')
+            .ok_or_else(|| self.fault(Fault::RangeError, "Q (last block) missing"))?;
+        let count = match b.get('L') {
+            Some(l) => Some(
+                code_x10(l)
+                    .map(|c| c / 10)
+                    .filter(|&c| c >= 1)
+                    .ok_or_else(|| self.fault(Fault::RangeError, "L must be a count ≥ 1"))?,
+            ),
+            None if g == G::LoopRange => None,
+            None => Some(1),
+        };
+        if g == G::LoopRange
+            && self.frame().repeats.iter().any(|r| {
+                matches!(
+                    r,
+                    Repeat::Range {
+                        remaining: None,
+                        ..
+                    }
+                )
+            })
+        {
+            return Err(self.fault(Fault::RangeError, "G27 inside G27"));
+        }
+        let (p, q) = (whole(p), whole(q));
+        let text = self.frame().text.clone();
+        let first = find_number(&text, p)
+            .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{p} not found")))?;
+        let last = find_number(&text, q)
+            .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{q} not found")))?;
+        if last.offset < first.offset || (g == G::LoopRange && b.number == Some(q)) {
+            return Err(self.fault(Fault::RangeError, format!("block range N{p}–N{q} is wrong")));
+        }
+        let here = self.frame().pos;
+        let then = match g {
+            // G25: continue after Q; G26: come back after the G26 block; G27: after the G27 block.
+            G::JumpRange => None,
+            _ => Some(here),
+        };
+        let f = self.frame();
+        f.repeats.push(Repeat::Range {
+            first,
+            last: q,
+            remaining: count,
+            then,
+            home: None,
+        });
+        f.pos = first;
+        Ok(())
+    }
+
+    fn conditional_repeat(&mut self, b: &Block, high: bool) -> Result<(), ProgramError> {
+        // G21/G23 (`000` §5.12): the manual's worked examples run the range when the input has
+        // a signal (G21) or has none (G23), the opposite of the headings (decision D21).
+        let run = match b.get('X') {
+            None => false,
+            Some(x) => {
+                let byte = x.trunc() as u32;
+                let bit = ((x.fract() * 10.0).round() as u8).min(7);
+                let on = self.setup.inputs.contains(&(byte, bit));
+                if high {
+                    !on
+                } else {
+                    on
+                }
+            }
+        };
+        if !run {
+            return Ok(());
+        }
+        let p = b
+            .get('P')
+            .ok_or_else(|| self.fault(Fault::RangeError, "P missing"))?;
+        let text = self.frame().text.clone();
+        let q = b.get('Q').map(whole);
+        let first = find_number(&text, whole(p))
+            .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{} not found", show(p))))?;
+        let Some(q) = q else {
+            // Q omitted: to the end of the program.
+            self.frame().pos = first;
+            return Ok(());
+        };
+        let count = b.get('L').map(whole).unwrap_or(1).max(1);
+        let f = self.frame();
+        f.repeats.push(Repeat::Range {
+            first,
+            last: q,
+            remaining: Some(count),
+            then: None,
+            home: None,
+        });
+        f.pos = first;
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- arcs
+
+    fn arc(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let end = self.end_point(b)?;
+        let here = self.work_position();
+        let (a, e) = (self.plane_point(&here)?, self.plane_point(&end)?);
+        let ccw = self.motion == G::ArcCcw;
+        let ik = b.has('I') || b.has('K');
+        let center = match (b.get('R'), ik) {
+            (Some(_), true) => return Err(self.fault(Fault::ArcRAndIk, "arc with both R and I/K")),
+            (Some(r), false) => geometry::center_from_radius(a, e, r, ccw),
             (None, true) => {
-                let (cz, cx) = (sz + b.k.unwrap_or(0.0), sx + b.i.unwrap_or(0.0));
-                let r_start = ((sz - cz).powi(2) + (sx - cx).powi(2)).sqrt();
-                let r_end = ((ez - cz).powi(2) + (ex - cx).powi(2)).sqrt();
-                if r_start < ARC_TOLERANCE || (r_start - r_end).abs() > ARC_TOLERANCE {
-                    return Err(self.err(
-                        alarm::ARC_END_NOT_ON_CIRCLE,
-                        format!("arc end point is not on the circle (radius {r_start:.4} at start, {r_end:.4} at end)"),
-                    ));
-                }
-                (cz, cx)
+                // I: the centre's X offset from the start; GTC2E gives it in diameter
+                // (`002` §4.3.2-3), Huaxing in radius (decision D3).
+                let i = b.get('I').unwrap_or(0.0);
+                let i = if self.dialect == Dialect::Gtc2eLathe {
+                    i * self.x_scale()
+                } else {
+                    i
+                };
+                let c = Pt::new(a.z + b.get('K').unwrap_or(0.0), a.r + i);
+                geometry::check_center(a, e, c)
             }
-            (None, false) => {
-                return Err(self.err(alarm::ARC_RADIUS_TOO_SMALL, "arc needs R or I/K"))
+            (None, false) => return Err(self.fault(Fault::ArcRadius, "arc needs R or I/K")),
+        }
+        .map_err(|e| self.arc_error(e))?;
+        let f = self.feed;
+        self.emit(
+            &end,
+            MoveKind::Arc {
+                center,
+                ccw,
+                feed: f,
+            },
+        )
+    }
+
+    fn arc_error(&self, e: ArcError) -> ProgramError {
+        match e {
+            ArcError::RadiusTooSmall => self.fault(
+                Fault::ArcRadius,
+                "arc radius R smaller than half the chord, or a full circle with R",
+            ),
+            ArcError::EndNotOnCircle => self.fault(
+                Fault::ArcEnd,
+                "arc end point is not on the circle of the start and I/K",
+            ),
+            ArcError::Collinear => self.fault(
+                Fault::ThreePointArc,
+                "three-point arc: the points are on one line",
+            ),
+        }
+    }
+
+    fn three_point_arc(&mut self, b: &Block, absolute: bool) -> Result<(), ProgramError> {
+        if !b.has('I') && !b.has('K') {
+            return Err(self.fault(Fault::ThreePointArc, "G05 needs the intermediate point I/K"));
+        }
+        let end = self.end_point(b)?;
+        let here = self.work_position();
+        let (a, e) = (self.plane_point(&here)?, self.plane_point(&end)?);
+        // I is the mid point's X in radius (G05: relative to the start), or its absolute
+        // X diameter (G05.1), K its Z (`000` §5.5; decision D22).
+        let (i, k) = (b.get('I').unwrap_or(0.0), b.get('K').unwrap_or(0.0));
+        let m = if absolute {
+            Pt::new(k, i * self.x_scale())
+        } else {
+            Pt::new(a.z + k, a.r + i)
+        };
+        let (c, ccw) = geometry::three_point(a, m, e).map_err(|e| self.arc_error(e))?;
+        let f = self.feed;
+        self.emit(
+            &end,
+            MoveKind::Arc {
+                center: c,
+                ccw,
+                feed: f,
+            },
+        )
+    }
+
+    // ---------------------------------------------------------------- threads
+
+    /// Lead from F (mm) or I (threads per inch); `000` alarm 2 for both, none or zero.
+    fn lead(&mut self, b: &Block, modal: bool) -> Result<f64, ProgramError> {
+        let lead = match (b.get('F'), b.get('I')) {
+            (Some(_), Some(_)) => {
+                return Err(self.fault(Fault::ThreadLead, "thread with both F and I"))
+            }
+            (Some(f), None) => f,
+            (None, Some(i)) if i > 0.0 => 25.4 / i,
+            (None, Some(i)) => {
+                return Err(self.fault(Fault::ThreadLead, format!("I{} threads per inch", show(i))))
+            }
+            (None, None) if modal && self.thread.lead > 0.0 => self.thread.lead,
+            (None, None) => return Err(self.fault(Fault::ThreadLead, "thread lead F or I missing")),
+        };
+        if !(lead > 0.0 && lead <= 500.0) {
+            return Err(self.fault(
+                Fault::ThreadLead,
+                format!("thread lead {lead} out of 0.0001–500 mm"),
+            ));
+        }
+        self.thread.lead = lead;
+        Ok(lead)
+    }
+
+    /// A word in least-input increments: without a decimal point it counts increments, with
+    /// one it is mm (decision D12).
+    fn increments(&self, b: &Block, c: char) -> Option<f64> {
+        b.words
+            .get(&c)
+            .map(|&(v, point)| if point { v } else { v * self.rules.increment })
+    }
+
+    /// A thread from the current point to `end` (work), with run-out: within `k` of the end
+    /// along the long axis the short axis moves `j` (radius, signed) (`000` §5.23.1).
+    fn thread_to(
+        &mut self,
+        end: &[f64],
+        lead: f64,
+        angle: f64,
+        j: f64,
+        k: f64,
+    ) -> Result<(), ProgramError> {
+        let here = self.work_position();
+        let (a, e) = (self.plane_point(&here)?, self.plane_point(end)?);
+        let long_is_z = (e.z - a.z).abs() >= (e.r - a.r).abs();
+        let len = if long_is_z {
+            (e.z - a.z).abs()
+        } else {
+            (e.r - a.r).abs()
+        };
+        if j != 0.0 && k > 0.0 && k < len {
+            let s = 1.0 - k / len;
+            let mid = a.lerp(e, s);
+            let out = if long_is_z {
+                Pt::new(e.z, e.r + j)
+            } else {
+                Pt::new(e.z + j, e.r)
+            };
+            self.emit(
+                &self.with_point(&here, mid),
+                MoveKind::Thread { lead, angle },
+            )?;
+            self.emit(
+                &self.with_point(&here, out),
+                MoveKind::Thread { lead, angle },
+            )?;
+        } else {
+            self.emit(end, MoveKind::Thread { lead, angle })?;
+        }
+        Ok(())
+    }
+
+    /// Run-out words J/K with the G32 rules (`000` §5.23.1).
+    fn runout(&mut self, b: &Block, g92: bool) -> (f64, f64) {
+        if let Some(j) = b.get('J') {
+            self.thread.j = Some(j);
+        }
+        if let Some(k) = b.get('K') {
+            self.thread.k = Some(k.abs());
+        }
+        let (j, k) = (self.thread.j, self.thread.k);
+        let j = if g92 { j.map(f64::abs) } else { j };
+        match (j, k) {
+            (None, _) | (Some(_), None) if !g92 && j.is_none() => (0.0, 0.0),
+            (Some(j), None) => (j, j.abs()),
+            (Some(j), Some(k)) if j != 0.0 => (j, if k == 0.0 { j.abs() } else { k }),
+            _ => (0.0, 0.0),
+        }
+    }
+
+    fn g32(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let lead = self.lead(b, true)?;
+        let (j, k) = self.runout(b, false);
+        // Q: start angle in 0.001° (a decimal point is ignored, `000` §5.23.1).
+        let angle = b.get('Q').map(|q| q / 1000.0).unwrap_or(0.0);
+        if !(0.0..=360.0).contains(&angle) {
+            return Err(self.fault(Fault::OutOfRange, "Q start angle out of 0–360000"));
+        }
+        let end = self.end_point(b)?;
+        self.thread_to(&end, lead, angle, j, k)
+    }
+
+    fn g34(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let lead = self.lead(b, true)?;
+        let dl = b.get('R').ok_or_else(|| {
+            self.fault(
+                Fault::ThreadLead,
+                "G34 needs R (lead change per revolution)",
+            )
+        })?;
+        let end = self.end_point(b)?;
+        let here = self.work_position();
+        let (a, e) = (self.plane_point(&here)?, self.plane_point(&end)?);
+        let len = (e.z - a.z).abs().max((e.r - a.r).abs());
+        // Variable lead as one-revolution pieces of constant lead (the average of each turn).
+        let mut s = 0.0;
+        let mut l = lead;
+        let mut pieces = 0;
+        while s < len - 1e-9 {
+            pieces += 1;
+            if l <= 0.0 || l > 500.0 || pieces > 100_000 {
+                return Err(self.fault(Fault::ThreadLead, format!("G34 lead becomes {l:.4} mm")));
+            }
+            let step = (l + dl / 2.0).max(1e-6).min(len - s);
+            s += step;
+            let p = a.lerp(e, s / len);
+            self.emit(
+                &self.with_point(&here, p),
+                MoveKind::Thread {
+                    lead: l + dl / 2.0,
+                    angle: 0.0,
+                },
+            )?;
+            l += dl;
+        }
+        Ok(())
+    }
+
+    fn g33(&mut self, b: &Block) -> Result<(), ProgramError> {
+        // Z tapping cycle (`000` §5.23.3): feed in synchronised, M05, reverse, back, M05.
+        let lead = self.lead(b, true)?;
+        let reverse = match self.spindle {
+            SpindleDir::Cw => 4,
+            SpindleDir::Ccw => 3,
+            SpindleDir::Stopped => {
+                return Err(self.fault(
+                    Fault::MissingWord,
+                    "G33 tapping needs the spindle running (M03/M04)",
+                ))
             }
         };
-        let mut center = self.position.clone();
-        center[xi] = cx / scale(xi);
-        center[zi] = cz;
-        Ok(center)
+        let forward = if reverse == 4 { 3 } else { 4 };
+        let starts = b.get('L').map(whole).unwrap_or(1).clamp(1, 99);
+        let start = self.work_position();
+        let (_, zi) = self.xz()?;
+        let mut bottom = start.clone();
+        bottom[zi] = match (b.get('Z'), b.get('W')) {
+            (Some(z), None) => z,
+            (None, Some(w)) => start[zi] + w,
+            _ => return Err(self.fault(Fault::MissingWord, "G33 needs Z or W")),
+        };
+        for n in 0..starts {
+            if n > 0 {
+                self.aux(Aux::M(forward));
+            }
+            let angle = 360.0 * n as f64 / starts as f64;
+            self.emit(&bottom, MoveKind::Thread { lead, angle })?;
+            self.aux(Aux::M(5));
+            self.aux(Aux::M(reverse));
+            self.emit(&start, MoveKind::Thread { lead, angle })?;
+            self.aux(Aux::M(5));
+        }
+        self.spindle = SpindleDir::Stopped;
+        Ok(())
     }
 
-    fn axis_index(&self, letter: char) -> Option<usize> {
-        self.axes.iter().position(|&a| a == letter)
+    // ---------------------------------------------------------------- single cycles
+
+    fn single_cycle(&mut self, b: &Block, g: G) -> Result<(), ProgramError> {
+        let here = self.work_position();
+        let (xi, zi) = self.xz()?;
+        // Retained X, Z, R (`000` §5.21.3).
+        let end = self.end_point(b)?;
+        if b.has('X') || b.has('U') {
+            self.cycle.x = Some(end[xi]);
+        }
+        if b.has('Z') || b.has('W') {
+            self.cycle.z = Some(end[zi]);
+        }
+        if let Some(r) = b.get('R') {
+            self.cycle.r = r;
+        }
+        let (Some(x), Some(z)) = (self.cycle.x, self.cycle.z) else {
+            return Err(self.fault(Fault::MissingWord, "cycle needs X(U) and Z(W)"));
+        };
+        let r = self.cycle.r;
+        let (x0, z0) = (here[xi], here[zi]);
+        let at = |x: f64, z: f64| {
+            let mut w = here.clone();
+            w[xi] = x;
+            w[zi] = z;
+            w
+        };
+        let f = self.feed;
+        let u = x - x0;
+        match g {
+            G::TurningCycle => {
+                // R: cut start X minus cut end X, radius (`000` §5.21.1); alarm 3.
+                if r != 0.0
+                    && u.abs() > 1e-9
+                    && r.signum() != u.signum()
+                    && r.abs() > (u / 2.0).abs() + 1e-9
+                {
+                    return Err(self.fault(
+                        Fault::TaperTooLarge,
+                        "R and U of opposite sign with |R| > |U/2|",
+                    ));
+                }
+                let xs = x + 2.0 * r;
+                self.emit(&at(xs, z0), MoveKind::Rapid)?;
+                self.emit(&at(x, z), MoveKind::Feed(f))?;
+                self.emit(&at(x0, z), MoveKind::Feed(f))?;
+                self.emit(&at(x0, z0), MoveKind::Rapid)?;
+            }
+            G::FacingCycle => {
+                let w = z - z0;
+                if r != 0.0
+                    && w.abs() > 1e-9
+                    && r.signum() != w.signum()
+                    && r.abs() > w.abs() + 1e-9
+                {
+                    return Err(self.fault(
+                        Fault::TaperTooLarge,
+                        "R and W of opposite sign with |R| > |W|",
+                    ));
+                }
+                let zs = z + r;
+                self.emit(&at(x0, zs), MoveKind::Rapid)?;
+                self.emit(&at(x, z), MoveKind::Feed(f))?;
+                self.emit(&at(x, z0), MoveKind::Feed(f))?;
+                self.emit(&at(x0, z0), MoveKind::Rapid)?;
+            }
+            _ => {
+                // G92 thread cycle (`000` §5.23.5).
+                let lead = self.lead(b, true)?;
+                if r != 0.0
+                    && u.abs() > 1e-9
+                    && r.signum() != u.signum()
+                    && r.abs() > (u / 2.0).abs() + 1e-9
+                {
+                    return Err(self.fault(
+                        Fault::TaperTooLarge,
+                        "G92: R and U of opposite sign with |R| > |U/2|",
+                    ));
+                }
+                if let Some(l) = b.get('L') {
+                    let l = whole(l);
+                    if !(1..=99).contains(&l) {
+                        return Err(self.fault(Fault::OutOfRange, format!("G92 L{l}: 1–99 starts")));
+                    }
+                    self.cycle_starts = l;
+                }
+                let (j, k) = self.runout(b, true);
+                // Run-out goes away from the part: toward the start X.
+                let away = if x0 >= x { 1.0 } else { -1.0 };
+                let starts = self.cycle_starts.max(1);
+                for n in 0..starts {
+                    let angle = 360.0 * n as f64 / starts as f64;
+                    self.emit(&at(x + 2.0 * r, z0), MoveKind::Rapid)?;
+                    self.thread_to(&at(x, z), lead, angle, away * j, k)?;
+                    let cur = self.work_position();
+                    self.emit(&at(x0, cur[zi]), MoveKind::Rapid)?;
+                    self.emit(&at(x0, z0), MoveKind::Rapid)?;
+                }
+            }
+        }
+        Ok(())
     }
 }
 
-fn integer(w: &Word) -> Option<i32> {
-    (w.value.fract() == 0.0 && w.value.abs() < i32::MAX as f64).then_some(w.value as i32)
+#[derive(Debug, Clone, Copy)]
+enum MoveKind {
+    Rapid,
+    Feed(f64),
+    Arc { center: Pt, ccw: bool, feed: f64 },
+    Thread { lead: f64, angle: f64 },
 }
+
+fn is_motion(c: &Canon) -> bool {
+    matches!(
+        c.command,
+        Command::Rapid { .. }
+            | Command::Linear { .. }
+            | Command::Arc { .. }
+            | Command::Thread { .. }
+    )
+}
+
+fn is_kept(n: i64) -> bool {
+    (200..=289).contains(&n)
+}
+
+/// `value × 10` as an integer code number (G50.1 → 501), if it has at most one decimal.
+fn code_x10(v: f64) -> Option<u32> {
+    let x10 = (v * 10.0).round();
+    ((v * 10.0 - x10).abs() < 1e-6 && (0.0..1e8).contains(&x10)).then_some(x10 as u32)
+}
+
+fn whole(v: f64) -> u32 {
+    if v.is_finite() && v >= 0.0 {
+        v.round().min(u32::MAX as f64) as u32
+    } else {
+        0
+    }
+}
+
+/// Shows a number without trailing zeros.
+fn show(v: f64) -> String {
+    let s = format!("{v:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
+fn incremental_letter(axis: char) -> Option<char> {
+    match axis {
+        'X' => Some('U'),
+        'Z' => Some('W'),
+        'Y' => Some('V'),
+        'C' => Some('H'),
+        _ => None,
+    }
+}
+
+fn gtc_m_group(x10: u32) -> u32 {
+    match x10 / 10 {
+        0 | 2 | 30 | 20 => 4,
+        3..=5 => 5,
+        8 | 9 => 6,
+        10 | 11 => 7,
+        54 | 55 => 8,
+        12 | 13 => 9,
+        22..=25 => 10,
+        52 | 53 | 65 => 11,
+        _ => 12,
+    }
+}
+
+impl Variables for Interpreter {
+    fn read(&self, n: i64) -> Result<Value, EvalError> {
+        let frame = self
+            .frames
+            .last()
+            .ok_or_else(|| EvalError("no program".into()))?;
+        Ok(match n {
+            0 => None,
+            1..=40 => frame.locals[n as usize],
+            100..=289 => self.common.get(&n).copied(),
+            1000..=1031 => {
+                let (byte, bit) = (54 + (n - 1000) / 8, (n - 1000) % 8);
+                let _ = (byte, bit);
+                Some(0.0)
+            }
+            4001..=4499 => {
+                let (table, num) = (n / 100 - 40, (n % 100) as u32);
+                let t = self.setup.offsets.tool(num);
+                Some(match table {
+                    0 => t.x,
+                    1 => 0.0,
+                    2 => t.z,
+                    3 => t.radius,
+                    _ => t.tip as f64,
+                })
+            }
+            5000..=5005 | 5020..=5025 => {
+                let letter = ['X', 'Y', 'Z', 'A', 'B', 'C'][(n % 10) as usize];
+                let machine = n >= 5020;
+                self.axis(letter).map(|i| {
+                    if machine {
+                        self.pos[i]
+                    } else {
+                        self.work_position()[i]
+                    }
+                })
+            }
+            5220..=5325 if (n - 5220) % 20 < 6 => {
+                let sys = ((n - 5220) / 20) as u8;
+                let letter = ['X', 'Y', 'Z', 'A', 'B', 'C'][((n - 5220) % 20) as usize];
+                Some(self.setup.offsets.work(sys, letter))
+            }
+            _ => return Err(EvalError(format!("#{n} is not a variable of this control"))),
+        })
+    }
+}
+
+// Cycles that need more room live in their own files.
+mod compound;
+mod grooving;
+mod gtc;
 
 /// Interprets a whole program without running it: every command, or the first error.
-pub fn check(
+pub fn check(dialect: Dialect, text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
+    check_with_library(dialect, text, setup, Library::new())
+}
+
+pub fn check_with_library(
     dialect: Dialect,
     text: &str,
-    axes: &[char],
-    diameter: &[bool],
-    start: &[f64],
+    setup: Setup,
+    library: Library,
 ) -> Result<Vec<Canon>, ProgramError> {
-    let mut interp = Interpreter::new(dialect, text, axes, diameter, start);
+    let mut interp = Interpreter::with_library(dialect, text, setup, library);
     let mut out = Vec::new();
     while let Some(c) = interp.next_command()? {
         out.push(c);
     }
     Ok(out)
+}
+
+/// Every error of a program without running it: each line's syntax and codes are checked on
+/// their own, then the program is interpreted up to its first error (after which the state
+/// is undefined). Sorted by line, one per line.
+pub fn diagnose(dialect: Dialect, text: &str, setup: Setup, library: Library) -> Vec<ProgramError> {
+    let rules = dialect.rules();
+    let mut errors: Vec<ProgramError> = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = (i + 1) as u32;
+        match parse_line(raw, rules.macros) {
+            Err(e) => errors.push(ProgramError::new(dialect.alarm(e.fault), line, e.text)),
+            Ok(l) => {
+                if let Stmt::Words(words) = &l.stmt {
+                    for w in words {
+                        let (Expr::Num { value, .. }, 'G' | 'M') = (&w.value, w.letter) else {
+                            continue;
+                        };
+                        let known = code_x10(*value).and_then(|c| {
+                            if w.letter == 'G' {
+                                dialect.g_code(c).map(|_| ())
+                            } else {
+                                dialect.m_code(c).map(|_| ())
+                            }
+                        });
+                        if known.is_none() {
+                            errors.push(ProgramError::new(
+                                dialect.alarm(Fault::UndefinedCode),
+                                line,
+                                format!("undefined {} code {}{}", w.letter, w.letter, show(*value)),
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if let Err(e) = check_with_library(dialect, text, setup, library) {
+        errors.push(e);
+    }
+    errors.sort_by_key(|e| e.line);
+    errors.dedup_by_key(|e| e.line);
+    errors
 }

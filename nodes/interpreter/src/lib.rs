@@ -1,17 +1,27 @@
 //! The interpreter: part program text in, canonical commands out.
 //!
-//! Read a block's path through it in this order: [`lexer`] (text → words), [`dialect`] (which
-//! codes exist and what they mean), [`interpreter`] (modal state, end points, arc centres) →
-//! [`canon`] (what motion receives). [`node`] binds the core to the ROS 2 topics.
+//! Read a block's path through it in this order: [`syntax`] (text → statements and words,
+//! with [`expr`] for macro expressions), [`dialect`] (which codes exist and what they mean),
+//! [`interpreter`] (modal state, offsets, program flow, cycles; [`rough`] and [`geometry`] for
+//! contour work) → [`canon`] (what motion receives). [`trace`] prints the stream for checks and
+//! golden files; [`node`] binds the core to the ROS 2 topics.
 
 pub mod canon;
 pub mod dialect;
 pub mod error;
+pub mod expr;
+pub mod geometry;
 pub mod interpreter;
-pub mod lexer;
 pub mod node;
+pub mod program;
+pub mod rough;
+pub mod setup;
+pub mod syntax;
+pub mod trace;
 
 pub use canon::{Aux, Canon, Command};
 pub use dialect::Dialect;
 pub use error::ProgramError;
-pub use interpreter::{check, Interpreter};
+pub use interpreter::{check, check_with_library, diagnose, Interpreter};
+pub use program::Library;
+pub use setup::Setup;

@@ -19,7 +19,7 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 
 use cnc_msgs::canon::to_motion_block;
 
-use crate::{Command, Dialect, Interpreter};
+use crate::{Command, Dialect, Interpreter, Library, Setup};
 
 /// Largest program text accepted, bytes.
 pub const MAX_PROGRAM_BYTES: usize = 4 * 1024 * 1024;
@@ -181,8 +181,17 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                             None => (false, "no axis position from motion yet".into()),
                             Some(start) => {
                                 run_counter += 1;
-                                let interp =
-                                    Interpreter::new(dialect, text, &axes, &diameter, &start);
+                                let mut setup = Setup::new(&axes, &diameter, &start);
+                                setup.reference = cfg.home();
+                                // The cell runs programs as the operator would: M99 or G27
+                                // loops go on until stop.
+                                setup.single_pass = false;
+                                let interp = Interpreter::with_library(
+                                    dialect,
+                                    text,
+                                    setup,
+                                    library(&programs),
+                                );
                                 run = Some(Run {
                                     id: run_counter,
                                     program: c.program.clone(),
@@ -342,4 +351,20 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Program memory as a subprogram library: every stored program with an O number on its first
+/// line or in its name (`O0010`, `O0010.nc`).
+fn library(programs: &BTreeMap<String, String>) -> Library {
+    let mut lib = Library::new();
+    for (name, text) in programs {
+        let number = Library::declared_number(text)
+            .or_else(|| Library::file_number(std::path::Path::new(name)));
+        if let Some(n) = number {
+            if lib.get(n).is_none() {
+                lib.insert(n, name, text);
+            }
+        }
+    }
+    lib
 }

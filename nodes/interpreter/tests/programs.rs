@@ -1,9 +1,33 @@
 //! Interpreter core tests on the manual's own example programs and on bad programs.
 
-use cnc_interpreter::{check, error::alarm, Aux, Command, Dialect};
+use cnc_interpreter::{Aux, Canon, Command, Dialect, ProgramError, Setup};
 
 const AXES: [char; 2] = ['X', 'Z'];
 const DIAMETER: [bool; 2] = [true, false];
+
+fn check(
+    d: Dialect,
+    text: &str,
+    axes: &[char],
+    diameter: &[bool],
+    start: &[f64],
+) -> Result<Vec<Canon>, ProgramError> {
+    cnc_interpreter::check(d, text, Setup::new(axes, diameter, start))
+}
+
+mod alarm {
+    pub const DWELL_TIME: u32 = 1;
+    pub const TOOL_NUMBER: u32 = 6;
+    pub const UNDEFINED_CODE: u32 = 7;
+    pub const GROUP_00_WITH_01: u32 = 8;
+    pub const ABS_AND_INC_SAME_AXIS: u32 = 9;
+    pub const TOO_MANY_M: u32 = 10;
+    pub const ARC_RADIUS_TOO_SMALL: u32 = 11;
+    pub const DATA_FORMAT: u32 = 13;
+    pub const ARC_R_AND_IJK: u32 = 15;
+    pub const FEED_OUT_OF_RANGE: u32 = 16;
+    pub const ARC_END_NOT_ON_CIRCLE: u32 = 50;
+}
 
 fn fixture(name: &str) -> String {
     let path = format!(
@@ -74,11 +98,11 @@ fn fixture_001_basic_program_visits_a_b_c_d() {
         aux,
         [
             Aux::M(10),
-            Aux::T(101),
+            Aux::T(1),
             Aux::S(600.0),
             Aux::M(3),
             Aux::M(8),
-            Aux::T(100),
+            Aux::T(1),
             Aux::S(0.0),
             Aux::M(5),
             Aux::M(9),
@@ -193,9 +217,7 @@ fn unknown_g_code_on_line_3_stops_before_it() {
     let mut interp = cnc_interpreter::Interpreter::new(
         Dialect::IsoLathe,
         text,
-        &AXES,
-        &DIAMETER,
-        &[100.0, 50.0],
+        Setup::new(&AXES, &DIAMETER, &[100.0, 50.0]),
     );
     let mut lines = vec![];
     let err = loop {
@@ -248,7 +270,8 @@ fn program_errors_carry_number_and_line() {
         ("G04 G01 X10 F100\n", alarm::GROUP_00_WITH_01, 1),
         ("G00 X10 X20\n", alarm::DATA_FORMAT, 1),
         ("\n\nG01 X1 F-5\n", alarm::FEED_OUT_OF_RANGE, 3),
-        ("T12.5\n", alarm::DATA_FORMAT, 1),
+        ("T12.5\n", alarm::TOOL_NUMBER, 1),
+        ("G04 P-100000000\n", alarm::DWELL_TIME, 1),
         ("G01 X1 F100 $\n", alarm::DATA_FORMAT, 1),
     ];
     for &(text, number, line) in cases {

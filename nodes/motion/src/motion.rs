@@ -19,6 +19,8 @@ pub mod alarm {
     /// The block stream from the interpreter is out of step: queue overflow, a block with the
     /// wrong number of axes, or one that could not run (`000` alarm 111, pre-read/execution sync).
     pub const BAD_BLOCK: u32 = 111;
+    /// Feed per revolution or threading with the spindle stopped (`000` alarm 36).
+    pub const SPINDLE_NOT_TURNING: u32 = 36;
 }
 
 /// Something the shell must publish.
@@ -98,6 +100,10 @@ pub struct Motion {
     strobe_seq: u64,
     f: FImage,
     events: Vec<MotionEvent>,
+    /// Last spindle speed sent to the PLC, rpm: the base of feed per revolution and threads
+    /// until motion follows the spindle encoder (issue 4).
+    spindle_rpm: f64,
+    feed_per_rev: bool,
 }
 
 impl Motion {
@@ -121,6 +127,8 @@ impl Motion {
             cycle_stop: false,
             alarm: false,
             strobe_seq: 0,
+            spindle_rpm: 0.0,
+            feed_per_rev: false,
             f: FImage::default(),
             events: Vec::new(),
         }
@@ -269,6 +277,9 @@ impl Motion {
                     break;
                 };
                 self.line = block.line;
+                if let Command::FeedMode { per_rev } = block.kind {
+                    self.feed_per_rev = per_rev;
+                }
                 match self.activate(&block) {
                     Ok(a) => self.active = Some((block, a)),
                     Err((number, text)) => {
@@ -365,7 +376,10 @@ impl Motion {
         let n = self.cfg.axes.len();
         let bad_len = |v: &Vec<f64>| v.len() != n || v.iter().any(|x| !x.is_finite());
         match &block.kind {
-            Command::Rapid { end } | Command::Linear { end, .. } | Command::Arc { end, .. }
+            Command::Rapid { end }
+            | Command::Linear { end, .. }
+            | Command::Arc { end, .. }
+            | Command::Thread { end, .. }
                 if bad_len(end) =>
             {
                 Err((
@@ -393,7 +407,33 @@ impl Motion {
                     profiles,
                 })
             }
+            Command::Thread { end, lead, .. } => {
+                // Until motion follows the encoder (issue 4) a thread runs as a straight move
+                // at lead × commanded speed along the long axis.
+                let start = self.commanded_display();
+                let long = (0..n)
+                    .map(|i| (end[i] - start[i]).abs() * self.cfg.axes[i].scale())
+                    .fold(0.0, f64::max);
+                let length = (0..n)
+                    .map(|i| ((end[i] - start[i]) * self.cfg.axes[i].scale()).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let rpm = self.spindle_rpm_for("thread cutting")?;
+                let feed = if long > 0.0 {
+                    lead * rpm * length / long
+                } else {
+                    lead * rpm
+                };
+                self.activate(&Block {
+                    kind: Command::Linear {
+                        end: end.clone(),
+                        feed,
+                    },
+                    ..block.clone()
+                })
+            }
             Command::Linear { end, feed } => {
+                let feed = &self.feed_mm_per_min(*feed)?;
                 self.check_limits(end)?;
                 let end = self.to_slide(end);
                 let start = self.commanded.clone();
@@ -419,6 +459,7 @@ impl Motion {
                 clockwise,
                 feed,
             } => {
+                let feed = &self.feed_mm_per_min(*feed)?;
                 if bad_len(center) {
                     return Err((
                         alarm::BAD_BLOCK,
@@ -505,11 +546,36 @@ impl Motion {
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),
+            // Feed mode was taken over when the block was popped; this planner stops exactly
+            // at every block end, so G64 blending waits for the look-ahead planner (issue 4).
+            Command::FeedMode { .. } | Command::PathMode { .. } => {
+                Ok(Active::Dwell { remaining: 0.0 })
+            }
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
                 strobe: None,
             }),
             Command::ProgramEnd => Ok(Active::End),
+        }
+    }
+
+    fn spindle_rpm_for(&self, what: &str) -> Result<f64, (u32, String)> {
+        if self.spindle_rpm > 0.0 {
+            Ok(self.spindle_rpm)
+        } else {
+            Err((
+                alarm::SPINDLE_NOT_TURNING,
+                format!("{what} with no spindle speed commanded"),
+            ))
+        }
+    }
+
+    /// A programmed feed in mm/min, from mm/rev under G99.
+    fn feed_mm_per_min(&self, feed: f64) -> Result<f64, (u32, String)> {
+        if self.feed_per_rev {
+            Ok(feed * self.spindle_rpm_for("feed per revolution")?)
+        } else {
+            Ok(feed)
         }
     }
 
@@ -605,6 +671,7 @@ impl Motion {
                             self.f.mf = 1;
                         }
                         Aux::S(s) => {
+                            self.spindle_rpm = s;
                             self.f.s_value = s;
                             self.f.sf = 1;
                         }

@@ -1,0 +1,626 @@
+//! Program text → statements: one line is one block (`000` §3.3.2, `002` §4.1).
+//!
+//! A line is: optional `/` block skip (with an optional level digit), optional `N` sequence
+//! number, then one statement: address words (`G01 X[#1+2] F100`), a macro assignment
+//! (`#1=#1+20`), `GOTO n`, or `IF[cond]` followed by any of these. `;` ends the block and what
+//! follows is a comment; `( … )` is a comment, also in full-width form `（ … ）`. Non-ASCII text
+//! outside parentheses starts a comment to the end of the line: the control's keyboard types only
+//! letters and digits, so such text can only be a comment written on a PC (decision D2).
+//! A `%` alone marks the start or end of the program text; `%NN` names a GTC2E program.
+
+use crate::error::Fault;
+use crate::expr::{BinOp, Expr, Func, UnOp};
+
+/// One address word; the value is evaluated when the block runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Word {
+    pub letter: char,
+    pub value: Expr,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stmt {
+    Empty,
+    Words(Vec<Word>),
+    Assign { var: Expr, value: Expr },
+    Goto(Expr),
+    If { cond: Expr, then: Box<Stmt> },
+}
+
+/// One parsed line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Line {
+    /// Block skip level (1 for a plain `/`).
+    pub skip: Option<u8>,
+    pub number: Option<u32>,
+    pub stmt: Stmt,
+    /// A `%` mark (start or end of the program text).
+    pub percent: bool,
+    /// `O1234` or `%NN`: the program's name.
+    pub name: Option<String>,
+}
+
+/// A syntax error: the fault and its text; the interpreter adds the line and the number.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SyntaxError {
+    pub fault: Fault,
+    pub text: String,
+}
+
+fn err<T>(fault: Fault, text: impl Into<String>) -> Result<T, SyntaxError> {
+    Err(SyntaxError {
+        fault,
+        text: text.into(),
+    })
+}
+
+/// Longest number text accepted; longer is a data format error, not a slow parse.
+const MAX_NUMBER_CHARS: usize = 24;
+/// Deepest expression nesting accepted (the manual limits bracket levels, §5.27.5).
+const MAX_DEPTH: usize = 16;
+
+/// Strips comments (decision D2) and returns the ASCII code of the line.
+pub fn code_part(text: &str) -> Result<String, SyntaxError> {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            ';' | '；' => break,
+            '(' | '（' => {
+                // Parentheses inside a comment nest (the fixtures' headers do this).
+                let mut depth = 1;
+                for c in chars.by_ref() {
+                    match c {
+                        '(' | '（' => depth += 1,
+                        ')' | '）' => depth -= 1,
+                        _ => {}
+                    }
+                    if depth == 0 {
+                        break;
+                    }
+                }
+                if depth != 0 {
+                    return err(Fault::DataFormat, "comment not closed: ')' missing");
+                }
+                out.push(' ');
+            }
+            '\u{3000}' | '\t' | '\r' => out.push(' '),
+            c if !c.is_ascii() => break,
+            c => out.push(c.to_ascii_uppercase()),
+        }
+    }
+    Ok(out)
+}
+
+/// Parses one line. `macros` says whether the dialect has macro statements (Huaxing does,
+/// GTC2E does not: there `#`, `[` and `IF` are illegal commands).
+pub fn parse_line(text: &str, macros: bool) -> Result<Line, SyntaxError> {
+    let code = code_part(text)?;
+    let mut p = Parser {
+        s: code.as_bytes(),
+        i: 0,
+        macros,
+        depth: 0,
+    };
+    p.line()
+}
+
+struct Parser<'a> {
+    s: &'a [u8],
+    i: usize,
+    macros: bool,
+    depth: usize,
+}
+
+impl Parser<'_> {
+    fn peek(&self) -> Option<u8> {
+        self.s.get(self.i).copied()
+    }
+
+    fn skip_ws(&mut self) {
+        while self.peek() == Some(b' ') {
+            self.i += 1;
+        }
+    }
+
+    fn eat(&mut self, c: u8) -> bool {
+        self.skip_ws();
+        if self.peek() == Some(c) {
+            self.i += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    fn at_end(&mut self) -> bool {
+        self.skip_ws();
+        self.i >= self.s.len()
+    }
+
+    /// An upper-case letter run starting here (without consuming it).
+    fn ident(&self) -> &str {
+        let start = self.i;
+        let mut end = start;
+        while end < self.s.len() && self.s[end].is_ascii_uppercase() {
+            end += 1;
+        }
+        std::str::from_utf8(&self.s[start..end]).unwrap_or("")
+    }
+
+    fn line(&mut self) -> Result<Line, SyntaxError> {
+        let mut line = Line {
+            skip: None,
+            number: None,
+            stmt: Stmt::Empty,
+            percent: false,
+            name: None,
+        };
+        self.skip_ws();
+        if self.peek() == Some(b'/') {
+            self.i += 1;
+            let mut level = 1u8;
+            if let Some(d) = self.peek().filter(u8::is_ascii_digit) {
+                level = d - b'0';
+                self.i += 1;
+            }
+            line.skip = Some(level.max(1));
+        }
+        self.skip_ws();
+        if self.peek() == Some(b'%') {
+            self.i += 1;
+            let start = self.i;
+            while self.peek().is_some_and(|c| c.is_ascii_alphanumeric()) {
+                self.i += 1;
+            }
+            if self.i > start {
+                line.name = Some(String::from_utf8_lossy(&self.s[start..self.i]).into_owned());
+            } else {
+                line.percent = true;
+            }
+            if !self.at_end() {
+                return err(Fault::DataFormat, "text after the % mark");
+            }
+            return Ok(line);
+        }
+        if self.peek() == Some(b'O') && self.s.get(self.i + 1).is_some_and(u8::is_ascii_digit) {
+            self.i += 1;
+            let n = self.unsigned("O")?;
+            line.name = Some(format!("O{n:04}"));
+        }
+        self.skip_ws();
+        if self.peek() == Some(b'N') && self.s.get(self.i + 1).is_some_and(u8::is_ascii_digit) {
+            self.i += 1;
+            line.number = Some(self.unsigned("N")?);
+        }
+        line.stmt = self.statement()?;
+        // `N0120 %` ends the text after a numbered empty block.
+        if self.eat(b'%') {
+            line.percent = true;
+        }
+        if !self.at_end() {
+            let rest = String::from_utf8_lossy(&self.s[self.i..]).into_owned();
+            return err(Fault::DataFormat, format!("unexpected text {rest:?}"));
+        }
+        Ok(line)
+    }
+
+    fn unsigned(&mut self, what: &str) -> Result<u32, SyntaxError> {
+        let start = self.i;
+        while self.peek().is_some_and(|c| c.is_ascii_digit()) {
+            self.i += 1;
+        }
+        let digits = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
+        if digits.is_empty() || digits.len() > 9 {
+            return err(
+                Fault::DataFormat,
+                format!("{what} needs a number of 1–9 digits"),
+            );
+        }
+        digits
+            .parse()
+            .or_else(|_| err(Fault::DataFormat, format!("bad {what} number")))
+    }
+
+    fn require_macros(&self, what: &str) -> Result<(), SyntaxError> {
+        if self.macros {
+            Ok(())
+        } else {
+            err(
+                Fault::UndefinedCode,
+                format!("{what}: this control has no macro statements"),
+            )
+        }
+    }
+
+    fn statement(&mut self) -> Result<Stmt, SyntaxError> {
+        self.skip_ws();
+        match self.peek() {
+            None | Some(b'%') => Ok(Stmt::Empty),
+            Some(b'#') => {
+                self.require_macros("#")?;
+                self.assignment()
+            }
+            Some(c) if c.is_ascii_uppercase() => match self.ident() {
+                "IF" => {
+                    self.require_macros("IF")?;
+                    self.i += 2;
+                    if !self.eat(b'[') {
+                        return err(Fault::Macro, "IF needs a condition in [ ]");
+                    }
+                    let cond = self.expr()?;
+                    if !self.eat(b']') {
+                        return err(Fault::Macro, "']' missing after the IF condition");
+                    }
+                    let then = self.statement()?;
+                    if then == Stmt::Empty {
+                        return err(Fault::Macro, "IF without GOTO, assignment or block");
+                    }
+                    Ok(Stmt::If {
+                        cond,
+                        then: Box::new(then),
+                    })
+                }
+                "GOTO" => {
+                    self.require_macros("GOTO")?;
+                    self.i += 4;
+                    Ok(Stmt::Goto(self.word_value("GOTO")?))
+                }
+                _ => self.words(),
+            },
+            Some(c) => err(
+                Fault::DataFormat,
+                format!("unexpected character {:?}", c as char),
+            ),
+        }
+    }
+
+    fn assignment(&mut self) -> Result<Stmt, SyntaxError> {
+        self.i += 1; // '#'
+        let var = self.var_index()?;
+        if !self.eat(b'=') {
+            return err(Fault::Macro, "'=' missing in the assignment");
+        }
+        let value = self.expr()?;
+        Ok(Stmt::Assign { var, value })
+    }
+
+    fn words(&mut self) -> Result<Stmt, SyntaxError> {
+        let mut words = Vec::new();
+        loop {
+            self.skip_ws();
+            let Some(c) = self.peek() else { break };
+            if !c.is_ascii_uppercase() {
+                return err(
+                    Fault::DataFormat,
+                    format!("unexpected character {:?}", c as char),
+                );
+            }
+            let id = self.ident();
+            if id.len() > 1 {
+                return err(Fault::UndefinedCode, format!("unknown word {id:?}"));
+            }
+            self.i += 1;
+            let letter = c as char;
+            let value = self.word_value(&letter.to_string())?;
+            words.push(Word { letter, value });
+        }
+        Ok(Stmt::Words(words))
+    }
+
+    /// A word's value: signed number, `#var` or `[expr]` (also `-#1`, `-[…]`).
+    fn word_value(&mut self, letter: &str) -> Result<Expr, SyntaxError> {
+        self.skip_ws();
+        let mut negative = false;
+        if let Some(sign @ (b'-' | b'+')) = self.peek() {
+            negative = sign == b'-';
+            self.i += 1;
+            self.skip_ws();
+        }
+        let value = match self.peek() {
+            Some(b'#') => {
+                self.require_macros("#")?;
+                self.i += 1;
+                Expr::Var(Box::new(self.var_index()?))
+            }
+            Some(b'[') => {
+                self.require_macros("[")?;
+                self.i += 1;
+                let e = self.expr()?;
+                if !self.eat(b']') {
+                    return err(Fault::Macro, "']' missing");
+                }
+                e
+            }
+            Some(c) if c.is_ascii_digit() || c == b'.' => self.number(letter)?,
+            _ => {
+                return err(
+                    Fault::DataFormat,
+                    format!("address {letter} needs a number"),
+                )
+            }
+        };
+        Ok(if negative {
+            match value {
+                Expr::Num { value, point } => Expr::Num {
+                    value: -value,
+                    point,
+                },
+                e => Expr::Unary(UnOp::Neg, Box::new(e)),
+            }
+        } else {
+            value
+        })
+    }
+
+    fn number(&mut self, letter: &str) -> Result<Expr, SyntaxError> {
+        let start = self.i;
+        while self.peek().is_some_and(|c| c.is_ascii_digit() || c == b'.') {
+            self.i += 1;
+            if self.i - start > MAX_NUMBER_CHARS {
+                return err(Fault::DataFormat, format!("number after {letter} too long"));
+            }
+        }
+        let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
+        let point = text.contains('.');
+        if text.matches('.').count() > 1 || !text.bytes().any(|c| c.is_ascii_digit()) {
+            return err(
+                Fault::DataFormat,
+                format!("address {letter} needs a number, found {text:?}"),
+            );
+        }
+        match text.parse::<f64>() {
+            Ok(value) if value.is_finite() => Ok(Expr::Num { value, point }),
+            _ => err(Fault::DataFormat, format!("bad number {text:?}")),
+        }
+    }
+
+    /// What follows `#`: a number, another `#…`, or `[expr]`.
+    fn var_index(&mut self) -> Result<Expr, SyntaxError> {
+        self.skip_ws();
+        match self.peek() {
+            Some(b'#') => {
+                self.i += 1;
+                Ok(Expr::Var(Box::new(self.var_index()?)))
+            }
+            Some(b'[') => {
+                self.i += 1;
+                let e = self.expr()?;
+                if !self.eat(b']') {
+                    return err(Fault::Macro, "']' missing after #[");
+                }
+                Ok(e)
+            }
+            Some(c) if c.is_ascii_digit() => self.number("#"),
+            _ => err(Fault::Macro, "# needs a variable number"),
+        }
+    }
+
+    fn expr(&mut self) -> Result<Expr, SyntaxError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return err(Fault::Macro, "expression nested too deeply");
+        }
+        let e = self.binary(1);
+        self.depth -= 1;
+        e
+    }
+
+    fn binary(&mut self, min_prec: u8) -> Result<Expr, SyntaxError> {
+        let mut lhs = self.unary()?;
+        loop {
+            self.skip_ws();
+            let Some((op, len)) = self.operator() else {
+                break;
+            };
+            if op.precedence() < min_prec {
+                break;
+            }
+            self.i += len;
+            let rhs = self.binary(op.precedence() + 1)?;
+            lhs = Expr::Binary(op, Box::new(lhs), Box::new(rhs));
+        }
+        Ok(lhs)
+    }
+
+    fn operator(&self) -> Option<(BinOp, usize)> {
+        let two = self.s.get(self.i..self.i + 2).unwrap_or(&[]);
+        let op2 = match two {
+            b"==" => Some(BinOp::Eq),
+            b"!=" => Some(BinOp::Ne),
+            b">=" => Some(BinOp::Ge),
+            b"<=" => Some(BinOp::Le),
+            b"&&" => Some(BinOp::And),
+            b"||" => Some(BinOp::Or),
+            _ => None,
+        };
+        if let Some(op) = op2 {
+            return Some((op, 2));
+        }
+        let op = match self.peek()? {
+            b'+' => BinOp::Add,
+            b'-' => BinOp::Sub,
+            b'*' => BinOp::Mul,
+            b'/' => BinOp::Div,
+            b'>' => BinOp::Gt,
+            b'<' => BinOp::Lt,
+            b'&' => BinOp::BitAnd,
+            b'|' => BinOp::BitOr,
+            b'^' => BinOp::BitXor,
+            _ => return None,
+        };
+        Some((op, 1))
+    }
+
+    fn unary(&mut self) -> Result<Expr, SyntaxError> {
+        self.skip_ws();
+        let op = match self.peek() {
+            Some(b'-') => Some(UnOp::Neg),
+            Some(b'+') => None,
+            Some(b'!') if self.s.get(self.i + 1) != Some(&b'=') => Some(UnOp::Not),
+            Some(b'~') => Some(UnOp::BitNot),
+            _ => return self.primary(),
+        };
+        self.i += 1;
+        self.depth += 1;
+        if self.depth > MAX_DEPTH * 4 {
+            return err(Fault::Macro, "expression nested too deeply");
+        }
+        let inner = self.unary();
+        self.depth -= 1;
+        let inner = inner?;
+        Ok(match op {
+            Some(op) => Expr::Unary(op, Box::new(inner)),
+            None => inner,
+        })
+    }
+
+    fn primary(&mut self) -> Result<Expr, SyntaxError> {
+        self.skip_ws();
+        match self.peek() {
+            Some(b'#') => {
+                self.i += 1;
+                Ok(Expr::Var(Box::new(self.var_index()?)))
+            }
+            Some(b'[') => {
+                self.i += 1;
+                let e = self.expr()?;
+                if !self.eat(b']') {
+                    return err(Fault::Macro, "']' missing");
+                }
+                Ok(e)
+            }
+            Some(c) if c.is_ascii_digit() || c == b'.' => self.number("expression"),
+            Some(c) if c.is_ascii_uppercase() => {
+                let name = self.ident().to_string();
+                let Some(f) = Func::from_name(&name) else {
+                    return err(Fault::Macro, format!("unknown function {name}"));
+                };
+                self.i += name.len();
+                let mut args = Vec::new();
+                for _ in 0..f.arity() {
+                    if !self.eat(b'[') {
+                        return err(Fault::Macro, format!("{name} needs [argument]"));
+                    }
+                    args.push(self.expr()?);
+                    if !self.eat(b']') {
+                        return err(Fault::Macro, format!("']' missing after {name}"));
+                    }
+                }
+                Ok(Expr::Call(f, args))
+            }
+            _ => err(Fault::Macro, "expression expected"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::{EvalError, Value, Variables};
+
+    struct Vars;
+    impl Variables for Vars {
+        fn read(&self, n: i64) -> Result<Value, EvalError> {
+            Ok(match n {
+                0 => None,
+                n => Some(n as f64),
+            })
+        }
+    }
+
+    fn words(text: &str) -> Vec<(char, Option<f64>)> {
+        match parse_line(text, true).unwrap().stmt {
+            Stmt::Words(w) => w
+                .iter()
+                .map(|w| (w.letter, w.value.eval(&Vars).unwrap()))
+                .collect(),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn words_comments_and_semicolons() {
+        assert_eq!(
+            words("N0040 W-32 F200; (从 B 点切削至 C 点)"),
+            [('W', Some(-32.0)), ('F', Some(200.0))]
+        );
+        assert_eq!(words("N0025 M8 (开冷却液)"), [('M', Some(8.0))]);
+        assert_eq!(
+            words("g01 x.5 z-.25"),
+            [('G', Some(1.0)), ('X', Some(0.5)), ('Z', Some(-0.25))]
+        );
+        assert_eq!(
+            words("N10 G01 X10 直线插补"),
+            [('G', Some(1.0)), ('X', Some(10.0))]
+        );
+        assert_eq!(words("G0X#1"), [('G', Some(0.0)), ('X', Some(1.0))]);
+        assert_eq!(words("X[-#2]"), [('X', Some(-2.0))]);
+        assert_eq!(words("U[-2*[#2]]"), [('U', Some(-4.0))]);
+        let l = parse_line("N0010 M53.1K[#4]", true).unwrap();
+        assert_eq!(l.number, Some(10));
+    }
+
+    #[test]
+    fn macro_statements() {
+        let l = parse_line("N0050IF[#1 < 100]GOTO30", true).unwrap();
+        assert!(matches!(l.stmt, Stmt::If { .. }));
+        let l = parse_line("N0010#1=1", true).unwrap();
+        assert!(matches!(l.stmt, Stmt::Assign { .. }));
+        let l = parse_line("N0010GOTO[#1+100]", true).unwrap();
+        assert!(matches!(l.stmt, Stmt::Goto(_)));
+        let l = parse_line("IF[#8==#3] M99", true).unwrap();
+        assert!(matches!(l.stmt, Stmt::If { .. }));
+    }
+
+    #[test]
+    fn precedence_as_printed() {
+        let Stmt::Assign { value, .. } = parse_line("#1=2+3*4", true).unwrap().stmt else {
+            panic!()
+        };
+        assert_eq!(value.eval(&Vars).unwrap(), Some(14.0));
+        let Stmt::Assign { value, .. } = parse_line("#1=5&4==4", true).unwrap().stmt else {
+            panic!()
+        };
+        // Bitwise binds loosest (D11): 5 & (4 == 4) = 5 & 1 = 1.
+        assert_eq!(value.eval(&Vars).unwrap(), Some(1.0));
+    }
+
+    #[test]
+    fn block_skip_percent_and_names() {
+        assert_eq!(parse_line("/N10 X1", true).unwrap().skip, Some(1));
+        assert_eq!(parse_line("/2 X1", true).unwrap().skip, Some(2));
+        assert!(parse_line("N0120 %", true).unwrap().percent);
+        assert_eq!(
+            parse_line("O0001 ; (程序名)", true)
+                .unwrap()
+                .name
+                .as_deref(),
+            Some("O0001")
+        );
+        assert_eq!(
+            parse_line("%12", false).unwrap().name.as_deref(),
+            Some("12")
+        );
+    }
+
+    #[test]
+    fn malformed_text_is_an_error() {
+        for bad in [
+            "G01 X1..2",
+            "G01 X",
+            "G01 (open",
+            "G01 X1 = 2",
+            "#1=[2",
+            "#1=SIN 2",
+        ] {
+            assert!(parse_line(bad, true).is_err(), "{bad}");
+        }
+        assert!(parse_line(&format!("X{}", "9".repeat(400)), true).is_err());
+        assert!(parse_line(&format!("#1={}1{}", "[".repeat(100), "]".repeat(100)), true).is_err());
+        assert_eq!(
+            parse_line("#1=2", false).unwrap_err().fault,
+            Fault::UndefinedCode
+        );
+    }
+}
