@@ -71,6 +71,8 @@ enum Repeat {
         remaining: Option<u32>,
         then: Option<Pos>,
         home: Option<Vec<f64>>,
+        /// Program end of the block that started the range (`G70 P Q M30`), run after it.
+        end_code: Option<i32>,
     },
     /// GTC2E `M98 P L`: a subroutine by line number, ended by M99.
     LineCall {
@@ -384,6 +386,7 @@ impl Interpreter {
                 remaining,
                 then,
                 home,
+                end_code,
             }) = frame.repeats.last().cloned()
             else {
                 return Ok(());
@@ -399,6 +402,12 @@ impl Interpreter {
                     }
                     if let Some(home) = home {
                         self.rapid_to(&home);
+                    }
+                    if let Some(code) = end_code {
+                        self.saw_end = true;
+                        self.aux(Aux::M(code));
+                        self.finish();
+                        return Ok(());
                     }
                     // An enclosing range may end on the same line.
                     continue;
@@ -965,7 +974,9 @@ impl Interpreter {
                 self.push(Command::PathMode { exact_stop: false });
             }
         }
-        self.flow_m_codes(&b)?;
+        if !b.has_g(G::Finishing) {
+            self.flow_m_codes(&b)?;
+        }
         if self.has_axis_words(&b) || self.pending.len() > produced {
             self.previous_start = start_of_block;
         }
@@ -1596,6 +1607,7 @@ impl Interpreter {
             remaining: count,
             then,
             home: None,
+            end_code: None,
         });
         f.pos = first;
         Ok(())
@@ -1640,6 +1652,7 @@ impl Interpreter {
             remaining: Some(count),
             then: None,
             home: None,
+            end_code: None,
         });
         f.pos = first;
         Ok(())

@@ -424,7 +424,11 @@ impl Interpreter {
         }
         let home = self.work_position();
         let then = self.frame().pos;
-        // M codes of the G70 block itself (M30 in `G70 P Q M30`) come after the cycle.
+        // A program end in the G70 block itself (`G70 P Q M30`) comes after the cycle.
+        let end_code =
+            b.m.iter()
+                .find(|m| m.0 == M::ProgramEnd)
+                .map(|m| (m.1 / 10) as i32);
         let f = self.frame();
         f.repeats.push(Repeat::Range {
             first,
@@ -432,6 +436,7 @@ impl Interpreter {
             remaining: Some(1),
             then: Some(then),
             home: Some(home),
+            end_code,
         });
         f.pos = first;
         Ok(())

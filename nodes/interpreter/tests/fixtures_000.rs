@@ -1,0 +1,596 @@
+//! The Huaxing manual's example programs (`../shared/fixtures/000/`), with what each header
+//! says, checked on the canonical stream and, for cutting cycles, on the swept 2-D stock.
+
+use cnc_interpreter::{Aux, Canon, Command, Dialect, Library, ProgramError, Setup};
+
+const HOME: [f64; 2] = [200.0, 100.0];
+
+fn fixture(name: &str) -> String {
+    let path = format!(
+        "{}/../../../shared/fixtures/000/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    text.split("(--- listing as printed ---)")
+        .nth(1)
+        .expect("listing marker")
+        .to_string()
+}
+
+/// The 1-based line of the listing that starts with `start`.
+fn line_of(text: &str, start: &str) -> u32 {
+    text.lines()
+        .position(|l| l.trim_start().starts_with(start))
+        .expect("line") as u32
+        + 1
+}
+
+fn run(text: &str, start: [f64; 2]) -> Result<Vec<Canon>, ProgramError> {
+    cnc_interpreter::check(Dialect::HuaxingLathe, text, Setup::lathe(start))
+}
+
+fn run_lib(text: &str, lib: Library) -> Result<Vec<Canon>, ProgramError> {
+    cnc_interpreter::check_with_library(Dialect::HuaxingLathe, text, Setup::lathe(HOME), lib)
+}
+
+fn end_of(c: &Command) -> Option<[f64; 2]> {
+    match c {
+        Command::Rapid { end }
+        | Command::Linear { end, .. }
+        | Command::Arc { end, .. }
+        | Command::Thread { end, .. } => Some([end[0], end[1]]),
+        _ => None,
+    }
+}
+
+fn ends(cmds: &[Canon]) -> Vec<[f64; 2]> {
+    cmds.iter().filter_map(|c| end_of(&c.command)).collect()
+}
+
+fn close(a: [f64; 2], b: [f64; 2], tol: f64) -> bool {
+    (a[0] - b[0]).abs() <= tol && (a[1] - b[1]).abs() <= tol
+}
+
+/// The material of a turned part as a boundary along one axis: for G71-style work the radius
+/// of the material at each Z (material inside), for G72-style work the face Z at each radius
+/// (material toward −Z). Sampled every `h` mm; feeds lower the boundary, rapids must not cut.
+struct Stock {
+    radial: bool,
+    t0: f64,
+    h: f64,
+    v: Vec<f64>,
+    max_cut: f64,
+    rapid_through: Vec<String>,
+}
+
+impl Stock {
+    fn new(radial: bool, t0: f64, t1: f64, value: f64) -> Stock {
+        let h = 0.01;
+        let n = ((t1 - t0) / h).round() as usize + 1;
+        Stock {
+            radial,
+            t0,
+            h,
+            v: vec![value; n],
+            max_cut: 0.0,
+            rapid_through: vec![],
+        }
+    }
+    /// Plane point of a machine end (X diameter, Z) as (t, value).
+    fn tv(&self, p: [f64; 2]) -> (f64, f64) {
+        let (r, z) = (p[0] / 2.0, p[1]);
+        if self.radial {
+            (z, r)
+        } else {
+            (r, z)
+        }
+    }
+    fn segment(&mut self, a: [f64; 2], b: [f64; 2], rapid: bool, line: u32) {
+        let ((ta, va), (tb, vb)) = (self.tv(a), self.tv(b));
+        let (lo, hi) = (ta.min(tb), ta.max(tb));
+        let i0 = ((lo - self.t0) / self.h).ceil().max(0.0) as usize;
+        let i1 = (((hi - self.t0) / self.h).floor() as i64).min(self.v.len() as i64 - 1);
+        if i1 < i0 as i64 {
+            return;
+        }
+        for i in i0..=(i1 as usize) {
+            let t = self.t0 + i as f64 * self.h;
+            let path = if (tb - ta).abs() < 1e-12 {
+                va.min(vb)
+            } else {
+                va + (vb - va) * (t - ta) / (tb - ta)
+            };
+            let cut = self.v[i] - path;
+            if cut > 1e-6 {
+                if rapid {
+                    self.rapid_through.push(format!(
+                        "line {line}: rapid {cut:.4} mm into stock at {t:.3}"
+                    ));
+                } else {
+                    self.max_cut = self.max_cut.max(cut);
+                    self.v[i] = path;
+                }
+            }
+        }
+    }
+    fn apply(&mut self, cmds: &[Canon], start: [f64; 2]) {
+        let mut cur = start;
+        for c in cmds {
+            match &c.command {
+                Command::Rapid { end } => {
+                    // Each axis at its own rate: check both dog-leg corners' hull as a line and
+                    // the two axis-first paths (the conservative envelope).
+                    let e = [end[0], end[1]];
+                    self.segment(cur, e, true, c.line);
+                    cur = e;
+                }
+                Command::Linear { end, .. } | Command::Thread { end, .. } => {
+                    let e = [end[0], end[1]];
+                    self.segment(cur, e, false, c.line);
+                    cur = e;
+                }
+                Command::Arc {
+                    end,
+                    center,
+                    clockwise,
+                    ..
+                } => {
+                    let (cz, cr) = (center[1], center[0] / 2.0);
+                    let (az, ar) = (cur[1], cur[0] / 2.0);
+                    let (ez, er) = (end[1], end[0] / 2.0);
+                    let rad = ((az - cz).powi(2) + (ar - cr).powi(2)).sqrt();
+                    let a0 = (ar - cr).atan2(az - cz);
+                    let a1 = (er - cr).atan2(ez - cz);
+                    let mut sw = a1 - a0;
+                    if *clockwise {
+                        while sw >= 0.0 {
+                            sw -= std::f64::consts::TAU;
+                        }
+                    } else {
+                        while sw <= 0.0 {
+                            sw += std::f64::consts::TAU;
+                        }
+                    }
+                    let n = 20000;
+                    let mut p = cur;
+                    for k in 1..=n {
+                        let ang = a0 + sw * k as f64 / n as f64;
+                        let q = [2.0 * (cr + rad * ang.sin()), cz + rad * ang.cos()];
+                        self.segment(p, q, false, c.line);
+                        p = q;
+                    }
+                    cur = [end[0], end[1]];
+                }
+                _ => {}
+            }
+        }
+    }
+    fn at(&self, t: f64) -> f64 {
+        self.v[((t - self.t0) / self.h).round() as usize]
+    }
+}
+
+/// Radius of a polyline contour (Z, X-diameter points) at z (first hit).
+fn contour_at(points: &[[f64; 2]], z: f64) -> Option<f64> {
+    points.windows(2).find_map(|w| {
+        let ([z0, x0], [z1, x1]) = (w[0], w[1]);
+        let (lo, hi) = (z0.min(z1), z0.max(z1));
+        (z >= lo && z <= hi && (z1 - z0).abs() > 1e-9)
+            .then(|| (x0 + (x1 - x0) * (z - z0) / (z1 - z0)) / 2.0)
+    })
+}
+
+#[test]
+fn fixture_029_g71_type_one_leaves_contour_plus_allowance() {
+    let cmds = run(&fixture("029_g71_type1_example1.nc"), HOME).unwrap();
+    // Blank: bar dia 100 from Z140 to Z60 (the contour's span), start point X100 Z160.
+    let mut stock = Stock::new(true, 40.0, 170.0, 50.0);
+    stock.apply(&cmds, HOME);
+    assert!(stock.rapid_through.is_empty(), "{:?}", stock.rapid_through);
+    assert!(stock.max_cut <= 2.0 + 1e-6, "deepest cut {}", stock.max_cut);
+    // Contour (Z, X) shifted by U2 (diameter) W2: material left = contour + allowance.
+    let contour = [
+        [140.0, 20.0],
+        [100.0, 40.0],
+        [100.0, 60.0],
+        [80.0, 60.0],
+        [60.0, 80.0],
+        [60.0, 100.0],
+    ];
+    let shifted: Vec<[f64; 2]> = contour.iter().map(|p| [p[0] + 2.0, p[1] + 2.0]).collect();
+    let mut z = 62.05;
+    while z < 141.95 {
+        let want = contour_at(&shifted, z).unwrap();
+        assert!(
+            (stock.at(z) - want).abs() < 1e-6,
+            "at Z{z}: {} vs {want}",
+            stock.at(z)
+        );
+        z += 0.5;
+    }
+    // The cycle ends at its start point, then M30.
+    assert!(close(*ends(&cmds).last().unwrap(), [100.0, 160.0], 1e-9));
+}
+
+#[test]
+fn fixture_030_g71_type_two_cuts_pockets() {
+    let cmds = run(&fixture("030_g71_type2_example2.nc"), HOME).unwrap();
+    let mut stock = Stock::new(true, 0.0, 130.0, 40.0);
+    stock.apply(&cmds, HOME);
+    assert!(stock.rapid_through.is_empty(), "{:?}", stock.rapid_through);
+    assert!(stock.max_cut <= 2.0 + 1e-6, "deepest cut {}", stock.max_cut);
+    // Straight pieces of the contour (+U3 diameter, W0): X25 Z110..100, X70 Z90..85, X60 at Z45.
+    for (z, x) in [(105.0, 25.0), (87.5, 70.0), (45.0, 60.0)] {
+        assert!(
+            (stock.at(z) - (x + 3.0) / 2.0).abs() < 1e-6,
+            "at Z{z}: {}",
+            stock.at(z)
+        );
+    }
+    assert!(close(*ends(&cmds).last().unwrap(), [80.0, 125.0], 1e-9));
+}
+
+#[test]
+fn fixture_033_g72_faces_in_layers_and_g70_finishes() {
+    let text = fixture("033_g72_radial_roughing_O0005.nc");
+    let cmds = run(&text, HOME).unwrap();
+    // Face model: material below Z10 for every radius up to 88 (X176).
+    let mut stock = Stock::new(false, 0.0, 88.0, 10.0);
+    // The roughing is what the G72 blocks produced; G70 later runs lines after them.
+    let g72_line = line_of(&text, "G72 P10");
+    let rough: Vec<Canon> = cmds
+        .iter()
+        .filter(|c| c.line <= g72_line)
+        .cloned()
+        .collect();
+    stock.apply(&rough, HOME);
+    assert!(stock.rapid_through.is_empty(), "{:?}", stock.rapid_through);
+    assert!(stock.max_cut <= 2.0 + 1e-6, "deepest cut {}", stock.max_cut);
+    // Contour X160 Z-55 → X80 Z-35 → Z-20 → X40 Z0, shifted U0.2 W0.1.
+    let face = |r: f64| {
+        let x = 2.0 * r;
+        if x >= 80.2 {
+            -55.0 + (160.2 - x) / 80.0 * 20.0 + 0.1
+        } else if x >= 40.2 {
+            -20.0 + (80.2 - x) / 40.0 * 20.0 + 0.1
+        } else {
+            f64::NAN
+        }
+    };
+    let mut r = 20.2;
+    while r < 80.0 {
+        let want = face(r);
+        assert!(
+            (stock.at(r) - want).abs() < 1e-6,
+            "at R{r}: {} vs {want}",
+            stock.at(r)
+        );
+        r += 0.37;
+    }
+    // G70 runs the contour blocks themselves, then returns to the start; M30 after it.
+    let g70: Vec<&Canon> = cmds.iter().filter(|c| c.line > g72_line).collect();
+    assert!(g70.iter().any(|c| matches!(c.command, Command::Linear { ref end, .. } if close([end[0], end[1]], [40.0, 0.0], 1e-9))));
+    let last_move = cmds.iter().rev().find_map(|c| end_of(&c.command)).unwrap();
+    assert!(close(last_move, [176.0, 10.0], 1e-9));
+    assert!(matches!(
+        cmds[cmds.len() - 2].command,
+        Command::Aux(Aux::M(30))
+    ));
+}
+
+#[test]
+fn fixture_034_g73_repeats_the_pattern_three_times() {
+    let cmds = run(&fixture("034_g73_pattern_repeat_O0006.nc"), HOME).unwrap();
+    // Feed per revolution for the roughing (G99), three passes approaching the contour.
+    assert!(cmds
+        .iter()
+        .any(|c| c.command == Command::FeedMode { per_rev: true }));
+    let finals: Vec<[f64; 2]> = ends(&cmds)
+        .into_iter()
+        .filter(|e| {
+            (e[1] - (-80.0 + 0.3)).abs() < 1e-9
+                || (e[1] - (-79.5)).abs() < 1e-9
+                || (e[1] - (-80.0 + 0.3 + 1.0)).abs() < 1e-9
+        })
+        .collect();
+    assert!(!finals.is_empty());
+    // Last rough pass: contour + (U0.5, W0.3): the final point X180 Z-80 lands at X180.5 Z-79.7.
+    assert!(ends(&cmds).iter().any(|e| close(*e, [180.5, -79.7], 1e-9)));
+    // First pass: + relief (U1.0 radius = 2 mm diameter, W1.0).
+    assert!(ends(&cmds).iter().any(|e| close(*e, [182.5, -78.7], 1e-9)));
+    let feed_moves = cmds
+        .iter()
+        .filter(|c| matches!(c.command, Command::Linear { feed, .. } if (feed - 0.3).abs() < 1e-12))
+        .count();
+    assert!(feed_moves >= 3 * 4, "{feed_moves}");
+}
+
+#[test]
+fn fixture_027_g90_turns_dia_60_and_the_taper() {
+    let cmds = run(&fixture("027_g90_axial_cycle_O0002.nc"), HOME).unwrap();
+    // Blank dia 125 from the face Z0 back to Z-115.
+    let mut stock = Stock::new(true, -115.0, 0.0, 62.5);
+    stock.apply(&cmds, HOME);
+    assert!(stock.rapid_through.is_empty(), "{:?}", stock.rapid_through);
+    // The program's own steps: 5 mm (radius) per diameter pass, 7.5 mm per taper pass (R).
+    assert!(stock.max_cut <= 7.5 + 1e-6, "deepest cut {}", stock.max_cut);
+    assert!((stock.at(-100.0) - 60.0).abs() < 1e-6);
+    assert!((stock.at(-15.0) - 30.0).abs() < 1e-6);
+    // The taper's last pass: X60 at Z-30 to X120 at Z-80.
+    assert!(
+        (stock.at(-55.0) - (30.0 + 30.0 * 25.0 / 50.0)).abs() < 1e-6,
+        "{}",
+        stock.at(-55.0)
+    );
+}
+
+#[test]
+fn fixture_039_g92_threads_in_four_passes_with_lead_3() {
+    let cmds = run(&fixture("039_g92_thread_cycle_O0012.nc"), HOME).unwrap();
+    let threads: Vec<(f64, [f64; 2])> = cmds
+        .iter()
+        .filter_map(|c| {
+            if let Command::Thread { end, lead, .. } = &c.command {
+                Some((*lead, [end[0], end[1]]))
+            } else {
+                None
+            }
+        })
+        .collect();
+    assert!(threads.iter().all(|t| (t.0 - 3.0).abs() < 1e-12));
+    // Each pass: thread to Z-27 (K1 run-out start), then run-out J3 (radius) to Z-28.
+    let bottoms: Vec<f64> = threads
+        .iter()
+        .filter(|t| (t.1[1] + 27.0).abs() < 1e-9)
+        .map(|t| t.1[0])
+        .collect();
+    assert_eq!(bottoms, [58.7, 57.7, 57.0, 56.9]);
+    assert!(threads
+        .iter()
+        .filter(|t| (t.1[1] + 28.0).abs() < 1e-9)
+        .all(|t| bottoms.iter().any(|b| (t.1[0] - b - 6.0).abs() < 1e-9)));
+}
+
+#[test]
+fn fixture_040_g76_depths_follow_the_square_root_rule() {
+    let cmds = run(&fixture("040_g76_multiple_thread_O0013.nc"), HOME).unwrap();
+    // G50 shifts the work system, so compare depths, not absolute X.
+    let threads: Vec<[f64; 2]> = cmds
+        .iter()
+        .filter_map(|c| {
+            if let Command::Thread { end, lead, .. } = &c.command {
+                assert_eq!(*lead, 6.0);
+                Some([end[0], end[1]])
+            } else {
+                None
+            }
+        })
+        .collect();
+    // Pass bottoms (before the run-out) are where Z is 3 mm (0.5 × lead) short of the end.
+    let zend = threads.iter().map(|t| t[1]).fold(f64::INFINITY, f64::min);
+    let bottoms: Vec<f64> = threads
+        .iter()
+        .filter(|t| (t[1] - (zend + 3.0)).abs() < 1e-6)
+        .map(|t| t[0])
+        .collect();
+    let root = bottoms.iter().copied().fold(f64::INFINITY, f64::min);
+    let depths: Vec<f64> = bottoms.iter().map(|x| 3.68 - (x - root) / 2.0).collect();
+    // 1.8 √n while below k − d = 3.58 (1.8 √4 = 3.6 is not), then the last rough pass at
+    // 3.58, then 2 finishing passes at 3.68.
+    let expect = [1.8, 1.8 * 2f64.sqrt(), 1.8 * 3f64.sqrt(), 3.58, 3.68, 3.68];
+    assert_eq!(depths.len(), expect.len(), "{depths:?}");
+    for (d, e) in depths.iter().zip(expect) {
+        assert!((d - e).abs() < 1e-9, "{depths:?}");
+    }
+}
+
+#[test]
+fn fixture_035_036_grooving_pecks_never_deeper_than_the_step() {
+    let cmds = run(&fixture("036_g75_radial_grooving_O0008.nc"), HOME).unwrap();
+    let mut stock = Stock::new(true, -60.0, 0.0, 62.5);
+    stock.apply(&cmds, HOME);
+    assert!(stock.rapid_through.is_empty(), "{:?}", stock.rapid_through);
+    assert!(stock.max_cut <= 6.0 + 1e-6, "{}", stock.max_cut);
+    // Groove floor X40 at every plunge from Z-24 in steps of 3 (Q30000) to Z-50 (the 4 mm
+    // tool covers between them; the stock model follows the tool point).
+    for z in [-24.0, -30.0, -42.0, -50.0] {
+        assert!(
+            (stock.at(z) - 20.0).abs() < 1e-6,
+            "at Z{z}: {}",
+            stock.at(z)
+        );
+    }
+    let cmds = run(&fixture("035_g74_face_grooving_O0007.nc"), HOME).unwrap();
+    let mut face = Stock::new(false, 0.0, 18.0, 0.0);
+    face.apply(&cmds, HOME);
+    assert!(face.max_cut <= 5.0 + 1e-6, "{}", face.max_cut);
+    for r in [10.0, 12.0, 15.0, 18.0] {
+        assert!((face.at(r) + 20.0).abs() < 1e-6, "at R{r}: {}", face.at(r));
+    }
+}
+
+#[test]
+fn fixture_037_g32_taper_thread_passes() {
+    let cmds = run(&fixture("037_g32_taper_thread_O0009.nc"), HOME).unwrap();
+    let t: Vec<[f64; 2]> = cmds
+        .iter()
+        .filter_map(|c| {
+            if let Command::Thread { end, lead, .. } = &c.command {
+                assert_eq!(*lead, 2.0);
+                Some([end[0], end[1]])
+            } else {
+                None
+            }
+        })
+        .collect();
+    assert_eq!(t.len(), 2);
+    assert!(close(t[0], [48.8571, -72.0], 1e-9) && close(t[1], [47.4286, -72.0], 1e-9));
+}
+
+#[test]
+fn fixture_002_g96_speeds_at_the_end_points() {
+    let cmds = run(&fixture("002_g96_constant_surface_speed.nc"), HOME).unwrap();
+    let s: Vec<f64> = cmds
+        .iter()
+        .filter_map(|c| {
+            if let Command::Aux(Aux::S(v)) = c.command {
+                Some(v)
+            } else {
+                None
+            }
+        })
+        .collect();
+    // 300 m/min: X100 → 955, X50 → 1910, X80 → 1194 r/min (manual's figures, rounded).
+    for want in [955.0, 1910.0, 1194.0] {
+        assert!(
+            s.iter().any(|v| (v - want).abs() < 0.5),
+            "{want} not in {s:?}"
+        );
+    }
+}
+
+#[test]
+fn macros_fixtures_042_to_050() {
+    let cmds = run(&fixture("042_macro_variables_intro.nc"), [0.0, 0.0]).unwrap();
+    assert!(
+        matches!(&cmds[0].command, Command::Linear { end, feed } if (end[0] - 34.202).abs() < 1e-3 && *feed == 500.0)
+    );
+    let cmds = run(
+        &fixture("045_macro_expressions_in_blocks.nc")
+            .lines()
+            .nth(2)
+            .unwrap()
+            .replace("N0010", "#3=100\n"),
+        [0.0, 0.0],
+    )
+    .unwrap();
+    assert!(ends(&cmds).iter().any(|e| (e[0] - 84.2788).abs() < 1e-3));
+    let xs: Vec<f64> = ends(&run(&fixture("048_macro_if_goto.nc"), [0.0, 0.0]).unwrap())
+        .iter()
+        .map(|e| e[0])
+        .collect();
+    assert_eq!(xs, [0.0, 20.0, 40.0, 60.0, 80.0, 100.0]);
+    let xs: Vec<f64> = ends(&run(&fixture("049_macro_if_execute.nc"), [0.0, 0.0]).unwrap())
+        .iter()
+        .map(|e| e[0])
+        .collect();
+    assert_eq!(xs, [10.0]);
+    // 050: 20 passes feeding to 80, 78, … 42, each followed by a rapid 4 mm out; the listing's
+    // elision "N0090..." after the loop is a data format error on that line.
+    let text = fixture("050_macro_loop_example.nc");
+    let e = run(&text, [100.0, 20.0]).unwrap_err();
+    assert_eq!((e.number, line_of(&text, "N0090...")), (13, e.line));
+    let text: String = text
+        .lines()
+        .take_while(|l| !l.starts_with("N0090"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let feeds: Vec<f64> = run(&text, [100.0, 20.0])
+        .unwrap()
+        .iter()
+        .filter_map(|c| {
+            if let Command::Linear { end, .. } = &c.command {
+                Some(end[0])
+            } else {
+                None
+            }
+        })
+        .collect();
+    assert_eq!(feeds.len(), 21);
+    assert!((feeds[20] - 42.0).abs() < 1e-9);
+}
+
+#[test]
+fn fixture_051_sphere_calls_o0010_from_the_library() {
+    let mut lib = Library::new();
+    lib.insert(10, "O0010", &fixture("052_macro_sphere_sub_O0010.nc"));
+    let cmds = run_lib(&fixture("051_macro_sphere_main.nc"), lib).unwrap();
+    let radii: Vec<f64> = cmds
+        .iter()
+        .scan([200.0, 120.0], |cur, c| {
+            let r = if let Command::Arc { center, .. } = &c.command {
+                Some(
+                    ((cur[0] / 2.0 - center[0] / 2.0).powi(2) + (cur[1] - center[1]).powi(2))
+                        .sqrt(),
+                )
+            } else {
+                None
+            };
+            if let Some(e) = end_of(&c.command) {
+                *cur = e;
+            }
+            Some(r)
+        })
+        .flatten()
+        .collect();
+    let want: Vec<f64> = (1..=10).map(|k| 10.0 * k as f64).collect();
+    assert_eq!(radii.len(), 10);
+    for (r, w) in radii.iter().zip(want) {
+        assert!((r - w).abs() < 1e-9, "{radii:?}");
+    }
+}
+
+#[test]
+fn block_range_fixtures_018_to_022_run_in_the_stated_order() {
+    let order = |name: &str, inputs: &[(u32, u8)]| {
+        let mut setup = Setup::lathe([0.0, 0.0]);
+        setup.inputs = inputs.iter().copied().collect();
+        let text = fixture(name);
+        let cmds = cnc_interpreter::check(Dialect::HuaxingLathe, &text, setup).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        cmds.iter()
+            .filter(|c| end_of(&c.command).is_some())
+            .map(|c| {
+                lines[c.line as usize - 1]
+                    .split_whitespace()
+                    .next()
+                    .unwrap_or("")
+                    .to_string()
+            })
+            .collect::<Vec<_>>()
+            .join("-")
+    };
+    assert_eq!(
+        order("020_g25_jump_machining.nc", &[]),
+        "N0010-N0040-N0050-N0040-N0050"
+    );
+    assert_eq!(
+        order("021_g26_transfer_machining.nc", &[]),
+        "N0010-N0040-N0050-N0040-N0050-N0030-N0040-N0050"
+    );
+    // G21 runs the range when X2.7 has a signal, G23 when it has none (decision D21).
+    assert_eq!(
+        order("018_g21_jump_if_input_low.nc", &[(2, 7)]),
+        "N0010-N0040-N0050-N0040-N0050"
+    );
+    assert_eq!(
+        order("018_g21_jump_if_input_low.nc", &[]),
+        "N0010-N0030-N0040-N0050"
+    );
+    assert_eq!(
+        order("019_g23_jump_if_input_high.nc", &[]),
+        "N0010-N0040-N0050-N0040-N0050"
+    );
+    assert_eq!(
+        order("019_g23_jump_if_input_high.nc", &[(2, 7)]),
+        "N0010-N0030-N0040-N0050"
+    );
+    // G27 without L loops forever; a check stops after the first pass.
+    assert_eq!(
+        order("022_g27_infinite_loop.nc", &[]),
+        "N0010-N0020-N0030-N0040-N0030-N0040"
+    );
+}
+
+#[test]
+fn fixtures_with_the_alarm_the_manual_predicts() {
+    // 041: after `G3 W-40 R20` the block `W-10` is still G03 by the modal rules and has no R:
+    // alarm 11 (decision D26), after the arc of line 13 ran.
+    let text = fixture("041_g98_feed_vector_example.nc");
+    let e = run(&text, HOME).unwrap_err();
+    assert_eq!((e.number, line_of(&text, "W-10;")), (11, e.line));
+    // 057 writes `C01` (for G01): this lathe has no C axis, alarm 7 on that line.
+    let e = run(&fixture("057_ch20_ex3_aluminium_shaft.nc"), HOME).unwrap_err();
+    assert_eq!(e.number, 7);
+    assert!(e.text.contains('C'), "{e}");
+}
