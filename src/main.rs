@@ -131,7 +131,12 @@ fn check(
     if trace {
         let mut interp = cnc_interpreter::Interpreter::with_library(dialect, &text, setup, lib);
         let mut out = String::new();
+        let mut count = 0;
         while let Ok(Some(c)) = interp.next_command() {
+            count += 1;
+            if count > cnc_interpreter::interpreter::MAX_CHECK_COMMANDS {
+                break; // the diagnosis above reports the endless program
+            }
             out.push_str(&cnc_interpreter::trace::line(&letters, &c));
             out.push('\n');
         }

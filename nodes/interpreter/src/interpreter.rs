@@ -31,6 +31,11 @@ const MAX_CONTOUR_BLOCKS: usize = 100;
 /// Most blocks read without producing a command before the program is judged stuck in a
 /// loop that never moves (macro `GOTO` loops): alarm instead of hanging.
 const MAX_SILENT_BLOCKS: u32 = 1_000_000;
+/// Most commands a check collects: a program that jumps back forever must end a check with an
+/// alarm, not hang it.
+pub const MAX_CHECK_COMMANDS: usize = 5_000_000;
+/// Most passes or pecks one cycle block may generate.
+const MAX_CYCLE_STEPS: usize = 1_000_000;
 /// Number of local variables per program level (`000` §5.27.2: #1–#40).
 const LOCALS: usize = 41;
 
@@ -124,12 +129,11 @@ struct ThreadWords {
     k: Option<f64>,
 }
 
-/// GTC2E G31 settings: X retract length, early-retract distance, retract speed 1–7.
+/// GTC2E G31 settings: X retract length and early-retract distance.
 #[derive(Debug, Clone, Copy, Default)]
 struct GtcRetract {
     u: Option<f64>,
     w: f64,
-    speed: u32,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -249,10 +253,7 @@ impl Interpreter {
             thread: ThreadWords::default(),
             cycle: CycleWords::default(),
             gtc_cycle: None,
-            gtc_retract: GtcRetract {
-                speed: 3,
-                ..GtcRetract::default()
-            },
+            gtc_retract: GtcRetract::default(),
             last_x_direction: -1.0,
             cycle_starts: 1,
             compound: compound::CompoundWords::default(),
@@ -296,15 +297,6 @@ impl Interpreter {
                 return Err(e);
             }
         }
-    }
-
-    /// Values of the kept macro variables now, for the shell to persist.
-    pub fn kept_variables(&self) -> BTreeMap<i64, f64> {
-        self.common
-            .iter()
-            .filter(|(k, _)| is_kept(**k))
-            .map(|(&k, &v)| (k, v))
-            .collect()
     }
 
     // ---------------------------------------------------------------- errors
@@ -522,7 +514,7 @@ impl Interpreter {
 
     /// Evaluates and checks every word of a block.
     fn decode(&self, words: &[crate::syntax::Word], b: &mut Block) -> Result<(), ProgramError> {
-        let mut groups: Vec<u8> = Vec::new();
+        let mut groups: Vec<u32> = Vec::new();
         let mut m_groups: Vec<u32> = Vec::new();
         for w in words {
             let value = w.value.eval(self).map_err(|e| self.eval_err(e))?;
@@ -532,59 +524,19 @@ impl Interpreter {
             match w.letter {
                 'O' | 'N' => {}
                 'G' => {
-                    let x10 = code_x10(v).ok_or_else(|| {
-                        self.fault(Fault::UndefinedCode, format!("undefined G code G{v}"))
-                    })?;
-                    let code = self.dialect.g_code(x10).ok_or_else(|| {
-                        self.fault(
-                            Fault::UndefinedCode,
-                            format!("undefined G code G{}", show(v)),
-                        )
-                    })?;
+                    let (x10, code) = self.lookup('G', v, |n| self.dialect.g_code(n))?;
                     if let G::Unsupported(why) = code.meaning {
                         return Err(self.fault(Fault::NotSupported, format!("G{}: {why}", show(v))));
                     }
-                    if code.group != 0
-                        && groups.contains(&code.group)
-                        && self.dialect == Dialect::Gtc2eLathe
-                    {
-                        return Err(self.fault(
-                            Fault::SameGroup,
-                            format!(
-                                "G{} shares its group with another G code of the block",
-                                show(v)
-                            ),
-                        ));
-                    }
-                    groups.push(code.group);
+                    self.one_per_group('G', v, code.group != 0, code.group as u32, &mut groups)?;
                     b.g.push((code.group, code.meaning, x10));
                 }
                 'M' => {
-                    let x10 = code_x10(v).ok_or_else(|| {
-                        self.fault(Fault::UndefinedCode, format!("undefined M code M{v}"))
-                    })?;
-                    let m = self.dialect.m_code(x10).ok_or_else(|| {
-                        self.fault(
-                            Fault::UndefinedCode,
-                            format!("undefined M code M{}", show(v)),
-                        )
-                    })?;
+                    let (x10, m) = self.lookup('M', v, |n| self.dialect.m_code(n))?;
                     if let M::Unsupported(why) = m {
                         return Err(self.fault(Fault::NotSupported, format!("M{}: {why}", show(v))));
                     }
-                    if self.dialect == Dialect::Gtc2eLathe {
-                        let g = gtc_m_group(x10);
-                        if m_groups.contains(&g) {
-                            return Err(self.fault(
-                                Fault::SameGroup,
-                                format!(
-                                    "M{} shares its group with another M code of the block",
-                                    show(v)
-                                ),
-                            ));
-                        }
-                        m_groups.push(g);
-                    }
+                    self.one_per_group('M', v, true, gtc_m_group(x10), &mut m_groups)?;
                     b.m.push((m, x10));
                     if b.m.len() > MAX_M_PER_BLOCK {
                         return Err(self.fault(Fault::TooManyM, "more than 3 M codes in one block"));
@@ -643,6 +595,45 @@ impl Interpreter {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// A G or M word's code number (×10) and its meaning in the dialect's table.
+    fn lookup<T>(
+        &self,
+        letter: char,
+        v: f64,
+        table: impl Fn(u32) -> Option<T>,
+    ) -> Result<(u32, T), ProgramError> {
+        code_x10(v)
+            .and_then(|n| Some((n, table(n)?)))
+            .ok_or_else(|| {
+                self.fault(
+                    Fault::UndefinedCode,
+                    format!("undefined {letter} code {letter}{}", show(v)),
+                )
+            })
+    }
+
+    /// GTC2E allows one code per modal group in a block (`002` §4.1 rule 1, message 16).
+    fn one_per_group(
+        &self,
+        letter: char,
+        v: f64,
+        modal: bool,
+        group: u32,
+        seen: &mut Vec<u32>,
+    ) -> Result<(), ProgramError> {
+        if self.dialect == Dialect::Gtc2eLathe && modal && seen.contains(&group) {
+            return Err(self.fault(
+                Fault::SameGroup,
+                format!(
+                    "{letter}{} shares its group with another {letter} code of the block",
+                    show(v)
+                ),
+            ));
+        }
+        seen.push(group);
         Ok(())
     }
 
@@ -716,7 +707,7 @@ impl Interpreter {
 
     fn x_scale(&self) -> f64 {
         match self.axis('X') {
-            Some(i) if self.setup.diameter[i] => 0.5,
+            Some(i) if self.setup.diameter.get(i) == Some(&true) => 0.5,
             _ => 1.0,
         }
     }
@@ -960,7 +951,6 @@ impl Interpreter {
         }
         if b.has_g(G::ExactStopBlock) && self.pending.len() > produced && !self.exact_stop_mode {
             // G09: this block ends at rest; the next blends again.
-            let at = self.pending.len();
             let first = self.pending.iter().skip(produced).position(is_motion);
             if let Some(i) = first {
                 self.pending.insert(
@@ -970,7 +960,6 @@ impl Interpreter {
                         command: Command::PathMode { exact_stop: true },
                     },
                 );
-                let _ = at;
                 self.push(Command::PathMode { exact_stop: false });
             }
         }
@@ -1545,7 +1534,7 @@ impl Interpreter {
         let mut target = self.pos.clone();
         for i in 0..target.len() {
             if named[i] {
-                target[i] = self.setup.reference[i];
+                target[i] = self.setup.reference.get(i).copied().unwrap_or(target[i]);
             }
         }
         self.push(Command::Rapid {
@@ -2039,10 +2028,6 @@ fn is_motion(c: &Canon) -> bool {
     )
 }
 
-fn is_kept(n: i64) -> bool {
-    (200..=289).contains(&n)
-}
-
 /// `value × 10` as an integer code number (G50.1 → 501), if it has at most one decimal.
 fn code_x10(v: f64) -> Option<u32> {
     let x10 = (v * 10.0).round();
@@ -2098,10 +2083,10 @@ impl Variables for Interpreter {
             0 => None,
             1..=40 => frame.locals[n as usize],
             100..=289 => self.common.get(&n).copied(),
-            1000..=1031 => {
-                let (byte, bit) = (54 + (n - 1000) / 8, (n - 1000) % 8);
-                let _ = (byte, bit);
-                Some(0.0)
+            1000..=1033 => {
+                return Err(EvalError(format!(
+                    "#{n}: PLC inputs are not connected to the interpreter yet"
+                )))
             }
             4001..=4499 => {
                 let (table, num) = (n / 100 - 40, (n % 100) as u32);
@@ -2151,9 +2136,27 @@ pub fn check_with_library(
     setup: Setup,
     library: Library,
 ) -> Result<Vec<Canon>, ProgramError> {
+    check_limited(dialect, text, setup, library, MAX_CHECK_COMMANDS)
+}
+
+/// As [`check_with_library`], ending with an alarm after `limit` commands.
+pub fn check_limited(
+    dialect: Dialect,
+    text: &str,
+    setup: Setup,
+    library: Library,
+    limit: usize,
+) -> Result<Vec<Canon>, ProgramError> {
     let mut interp = Interpreter::with_library(dialect, text, setup, library);
     let mut out = Vec::new();
     while let Some(c) = interp.next_command()? {
+        if out.len() >= limit {
+            return Err(ProgramError::new(
+                dialect.alarm(Fault::Macro),
+                c.line,
+                format!("program does not end within {limit} commands (endless loop?)"),
+            ));
+        }
         out.push(c);
     }
     Ok(out)

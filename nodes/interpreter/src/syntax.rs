@@ -57,7 +57,7 @@ fn err<T>(fault: Fault, text: impl Into<String>) -> Result<T, SyntaxError> {
 /// Longest number text accepted; longer is a data format error, not a slow parse.
 const MAX_NUMBER_CHARS: usize = 24;
 /// Deepest expression nesting accepted (the manual limits bracket levels, §5.27.5).
-const MAX_DEPTH: usize = 16;
+const MAX_DEPTH: usize = 32;
 
 /// Strips comments (decision D2) and returns the ASCII code of the line.
 pub fn code_part(text: &str) -> Result<String, SyntaxError> {
@@ -233,7 +233,24 @@ impl Parser<'_> {
         }
     }
 
+    /// Enters one nesting level (`IF` after `IF`, `##…`, brackets, unary signs): a line can
+    /// nest only so deep, so a hostile line cannot exhaust the stack.
+    fn nest(&mut self) -> Result<(), SyntaxError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return err(Fault::Macro, "statement or expression nested too deeply");
+        }
+        Ok(())
+    }
+
     fn statement(&mut self) -> Result<Stmt, SyntaxError> {
+        self.nest()?;
+        let s = self.statement_inner();
+        self.depth -= 1;
+        s
+    }
+
+    fn statement_inner(&mut self) -> Result<Stmt, SyntaxError> {
         self.skip_ws();
         match self.peek() {
             None | Some(b'%') => Ok(Stmt::Empty),
@@ -325,12 +342,7 @@ impl Parser<'_> {
             }
             Some(b'[') => {
                 self.require_macros("[")?;
-                self.i += 1;
-                let e = self.expr()?;
-                if !self.eat(b']') {
-                    return err(Fault::Macro, "']' missing");
-                }
-                e
+                self.bracketed()?
             }
             Some(c) if c.is_ascii_digit() || c == b'.' => self.number(letter)?,
             _ => {
@@ -377,30 +389,37 @@ impl Parser<'_> {
 
     /// What follows `#`: a number, another `#…`, or `[expr]`.
     fn var_index(&mut self) -> Result<Expr, SyntaxError> {
+        self.nest()?;
+        let e = self.var_index_inner();
+        self.depth -= 1;
+        e
+    }
+
+    fn var_index_inner(&mut self) -> Result<Expr, SyntaxError> {
         self.skip_ws();
         match self.peek() {
             Some(b'#') => {
                 self.i += 1;
                 Ok(Expr::Var(Box::new(self.var_index()?)))
             }
-            Some(b'[') => {
-                self.i += 1;
-                let e = self.expr()?;
-                if !self.eat(b']') {
-                    return err(Fault::Macro, "']' missing after #[");
-                }
-                Ok(e)
-            }
+            Some(b'[') => self.bracketed(),
             Some(c) if c.is_ascii_digit() => self.number("#"),
             _ => err(Fault::Macro, "# needs a variable number"),
         }
     }
 
-    fn expr(&mut self) -> Result<Expr, SyntaxError> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
-            return err(Fault::Macro, "expression nested too deeply");
+    /// `[expr]`, at the `[`.
+    fn bracketed(&mut self) -> Result<Expr, SyntaxError> {
+        self.i += 1;
+        let e = self.expr()?;
+        if !self.eat(b']') {
+            return err(Fault::Macro, "']' missing");
         }
+        Ok(e)
+    }
+
+    fn expr(&mut self) -> Result<Expr, SyntaxError> {
+        self.nest()?;
         let e = self.binary(1);
         self.depth -= 1;
         e
@@ -462,10 +481,7 @@ impl Parser<'_> {
             _ => return self.primary(),
         };
         self.i += 1;
-        self.depth += 1;
-        if self.depth > MAX_DEPTH * 4 {
-            return err(Fault::Macro, "expression nested too deeply");
-        }
+        self.nest()?;
         let inner = self.unary();
         self.depth -= 1;
         let inner = inner?;
@@ -482,14 +498,7 @@ impl Parser<'_> {
                 self.i += 1;
                 Ok(Expr::Var(Box::new(self.var_index()?)))
             }
-            Some(b'[') => {
-                self.i += 1;
-                let e = self.expr()?;
-                if !self.eat(b']') {
-                    return err(Fault::Macro, "']' missing");
-                }
-                Ok(e)
-            }
+            Some(b'[') => self.bracketed(),
             Some(c) if c.is_ascii_digit() || c == b'.' => self.number("expression"),
             Some(c) if c.is_ascii_uppercase() => {
                 let name = self.ident().to_string();
@@ -618,6 +627,10 @@ mod tests {
         }
         assert!(parse_line(&format!("X{}", "9".repeat(400)), true).is_err());
         assert!(parse_line(&format!("#1={}1{}", "[".repeat(100), "]".repeat(100)), true).is_err());
+        // Nesting that would exhaust the stack is refused, not followed.
+        assert!(parse_line(&format!("#1={}1", "#".repeat(100_000)), true).is_err());
+        assert!(parse_line(&format!("{}G0", "IF[1]".repeat(100_000)), true).is_err());
+        assert!(parse_line(&format!("#1={}1", "-".repeat(100_000)), true).is_err());
         assert_eq!(
             parse_line("#1=2", false).unwrap_err().fault,
             Fault::UndefinedCode

@@ -301,3 +301,30 @@ fn arbitrary_bytes_never_panic() {
         }
     }
 }
+
+#[test]
+fn endless_or_runaway_programs_end_in_an_alarm() {
+    let hx = |text: &str| {
+        cnc_interpreter::check(Dialect::HuaxingLathe, text, Setup::lathe([100.0, 50.0]))
+            .unwrap_err()
+    };
+    // A GOTO loop that moves, one that never moves, and cycles with absurd step counts.
+    let e = cnc_interpreter::interpreter::check_limited(
+        Dialect::HuaxingLathe,
+        "N10 G0 X1\nN20 G0 X2\nGOTO10\n",
+        Setup::lathe([100.0, 50.0]),
+        cnc_interpreter::Library::new(),
+        1000,
+    )
+    .unwrap_err();
+    assert_eq!(e.number, 20, "{e}");
+    let e = hx("N10 #1=1\nGOTO10\n");
+    assert_eq!((e.number, e.line), (20, 2), "{e}");
+    let e = hx("G0 X100 Z10\nG71 U0.00001 R1\nG71 P1 Q2 U0 W0\nN1 G0 X0\nN2 G1 Z-10000\n");
+    assert_eq!((e.number, e.line), (13, 3), "{e}");
+    let e = hx("G0 X100 Z5\nG75 R1\nG75 X0 Z-9000 P1 Q1 F10\n");
+    assert_eq!((e.number, e.line), (13, 3), "{e}");
+    // PLC inputs are not wired to the interpreter: reading one is an alarm, not a made-up 0.
+    let e = hx("#1=#1002\n");
+    assert_eq!((e.number, e.line), (20, 1), "{e}");
+}

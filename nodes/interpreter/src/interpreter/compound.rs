@@ -246,7 +246,8 @@ impl Interpreter {
                         w.relief_z = v;
                     }
                     if let Some(r) = b.get('R') {
-                        w.passes = whole(r).max(1);
+                        // 1–9999 passes (`000` §5.22.3).
+                        w.passes = whole(r).clamp(1, 9999);
                     }
                 }
             }
@@ -350,6 +351,23 @@ impl Interpreter {
                             "the contour turns back along the cut axis",
                         ));
                     }
+                }
+                // Bound the work a cycle may generate (a tiny depth over a long contour).
+                let span = shifted
+                    .iter()
+                    .map(|e| {
+                        let (lo, hi) = e.extent(radial);
+                        (lo - coord(a1)).abs().max((hi - coord(a1)).abs())
+                    })
+                    .fold(0.0, f64::max);
+                if span / w.depth > MAX_CYCLE_STEPS as f64 {
+                    return Err(self.fault(
+                        Fault::OutOfRange,
+                        format!(
+                            "depth of cut {} gives more than {MAX_CYCLE_STEPS} passes",
+                            w.depth
+                        ),
+                    ));
                 }
                 let rough = Rough {
                     radial,

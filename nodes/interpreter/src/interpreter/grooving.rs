@@ -45,6 +45,17 @@ impl Interpreter {
         if peck <= 0.0 {
             return Err(self.fault(Fault::MissingWord, "peck depth is 0"));
         }
+        let passes = if shift > 0.0 {
+            (qe - q0).abs() / shift
+        } else {
+            0.0
+        } + 1.0;
+        if passes * ((pe - p0).abs() / peck + 1.0) > MAX_CYCLE_STEPS as f64 {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!("grooving steps give more than {MAX_CYCLE_STEPS} pecks"),
+            ));
+        }
         let dir_p = if pe < p0 { -1.0 } else { 1.0 };
         let dir_q = if qe < q0 { -1.0 } else { 1.0 };
         let point = |p: f64, q: f64| {
@@ -60,12 +71,7 @@ impl Interpreter {
         };
         let feed = self.feed;
         let mut q = q0;
-        let mut guard = 0;
         loop {
-            guard += 1;
-            if guard > 100_000 {
-                return Err(self.fault(Fault::OutOfRange, "grooving cycle with too many passes"));
-            }
             // Pecks down to the end along the peck axis.
             let mut p = p0;
             while (pe - p) * dir_p > 1e-9 {

@@ -265,7 +265,7 @@ impl Interpreter {
             if !(1..=7).contains(&whole(l)) {
                 return Err(self.fault(Fault::OutOfRange, "G31 L: speed 1–7"));
             }
-            self.gtc_retract.speed = whole(l);
+            // The retract speed is the planner's business (issue 4); only its range is checked.
         }
         if u.is_some() {
             self.gtc_retract.u = u;
