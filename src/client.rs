@@ -7,6 +7,7 @@ use cnc_msgs::srv::*;
 use cnc_runtime::config::NetworkConfig;
 use cnc_runtime::dds::{qos, RosNode};
 use ros2_client::dds::{Client, Subscription};
+use ros2_client::qos::History;
 use ros2_client::{Name, ServiceMapping, ServiceTypeName};
 
 pub struct CellClient {
@@ -62,10 +63,12 @@ impl CellClient {
             start: client::<StartProgram>(&mut ros, mapping, ns, "start_program")?,
             stop: client::<Stop>(&mut ros, mapping, ns, "stop")?,
             reset: client::<Reset>(&mut ros, mapping, ns, "reset")?,
+            // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
+            // within a millisecond, and a depth-1 reader would see only STOPPED.
             machine: ros.subscription(
                 "machine_state",
                 "cnc_msgs/msg/MachineState",
-                qos::state(),
+                qos::state().history(History::KeepLast { depth: 64 }),
             )?,
             spindle_sub: ros.subscription("spindle", "cnc_msgs/msg/SpindleState", qos::state())?,
             parts: ros.subscription("part_count", "cnc_msgs/msg/PartCount", qos::state())?,
@@ -80,6 +83,27 @@ impl CellClient {
             axes: None,
             servo_stats: None,
         })
+    }
+
+    /// Waits until the machine reports a state other than WAIT (the interpreter knows where the
+    /// axes are, so a cycle start can be accepted).
+    pub fn wait_ready(&mut self, timeout: Duration) -> Result<(), String> {
+        let deadline = Instant::now() + timeout;
+        while Instant::now() < deadline {
+            self.poll();
+            if self
+                .state
+                .as_ref()
+                .is_some_and(|s| s.execution != MachineState::WAIT)
+            {
+                return Ok(());
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        Err(format!(
+            "the machine did not become ready within {} s",
+            timeout.as_secs()
+        ))
     }
 
     /// Takes every new sample of the state topics; returns the machine states seen, in order.

@@ -212,6 +212,9 @@ fn supervise(
         ServiceMapping::Enhanced,
     )?;
     let name = program.map(program_name);
+    if name.is_some() {
+        client.wait_ready(Duration::from_secs(30))?;
+    }
     if let (Some(name), Some(text)) = (&name, text) {
         let r = client.load_program(name, text)?;
         if !r.accepted {

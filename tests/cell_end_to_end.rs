@@ -56,6 +56,7 @@ fn program_runs_through_ros2_services_and_the_part_is_counted() {
         c.part_count.is_some() && c.state.is_some() && c.axes.is_some()
     });
     assert!(ok, "state topics never arrived");
+    client.wait_ready(Duration::from_secs(20)).unwrap();
     assert_eq!(client.part_count.as_ref().unwrap().count, 0);
     let r = client.load_program("part1.nc", PROGRAM).unwrap();
     assert!(r.accepted, "{}", r.message);
@@ -128,6 +129,7 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
         c.axes.is_some() && c.alarms.is_some()
     });
     assert!(ok);
+    client.wait_ready(Duration::from_secs(20)).unwrap();
     // Line 3 has an unknown G code; lines 1-2 stay near the start.
     let bad = "G00 X150 Z50\nG01 Z40 F3000\nG77 X10\nG01 X0 Z-100\nM30\n";
     assert!(client.load_program("bad.nc", bad).unwrap().accepted);

@@ -1,27 +1,46 @@
 //! The `cnc` binary as a user runs it: `run --program --cycles` exits 0 when the cycles complete
 //! and non-zero on an alarm. The domain comes from `ROS_DOMAIN_ID` (the launch config names none).
 
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
 
 fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, String) {
     let dir = std::env::temp_dir().join(format!("cnc_cli_{}_{domain}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let mut child = Command::new(env!("CARGO_BIN_EXE_cnc"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .args(["run", "launch_configs/sim_lathe.yaml", "--program"])
         .arg(&path)
         .args(["--cycles", cycles])
         .env("ROS_DOMAIN_ID", domain)
-        .output()
+        .stdout(Stdio::from(
+            std::fs::File::create(dir.join("out.txt")).unwrap(),
+        ))
+        .stderr(Stdio::from(
+            std::fs::File::create(dir.join("err.txt")).unwrap(),
+        ))
+        .spawn()
         .unwrap();
+    // A hung run is a failure, not a hung test suite.
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            break child.wait().unwrap();
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
     let text = format!(
         "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+        std::fs::read_to_string(dir.join("out.txt")).unwrap_or_default(),
+        std::fs::read_to_string(dir.join("err.txt")).unwrap_or_default()
     );
-    (out.status.success(), text)
+    (status.success(), text)
 }
 
 #[test]

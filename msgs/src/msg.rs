@@ -98,6 +98,7 @@ ros_message! {
             STOPPED: u8 = 4,
             PROGRAM_STOPPED: u8 = 5,
             PROGRAM_COMPLETED: u8 = 6,
+            WAIT: u8 = 7,
         }
         stamp: Time,
         mode: u8,
@@ -121,6 +122,7 @@ impl MachineState {
             Self::STOPPED => "STOPPED",
             Self::PROGRAM_STOPPED => "PROGRAM_STOPPED",
             Self::PROGRAM_COMPLETED => "PROGRAM_COMPLETED",
+            Self::WAIT => "WAIT",
             _ => "UNAVAILABLE",
         }
     }

@@ -172,6 +172,9 @@ def main():
           "transient-local spindle, part_count, alarms and machine_state arrive on joining")
     start_count = peer.latest["part_count"].count if peer.latest["part_count"] else None
     check(peer.latest["alarms"] is not None and len(peer.latest["alarms"].alarms) == 0, "no active alarms at start")
+    # A supervisor waits for the machine to leave WAIT (no axis position yet) before cycle start.
+    check(wait(lambda: peer.latest["machine_state"].execution_name != "WAIT", 30),
+          "machine_state leaves WAIT")
 
     r = peer.call("load_program", "LoadProgram", name="interop.nc", text=GOOD)
     check(r.accepted, f"LoadProgram (Cyclone mapping) accepted: {r.message}")

@@ -13,7 +13,11 @@ use ros2_client::dds::rustdds::QosPolicies;
 use crate::server::{DualServer, Request};
 
 /// How long a service waits for the interpreter's answer.
-const COMMAND_TIMEOUT: Duration = Duration::from_secs(3);
+const COMMAND_TIMEOUT: Duration = Duration::from_secs(10);
+/// A command published before discovery has matched the interpreter's reader is lost (the
+/// command topic is volatile, so a late reader never replays old commands); it is repeated with
+/// the same id at this interval, and the interpreter answers a repeated id without acting twice.
+const COMMAND_REPEAT: Duration = Duration::from_millis(250);
 
 struct Commands {
     publisher: ros2_client::dds::Publisher<ProgramCommand>,
@@ -32,11 +36,15 @@ impl Commands {
             program: program.into(),
             text: text.into(),
         };
-        if let Err(e) = self.publisher.publish(msg) {
-            return (false, format!("command not delivered: {e:?}"));
-        }
         let deadline = Instant::now() + COMMAND_TIMEOUT;
+        let mut last_sent: Option<Instant> = None;
         while Instant::now() < deadline {
+            if last_sent.is_none_or(|t| t.elapsed() >= COMMAND_REPEAT) {
+                if let Err(e) = self.publisher.publish(msg.clone()) {
+                    return (false, format!("command not delivered: {e:?}"));
+                }
+                last_sent = Some(Instant::now());
+            }
             while let Ok(Some((r, _))) = self.results.take() {
                 if r.id == id {
                     return (r.accepted, r.message);

@@ -5,8 +5,11 @@
 //! `_internal/command_result`. During a run, at most `capacity` unfinished blocks are in flight:
 //! motion's `done_seq` returns the credit.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::time::Duration;
+
+/// Answers remembered so that a repeated command (same id) is answered, not executed again.
+const ANSWERS_KEPT: usize = 64;
 
 use cnc_msgs::msg::{
     Alarm, AlarmEvent, AxisState, CommandResult, MachineState, MotionBlock, MotionStatus,
@@ -87,11 +90,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
 
     let mut programs: BTreeMap<String, String> = BTreeMap::new();
     let mut run: Option<Run> = None;
+    let mut answered: VecDeque<CommandResult> = VecDeque::with_capacity(ANSWERS_KEPT);
     let mut run_counter = monotonic_ns() / 1000; // run ids grow across restarts of this node
     let mut status = MotionStatus::default();
     let mut position: Option<Vec<f64>> = None;
     let mut active_alarms: Vec<(String, u32)> = Vec::new();
-    let mut execution = MachineState::READY;
+    // Cycle start needs the axes' position from motion; until then the machine waits.
+    let mut execution = MachineState::WAIT;
     let mut program_name = String::new();
     let mut last_published: Option<(u8, u32, bool, bool, String)> = None;
     let mut last_publish_ns = 0u64;
@@ -107,6 +112,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             if a.axes.len() == axes.len() && a.axes.iter().all(|x| x.commanded_position.is_finite())
             {
                 position = Some(a.axes.iter().map(|x| x.commanded_position).collect());
+                if execution == MachineState::WAIT {
+                    execution = MachineState::READY;
+                }
             }
         }
         while let Ok(Some((e, _))) = alarm_sub.take() {
@@ -138,6 +146,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         while let Ok(Some((c, _))) = commands.take() {
             busy = true;
+            // hmi_bridge repeats a command until it is answered: a repeat gets the same answer
+            // again and is not acted on twice.
+            if let Some(done) = answered.iter().find(|r| r.id == c.id) {
+                let _ = results.publish(done.clone());
+                continue;
+            }
             let (accepted, message) = match c.command {
                 ProgramCommand::LOAD => {
                     if !valid_program_name(&c.program) {
@@ -239,16 +253,25 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                             active_alarms.retain(|k| k != &(source.clone(), number));
                         }
                     }
-                    execution = MachineState::READY;
+                    execution = if position.is_some() {
+                        MachineState::READY
+                    } else {
+                        MachineState::WAIT
+                    };
                     (true, "reset".into())
                 }
                 other => (false, format!("unknown command {other}")),
             };
-            let _ = results.publish(CommandResult {
+            let result = CommandResult {
                 id: c.id,
                 accepted,
                 message,
-            });
+            };
+            let _ = results.publish(result.clone());
+            if answered.len() == ANSWERS_KEPT {
+                answered.pop_front();
+            }
+            answered.push_back(result);
         }
         // Feed the motion queue while credit lasts.
         if let Some(r) = run.as_mut() {
@@ -317,7 +340,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             }
         }
         let line = if run.as_ref().is_some_and(|r| r.id == status.run_id)
-            || execution != MachineState::READY
+            || !matches!(execution, MachineState::READY | MachineState::WAIT)
         {
             status.line
         } else {
