@@ -472,7 +472,7 @@ impl Interpreter {
 
     fn jump_to_number(&mut self, n: u32) -> Result<(), ProgramError> {
         let text = self.frame().text.clone();
-        let pos = find_number(&text, n)
+        let pos = find_number(&text, self.frame().pos, n)
             .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("block N{n} not found")))?;
         self.frame().pos = pos;
         Ok(())
@@ -1182,12 +1182,12 @@ impl Interpreter {
             .get('P')
             .ok_or_else(|| self.fault(Fault::MissingWord, "P (line number) missing"))?;
         let n = code_x10(p).filter(|c| c % 10 == 0).map(|c| c / 10);
-        let text = self
+        let (text, here) = self
             .frames
             .last()
-            .map(|f| f.text.clone())
-            .unwrap_or_else(|| Arc::from(""));
-        n.and_then(|n| find_number(&text, n)).ok_or_else(|| {
+            .map(|f| (f.text.clone(), f.pos))
+            .unwrap_or_else(|| (Arc::from(""), Pos::default()));
+        n.and_then(|n| find_number(&text, here, n)).ok_or_else(|| {
             self.fault(
                 Fault::TargetNotFound,
                 format!("line N{} not found", show(p)),
@@ -1576,9 +1576,9 @@ impl Interpreter {
         }
         let (p, q) = (whole(p), whole(q));
         let text = self.frame().text.clone();
-        let first = find_number(&text, p)
+        let first = find_number(&text, self.frame().pos, p)
             .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{p} not found")))?;
-        let last = find_number(&text, q)
+        let last = find_number(&text, first, q)
             .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{q} not found")))?;
         if last.offset < first.offset || (g == G::LoopRange && b.number == Some(q)) {
             return Err(self.fault(Fault::RangeError, format!("block range N{p}–N{q} is wrong")));
@@ -1626,7 +1626,7 @@ impl Interpreter {
             .ok_or_else(|| self.fault(Fault::RangeError, "P missing"))?;
         let text = self.frame().text.clone();
         let q = b.get('Q').map(whole);
-        let first = find_number(&text, whole(p))
+        let first = find_number(&text, self.frame().pos, whole(p))
             .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{} not found", show(p))))?;
         let Some(q) = q else {
             // Q omitted: to the end of the program.

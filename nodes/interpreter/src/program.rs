@@ -56,16 +56,24 @@ pub fn line_number(line: &str) -> Option<u32> {
     digits.parse().ok()
 }
 
-/// Finds the first line numbered `n`, scanning from the top.
-pub fn find_number(text: &str, n: u32) -> Option<Pos> {
-    let mut pos = Pos::default();
-    while let Some((line, next)) = read_line(text, pos) {
-        if line_number(line) == Some(n) {
-            return Some(pos);
+/// Finds the line numbered `n`, searching forward from `from` to the end of the program and
+/// then from the top, as a sequence-number search on the control does (decision D28). A
+/// target just ahead is found without reading the whole program, and of two blocks with the
+/// same number the next one ahead is taken.
+pub fn find_number(text: &str, from: Pos, n: u32) -> Option<Pos> {
+    let scan = |mut pos: Pos, end: usize| {
+        while let Some((line, next)) = read_line(text, pos) {
+            if pos.offset >= end {
+                break;
+            }
+            if line_number(line) == Some(n) {
+                return Some(pos);
+            }
+            pos = next;
         }
-        pos = next;
-    }
-    None
+        None
+    };
+    scan(from, usize::MAX).or_else(|| scan(Pos::default(), from.offset))
 }
 
 /// Programs the interpreter can call by number: the library folder's programs, found by the
@@ -170,8 +178,16 @@ mod tests {
         assert_eq!(line_number("/N10 X1"), Some(10));
         assert_eq!(line_number("G01 N10"), None);
         let text = "N10 X1\nN20 X2\nN0030 X3\n";
-        assert_eq!(find_number(text, 30).map(|p| p.line), Some(2));
-        assert_eq!(find_number(text, 40), None);
+        let top = Pos::default();
+        assert_eq!(find_number(text, top, 30).map(|p| p.line), Some(2));
+        assert_eq!(find_number(text, top, 40), None);
+        // Forward from the current block first, then from the top; the next of two N10s wins.
+        let text = "N10 X1\nN20 X2\nN10 X3\nN30 X4\n";
+        let at = |line| find_number(text, top, line).unwrap();
+        let third = find_number(text, at(20), 10).unwrap();
+        assert_eq!(third.line, 2);
+        assert_eq!(find_number(text, at(30), 10).map(|p| p.line), Some(0));
+        assert_eq!(find_number(text, at(30), 20).map(|p| p.line), Some(1));
         assert_eq!(Library::declared_number("\n O0010 ;x\nN1"), Some(10));
         assert_eq!(Library::file_number(Path::new("lib/O2011.nc")), Some(2011));
         assert_eq!(Library::file_number(Path::new("lib/part.nc")), None);

@@ -36,21 +36,8 @@ fn err(what: &str, e: impl Debug) -> String {
     format!("iceoryx2 {what}: {e:?}")
 }
 
-/// Removes what nodes of crashed or killed processes left registered. Without this, a cell
-/// restarted after a crash finds its channels full of dead publishers
-/// (`ExceedsMaxSupportedPublishers`) and cannot start.
-fn remove_dead_nodes() {
-    let _ = Node::<ipc::Service>::list(Config::global_config(), |state| {
-        if let NodeState::<ipc::Service>::Dead(view) = state {
-            let _ = view.blocking_remove_stale_resources(Duration::from_secs(1));
-        }
-        CallbackProgression::Continue
-    });
-}
-
 impl ShmNode {
     pub fn new(instance: &str, node_name: &str) -> Result<Self, String> {
-        remove_dead_nodes();
         let name: NodeName = node_name.try_into().map_err(|e| err("node name", e))?;
         let node = NodeBuilder::new()
             .name(&name)

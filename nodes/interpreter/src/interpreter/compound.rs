@@ -56,12 +56,12 @@ impl Default for CompoundWords {
 impl Interpreter {
     /// Reads blocks `ns`..`nf` as a contour from the work position `here`.
     pub(super) fn contour(&self, ns: u32, nf: u32, here: &[f64]) -> Result<Contour, ProgramError> {
-        let text = self
+        let (text, from) = self
             .frames
             .last()
-            .map(|f| f.text.clone())
-            .unwrap_or_else(|| Arc::from(""));
-        let first = find_number(&text, ns).ok_or_else(|| {
+            .map(|f| (f.text.clone(), f.pos))
+            .unwrap_or_else(|| (Arc::from(""), Pos::default()));
+        let first = find_number(&text, from, ns).ok_or_else(|| {
             self.fault(
                 Fault::TargetNotFound,
                 format!("contour block N{ns} not found"),
@@ -435,9 +435,9 @@ impl Interpreter {
     pub(super) fn finishing(&mut self, b: &Block) -> Result<(), ProgramError> {
         let (ns, nf) = self.p_q(b)?;
         let text = self.frame().text.clone();
-        let first = find_number(&text, ns)
+        let first = find_number(&text, self.frame().pos, ns)
             .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{ns} not found")))?;
-        if find_number(&text, nf).is_none() {
+        if find_number(&text, first, nf).is_none() {
             return Err(self.fault(Fault::TargetNotFound, format!("N{nf} not found")));
         }
         let home = self.work_position();
