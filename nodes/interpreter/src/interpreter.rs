@@ -712,6 +712,14 @@ impl Interpreter {
         }
     }
 
+    /// Sets the plane axes of work position `w` to the plane point `p`.
+    fn set_plane_point(&self, w: &mut [f64], p: Pt) {
+        if let Ok((xi, zi)) = self.xz() {
+            w[xi] = p.r / self.x_scale();
+            w[zi] = p.z;
+        }
+    }
+
     fn with_point(&self, base: &[f64], p: Pt) -> Vec<f64> {
         let mut w = base.to_vec();
         if let Ok((xi, zi)) = self.xz() {
@@ -774,15 +782,28 @@ impl Interpreter {
                 ));
             }
         }
+        // Feed and lead are checked before anything changes: a bad block moves nothing.
+        let feed = match kind {
+            MoveKind::Feed(feed) | MoveKind::Arc { feed, .. } => self.check_feed(feed)?,
+            MoveKind::Rapid => 0.0,
+            MoveKind::Thread { lead, .. } => {
+                if !(lead > 0.0 && lead.is_finite()) {
+                    return Err(self.fault(
+                        Fault::ThreadLead,
+                        format!("thread lead {lead} is not valid"),
+                    ));
+                }
+                0.0
+            }
+        };
         self.spindle_for(end);
         let m = self.to_machine(end);
+        // The machine position becomes `m`; the command takes `m` itself (no copy per move).
+        self.pos.copy_from_slice(&m);
         let command = match kind {
-            MoveKind::Rapid => Command::Rapid { end: m.clone() },
-            MoveKind::Feed(feed) => Command::Linear {
-                end: m.clone(),
-                feed: self.check_feed(feed)?,
-            },
-            MoveKind::Arc { center, ccw, feed } => {
+            MoveKind::Rapid => Command::Rapid { end: m },
+            MoveKind::Feed(_) => Command::Linear { end: m, feed },
+            MoveKind::Arc { center, ccw, .. } => {
                 let mut c = self.to_machine(&self.with_point(end, center));
                 // Axes outside the plane keep the end's value.
                 if let Ok((xi, zi)) = self.xz() {
@@ -793,28 +814,19 @@ impl Interpreter {
                     }
                 }
                 Command::Arc {
-                    end: m.clone(),
+                    end: m,
                     center: c,
                     clockwise: !ccw,
-                    feed: self.check_feed(feed)?,
+                    feed,
                 }
             }
-            MoveKind::Thread { lead, angle } => {
-                if !(lead > 0.0 && lead.is_finite()) {
-                    return Err(self.fault(
-                        Fault::ThreadLead,
-                        format!("thread lead {lead} is not valid"),
-                    ));
-                }
-                Command::Thread {
-                    end: m.clone(),
-                    lead,
-                    start_angle: angle,
-                }
-            }
+            MoveKind::Thread { lead, angle } => Command::Thread {
+                end: m,
+                lead,
+                start_angle: angle,
+            },
         };
         self.push(command);
-        self.pos = m;
         Ok(())
     }
 
@@ -846,19 +858,29 @@ impl Interpreter {
 
     /// Emits cycle moves given in the plane (radius), starting from the current position.
     fn emit_plane(&mut self, moves: &[Move], feed: f64) -> Result<(), ProgramError> {
+        let mut end = self.work_position();
         for m in moves {
-            let base = self.work_position();
+            // `end` is the work position the last move reached; only the plane axes change.
             match *m {
-                Move::Rapid(p) => self.emit(&self.with_point(&base, p), MoveKind::Rapid)?,
-                Move::Feed(p) => self.emit(&self.with_point(&base, p), MoveKind::Feed(feed))?,
-                Move::Arc { to, c, ccw } => self.emit(
-                    &self.with_point(&base, to),
-                    MoveKind::Arc {
-                        center: c,
-                        ccw,
-                        feed,
-                    },
-                )?,
+                Move::Rapid(p) => {
+                    self.set_plane_point(&mut end, p);
+                    self.emit(&end, MoveKind::Rapid)?
+                }
+                Move::Feed(p) => {
+                    self.set_plane_point(&mut end, p);
+                    self.emit(&end, MoveKind::Feed(feed))?
+                }
+                Move::Arc { to, c, ccw } => {
+                    self.set_plane_point(&mut end, to);
+                    self.emit(
+                        &end,
+                        MoveKind::Arc {
+                            center: c,
+                            ccw,
+                            feed,
+                        },
+                    )?
+                }
             }
         }
         Ok(())
