@@ -438,6 +438,9 @@ fn huaxing_m(n: u32) -> Option<M> {
         590 | 600 | 660 | 850 | 860 | 870 | 880 | 890 => {
             Unsupported("NC-internal M code of multi-channel or live-tool machines")
         }
+        90000..=99990 if n.is_multiple_of(10) => Unsupported(
+            "M9000–M9999 call programs through an address table the manual does not give",
+        ),
         _ => return None,
     })
 }
