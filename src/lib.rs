@@ -3,3 +3,4 @@
 
 pub mod cell;
 pub mod client;
+pub mod simulate;

@@ -54,6 +54,22 @@ enum Verb {
         #[arg(long)]
         trace: bool,
     },
+    /// Run a program through the interpreter and the planner on a simulated clock: prints
+    /// `cycle time: <seconds> s` and can draw the tool path over the turned part.
+    Simulate {
+        program: PathBuf,
+        #[arg(long, default_value = DEFAULT_CONFIG)]
+        config: PathBuf,
+        /// Dialect (huaxing-lathe, gtc2e-lathe, iso-lathe); default: the config's.
+        #[arg(long)]
+        dialect: Option<String>,
+        /// Folder of subprograms; default: the program's folder.
+        #[arg(long)]
+        library: Option<PathBuf>,
+        /// Write the tool path over the finished 2-D profile as an SVG file.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+    },
 }
 
 static STOP: AtomicBool = AtomicBool::new(false);
@@ -87,6 +103,19 @@ fn main() -> ExitCode {
             library.as_deref(),
             trace,
         ),
+        Some(Verb::Simulate {
+            program,
+            config,
+            dialect,
+            library,
+            svg,
+        }) => simulate(
+            &program,
+            &config,
+            dialect.as_deref(),
+            library.as_deref(),
+            svg.as_deref(),
+        ),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
     match result {
@@ -105,25 +134,10 @@ fn check(
     library: Option<&Path>,
     trace: bool,
 ) -> Result<(), String> {
-    use cnc_interpreter::{diagnose, Dialect, Library, Setup};
+    use cnc_interpreter::{diagnose, Setup};
     let cfg = LaunchConfig::load(config)?;
     let text = read_program(program)?;
-    let name = dialect.unwrap_or(&cfg.machine.dialect);
-    let dialect = Dialect::from_name(name).ok_or_else(|| {
-        let known: Vec<&str> = Dialect::ALL.iter().map(|d| d.name()).collect();
-        format!("unknown dialect {name:?}; known: {}", known.join(", "))
-    })?;
-    let dir = match library {
-        Some(d) => d.to_path_buf(),
-        None => program
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."))
-            .to_path_buf(),
-    };
-    // Files that are not programs or repeat a number are left out of the library.
-    let (lib, _skipped) =
-        Library::load_dir(&dir).map_err(|e| format!("library {}: {e}", dir.display()))?;
+    let (dialect, lib) = dialect_and_library(&cfg, program, dialect, library)?;
     let letters = cfg.axis_letters();
     let mut setup = Setup::new(&letters, &cfg.diameter_axes(), &cfg.home());
     setup.reference = cfg.home();
@@ -150,6 +164,55 @@ fn check(
         eprintln!("{}: {e}", program.display());
     }
     Err(format!("{} alarm(s)", errors.len()))
+}
+
+/// The dialect (the command line's, else the config's) and the subprogram library (the
+/// folder given, else the program's own).
+fn dialect_and_library(
+    cfg: &LaunchConfig,
+    program: &Path,
+    dialect: Option<&str>,
+    library: Option<&Path>,
+) -> Result<(cnc_interpreter::Dialect, cnc_interpreter::Library), String> {
+    use cnc_interpreter::{Dialect, Library};
+    let name = dialect.unwrap_or(&cfg.machine.dialect);
+    let dialect = Dialect::from_name(name).ok_or_else(|| {
+        let known: Vec<&str> = Dialect::ALL.iter().map(|d| d.name()).collect();
+        format!("unknown dialect {name:?}; known: {}", known.join(", "))
+    })?;
+    let dir = match library {
+        Some(d) => d.to_path_buf(),
+        None => program
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."))
+            .to_path_buf(),
+    };
+    // Files that are not programs or repeat a number are left out of the library.
+    let (lib, _skipped) =
+        Library::load_dir(&dir).map_err(|e| format!("library {}: {e}", dir.display()))?;
+    Ok((dialect, lib))
+}
+
+fn simulate(
+    program: &Path,
+    config: &Path,
+    dialect: Option<&str>,
+    library: Option<&Path>,
+    svg: Option<&Path>,
+) -> Result<(), String> {
+    let cfg = LaunchConfig::load(config)?;
+    let text = read_program(program)?;
+    let (dialect, lib) = dialect_and_library(&cfg, program, dialect, library)?;
+    let sim = cnc::simulate::simulate(&cfg, dialect, &text, lib)
+        .map_err(|e| format!("{}: {e}", program.display()))?;
+    println!("cycle time: {:.3} s", sim.cycle_time);
+    if let Some(path) = svg {
+        std::fs::write(path, cnc::simulate::svg(&sim))
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        eprintln!("tool path and part drawn in {}", path.display());
+    }
+    Ok(())
 }
 
 fn read_program(path: &Path) -> Result<String, String> {

@@ -74,3 +74,50 @@ fn run_exits_nonzero_on_an_alarm_with_number_and_line() {
     assert!(!ok, "{out}");
     assert!(out.contains("alarm 11") && out.contains("line 3"), "{out}");
 }
+
+#[test]
+fn simulate_prints_the_cycle_time_and_draws_the_part() {
+    let dir = std::env::temp_dir().join(format!("cnc_sim_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("part.svg");
+    let program = dir.join("shaft.nc");
+    // 100 mm at 600 mm/min: 10 s of feed plus rapids and accelerations.
+    std::fs::write(&program, "G00 X50 Z5\nG01 Z-95 F600\nG00 X100\nM30\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("simulate")
+        .arg(&program)
+        .arg("--svg")
+        .arg(&svg)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let seconds: f64 = stdout
+        .lines()
+        .find_map(|l| {
+            l.strip_prefix("cycle time: ")?
+                .strip_suffix(" s")?
+                .parse()
+                .ok()
+        })
+        .unwrap_or_else(|| panic!("no cycle time line: {stdout}"));
+    assert!(seconds > 10.0 && seconds < 13.0, "{seconds}");
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    assert!(picture.starts_with("<svg") && picture.contains("class=\"part\""));
+    assert!(picture.contains("class=\"feed\"") && picture.contains("class=\"rapid\""));
+    // A bad program: the alarm with its line, non-zero exit, no cycle time.
+    std::fs::write(&program, "G00 X50\nG02 X60 Z-10 R1\nM30\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .arg("simulate")
+        .arg(&program)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("line 2"), "{err}");
+}

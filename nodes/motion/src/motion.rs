@@ -231,6 +231,14 @@ impl Motion {
         }
     }
 
+    /// Whether the active block is a feed move (line, arc or thread) rather than a rapid,
+    /// dwell or strobe; `None` when no block is active.
+    pub fn active_cutting(&self) -> Option<bool> {
+        self.active
+            .as_ref()
+            .map(|(_, a)| matches!(a, Active::Path { .. }))
+    }
+
     pub fn take_events(&mut self) -> Vec<MotionEvent> {
         std::mem::take(&mut self.events)
     }

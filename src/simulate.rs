@@ -1,0 +1,285 @@
+//! `cnc simulate`: the interpreter and the motion planner on a simulated clock, without
+//! drives, PLC or DDS. It gives the programmer the cycle time and a picture of the part before
+//! cutting it.
+//!
+//! What the estimate includes: every move as motion plans it (acceleration, per-axis rapids,
+//! feed per revolution and threads at the programmed spindle speed), dwells and program end.
+//! What it leaves out: the PLC's own time for M, S and T codes (spindle ramps, turret
+//! indexing, chuck), which are answered at once here; the simulated machine of `cnc run`
+//! includes them.
+
+use cnc_interpreter::{Canon, Dialect, Interpreter, Library, Setup};
+use cnc_motion::{Aux, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
+use cnc_msgs::signals::GImage;
+use cnc_runtime::LaunchConfig;
+
+/// Simulated time after which a program is taken as endless (a real cycle is minutes).
+const MAX_SIMULATED_SECONDS: f64 = 24.0 * 3600.0;
+
+/// A tool position in the turning plane: Z and X (diameter), and whether the tool was cutting
+/// (feeding) to get there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathPoint {
+    pub z: f64,
+    pub x: f64,
+    pub cutting: bool,
+}
+
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    /// Seconds from cycle start to the end of the program.
+    pub cycle_time: f64,
+    /// The tool path, one point per servo period in which the tool moved.
+    pub path: Vec<PathPoint>,
+    /// Canonical commands executed.
+    pub commands: usize,
+}
+
+/// Interprets `text` and runs its blocks through the planner from the config's home position.
+pub fn simulate(
+    cfg: &LaunchConfig,
+    dialect: Dialect,
+    text: &str,
+    library: Library,
+) -> Result<Simulation, String> {
+    let letters = cfg.axis_letters();
+    let (xi, zi) = match (cfg.axis_index("X"), cfg.axis_index("Z")) {
+        (Some(x), Some(z)) => (x, z),
+        _ => return Err("simulate needs a lathe with X and Z axes".into()),
+    };
+    let mut setup = Setup::new(&letters, &cfg.diameter_axes(), &cfg.home());
+    setup.reference = cfg.home();
+    let mut interp = Interpreter::with_library(dialect, text, setup, library);
+    let mcfg = MotionConfig::from_launch(cfg);
+    let start: Vec<f64> = cfg
+        .home()
+        .iter()
+        .zip(&mcfg.axes)
+        .map(|(p, a)| p * a.scale())
+        .collect();
+    let period = mcfg.period;
+    let capacity = mcfg.queue_capacity.max(2) as u64;
+    let mut motion = Motion::new(mcfg, &start);
+    // Ideal drives: each axis is where it was commanded one period earlier.
+    let mut actual = start.clone();
+    let mut g = GImage::default();
+    let mut sent = 0u64;
+    let mut finished = false;
+    let mut ticks = 0u64;
+    let mut path = Vec::new();
+    let mut last = motion.commanded_display();
+    let mut spindle_rpm = 0.0;
+    let max_ticks = (MAX_SIMULATED_SECONDS / period) as u64;
+    loop {
+        // Keep motion's queue full, as the interpreter node does.
+        while !finished && sent - motion.done_seq() < capacity {
+            match interp.next_command() {
+                Ok(Some(Canon { line, command })) => {
+                    if let Command::Aux(Aux::S(s)) = command {
+                        spindle_rpm = s;
+                    }
+                    sent += 1;
+                    if command == Command::ProgramEnd {
+                        finished = true;
+                    }
+                    motion.push(Block {
+                        run_id: 1,
+                        seq: sent,
+                        line,
+                        kind: command,
+                    });
+                }
+                Ok(None) => finished = true,
+                Err(e) => return Err(format!("alarm {} at line {}: {}", e.number, e.line, e.text)),
+            }
+        }
+        if finished && motion.done_seq() == sent && motion.state() == RunState::Idle {
+            break;
+        }
+        if ticks >= max_ticks {
+            return Err(format!(
+                "program still running after {MAX_SIMULATED_SECONDS} s of simulated time"
+            ));
+        }
+        // The simulated PLC answers every strobe at once and the spindle is at speed.
+        g.fin_seq = motion.f_image().strobe_seq;
+        g.spindle_actual_rpm = spindle_rpm;
+        // The move of this period belongs to the block active when it began.
+        let before = motion.active_cutting();
+        let commanded = motion.tick(Some(&actual), &g);
+        actual.copy_from_slice(commanded);
+        ticks += 1;
+        if let Some(MotionEvent::Alarm { number, text, line }) =
+            motion.take_events().into_iter().next()
+        {
+            return Err(format!("motion alarm {number} at line {line}: {text}"));
+        }
+        let cutting = before.or(motion.active_cutting()).unwrap_or(false);
+        let now = motion.commanded_display();
+        if now != last {
+            path.push(PathPoint {
+                z: now[zi],
+                x: now[xi],
+                cutting,
+            });
+            last = now;
+        }
+    }
+    Ok(Simulation {
+        cycle_time: ticks as f64 * period,
+        path,
+        commands: sent as usize,
+    })
+}
+
+/// The finished outside profile: for each Z step, the smallest diameter the tool reached
+/// while cutting there (the stock turned away by the tool), between the extremes of the cuts.
+pub fn turned_profile(path: &[PathPoint], step: f64) -> Vec<(f64, f64)> {
+    let cuts: Vec<&PathPoint> = path.iter().filter(|p| p.cutting).collect();
+    let (Some(z0), Some(z1)) = (
+        cuts.iter().map(|p| p.z).reduce(f64::min),
+        cuts.iter().map(|p| p.z).reduce(f64::max),
+    ) else {
+        return Vec::new();
+    };
+    let n = (((z1 - z0) / step).ceil() as usize).clamp(1, 100_000);
+    let mut min_x = vec![f64::INFINITY; n + 1];
+    for w in path.windows(2) {
+        if !w[1].cutting {
+            continue;
+        }
+        // Every station the segment passes over, so a long cut is not sampled at its ends only.
+        let (a, b) = (w[0], w[1]);
+        let (lo, hi) = (a.z.min(b.z), a.z.max(b.z));
+        let i0 = ((lo - z0) / step).ceil().max(0.0) as usize;
+        let i1 = (((hi - z0) / step).floor().max(0.0) as usize).min(n);
+        for (i, slot) in min_x.iter_mut().enumerate().take(i1 + 1).skip(i0) {
+            let z = z0 + i as f64 * step;
+            let x = if (b.z - a.z).abs() < 1e-12 {
+                a.x.min(b.x)
+            } else {
+                a.x + (b.x - a.x) * (z - a.z) / (b.z - a.z)
+            };
+            *slot = slot.min(x);
+        }
+        for p in [a, b] {
+            let i = (((p.z - z0) / step).round().max(0.0) as usize).min(n);
+            min_x[i] = min_x[i].min(p.x);
+        }
+    }
+    min_x
+        .iter()
+        .enumerate()
+        .filter(|(_, x)| x.is_finite())
+        .map(|(i, x)| (z0 + i as f64 * step, *x))
+        .collect()
+}
+
+/// The part (upper half, X as radius) and the tool path as an SVG drawing, Z to the right.
+pub fn svg(sim: &Simulation) -> String {
+    let profile = turned_profile(&sim.path, 0.1);
+    let pts = sim.path.iter().map(|p| (p.z, p.x / 2.0));
+    let (mut zmin, mut zmax, mut rmax) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+    for (z, r) in pts.chain(profile.iter().map(|&(z, x)| (z, x / 2.0))) {
+        zmin = zmin.min(z);
+        zmax = zmax.max(z);
+        rmax = rmax.max(r);
+    }
+    if !zmin.is_finite() {
+        (zmin, zmax, rmax) = (0.0, 1.0, 1.0);
+    }
+    let margin = 5.0;
+    let scale = 800.0 / (zmax - zmin + 2.0 * margin).max(1.0);
+    let width = (zmax - zmin + 2.0 * margin) * scale;
+    let height = (rmax + 2.0 * margin) * scale;
+    let px = |z: f64| (z - zmin + margin) * scale;
+    let py = |r: f64| height - (r + margin) * scale;
+    let mut out = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\" \
+         viewBox=\"0 0 {width:.1} {height:.1}\">\n\
+         <title>cycle time {:.1} s, {} commands</title>\n\
+         <line x1=\"0\" y1=\"{:.1}\" x2=\"{width:.1}\" y2=\"{:.1}\" stroke=\"#888\" \
+         stroke-dasharray=\"8 4\"/>\n",
+        sim.cycle_time,
+        sim.commands,
+        py(0.0),
+        py(0.0)
+    );
+    if let (Some(first), Some(last)) = (profile.first(), profile.last()) {
+        let mut d = format!("M{:.2} {:.2}", px(first.0), py(0.0));
+        for &(z, x) in &profile {
+            d.push_str(&format!(" L{:.2} {:.2}", px(z), py(x / 2.0)));
+        }
+        d.push_str(&format!(" L{:.2} {:.2} Z", px(last.0), py(0.0)));
+        out.push_str(&format!(
+            "<path class=\"part\" d=\"{d}\" fill=\"#c8ccd4\" stroke=\"#333\"/>\n"
+        ));
+    }
+    for cutting in [false, true] {
+        let mut d = String::new();
+        let mut pen_down = false;
+        for w in sim.path.windows(2) {
+            if w[1].cutting == cutting {
+                if !pen_down {
+                    d.push_str(&format!("M{:.2} {:.2}", px(w[0].z), py(w[0].x / 2.0)));
+                    pen_down = true;
+                }
+                d.push_str(&format!(" L{:.2} {:.2}", px(w[1].z), py(w[1].x / 2.0)));
+            } else {
+                pen_down = false;
+            }
+        }
+        let (class, style) = if cutting {
+            ("feed", "stroke=\"#1f5fbf\"")
+        } else {
+            ("rapid", "stroke=\"#d0342c\" stroke-dasharray=\"4 3\"")
+        };
+        out.push_str(&format!(
+            "<path class=\"{class}\" d=\"{d}\" fill=\"none\" {style} stroke-width=\"1\"/>\n"
+        ));
+    }
+    out.push_str("</svg>\n");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config() -> LaunchConfig {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/launch_configs/sim_lathe.yaml");
+        LaunchConfig::load(std::path::Path::new(path)).unwrap()
+    }
+
+    #[test]
+    fn cycle_time_of_a_long_feed_is_its_length_over_the_feed() {
+        let cfg = config();
+        // 100 mm at 600 mm/min = 10 s, plus the rapids and the accelerations.
+        let text = "G00 X50 Z5\nG01 Z-95 F600\nG00 X100\nM30\n";
+        let sim = simulate(&cfg, Dialect::HuaxingLathe, text, Library::new()).unwrap();
+        assert!(
+            sim.cycle_time > 10.0 && sim.cycle_time < 13.0,
+            "{}",
+            sim.cycle_time
+        );
+        // The turned profile is the diameter 50 over the cut.
+        let profile = turned_profile(&sim.path, 1.0);
+        assert!(profile.len() > 90, "{}", profile.len());
+        assert!(profile.iter().all(|&(_, x)| (x - 50.0).abs() < 1e-6));
+        let picture = svg(&sim);
+        assert!(picture.starts_with("<svg") && picture.contains("class=\"part\""));
+    }
+
+    #[test]
+    fn an_alarm_is_reported_with_its_line() {
+        let cfg = config();
+        let e = simulate(
+            &cfg,
+            Dialect::HuaxingLathe,
+            "G00 X50\nG02 X60 Z-10 R1\nM30\n",
+            Library::new(),
+        )
+        .unwrap_err();
+        assert!(e.contains("line 2"), "{e}");
+    }
+}
