@@ -144,6 +144,12 @@ pub enum Fault {
     CompNoIntersection,
     /// Compensation direction changed at start/cancel (`000` 89).
     CompDirection,
+    /// Tool-nose compensation asked for with a nose radius of 0 (`000` 21).
+    CompRadiusZero,
+    /// A concave arc smaller than the nose radius (`000` 87).
+    CompArcVanishes,
+    /// G00 while tool-nose compensation is active (`000` 118).
+    CompRapid,
     /// Code must start the block (`000` 103, 92).
     MustStartBlock,
     /// Chamfer line too short (`000` 119).
@@ -199,6 +205,9 @@ pub fn huaxing_number(f: Fault) -> u32 {
         CompStartNotLine => 85,
         CompNoIntersection => 88,
         CompDirection => 89,
+        CompRadiusZero => 21,
+        CompArcVanishes => 87,
+        CompRapid => 118,
         MustStartBlock => 103,
         ChamferTooShort => 119,
         G50S => 112,

@@ -175,6 +175,15 @@ pub struct Interpreter {
     gtc_css_from: (f64, f64),
     spindle: SpindleDir,
     nose: G,
+    /// Tool-nose radius compensation while G41/G42 is in force.
+    nose_comp: Option<nose::NoseComp>,
+    /// G40 given: the next move leaves compensation.
+    nose_cancel: bool,
+    /// Set while compensated moves are being queued (they are not compensated again).
+    emitting_comp: bool,
+    /// While compensation holds an element back, commands from this index of `pending` on
+    /// wait for it (they come after it in the program).
+    hold_at: Option<usize>,
     work_system: u8,
     /// G50 floating shift, G52 local shift and GTC2E cumulative shifts, per axis.
     shift: Vec<f64>,
@@ -244,6 +253,10 @@ impl Interpreter {
             gtc_css_from: (0.0, 0.0),
             spindle: SpindleDir::Stopped,
             nose: G::NoseCancel,
+            nose_comp: None,
+            nose_cancel: false,
+            emitting_comp: false,
+            hold_at: None,
             work_system: setup.work_system.min(5),
             shift: vec![0.0; n],
             tool_offset: vec![0.0; n],
@@ -278,9 +291,14 @@ impl Interpreter {
             if let Some(e) = &self.error {
                 return Err(e.clone());
             }
-            if let Some(c) = self.pending.pop_front() {
-                self.silent_blocks = 0;
-                return Ok(Some(c));
+            if self.hold_at != Some(0) {
+                if let Some(c) = self.pending.pop_front() {
+                    if let Some(h) = self.hold_at.as_mut() {
+                        *h -= 1;
+                    }
+                    self.silent_blocks = 0;
+                    return Ok(Some(c));
+                }
             }
             if self.done {
                 return Ok(None);
@@ -363,6 +381,15 @@ impl Interpreter {
     }
 
     fn finish(&mut self) {
+        // Program end cancels tool-nose compensation (`000` §5.3): the held element ends at
+        // its offset end.
+        if let Some(mut comp) = self.nose_comp.take() {
+            let outs = comp.flush();
+            let here = self.work_position();
+            let _ = self.emit_outs(outs, &here);
+            self.nose = G::NoseCancel;
+        }
+        self.hold_at = None;
         self.push(Command::ProgramEnd);
         self.done = true;
     }
@@ -774,6 +801,9 @@ impl Interpreter {
 
     /// Emits a move to work position `end` and makes it the current position.
     fn emit(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        if self.nose_comp.is_some() && !self.emitting_comp {
+            return self.emit_compensated(end, kind);
+        }
         for (i, v) in end.iter().enumerate() {
             if !v.is_finite() || v.abs() > 1e6 {
                 return Err(self.fault(
@@ -828,6 +858,203 @@ impl Interpreter {
         };
         self.push(command);
         Ok(())
+    }
+
+    // ---------------------------------------------------------------- nose compensation
+
+    /// G41/G42. Huaxing: in a G01 block with axis words (alarm 85), radius and tip direction
+    /// from the tool table (`000` §6.1.2). GTC2E: `G41 R..` on its own, R the nose radius
+    /// (negative: the other side), programmed point = nose centre (`002` §4.3.2-18).
+    fn start_nose(&mut self, b: &Block, g: G) -> Result<(), ProgramError> {
+        if self.nose_comp.is_some() {
+            return Err(self.fault(
+                Fault::CompDirection,
+                "G41/G42 while tool-nose compensation is active: cancel with G40 first",
+            ));
+        }
+        let mut side = if g == G::NoseLeft {
+            nose::Side::Left
+        } else {
+            nose::Side::Right
+        };
+        let (radius, tip, startup_line) = if self.dialect == Dialect::Gtc2eLathe {
+            // GTC2E names the side as seen on its front tool post, X toward the operator:
+            // mirrored against the X-up view the compensation works in (decision D30,
+            // fixture 021: G41 runs the convex G03 R15 at R18).
+            side = match side {
+                nose::Side::Left => nose::Side::Right,
+                nose::Side::Right => nose::Side::Left,
+            };
+            let r = b
+                .get('R')
+                .ok_or_else(|| self.fault(Fault::MissingWord, "G41/G42 needs R (nose radius)"))?;
+            if r < 0.0 {
+                side = match side {
+                    nose::Side::Left => nose::Side::Right,
+                    nose::Side::Right => nose::Side::Left,
+                };
+            }
+            (r.abs(), 0, false)
+        } else {
+            if !self.compensation_line(b) {
+                return Err(self.fault(
+                    Fault::CompStartNotLine,
+                    "G41/G42 must be given in a G01 block with X/Z (or U/W)",
+                ));
+            }
+            let t = self.setup.offsets.tool(self.offset_number);
+            (t.radius, t.tip, true)
+        };
+        if radius.is_nan() || radius <= 0.0 || radius > 1000.0 {
+            return Err(self.fault(
+                Fault::CompRadiusZero,
+                format!(
+                    "tool-nose radius {} of offset {} is not usable",
+                    show(radius),
+                    self.offset_number
+                ),
+            ));
+        }
+        let from = self.plane_point(&self.work_position())?;
+        self.nose_comp = Some(nose::NoseComp::new(side, radius, tip, from, startup_line));
+        self.nose = g;
+        self.nose_cancel = false;
+        Ok(())
+    }
+
+    /// G40: the next move leaves compensation. Huaxing wants it in a G01 block with axis words
+    /// (alarm 85); GTC2E allows it alone (the next move cancels).
+    fn cancel_nose(&mut self, b: &Block) -> Result<(), ProgramError> {
+        if self.nose_comp.is_none() {
+            return Ok(());
+        }
+        if self.dialect != Dialect::Gtc2eLathe && !self.compensation_line(b) {
+            return Err(self.fault(
+                Fault::CompStartNotLine,
+                "G40 must be given in a G01 block with X/Z (or U/W)",
+            ));
+        }
+        self.nose_cancel = true;
+        Ok(())
+    }
+
+    /// A G01 block with axis words: where Huaxing starts and cancels compensation.
+    fn compensation_line(&self, b: &Block) -> bool {
+        b.group(1).unwrap_or(self.motion) == G::Linear && self.has_axis_words(b)
+    }
+
+    fn comp_fault(&self, e: nose::CompError) -> ProgramError {
+        match e {
+            nose::CompError::NoIntersection => self.fault(
+                Fault::CompNoIntersection,
+                "tool-nose compensation: the offset path has no intersection here",
+            ),
+            nose::CompError::ArcVanishes => self.fault(
+                Fault::CompArcVanishes,
+                "tool-nose compensation: arc radius smaller than the nose radius",
+            ),
+        }
+    }
+
+    /// A move while compensation is active: handed to the compensation, which returns the
+    /// moves of the controlled point that are now certain.
+    fn emit_compensated(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        let from = self.plane_point(&self.work_position())?;
+        let to = self.plane_point(end)?;
+        let (path, ck) = match kind {
+            MoveKind::Rapid if self.dialect != Dialect::Gtc2eLathe => {
+                return Err(self.fault(
+                    Fault::CompRapid,
+                    "G00 while tool-nose compensation is active: cancel with G40 first",
+                ))
+            }
+            MoveKind::Rapid => (nose::Path::Line { a: from, b: to }, nose::Kind::Rapid),
+            MoveKind::Feed(f) => (nose::Path::Line { a: from, b: to }, nose::Kind::Feed(f)),
+            MoveKind::Arc { center, ccw, feed } => (
+                nose::Path::Arc {
+                    a: from,
+                    b: to,
+                    c: center,
+                    cw: !ccw,
+                },
+                nose::Kind::Feed(feed),
+            ),
+            MoveKind::Thread { .. } => {
+                return Err(self.fault(
+                    Fault::CompInCycle,
+                    "thread cutting while tool-nose compensation is active",
+                ))
+            }
+        };
+        let line = self.line;
+        let outs = if self.nose_cancel {
+            self.nose_cancel = false;
+            self.nose = G::NoseCancel;
+            match self.nose_comp.take() {
+                Some(mut comp) => comp.cancel(to, ck, line),
+                None => Vec::new(),
+            }
+        } else if (from.z - to.z).hypot(from.r - to.r) < 1e-9 {
+            // No move: nothing to compensate.
+            return Ok(());
+        } else {
+            let pushed = match self.nose_comp.as_mut() {
+                Some(comp) => comp.push(path, ck, line),
+                None => Ok(Vec::new()),
+            };
+            pushed.map_err(|e| self.comp_fault(e))?
+        };
+        self.emit_outs(outs, end)
+    }
+
+    /// Queues compensated moves where they belong in program order (before anything queued
+    /// after the element compensation held back), then puts the program's position back on
+    /// the programmed end point: incremental words and the next element start there.
+    fn emit_outs(
+        &mut self,
+        outs: Vec<nose::Out>,
+        programmed_end: &[f64],
+    ) -> Result<(), ProgramError> {
+        let insert_at = self
+            .hold_at
+            .unwrap_or(self.pending.len())
+            .min(self.pending.len());
+        let before = self.pending.len();
+        let saved_line = self.line;
+        self.emitting_comp = true;
+        let mut result = Ok(());
+        for o in outs {
+            self.line = o.line;
+            let base = self.work_position();
+            let end = self.with_point(&base, o.path.end());
+            let kind = match (o.path, o.kind) {
+                (nose::Path::Arc { c, cw, .. }, nose::Kind::Feed(feed)) => MoveKind::Arc {
+                    center: c,
+                    ccw: !cw,
+                    feed,
+                },
+                (_, nose::Kind::Feed(f)) => MoveKind::Feed(f),
+                (_, nose::Kind::Rapid) => MoveKind::Rapid,
+            };
+            result = self.emit(&end, kind);
+            if result.is_err() {
+                break;
+            }
+        }
+        self.emitting_comp = false;
+        self.line = saved_line;
+        let new: Vec<Canon> = self.pending.drain(before..).collect();
+        let n = new.len();
+        for (k, c) in new.into_iter().enumerate() {
+            self.pending.insert(insert_at + k, c);
+        }
+        self.hold_at = self
+            .nose_comp
+            .as_ref()
+            .filter(|c| c.holding())
+            .map(|_| insert_at + n);
+        self.pos = self.to_machine(programmed_end);
+        result
     }
 
     fn check_feed(&self, feed: f64) -> Result<f64, ProgramError> {
@@ -924,12 +1151,8 @@ impl Interpreter {
                         "G17/G19 need a Y axis; this lathe works in G18",
                     ))
                 }
-                G::NoseLeft | G::NoseRight => {
-                    return Err(self.fault(
-                        Fault::NotSupported,
-                        "tool-nose radius compensation G41/G42 is not implemented yet",
-                    ))
-                }
+                G::NoseLeft | G::NoseRight => self.start_nose(&b, g)?,
+                G::NoseCancel => self.cancel_nose(&b)?,
                 G::TurretMode { gang } => self.gang_mode = gang,
                 G::OffsetShift(n) => self.gtc_offset_shift(n),
                 _ => {}
@@ -1451,6 +1674,14 @@ impl Interpreter {
             if !arc_ik {
                 return Ok(());
             }
+        }
+        if self.nose_comp.is_some()
+            && !matches!(self.motion, G::Rapid | G::Linear | G::ArcCw | G::ArcCcw)
+        {
+            return Err(self.fault(
+                Fault::CompInCycle,
+                "tool-nose compensation active: cycles, threads and three-point arcs need G40 first",
+            ));
         }
         match self.motion {
             G::Rapid => {
@@ -2146,6 +2377,7 @@ impl Variables for Interpreter {
 mod compound;
 mod grooving;
 mod gtc;
+mod nose;
 
 /// Interprets a whole program without running it: every command, or the first error.
 pub fn check(dialect: Dialect, text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {

@@ -1,0 +1,580 @@
+//! Tool-nose radius compensation (G41/G42, `000` Chapter 6, `002` §4.3.2-18): the tool's
+//! nose is a circle of radius R, and the programmed point is its imaginary tip. With
+//! compensation the nose circle runs along the programmed contour on the chosen side, and the
+//! controlled point (the imaginary tip) follows the nose centre's path shifted by the tip
+//! vector of the tool's tip direction.
+//!
+//! Works in the turning plane (`Pt`: Z, radius) on whole elements, one element behind the
+//! program: an element is held until the next one shows how the two meet (decision D30 in
+//! `docs/decisions.md`):
+//! - inner corner: both offset elements are cut back to their intersection;
+//! - outer corner: an arc of radius R around the corner joins them;
+//! - start-up (`startup_line`, Huaxing): the start-up G01 goes from the uncompensated point
+//!   to the offset start of the next element; otherwise (GTC2E) the first element is offset
+//!   from its start and a connecting move gets there;
+//! - cancel: the held element ends at its offset end, then a line to the uncompensated point.
+//!
+//! Pure geometry: no interpreter state, errors as [`CompError`].
+
+use crate::geometry::Pt;
+
+const EPS: f64 = 1e-9;
+
+/// Which side of the contour the nose runs on, looking along the direction of travel in the
+/// Z–X plane drawn with +Z to the right and +X up (decision D30).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    Left,
+    Right,
+}
+
+/// A programmed or offset element of the contour.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Path {
+    Line { a: Pt, b: Pt },
+    Arc { a: Pt, b: Pt, c: Pt, cw: bool },
+}
+
+/// How the element is moved: rapid or feed (G02/G03 carry their feed too).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Kind {
+    Rapid,
+    Feed(f64),
+}
+
+/// One move for the controlled point (imaginary tip), in the plane, with its source line.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Out {
+    pub path: Path,
+    pub kind: Kind,
+    pub line: u32,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum CompError {
+    /// Two offset elements of an inner corner do not meet.
+    NoIntersection,
+    /// The nose radius is larger than a concave arc's radius.
+    ArcVanishes,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Held {
+    /// The offset element, its start already joined to what came before.
+    path: Path,
+    kind: Kind,
+    line: u32,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Start {
+    /// The next element is the start-up move from this uncompensated point (Huaxing).
+    StartupLine(Pt),
+    /// The next element is offset from its start; a connecting move leaves this point (GTC2E).
+    Connect(Pt),
+    Running,
+}
+
+#[derive(Debug, Clone)]
+pub struct NoseComp {
+    /// Signed offset: +R to the left, −R to the right.
+    offset: f64,
+    /// From nose centre to imaginary tip.
+    tip: Pt,
+    start: Start,
+    /// The Huaxing start-up element, waiting for the element after it.
+    startup: Option<(Pt, Path, Kind, u32)>,
+    held: Option<Held>,
+}
+
+/// The vector from the nose centre to the imaginary tip for tip direction 0–9, with Z to the
+/// right and X up: 3 is the outside-turning tool toward the chuck (tip below and left of the
+/// centre), 2 the boring bar; 0 and 9 program the centre itself (decision D30).
+pub fn tip_vector(direction: u8, radius: f64) -> Pt {
+    let (z, r) = match direction {
+        1 => (1.0, 1.0),
+        2 => (-1.0, 1.0),
+        3 => (-1.0, -1.0),
+        4 => (1.0, -1.0),
+        5 => (1.0, 0.0),
+        6 => (0.0, 1.0),
+        7 => (-1.0, 0.0),
+        8 => (0.0, -1.0),
+        _ => (0.0, 0.0),
+    };
+    Pt::new(z * radius, r * radius)
+}
+
+fn add(a: Pt, b: Pt) -> Pt {
+    Pt::new(a.z + b.z, a.r + b.r)
+}
+fn sub(a: Pt, b: Pt) -> Pt {
+    Pt::new(a.z - b.z, a.r - b.r)
+}
+fn scale(a: Pt, k: f64) -> Pt {
+    Pt::new(a.z * k, a.r * k)
+}
+fn len(a: Pt) -> f64 {
+    a.z.hypot(a.r)
+}
+fn unit(a: Pt) -> Pt {
+    let l = len(a);
+    if l < EPS {
+        Pt::new(0.0, 0.0)
+    } else {
+        scale(a, 1.0 / l)
+    }
+}
+fn cross(a: Pt, b: Pt) -> f64 {
+    a.z * b.r - a.r * b.z
+}
+fn dot(a: Pt, b: Pt) -> f64 {
+    a.z * b.z + a.r * b.r
+}
+/// Rotated a quarter turn counter-clockwise: the left normal of a direction.
+fn left(a: Pt) -> Pt {
+    Pt::new(-a.r, a.z)
+}
+
+impl Path {
+    pub fn start(&self) -> Pt {
+        match *self {
+            Path::Line { a, .. } | Path::Arc { a, .. } => a,
+        }
+    }
+    pub fn end(&self) -> Pt {
+        match *self {
+            Path::Line { b, .. } | Path::Arc { b, .. } => b,
+        }
+    }
+    fn tangent_at(&self, p: Pt) -> Pt {
+        match *self {
+            Path::Line { a, b } => unit(sub(b, a)),
+            Path::Arc { c, cw, .. } => {
+                let radial = unit(sub(p, c));
+                // Counter-clockwise travel is the radial direction turned left.
+                if cw {
+                    scale(left(radial), -1.0)
+                } else {
+                    left(radial)
+                }
+            }
+        }
+    }
+    fn start_tangent(&self) -> Pt {
+        self.tangent_at(self.start())
+    }
+    fn end_tangent(&self) -> Pt {
+        self.tangent_at(self.end())
+    }
+    fn translated(&self, d: Pt) -> Path {
+        match *self {
+            Path::Line { a, b } => Path::Line {
+                a: add(a, d),
+                b: add(b, d),
+            },
+            Path::Arc { a, b, c, cw } => Path::Arc {
+                a: add(a, d),
+                b: add(b, d),
+                c: add(c, d),
+                cw,
+            },
+        }
+    }
+    /// The element moved sideways by `offset` (+ left).
+    fn offset(&self, offset: f64) -> Result<Path, CompError> {
+        match *self {
+            Path::Line { a, b } => {
+                let n = scale(left(unit(sub(b, a))), offset);
+                Ok(Path::Line {
+                    a: add(a, n),
+                    b: add(b, n),
+                })
+            }
+            Path::Arc { a, b, c, cw } => {
+                let rho = len(sub(a, c));
+                // The left side of a clockwise arc is its outside.
+                let new = if cw { rho + offset } else { rho - offset };
+                if new <= EPS {
+                    return Err(CompError::ArcVanishes);
+                }
+                let k = new / rho;
+                Ok(Path::Arc {
+                    a: add(c, scale(sub(a, c), k)),
+                    b: add(c, scale(sub(b, c), new / len(sub(b, c)))),
+                    c,
+                    cw,
+                })
+            }
+        }
+    }
+    fn with_start(&self, p: Pt) -> Path {
+        match *self {
+            Path::Line { b, .. } => Path::Line { a: p, b },
+            Path::Arc { b, c, cw, .. } => Path::Arc { a: p, b, c, cw },
+        }
+    }
+    fn with_end(&self, p: Pt) -> Path {
+        match *self {
+            Path::Line { a, .. } => Path::Line { a, b: p },
+            Path::Arc { a, c, cw, .. } => Path::Arc { a, b: p, c, cw },
+        }
+    }
+}
+
+/// Points where the full line or circle of `p` meets that of `q`.
+fn intersections(p: &Path, q: &Path) -> Vec<Pt> {
+    match (*p, *q) {
+        (Path::Line { a, b }, Path::Line { a: c, b: d }) => {
+            let (u, v) = (sub(b, a), sub(d, c));
+            let den = cross(u, v);
+            if den.abs() < EPS {
+                return Vec::new();
+            }
+            let t = cross(sub(c, a), v) / den;
+            vec![add(a, scale(u, t))]
+        }
+        (Path::Line { a, b }, Path::Arc { c, a: s, .. })
+        | (Path::Arc { c, a: s, .. }, Path::Line { a, b }) => line_circle(a, b, c, len(sub(s, c))),
+        (Path::Arc { c: c1, a: s1, .. }, Path::Arc { c: c2, a: s2, .. }) => {
+            circle_circle(c1, len(sub(s1, c1)), c2, len(sub(s2, c2)))
+        }
+    }
+}
+
+fn line_circle(a: Pt, b: Pt, c: Pt, rho: f64) -> Vec<Pt> {
+    let u = unit(sub(b, a));
+    let f = sub(a, c);
+    let bq = dot(f, u);
+    let cq = dot(f, f) - rho * rho;
+    let disc = bq * bq - cq;
+    if disc < -EPS {
+        return Vec::new();
+    }
+    let s = disc.max(0.0).sqrt();
+    vec![add(a, scale(u, -bq - s)), add(a, scale(u, -bq + s))]
+}
+
+fn circle_circle(c1: Pt, r1: f64, c2: Pt, r2: f64) -> Vec<Pt> {
+    let d = len(sub(c2, c1));
+    if d < EPS || d > r1 + r2 + EPS || d < (r1 - r2).abs() - EPS {
+        return Vec::new();
+    }
+    let a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d);
+    let h = (r1 * r1 - a * a).max(0.0).sqrt();
+    let u = unit(sub(c2, c1));
+    let m = add(c1, scale(u, a));
+    let n = left(u);
+    vec![add(m, scale(n, h)), add(m, scale(n, -h))]
+}
+
+impl NoseComp {
+    /// Compensation from the uncompensated point `from`; `startup_line` as on the Huaxing
+    /// control (the next block is the start-up move).
+    pub fn new(side: Side, radius: f64, tip: u8, from: Pt, startup_line: bool) -> NoseComp {
+        let offset = match side {
+            Side::Left => radius,
+            Side::Right => -radius,
+        };
+        NoseComp {
+            offset,
+            tip: tip_vector(tip, radius),
+            start: if startup_line {
+                Start::StartupLine(from)
+            } else {
+                Start::Connect(from)
+            },
+            startup: None,
+            held: None,
+        }
+    }
+
+    fn out(&self, path: Path, kind: Kind, line: u32) -> Out {
+        Out {
+            path: path.translated(self.tip),
+            kind,
+            line,
+        }
+    }
+
+    /// Takes the next programmed element; returns the moves now certain.
+    pub fn push(&mut self, path: Path, kind: Kind, line: u32) -> Result<Vec<Out>, CompError> {
+        let off = path.offset(self.offset)?;
+        let mut out = Vec::new();
+        match self.start {
+            Start::StartupLine(from) => {
+                // The start-up element waits for the element after it.
+                self.startup = Some((from, path, kind, line));
+                self.start = Start::Running;
+                return Ok(out);
+            }
+            Start::Connect(from) => {
+                out.push(Out {
+                    path: Path::Line {
+                        a: from,
+                        b: add(off.start(), self.tip),
+                    },
+                    kind,
+                    line,
+                });
+                self.held = Some(Held {
+                    path: off,
+                    kind,
+                    line,
+                });
+                self.start = Start::Running;
+                return Ok(out);
+            }
+            Start::Running => {}
+        }
+        if let Some((from, _, s_kind, s_line)) = self.startup.take() {
+            // Start-up move: to the offset start of this element (perpendicular to it).
+            out.push(Out {
+                path: Path::Line {
+                    a: from,
+                    b: add(off.start(), self.tip),
+                },
+                kind: s_kind,
+                line: s_line,
+            });
+            self.held = Some(Held {
+                path: off,
+                kind,
+                line,
+            });
+            return Ok(out);
+        }
+        let Some(held) = self.held.take() else {
+            self.held = Some(Held {
+                path: off,
+                kind,
+                line,
+            });
+            return Ok(out);
+        };
+        let (prev, next) = self.join(held, path, off, kind, line)?;
+        out.extend(prev);
+        self.held = Some(Held {
+            path: next,
+            kind,
+            line,
+        });
+        Ok(out)
+    }
+
+    /// Joins the held offset element to the offset of `path`: the held element (trimmed, and a
+    /// corner arc after it when the corner is outside) and the next offset element's start.
+    fn join(
+        &self,
+        held: Held,
+        path: Path,
+        off: Path,
+        kind: Kind,
+        line: u32,
+    ) -> Result<(Vec<Out>, Path), CompError> {
+        // An offset element runs parallel to its programmed one: same tangents.
+        let t1 = held.path.end_tangent();
+        let t2 = path.start_tangent();
+        let turn = cross(t1, t2);
+        let along = dot(t1, t2);
+        let corner = sub(held.path.end(), scale(left(t1), self.offset));
+        if turn.abs() < 1e-9 && along > 0.0 {
+            // Tangent: the offsets meet (within rounding); go straight on.
+            return Ok((
+                vec![self.out(held.path, held.kind, held.line)],
+                off.with_start(held.path.end()),
+            ));
+        }
+        // The nose is on the outside of the turn when it turns away from the offset side.
+        let outside = turn * self.offset < 0.0 || along <= -1.0 + 1e-9;
+        if outside {
+            let arc = Path::Arc {
+                a: held.path.end(),
+                b: off.start(),
+                c: corner,
+                cw: self.offset > 0.0,
+            };
+            return Ok((
+                vec![
+                    self.out(held.path, held.kind, held.line),
+                    self.out(arc, kind, line),
+                ],
+                off,
+            ));
+        }
+        // Inside: both are cut back to where they cross, the crossing nearest the corner.
+        let x = intersections(&held.path, &off)
+            .into_iter()
+            .min_by(|a, b| {
+                len(sub(*a, corner))
+                    .partial_cmp(&len(sub(*b, corner)))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+            .ok_or(CompError::NoIntersection)?;
+        Ok((
+            vec![self.out(held.path.with_end(x), held.kind, held.line)],
+            off.with_start(x),
+        ))
+    }
+
+    /// Cancel (G40): the held element to its offset end, then `path`'s end uncompensated.
+    pub fn cancel(&mut self, target: Pt, kind: Kind, line: u32) -> Vec<Out> {
+        let mut out = self.flush();
+        let from = out
+            .last()
+            .map(|o| o.path.end())
+            .unwrap_or_else(|| self.startup_point().unwrap_or(target));
+        out.push(Out {
+            path: Path::Line { a: from, b: target },
+            kind,
+            line,
+        });
+        out
+    }
+
+    fn startup_point(&self) -> Option<Pt> {
+        match self.start {
+            Start::StartupLine(p) | Start::Connect(p) => Some(p),
+            Start::Running => self.startup.map(|s| s.0),
+        }
+    }
+
+    /// True while an element waits for the next one.
+    pub fn holding(&self) -> bool {
+        self.held.is_some() || self.startup.is_some()
+    }
+
+    /// Ends compensation where it is (program end): the held element to its offset end.
+    pub fn flush(&mut self) -> Vec<Out> {
+        let mut out = Vec::new();
+        if let Some((from, path, kind, line)) = self.startup.take() {
+            // Only the start-up element was given: it ends offset from its own end.
+            let off = path.offset(self.offset).unwrap_or(path);
+            out.push(Out {
+                path: Path::Line {
+                    a: from,
+                    b: add(off.end(), self.tip),
+                },
+                kind,
+                line,
+            });
+        }
+        if let Some(h) = self.held.take() {
+            out.push(self.out(h.path, h.kind, h.line));
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(z: f64, r: f64) -> Pt {
+        Pt::new(z, r)
+    }
+
+    fn close(a: Pt, b: Pt) -> bool {
+        len(sub(a, b)) < 1e-9
+    }
+
+    #[test]
+    fn outside_turning_with_tip_3_keeps_the_diameter_on_straight_cuts() {
+        // G42, R1, tip 3: turning toward the chuck along r = 15, then facing up to r = 20.
+        let mut c = NoseComp::new(Side::Right, 1.0, 3, p(10.0, 15.0), false);
+        let f = Kind::Feed(100.0);
+        let out = c
+            .push(
+                Path::Line {
+                    a: p(10.0, 15.0),
+                    b: p(-20.0, 15.0),
+                },
+                f,
+                1,
+            )
+            .unwrap();
+        // The connecting move lands on the controlled point of the offset start: r stays 15.
+        assert!(close(out[0].path.end(), p(9.0, 15.0)), "{out:?}");
+        let out = c
+            .push(
+                Path::Line {
+                    a: p(-20.0, 15.0),
+                    b: p(-20.0, 20.0),
+                },
+                f,
+                2,
+            )
+            .unwrap();
+        // Inner corner (the shoulder): the nose centre stops at Z−19, touching the face at
+        // Z−20; with tip 3 the controlled point runs exactly on axis-parallel contour lines.
+        assert_eq!(out.len(), 1);
+        assert!(close(out[0].path.end(), p(-20.0, 15.0)), "{out:?}");
+        let out = c.flush();
+        // Ended without a cancel move: the centre stops beside the end, r 20, the tip at r 19.
+        assert!(close(out[0].path.end(), p(-20.0, 19.0)), "{out:?}");
+    }
+
+    #[test]
+    fn outer_corners_get_an_arc_of_the_nose_radius() {
+        let mut c = NoseComp::new(Side::Left, 3.0, 0, p(0.0, 0.0), false);
+        let f = Kind::Feed(100.0);
+        c.push(
+            Path::Line {
+                a: p(0.0, 0.0),
+                b: p(0.0, 10.0),
+            },
+            f,
+            1,
+        )
+        .unwrap();
+        // Up (+X) then toward +Z: a right turn, so the left offset is outside.
+        let out = c
+            .push(
+                Path::Line {
+                    a: p(0.0, 10.0),
+                    b: p(20.0, 10.0),
+                },
+                f,
+                2,
+            )
+            .unwrap();
+        assert_eq!(out.len(), 2, "{out:?}");
+        let out2 = c
+            .push(
+                Path::Line {
+                    a: p(20.0, 10.0),
+                    b: p(20.0, 0.0),
+                },
+                f,
+                3,
+            )
+            .unwrap();
+        let all: Vec<Out> = out.into_iter().chain(out2).collect();
+        assert!(
+            all.iter().any(|o| matches!(o.path, Path::Arc { .. })),
+            "{all:?}"
+        );
+        for o in &all {
+            if let Path::Arc { a, b, c, .. } = o.path {
+                assert!((len(sub(a, c)) - 3.0).abs() < 1e-9 && (len(sub(b, c)) - 3.0).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn a_concave_arc_smaller_than_the_nose_is_an_error() {
+        let mut c = NoseComp::new(Side::Left, 5.0, 0, p(0.0, 0.0), false);
+        // Counter-clockwise arc of radius 2: its left side is inside.
+        let e = c.push(
+            Path::Arc {
+                a: p(0.0, 0.0),
+                b: p(-4.0, 0.0),
+                c: p(-2.0, 0.0),
+                cw: false,
+            },
+            Kind::Feed(1.0),
+            1,
+        );
+        assert_eq!(e.unwrap_err(), CompError::ArcVanishes);
+    }
+}

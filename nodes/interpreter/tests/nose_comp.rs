@@ -1,0 +1,348 @@
+//! Tool-nose radius compensation on the manuals' examples (`000` §6, fixtures 053/054/058/059;
+//! `002` fixture 021), checked geometrically: the nose circle, placed at the controlled point
+//! minus the tip vector, never cuts into the programmed contour (no gouge) and touches every
+//! cutting element of it (the contour is cut to size).
+
+use cnc_interpreter::setup::ToolOffset;
+use cnc_interpreter::{Canon, Command, Dialect, Setup};
+
+const HOME: [f64; 2] = [200.0, 250.0];
+
+fn fixture(dir: &str, name: &str) -> String {
+    let path = format!(
+        "{}/../../../shared/fixtures/{dir}/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    match text.split_once("(--- listing as printed ---)") {
+        Some((_, listing)) => listing.to_string(),
+        None => text,
+    }
+}
+
+fn setup(radius: f64, tip: u8) -> Setup {
+    let mut s = Setup::lathe(HOME);
+    s.offsets.tools.insert(
+        1,
+        ToolOffset {
+            radius,
+            tip,
+            ..ToolOffset::default()
+        },
+    );
+    s
+}
+
+/// Plane elements (z, r) of a stream: lines and arcs with their centres, feeds only or all.
+#[derive(Debug, Clone, Copy)]
+enum El {
+    Line([f64; 2], [f64; 2]),
+    Arc([f64; 2], [f64; 2], [f64; 2], bool),
+}
+
+fn elements(cmds: &[Canon], start: [f64; 2]) -> Vec<(El, bool, u32)> {
+    let mut at = [start[1], start[0] / 2.0];
+    let mut out = Vec::new();
+    for c in cmds {
+        let (el, cut) = match &c.command {
+            Command::Rapid { end } => (El::Line(at, [end[1], end[0] / 2.0]), false),
+            Command::Linear { end, .. } => (El::Line(at, [end[1], end[0] / 2.0]), true),
+            Command::Arc {
+                end,
+                center,
+                clockwise,
+                ..
+            } => (
+                El::Arc(
+                    at,
+                    [end[1], end[0] / 2.0],
+                    [center[1], center[0] / 2.0],
+                    *clockwise,
+                ),
+                true,
+            ),
+            _ => continue,
+        };
+        at = match el {
+            El::Line(_, b) | El::Arc(_, b, _, _) => b,
+        };
+        out.push((el, cut, c.line));
+    }
+    out
+}
+
+/// Points along an element, every `step` mm or so.
+fn samples(el: El, step: f64) -> Vec<[f64; 2]> {
+    match el {
+        El::Line(a, b) => {
+            let l = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let n = ((l / step).ceil() as usize).max(1);
+            (0..=n)
+                .map(|i| {
+                    let t = i as f64 / n as f64;
+                    [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]
+                })
+                .collect()
+        }
+        El::Arc(a, b, c, cw) => {
+            let r = (a[0] - c[0]).hypot(a[1] - c[1]);
+            let a0 = (a[1] - c[1]).atan2(a[0] - c[0]);
+            let a1 = (b[1] - c[1]).atan2(b[0] - c[0]);
+            let mut sweep = a1 - a0;
+            let tau = std::f64::consts::TAU;
+            if cw {
+                while sweep > 1e-12 {
+                    sweep -= tau;
+                }
+            } else {
+                while sweep < -1e-12 {
+                    sweep += tau;
+                }
+            }
+            let n = (((sweep.abs() * r) / step).ceil() as usize).max(1);
+            (0..=n)
+                .map(|i| {
+                    let t = a0 + sweep * i as f64 / n as f64;
+                    [c[0] + r * t.cos(), c[1] + r * t.sin()]
+                })
+                .collect()
+        }
+    }
+}
+
+/// Distance from `p` to an element.
+fn distance(p: [f64; 2], el: El) -> f64 {
+    let d = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    match el {
+        El::Line(a, b) => {
+            let (u, w) = ([b[0] - a[0], b[1] - a[1]], [p[0] - a[0], p[1] - a[1]]);
+            let l2 = u[0] * u[0] + u[1] * u[1];
+            let t = if l2 > 0.0 {
+                ((w[0] * u[0] + w[1] * u[1]) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            d(p, [a[0] + u[0] * t, a[1] + u[1] * t])
+        }
+        El::Arc(a, b, c, cw) => {
+            let r = d(a, c);
+            let ang = |q: [f64; 2]| (q[1] - c[1]).atan2(q[0] - c[0]);
+            let tau = std::f64::consts::TAU;
+            // Counter-clockwise angle from a to x, and the arc's counter-clockwise span.
+            let ccw_from = |from: f64, to: f64| (to - from).rem_euclid(tau);
+            let (start, span) = if cw {
+                (ang(b), ccw_from(ang(b), ang(a)))
+            } else {
+                (ang(a), ccw_from(ang(a), ang(b)))
+            };
+            if ccw_from(start, ang(p)) <= span + 1e-12 {
+                (d(p, c) - r).abs()
+            } else {
+                d(p, a).min(d(p, b))
+            }
+        }
+    }
+}
+
+fn tip_vector(tip: u8, r: f64) -> [f64; 2] {
+    match tip {
+        1 => [r, r],
+        2 => [-r, r],
+        3 => [-r, -r],
+        4 => [r, -r],
+        5 => [r, 0.0],
+        6 => [0.0, r],
+        7 => [-r, 0.0],
+        8 => [0.0, -r],
+        _ => [0.0, 0.0],
+    }
+}
+
+/// Runs `text` compensated and uncompensated; checks gouging and contact on the cutting
+/// elements from `first_line` to `last_line` of the programmed contour.
+/// Which side of the contour the material is: an outside profile (material toward the axis)
+/// or a bore (material outward).
+#[derive(Clone, Copy, PartialEq)]
+enum Work {
+    Outside,
+    Bore,
+}
+
+fn check(
+    dialect: Dialect,
+    text: &str,
+    radius: f64,
+    tip: u8,
+    lines: (u32, u32),
+    work: Work,
+) -> Vec<Canon> {
+    let (first_line, last_line) = lines;
+    let comp =
+        cnc_interpreter::check(dialect, text, setup(radius, tip)).unwrap_or_else(|e| panic!("{e}"));
+    let plain_text = text
+        .replace("G41", "")
+        .replace("G42", "")
+        .replace("G40", "");
+    let plain = cnc_interpreter::check(dialect, &plain_text, setup(radius, tip))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let inside = |cut: bool, line: u32| cut && line > first_line && line < last_line;
+    let contour: Vec<El> = elements(&plain, HOME)
+        .into_iter()
+        .filter(|&(_, cut, line)| inside(cut, line))
+        .map(|(e, _, _)| e)
+        .collect();
+    assert!(!contour.is_empty());
+    let d = tip_vector(tip, radius);
+    // The start-up and cancel moves are approach and retreat in the air; the rest cuts.
+    let centre_path: Vec<[f64; 2]> = elements(&comp, HOME)
+        .into_iter()
+        .filter(|&(_, cut, line)| inside(cut, line))
+        .flat_map(|(e, _, _)| samples(e, 0.05))
+        .map(|p| [p[0] - d[0], p[1] - d[1]])
+        .collect();
+    // No gouge: the nose centre keeps at least R from every contour element.
+    for p in &centre_path {
+        for el in &contour {
+            let dist = distance(*p, *el);
+            assert!(
+                dist > radius - 0.01,
+                "nose centre {p:?} is {dist} from {el:?}"
+            );
+        }
+    }
+    // The nose stays out of the material: above an outside profile, below a bore, at every Z.
+    let profile: Vec<[f64; 2]> = contour.iter().flat_map(|e| samples(*e, 0.05)).collect();
+    for p in &centre_path {
+        let near: Vec<f64> = profile
+            .iter()
+            .filter(|q| (q[0] - p[0]).abs() < 0.05)
+            .map(|q| q[1])
+            .collect();
+        if near.is_empty() {
+            continue;
+        }
+        match work {
+            Work::Outside => {
+                let top = near.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+                assert!(
+                    p[1] > top - 0.01,
+                    "nose centre {p:?} inside the part (profile r {top})"
+                );
+            }
+            Work::Bore => {
+                let bottom = near.iter().cloned().fold(f64::INFINITY, f64::min);
+                assert!(
+                    p[1] < bottom + 0.01,
+                    "nose centre {p:?} in the wall (bore r {bottom})"
+                );
+            }
+        }
+    }
+    // Contact: every contour element is touched by the nose somewhere.
+    for el in &contour {
+        let nearest = centre_path
+            .iter()
+            .map(|p| distance(*p, *el))
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            (nearest - radius).abs() < 0.02,
+            "{el:?} not touched: nearest centre {nearest}"
+        );
+    }
+    comp
+}
+
+#[test]
+fn fixture_053_outside_g42_tip_3() {
+    let text = fixture("000", "053_tnrc_outer_G42.nc");
+    // Listing lines: N0040 (start-up) is line 5, N0180 (cancel) line 19.
+    check(Dialect::HuaxingLathe, &text, 1.0, 3, (5, 19), Work::Outside);
+}
+
+#[test]
+fn fixture_058_outside_g42_tip_3_chapter_20() {
+    let text = fixture("000", "058_ch20_ex4_tnrc_outer.nc");
+    check(Dialect::HuaxingLathe, &text, 1.0, 3, (5, 19), Work::Outside);
+}
+
+#[test]
+fn fixture_054_bore_g41_tip_2() {
+    let text = fixture("000", "054_tnrc_inner_G41.nc");
+    // N0040 (start-up) is line 5, N0140 (cancel) line 15.
+    let cmds = check(Dialect::HuaxingLathe, &text, 2.0, 2, (5, 15), Work::Bore);
+    // The bore diameter 50 is cut at the tip: with tip 2 the controlled point runs on the
+    // programmed line of an axis-parallel bore.
+    let on_bore = cmds.iter().any(|c| match &c.command {
+        Command::Linear { end, .. } => (end[0] - 50.0).abs() < 1e-6 && c.line == 6,
+        _ => false,
+    });
+    assert!(on_bore);
+}
+
+#[test]
+fn fixture_059_same_bore_but_printed_without_a_program_end() {
+    let text = fixture("000", "059_ch20_ex5_tnrc_inner.nc");
+    // The Huaxing control ends a program at its last block; the cut is that of 054.
+    check(Dialect::HuaxingLathe, &text, 2.0, 2, (5, 15), Work::Bore);
+}
+
+#[test]
+fn fixture_002_021_gtc2e_g41_r3_centre_programmed() {
+    let text = fixture("002", "021_g41_nose_radius_comp.nc");
+    let n = |label: &str| text.lines().position(|l| l.starts_with(label)).unwrap() as u32 + 1;
+    // G41 R3 on its own, the contour A-B-C-D-E, G40 on its own, then G0 U10 leaves it.
+    let first = n("N0000");
+    let last = n("N0060");
+    let comp = cnc_interpreter::check(Dialect::Gtc2eLathe, &text, Setup::lathe(HOME)).unwrap();
+    // Convex arc B-C (G3 R15) runs at R18, concave C-D (G2 R30) at R27 (the manual's figures).
+    let radii: Vec<f64> = elements(&comp, HOME)
+        .iter()
+        .filter_map(|(e, _, line)| match e {
+            El::Arc(a, _, c, _) if *line > first && *line < last => {
+                Some(((a[0] - c[0]).hypot(a[1] - c[1]) * 1000.0).round() / 1000.0)
+            }
+            _ => None,
+        })
+        .collect();
+    assert!(radii.contains(&18.0) && radii.contains(&27.0), "{radii:?}");
+    // Corner arcs of the nose radius at the outer corners B and E.
+    assert!(
+        radii.iter().filter(|r| **r == 3.0).count() >= 2,
+        "{radii:?}"
+    );
+    // B-C, C-D and D-E are cut to size from outside (A-B shares its line with the move that
+    // leaves the uncompensated start point A, so it is not in this check).
+    check(
+        Dialect::Gtc2eLathe,
+        &text,
+        3.0,
+        0,
+        (n("N0010"), last),
+        Work::Outside,
+    );
+}
+
+#[test]
+fn compensation_errors_raise_the_manual_alarms() {
+    let hx = |t: &str, r: f64| {
+        cnc_interpreter::check(Dialect::HuaxingLathe, t, setup(r, 3)).unwrap_err()
+    };
+    // Start-up not on a G01 line (85), G00 while active (118), no radius (21), a concave
+    // arc smaller than the nose (87), a cycle with compensation active (42).
+    let e = hx("T1\nG0 X50 Z10\nG42 G00 X40 Z5\nM30\n", 1.0);
+    assert_eq!((e.number, e.line), (85, 3), "{e}");
+    let e = hx("T1\nG0 X50 Z10\nG42 G01 X40 Z5 F100\nG00 X60\nM30\n", 1.0);
+    assert_eq!((e.number, e.line), (118, 4), "{e}");
+    let e = hx("T1\nG0 X50 Z10\nG42 G01 X40 Z5 F100\nM30\n", 0.0);
+    assert_eq!((e.number, e.line), (21, 3), "{e}");
+    let e = hx(
+        "T1\nG0 X50 Z10\nG42 G01 X40 Z5 F100\nG01 Z0\nG02 X40 Z-4 R2\nG01 Z-20\nG40 G01 X60\nM30\n",
+        3.0,
+    );
+    assert_eq!(e.number, 87, "{e}");
+    let e = hx(
+        "T1\nG0 X50 Z10\nG42 G01 X40 Z5 F100\nG90 X30 Z-10 F100\nM30\n",
+        1.0,
+    );
+    assert_eq!(e.number, 42, "{e}");
+}
