@@ -141,6 +141,7 @@ fn check(
     let letters = cfg.axis_letters();
     let mut setup = Setup::new(&letters, &cfg.diameter_axes(), &cfg.home());
     setup.reference = cfg.home();
+    setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
     let errors = diagnose(dialect, &text, setup.clone(), lib.clone());
     if trace {
         let mut interp = cnc_interpreter::Interpreter::with_library(dialect, &text, setup, lib);

@@ -49,6 +49,7 @@ pub fn simulate(
     };
     let mut setup = Setup::new(&letters, &cfg.diameter_axes(), &cfg.home());
     setup.reference = cfg.home();
+    setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
     let mut interp = Interpreter::with_library(dialect, text, setup, library);
     let mcfg = MotionConfig::from_launch(cfg);
     let start: Vec<f64> = cfg

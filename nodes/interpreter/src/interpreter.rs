@@ -877,22 +877,18 @@ impl Interpreter {
         } else {
             nose::Side::Right
         };
+        if self.setup.front_tool_post {
+            // Sides are named as seen from the tool post: with the turret in front (X toward
+            // the operator) they are mirrored against the X-up view compensation works in
+            // (`000` §6.1, decision D30).
+            side = side.other();
+        }
         let (radius, tip, startup_line) = if self.dialect == Dialect::Gtc2eLathe {
-            // GTC2E names the side as seen on its front tool post, X toward the operator:
-            // mirrored against the X-up view the compensation works in (decision D30,
-            // fixture 021: G41 runs the convex G03 R15 at R18).
-            side = match side {
-                nose::Side::Left => nose::Side::Right,
-                nose::Side::Right => nose::Side::Left,
-            };
             let r = b
                 .get('R')
                 .ok_or_else(|| self.fault(Fault::MissingWord, "G41/G42 needs R (nose radius)"))?;
             if r < 0.0 {
-                side = match side {
-                    nose::Side::Left => nose::Side::Right,
-                    nose::Side::Right => nose::Side::Left,
-                };
+                side = side.other();
             }
             (r.abs(), 0, false)
         } else {
@@ -902,7 +898,7 @@ impl Interpreter {
                     "G41/G42 must be given in a G01 block with X/Z (or U/W)",
                 ));
             }
-            let t = self.setup.offsets.tool(self.offset_number);
+            let t = self.setup.offsets.tool(self.nose_offset_number(b));
             (t.radius, t.tip, true)
         };
         if radius.is_nan() || radius <= 0.0 || radius > 1000.0 {
@@ -920,6 +916,22 @@ impl Interpreter {
         self.nose = g;
         self.nose_cancel = false;
         Ok(())
+    }
+
+    /// The offset whose nose radius and tip G41/G42 use: a T word in the same block (its
+    /// offset takes effect with this block's move), else the active one.
+    fn nose_offset_number(&self, b: &Block) -> u32 {
+        match b.get('T') {
+            Some(t) if t >= 0.0 && t.fract() == 0.0 && t <= 9999.0 => {
+                let code = t as u32;
+                if code < 100 {
+                    code
+                } else {
+                    code % 100
+                }
+            }
+            _ => self.offset_number,
+        }
     }
 
     /// G40: the next move leaves compensation. Huaxing wants it in a G01 block with axis words

@@ -197,6 +197,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                                 run_counter += 1;
                                 let mut setup = Setup::new(&axes, &diameter, &start);
                                 setup.reference = cfg.home();
+                                setup.front_tool_post =
+                                    cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
                                 // The cell runs programs as the operator would: M99 or G27
                                 // loops go on until stop.
                                 setup.single_pass = false;

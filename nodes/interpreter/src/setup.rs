@@ -74,6 +74,8 @@ pub struct Setup {
     pub single_pass: bool,
     /// Active work system at start (0 = G54).
     pub work_system: u8,
+    /// The turret is in front of the spindle axis: G41/G42 swap sides (decision D30).
+    pub front_tool_post: bool,
 }
 
 impl Setup {
@@ -101,6 +103,7 @@ impl Setup {
             optional_stop: false,
             single_pass: true,
             work_system: 0,
+            front_tool_post: false,
         }
     }
 }

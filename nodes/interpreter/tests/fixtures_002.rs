@@ -364,7 +364,9 @@ fn fixture_020_g96_ends_at_the_programmed_speed_at_x0() {
 #[test]
 fn fixture_021_g41_runs_compensated() {
     // The geometry is checked in tests/nose_comp.rs; here: it runs and ends at the start.
-    let cmds = run(&fixture("021_g41_nose_radius_comp.nc"), HOME);
+    let mut setup = Setup::lathe(HOME);
+    setup.front_tool_post = true;
+    let cmds = run_setup(&fixture("021_g41_nose_radius_comp.nc"), setup).unwrap();
     assert_eq!(last_position(&cmds), HOME);
 }
 

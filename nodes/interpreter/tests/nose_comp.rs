@@ -21,7 +21,13 @@ fn fixture(dir: &str, name: &str) -> String {
 }
 
 fn setup(radius: f64, tip: u8) -> Setup {
+    setup_post(radius, tip, false)
+}
+
+/// `front`: the turret in front of the spindle axis, which swaps G41 and G42.
+fn setup_post(radius: f64, tip: u8, front: bool) -> Setup {
     let mut s = Setup::lathe(HOME);
+    s.front_tool_post = front;
     s.offsets.tools.insert(
         1,
         ToolOffset {
@@ -176,9 +182,19 @@ fn check(
     lines: (u32, u32),
     work: Work,
 ) -> Vec<Canon> {
+    check_post(dialect, text, (radius, tip, false), lines, work)
+}
+
+fn check_post(
+    dialect: Dialect,
+    text: &str,
+    (radius, tip, front): (f64, u8, bool),
+    lines: (u32, u32),
+    work: Work,
+) -> Vec<Canon> {
     let (first_line, last_line) = lines;
-    let comp =
-        cnc_interpreter::check(dialect, text, setup(radius, tip)).unwrap_or_else(|e| panic!("{e}"));
+    let comp = cnc_interpreter::check(dialect, text, setup_post(radius, tip, front))
+        .unwrap_or_else(|e| panic!("{e}"));
     let plain_text = text
         .replace("G41", "")
         .replace("G42", "")
@@ -293,7 +309,9 @@ fn fixture_002_021_gtc2e_g41_r3_centre_programmed() {
     // G41 R3 on its own, the contour A-B-C-D-E, G40 on its own, then G0 U10 leaves it.
     let first = n("N0000");
     let last = n("N0060");
-    let comp = cnc_interpreter::check(Dialect::Gtc2eLathe, &text, Setup::lathe(HOME)).unwrap();
+    // The GTC2E manual's machines have the turret in front.
+    let comp =
+        cnc_interpreter::check(Dialect::Gtc2eLathe, &text, setup_post(3.0, 0, true)).unwrap();
     // Convex arc B-C (G3 R15) runs at R18, concave C-D (G2 R30) at R27 (the manual's figures).
     let radii: Vec<f64> = elements(&comp, HOME)
         .iter()
@@ -312,11 +330,10 @@ fn fixture_002_021_gtc2e_g41_r3_centre_programmed() {
     );
     // B-C, C-D and D-E are cut to size from outside (A-B shares its line with the move that
     // leaves the uncompensated start point A, so it is not in this check).
-    check(
+    check_post(
         Dialect::Gtc2eLathe,
         &text,
-        3.0,
-        0,
+        (3.0, 0, true),
         (n("N0010"), last),
         Work::Outside,
     );
@@ -345,4 +362,51 @@ fn compensation_errors_raise_the_manual_alarms() {
         1.0,
     );
     assert_eq!(e.number, 42, "{e}");
+}
+
+#[test]
+fn fixture_032_g71_roughs_and_g70_finishes_the_compensated_contour() {
+    let text = fixture("000", "032_g71_g70_tnrc_example4.nc");
+    // Listing lines: N0030 (G71 P40 Q140) is line 4, N0040 (G41 start-up) 5, N0140 (G40) 15.
+    // G41 on an outside contour: this example is drawn for a turret in front (§6.1: G41 is
+    // left with the tool post in front, right with it behind), unlike §6.1.5's G42 examples.
+    let comp = check_post(
+        Dialect::HuaxingLathe,
+        &text,
+        (0.8, 3, true),
+        (5, 15),
+        Work::Outside,
+    );
+    // The roughing passes (on the G71 line) rough to the compensated contour plus the
+    // allowance U0.2 W0.2, which shifts it +0.1 in radius and +0.2 in Z: on a wall facing −Z
+    // (the groove's right side) that is 0.2 toward the wall (G71's rule, as for a sharp tool).
+    let plain_text = text.replace("G41", "").replace("G40", "");
+    let plain =
+        cnc_interpreter::check(Dialect::HuaxingLathe, &plain_text, setup_post(0.8, 3, true))
+            .unwrap();
+    let contour: Vec<El> = elements(&plain, HOME)
+        .into_iter()
+        .filter(|&(_, cut, line)| cut && line > 5 && line < 15)
+        .map(|(e, _, _)| e)
+        .collect();
+    let clearance = |cmds: &[Canon], d: [f64; 2]| {
+        let mut closest = f64::INFINITY;
+        for (e, cut, line) in elements(cmds, HOME) {
+            if cut && line == 4 {
+                for p in samples(e, 0.05) {
+                    let c = [p[0] - d[0], p[1] - d[1]];
+                    for el in &contour {
+                        closest = closest.min(distance(c, *el));
+                    }
+                }
+            }
+        }
+        closest
+    };
+    // So the nose keeps at least its radius less the W allowance from the contour.
+    let nose = clearance(&comp, tip_vector(3, 0.8));
+    assert!(
+        nose > 0.8 - 0.2 - 0.01,
+        "roughing nose comes within {nose} of the contour"
+    );
 }

@@ -23,12 +23,24 @@ pub struct LaunchConfig {
 pub struct MachineConfig {
     /// ROS 2 namespace of every topic and service, e.g. `lathe1` → `/lathe1/spindle`.
     pub namespace: String,
-    /// Program dialect: `iso-lathe` for now.
+    /// Program dialect: `huaxing-lathe`, `gtc2e-lathe` or `iso-lathe`.
     pub dialect: String,
     pub axes: Vec<AxisEntry>,
     /// Arc plane as (horizontal, vertical) axis names; G02 is clockwise seen this way.
     #[serde(default = "default_arc_plane")]
     pub arc_plane: [String; 2],
+    /// Where the turret sits: `rear` (behind the spindle axis, X up in the drawing) or
+    /// `front` (toward the operator). G41/G42 swap sides with it (`000` §6.1, decision D30).
+    #[serde(default)]
+    pub tool_post: ToolPost,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ToolPost {
+    #[default]
+    Rear,
+    Front,
 }
 
 fn default_arc_plane() -> [String; 2] {

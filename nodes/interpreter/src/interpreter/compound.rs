@@ -71,6 +71,10 @@ impl Interpreter {
         let mut cur = here.to_vec();
         let mut motion = self.motion;
         let mut elems = Vec::new();
+        // Tool-nose compensation inside the contour: (G41/G42, offset, first element) and the
+        // element whose block cancels it (`000` §3.6: G71–G73 rough to the compensated contour).
+        let mut nose: Option<(G, u32, usize)> = None;
+        let mut nose_cancel: Option<usize> = None;
         let mut info = (false, false, false);
         let mut blocks = 0;
         loop {
@@ -100,8 +104,12 @@ impl Interpreter {
                 for &(_, g, _) in &b.g {
                     match g {
                         G::Rapid | G::Linear | G::ArcCw | G::ArcCcw => motion = g,
-                        G::NoseCancel
-                        | G::ConstantSurfaceSpeed
+                        G::NoseCancel => {
+                            if nose.is_some() && nose_cancel.is_none() {
+                                nose_cancel = Some(elems.len());
+                            }
+                        }
+                        G::ConstantSurfaceSpeed
                         | G::ConstantRpm
                         | G::FeedPerMinute
                         | G::FeedPerRevolution
@@ -109,11 +117,13 @@ impl Interpreter {
                         | G::ExactStopBlock
                         | G::ExactStopMode
                         | G::ContinuousMode => {}
+                        G::NoseLeft | G::NoseRight if nose.is_none() => {
+                            nose = Some((g, self.nose_offset_number(&b), elems.len()));
+                        }
                         G::NoseLeft | G::NoseRight => {
                             return Err(at(
-                                Fault::NotSupported,
-                                "tool-nose radius compensation in a contour is not implemented yet"
-                                    .into(),
+                                Fault::CompDirection,
+                                "G41/G42 twice in a cycle contour".into(),
                             ))
                         }
                         other => {
@@ -202,6 +212,14 @@ impl Interpreter {
             if line.number == Some(nf) {
                 break;
             }
+        }
+        if let Some((g, offset, first_elem)) = nose {
+            elems = self
+                .compensated_contour(&elems, g, offset, first_elem, nose_cancel, here)
+                .map_err(|mut e| {
+                    e.line = self.line;
+                    e
+                })?;
         }
         Ok(Contour {
             elems,
@@ -431,6 +449,64 @@ impl Interpreter {
         Ok(out)
     }
 
+    /// The contour the tool's controlled point follows with tool-nose compensation: the
+    /// elements before `first` as written, the one at `first` the start-up move, the one at
+    /// `cancel` (if any) the cancel move (decision D30).
+    fn compensated_contour(
+        &self,
+        elems: &[Elem],
+        g: G,
+        offset: u32,
+        first: usize,
+        cancel: Option<usize>,
+        here: &[f64],
+    ) -> Result<Vec<Elem>, ProgramError> {
+        let tool = self.setup.offsets.tool(offset);
+        if !(tool.radius > 0.0 && tool.radius <= 1000.0) {
+            return Err(self.fault(
+                Fault::CompRadiusZero,
+                format!(
+                    "tool-nose radius {} of offset {offset} is not usable",
+                    show(tool.radius)
+                ),
+            ));
+        }
+        let mut side = if g == G::NoseLeft {
+            nose::Side::Left
+        } else {
+            nose::Side::Right
+        };
+        if self.setup.front_tool_post {
+            side = side.other();
+        }
+        let start = elems
+            .get(first)
+            .map(|e| e.start())
+            .map_or_else(|| self.plane_point(here), Ok)?;
+        let mut comp = nose::NoseComp::new(side, tool.radius, tool.tip, start, true);
+        let mut outs = Vec::new();
+        let mut out_elems: Vec<Elem> = elems[..first.min(elems.len())].to_vec();
+        for (i, e) in elems.iter().enumerate().skip(first) {
+            let path = match *e {
+                Elem::Line { a, b } => nose::Path::Line { a, b },
+                Elem::Arc { a, b, c, ccw } => nose::Path::Arc { a, b, c, cw: !ccw },
+            };
+            if Some(i) == cancel {
+                outs.extend(comp.cancel(e.end(), nose::Kind::Feed(1.0), 0));
+                out_elems.extend(outs.drain(..).map(elem_of));
+                out_elems.extend(elems[i + 1..].iter().copied());
+                return Ok(out_elems);
+            }
+            outs.extend(
+                comp.push(path, nose::Kind::Feed(1.0), 0)
+                    .map_err(|x| self.comp_fault(x))?,
+            );
+        }
+        outs.extend(comp.flush());
+        out_elems.extend(outs.into_iter().map(elem_of));
+        Ok(out_elems)
+    }
+
     /// G70: runs the contour blocks as written, then returns to the start point.
     pub(super) fn finishing(&mut self, b: &Block) -> Result<(), ProgramError> {
         let (ns, nf) = self.p_q(b)?;
@@ -555,5 +631,12 @@ impl Interpreter {
             self.emit(&at(x0, z0), MoveKind::Rapid)?;
         }
         Ok(())
+    }
+}
+
+fn elem_of(o: nose::Out) -> Elem {
+    match o.path {
+        nose::Path::Line { a, b } => Elem::Line { a, b },
+        nose::Path::Arc { a, b, c, cw } => Elem::Arc { a, b, c, ccw: !cw },
     }
 }

@@ -28,6 +28,15 @@ pub enum Side {
     Right,
 }
 
+impl Side {
+    pub fn other(self) -> Side {
+        match self {
+            Side::Left => Side::Right,
+            Side::Right => Side::Left,
+        }
+    }
+}
+
 /// A programmed or offset element of the contour.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Path {
