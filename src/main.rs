@@ -134,14 +134,12 @@ fn check(
     library: Option<&Path>,
     trace: bool,
 ) -> Result<(), String> {
-    use cnc_interpreter::{diagnose, Setup};
+    use cnc_interpreter::diagnose;
     let cfg = LaunchConfig::load(config)?;
     let text = read_program(program)?;
     let (dialect, lib) = dialect_and_library(&cfg, program, dialect, library)?;
     let letters = cfg.axis_letters();
-    let mut setup = Setup::new(&letters, &cfg.diameter_axes(), &cfg.home());
-    setup.reference = cfg.home();
-    setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
+    let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
     let errors = diagnose(dialect, &text, setup.clone(), lib.clone());
     if trace {
         let mut interp = cnc_interpreter::Interpreter::with_library(dialect, &text, setup, lib);

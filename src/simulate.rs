@@ -8,7 +8,7 @@
 //! indexing, chuck), which are answered at once here; the simulated machine of `cnc run`
 //! includes them.
 
-use cnc_interpreter::{Canon, Dialect, Interpreter, Library, Setup};
+use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_motion::{Aux, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
 use cnc_msgs::signals::GImage;
 use cnc_runtime::LaunchConfig;
@@ -42,14 +42,11 @@ pub fn simulate(
     text: &str,
     library: Library,
 ) -> Result<Simulation, String> {
-    let letters = cfg.axis_letters();
     let (xi, zi) = match (cfg.axis_index("X"), cfg.axis_index("Z")) {
         (Some(x), Some(z)) => (x, z),
         _ => return Err("simulate needs a lathe with X and Z axes".into()),
     };
-    let mut setup = Setup::new(&letters, &cfg.diameter_axes(), &cfg.home());
-    setup.reference = cfg.home();
-    setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
+    let setup = cnc_interpreter::node::setup_from_config(cfg, &cfg.home());
     let mut interp = Interpreter::with_library(dialect, text, setup, library);
     let mcfg = MotionConfig::from_launch(cfg);
     let start: Vec<f64> = cfg

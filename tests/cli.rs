@@ -121,3 +121,49 @@ fn simulate_prints_the_cycle_time_and_draws_the_part() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("line 2"), "{err}");
 }
+
+#[test]
+fn check_uses_the_offset_page_of_the_launch_config() {
+    // Fixture 053 (G42 with T1): the config's offset 1 has nose radius 0.4, tip 3.
+    let program = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../shared/fixtures/000/053_tnrc_outer_G42.nc"
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["check", program, "--trace"])
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success() && text.contains("no alarm"), "{text}");
+    // The start-up move ends off the programmed X26 Z131, and outer corners get R0.4 arcs.
+    assert!(!text.contains("LINEAR X26.0000 Z131.0000"), "{text}");
+    assert!(text.contains("CX29.2000 CZ128.6000"), "{text}");
+
+    // A bad offset page is refused when the config is loaded.
+    let dir = std::env::temp_dir().join(format!("cnc_cfg_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cfg = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/launch_configs/sim_lathe.yaml"
+    ))
+    .unwrap()
+    .replace("{ radius: 0.4, tip: 3 }", "{ radius: 0.4, tip: 12 }");
+    let bad = dir.join("bad.yaml");
+    std::fs::write(&bad, cfg).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["check", program, "--config"])
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("machine.tools[1]"),
+        "{err}"
+    );
+}

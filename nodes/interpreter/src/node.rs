@@ -48,10 +48,43 @@ struct Run {
     failed: bool,
 }
 
+/// The interpreter's view of the machine from the launch config: axes, reference point, tool
+/// post, the offset page and the work offsets; the program starts at `start`.
+pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
+    let letters = cfg.axis_letters();
+    let mut setup = Setup::new(&letters, &cfg.diameter_axes(), start);
+    setup.reference = cfg.home();
+    setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
+    for (&n, t) in &cfg.machine.tools {
+        setup.offsets.tools.insert(
+            n,
+            crate::setup::ToolOffset {
+                x: t.x,
+                z: t.z,
+                wear_x: t.wear_x,
+                wear_z: t.wear_z,
+                radius: t.radius,
+                tip: t.tip,
+            },
+        );
+    }
+    for (code, axes) in &cfg.machine.work_offsets {
+        if let Some(i) = cfg.work_offset_index(code) {
+            let row = setup.offsets.work.entry(i).or_default();
+            for (axis, &v) in axes {
+                if let Some(c) = axis.chars().next() {
+                    row.insert(c, v);
+                }
+            }
+        }
+    }
+    setup
+}
+
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let dialect = Dialect::from_name(&cfg.machine.dialect)
         .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
-    let (axes, diameter) = (cfg.axis_letters(), cfg.diameter_axes());
+    let axes = cfg.axis_letters();
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
     let commands = ros.subscription::<ProgramCommand>(
         "_internal/program_command",
@@ -195,10 +228,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                             None => (false, "no axis position from motion yet".into()),
                             Some(start) => {
                                 run_counter += 1;
-                                let mut setup = Setup::new(&axes, &diameter, &start);
-                                setup.reference = cfg.home();
-                                setup.front_tool_post =
-                                    cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
+                                let mut setup = setup_from_config(&cfg, &start);
                                 // The cell runs programs as the operator would: M99 or G27
                                 // loops go on until stop.
                                 setup.single_pass = false;

@@ -1,6 +1,7 @@
 //! The launch config: one YAML file describes the machine, the network and the nodes.
 
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::net::IpAddr;
 
 /// Top level of `launch_configs/*.yaml`.
@@ -33,6 +34,31 @@ pub struct MachineConfig {
     /// `front` (toward the operator). G41/G42 swap sides with it (`000` §6.1, decision D30).
     #[serde(default)]
     pub tool_post: ToolPost,
+    /// The offset page: tool offsets by offset number (T0101 → 1), 1–99.
+    #[serde(default)]
+    pub tools: BTreeMap<u32, ToolEntry>,
+    /// Work offsets by code (`G54`…`G59`; on GTC2E the offset groups of G54–G57), per axis.
+    #[serde(default)]
+    pub work_offsets: BTreeMap<String, BTreeMap<String, f64>>,
+}
+
+/// One row of the offset page (`000` §5.2, `002` §3.7): geometry and wear (X as diameter),
+/// nose radius and imaginary tip direction 0–9.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToolEntry {
+    #[serde(default)]
+    pub x: f64,
+    #[serde(default)]
+    pub z: f64,
+    #[serde(default)]
+    pub wear_x: f64,
+    #[serde(default)]
+    pub wear_z: f64,
+    #[serde(default)]
+    pub radius: f64,
+    #[serde(default)]
+    pub tip: u8,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
@@ -237,6 +263,19 @@ impl LaunchConfig {
         Self::from_yaml(&text).map_err(|e| format!("{}: {e}", path.display()))
     }
 
+    /// `G54` → 0 … `G59` → 5.
+    pub fn work_offset_index(&self, code: &str) -> Option<u8> {
+        match code.to_ascii_uppercase().as_str() {
+            "G54" => Some(0),
+            "G55" => Some(1),
+            "G56" => Some(2),
+            "G57" => Some(3),
+            "G58" => Some(4),
+            "G59" => Some(5),
+            _ => None,
+        }
+    }
+
     fn validate(&self) -> Result<(), String> {
         let ns = &self.machine.namespace;
         if ns.is_empty()
@@ -288,6 +327,28 @@ impl LaunchConfig {
         }
         if self.servo.queue_capacity < 2 || self.servo.queue_capacity > 10_000 {
             return Err("servo.queue_capacity must be 2..10000".into());
+        }
+        for (n, t) in &self.machine.tools {
+            let finite = [t.x, t.z, t.wear_x, t.wear_z, t.radius]
+                .iter()
+                .all(|v| v.is_finite() && v.abs() <= 10_000.0);
+            if !(1..=99).contains(n) || !finite || t.radius < 0.0 || t.tip > 9 {
+                return Err(format!(
+                    "machine.tools[{n}]: offset 1..99, finite values within ±10000, radius ≥ 0, tip 0..9"
+                ));
+            }
+        }
+        for (code, axes) in &self.machine.work_offsets {
+            if self.work_offset_index(code).is_none() {
+                return Err(format!("machine.work_offsets: {code:?} is not G54..G59"));
+            }
+            for (axis, v) in axes {
+                if !self.machine.axes.iter().any(|a| &a.name == axis) || !v.is_finite() {
+                    return Err(format!(
+                        "machine.work_offsets.{code}: axis {axis:?} not configured or value not finite"
+                    ));
+                }
+            }
         }
         if self.network.interfaces.is_empty() {
             return Err("network.interfaces must name at least one interface address".into());
