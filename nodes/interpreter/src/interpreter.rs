@@ -179,6 +179,8 @@ pub struct Interpreter {
     nose_comp: Option<nose::NoseComp>,
     /// G40 given: the next move leaves compensation.
     nose_cancel: bool,
+    /// A G01 with chamfer L or rounding D, waiting for the next move.
+    corner: Option<corner::Corner>,
     /// Set while compensated moves are being queued (they are not compensated again).
     emitting_comp: bool,
     /// While compensation holds an element back, commands from this index of `pending` on
@@ -255,6 +257,7 @@ impl Interpreter {
             nose: G::NoseCancel,
             nose_comp: None,
             nose_cancel: false,
+            corner: None,
             emitting_comp: false,
             hold_at: None,
             work_system: setup.work_system.min(5),
@@ -381,6 +384,8 @@ impl Interpreter {
     }
 
     fn finish(&mut self) {
+        // A chamfer with no move after it: the line runs to its corner (decision D31).
+        let _ = self.resolve_corner(None);
         // Program end cancels tool-nose compensation (`000` §5.3): the held element ends at
         // its offset end.
         if let Some(mut comp) = self.nose_comp.take() {
@@ -801,6 +806,9 @@ impl Interpreter {
 
     /// Emits a move to work position `end` and makes it the current position.
     fn emit(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        if self.corner.is_some() {
+            self.resolve_corner(Some((end, kind)))?;
+        }
         if self.nose_comp.is_some() && !self.emitting_comp {
             return self.emit_compensated(end, kind);
         }
@@ -1702,16 +1710,14 @@ impl Interpreter {
                 self.emit(&end, MoveKind::Rapid)
             }
             G::Linear => {
-                if b.has('L') || b.has('D') {
-                    return Err(self.fault(
-                        Fault::NotSupported,
-                        "chamfer L / corner rounding D is not implemented yet",
-                    ));
-                }
+                let chamfer = self.chamfer_words(b)?;
                 let end = self.end_point(b)?;
                 self.track_x_direction(&end);
                 let f = self.feed;
-                self.emit(&end, MoveKind::Feed(f))
+                match chamfer {
+                    Some(c) => self.hold_corner(end, f, c),
+                    None => self.emit(&end, MoveKind::Feed(f)),
+                }
             }
             G::ArcCw | G::ArcCcw => self.arc(b),
             G::ThreePointArc { absolute } => self.three_point_arc(b, absolute),
@@ -2387,6 +2393,7 @@ impl Variables for Interpreter {
 
 // Cycles that need more room live in their own files.
 mod compound;
+mod corner;
 mod grooving;
 mod gtc;
 mod nose;

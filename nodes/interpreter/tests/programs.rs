@@ -328,3 +328,74 @@ fn endless_or_runaway_programs_end_in_an_alarm() {
     let e = hx("#1=#1002\n");
     assert_eq!((e.number, e.line), (20, 1), "{e}");
 }
+
+/// Chamfer L and corner rounding D in G01 (`000` §5.11, decision D31).
+#[test]
+fn chamfer_and_corner_rounding_in_g01() {
+    let hx = |t: &str| {
+        let cmds =
+            cnc_interpreter::check(Dialect::HuaxingLathe, t, Setup::lathe([20.0, 5.0])).unwrap();
+        cnc_interpreter::trace::format(&AXES, &cmds)
+    };
+    // Line-line chamfer L2: the Z cut stops 2 mm short, the chamfer ends 2 mm up the face.
+    assert_eq!(
+        hx("G01 Z-10 L2 F100\nX40\nM30\n"),
+        "L1 LINEAR X20.0000 Z-8.0000 F100.0000\n\
+         L1 LINEAR X24.0000 Z-10.0000 F100.0000\n\
+         L2 LINEAR X40.0000 Z-10.0000 F100.0000\n\
+         L3 M30\nL3 END\n"
+    );
+    // Rounding D2 of a right angle: an arc of radius 2 tangent to both lines.
+    assert_eq!(
+        hx("G01 Z-10 D2 F100\nX40\nM30\n"),
+        "L1 LINEAR X20.0000 Z-8.0000 F100.0000\n\
+         L1 ARC_CW X24.0000 Z-10.0000 CX24.0000 CZ-8.0000 F100.0000\n\
+         L2 LINEAR X40.0000 Z-10.0000 F100.0000\n\
+         L3 M30\nL3 END\n"
+    );
+    // An M code after the motion of the chamfered block stays after its line.
+    let t = hx("G01 Z-10 L2 F100 M09\nX40\nM30\n");
+    let order: Vec<&str> = t.lines().map(|l| l.split_once(' ').unwrap().1).collect();
+    assert_eq!(order[0], "LINEAR X20.0000 Z-8.0000 F100.0000");
+    assert_eq!(order[1], "LINEAR X24.0000 Z-10.0000 F100.0000");
+    assert_eq!(order[2], "M9", "{t}");
+    // Line-arc: the chamfer ends on the arc 2 mm from the corner; the arc keeps its centre.
+    let cmds = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "G01 Z-10 L2 F100\nG02 X40 Z-20 R10\nM30\n",
+        Setup::lathe([20.0, 5.0]),
+    )
+    .unwrap();
+    let ends: Vec<Vec<f64>> = cmds.iter().filter_map(|c| end_of(&c.command)).collect();
+    let q2 = &ends[1];
+    let (dz, dr) = (q2[1] + 10.0, q2[0] / 2.0 - 10.0);
+    assert!(((dz * dz + dr * dr).sqrt() - 2.0).abs() < 1e-9, "{q2:?}");
+    match &cmds[2].command {
+        Command::Arc { end, center, .. } => {
+            assert_close(end, &[40.0, -20.0]);
+            let r = |p: &[f64]| {
+                ((p[0] / 2.0 - center[0] / 2.0).powi(2) + (p[1] - center[1]).powi(2)).sqrt()
+            };
+            assert!((r(q2) - 10.0).abs() < 1e-9 && (r(end) - 10.0).abs() < 1e-9);
+        }
+        other => panic!("{other:?}"),
+    }
+    // Too long for the lines: alarm 119 on the chamfer's block; L and D together: alarm 12;
+    // a collinear corner and a chamfer before a rapid are left alone.
+    let e = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "G01 Z-10 L20 F100\nX40\nM30\n",
+        Setup::lathe([20.0, 5.0]),
+    )
+    .unwrap_err();
+    assert_eq!((e.number, e.line), (119, 1), "{e}");
+    let e = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "G01 Z-10 L2 D2 F100\nX40\nM30\n",
+        Setup::lathe([20.0, 5.0]),
+    )
+    .unwrap_err();
+    assert_eq!((e.number, e.line), (12, 1), "{e}");
+    assert!(hx("G01 Z-10 L2 F100\nZ-20\nM30\n").starts_with("L1 LINEAR X20.0000 Z-10.0000"));
+    assert!(hx("G01 Z-10 L2 F100\nG00 X40\nM30\n").starts_with("L1 LINEAR X20.0000 Z-10.0000"));
+}

@@ -1,0 +1,214 @@
+//! Chamfer `L` and corner rounding `D` in a G01 block (`000` §5.11, decision D31): the corner
+//! between this block's line and the next move is cut by a straight chamfer whose ends lie L
+//! from the corner on both elements, or rounded by an arc of radius D tangent to both lines.
+//!
+//! The line is held back until the next move shows the corner, like an element under nose
+//! compensation; commands queued after it wait for it.
+
+use super::*;
+
+/// What the corner gets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Chamfer {
+    Line(f64),
+    Round(f64),
+}
+
+/// A G01 whose end is a chamfered or rounded corner, waiting for the next move.
+#[derive(Debug, Clone)]
+pub(super) struct Corner {
+    /// Work positions where the line starts and ends (the corner).
+    pub start: Vec<f64>,
+    pub end: Vec<f64>,
+    pub feed: f64,
+    pub line: u32,
+    pub chamfer: Chamfer,
+}
+
+fn unit(z: f64, r: f64) -> Option<(f64, f64)> {
+    let l = z.hypot(r);
+    (l > 1e-9).then(|| (z / l, r / l))
+}
+
+impl Interpreter {
+    /// The chamfer or rounding words of a Huaxing G01 block; a value outside 0–1000 is
+    /// ignored, as the manual says.
+    pub(super) fn chamfer_words(&self, b: &Block) -> Result<Option<Chamfer>, ProgramError> {
+        if self.dialect != Dialect::HuaxingLathe {
+            return Ok(None);
+        }
+        let usable = |v: f64| v > 0.0 && v <= 1000.0;
+        match (b.get('L'), b.get('D')) {
+            (Some(_), Some(_)) => Err(self.fault(
+                Fault::Chamfer,
+                "chamfer L and corner rounding D in one block",
+            )),
+            (Some(l), None) if usable(l) => Ok(Some(Chamfer::Line(l))),
+            (None, Some(d)) if usable(d) => Ok(Some(Chamfer::Round(d))),
+            _ => Ok(None),
+        }
+    }
+
+    /// A G01 to `end` with a chamfer at its end: held until the next move.
+    pub(super) fn hold_corner(
+        &mut self,
+        end: Vec<f64>,
+        feed: f64,
+        chamfer: Chamfer,
+    ) -> Result<(), ProgramError> {
+        if self.nose_comp.is_some() {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "chamfer L / rounding D while tool-nose compensation is active",
+            ));
+        }
+        self.resolve_corner(Some((&end, MoveKind::Feed(feed))))?;
+        let start = self.work_position();
+        self.check_feed(feed)?;
+        self.hold_at = Some(self.pending.len());
+        self.corner = Some(Corner {
+            start,
+            end: end.clone(),
+            feed,
+            line: self.line,
+            chamfer,
+        });
+        // The program goes on from the corner: incremental words of the next block start there.
+        self.pos = self.to_machine(&end);
+        Ok(())
+    }
+
+    /// Emits the held line, cut back for the corner the next move (`next`, if any, ending at
+    /// the given work position) makes with it, and the chamfer or rounding; the current
+    /// position is then where the next move starts. Without a usable next move (program end,
+    /// a rapid, a cycle) the line runs to its corner unchamfered.
+    pub(super) fn resolve_corner(
+        &mut self,
+        next: Option<(&[f64], MoveKind)>,
+    ) -> Result<(), ProgramError> {
+        let Some(corner) = self.corner.take() else {
+            return Ok(());
+        };
+        let insert_at = self.hold_at.take().unwrap_or(self.pending.len());
+        let before = self.pending.len();
+        let saved_line = self.line;
+        self.line = corner.line;
+        let result = self.corner_moves(&corner, next);
+        self.line = saved_line;
+        // The line and the chamfer go where the line was in program order.
+        let new: Vec<Canon> = self.pending.drain(before..).collect();
+        for (k, c) in new.into_iter().enumerate() {
+            self.pending.insert(insert_at + k, c);
+        }
+        result
+    }
+
+    fn corner_moves(
+        &mut self,
+        corner: &Corner,
+        next: Option<(&[f64], MoveKind)>,
+    ) -> Result<(), ProgramError> {
+        let feed = MoveKind::Feed(corner.feed);
+        let a = self.plane_point(&corner.start)?;
+        let p = self.plane_point(&corner.end)?;
+        let plain = |me: &mut Self| me.emit(&corner.end, feed);
+        let Some(t1) = unit(p.z - a.z, p.r - a.r) else {
+            return plain(self);
+        };
+        let len1 = a.dist(p);
+        let Some((next_end, next_kind)) = next else {
+            return plain(self);
+        };
+        let b = self.plane_point(next_end)?;
+        let base = corner.end.clone();
+        match (corner.chamfer, next_kind) {
+            (_, MoveKind::Rapid | MoveKind::Thread { .. }) => plain(self),
+            (chamfer, MoveKind::Feed(_)) => {
+                let Some(t2) = unit(b.z - p.z, b.r - p.r) else {
+                    return plain(self);
+                };
+                let cross = t1.0 * t2.1 - t1.1 * t2.0;
+                let dot = t1.0 * t2.0 + t1.1 * t2.1;
+                if cross.abs() < 1e-9 && dot > 0.0 {
+                    return plain(self); // collinear: nothing to cut (`000` §5.11)
+                }
+                let len2 = p.dist(b);
+                let (d, round) = match chamfer {
+                    Chamfer::Line(l) => (l, None),
+                    Chamfer::Round(r) => {
+                        // Tangent length of a radius-r arc in the corner.
+                        let turn = cross.atan2(dot).abs();
+                        (r * (turn / 2.0).tan(), Some(r))
+                    }
+                };
+                if d > len1 + 1e-9 || d > len2 + 1e-9 {
+                    return Err(self.fault(
+                        Fault::ChamferTooShort,
+                        format!(
+                            "chamfer/rounding needs {} mm on each side of the corner; the lines are {} and {} mm",
+                            show(d),
+                            show(len1),
+                            show(len2)
+                        ),
+                    ));
+                }
+                let q1 = Pt::new(p.z - d * t1.0, p.r - d * t1.1);
+                let q2 = Pt::new(p.z + d * t2.0, p.r + d * t2.1);
+                self.emit(&self.with_point(&base, q1), feed)?;
+                match round {
+                    None => self.emit(&self.with_point(&base, q2), feed),
+                    Some(r) => {
+                        // The centre lies on the inside of the turn, r from both lines.
+                        let side = cross.signum();
+                        let n = (-t1.1 * side, t1.0 * side);
+                        let center = Pt::new(q1.z + r * n.0, q1.r + r * n.1);
+                        self.emit(
+                            &self.with_point(&base, q2),
+                            MoveKind::Arc {
+                                center,
+                                ccw: cross > 0.0,
+                                feed: corner.feed,
+                            },
+                        )
+                    }
+                }
+            }
+            (Chamfer::Line(l), MoveKind::Arc { center, ccw, .. }) => {
+                // The chamfer ends on the arc, l from the corner, in the arc's direction.
+                let rho = center.dist(p);
+                let dc = center.dist(p);
+                // The arc's own sweep from the corner to its end, in its direction.
+                let tau = std::f64::consts::TAU;
+                let a0 = (p.r - center.r).atan2(p.z - center.z);
+                let a1 = (b.r - center.r).atan2(b.z - center.z);
+                let sweep = if ccw {
+                    (a1 - a0).rem_euclid(tau)
+                } else {
+                    (a0 - a1).rem_euclid(tau)
+                };
+                let needed = 2.0 * (l / (2.0 * rho)).min(1.0).asin();
+                if l > len1 + 1e-9 || l >= 2.0 * rho || needed > sweep + 1e-9 {
+                    return Err(self.fault(
+                        Fault::ChamferTooShort,
+                        format!("chamfer L{} does not fit the line or the arc", show(l)),
+                    ));
+                }
+                // Points at distance l from p on the circle: p rotated about the centre by
+                // ±2·asin(l / 2ρ); the arc's direction picks the sign.
+                let ang = 2.0 * (l / (2.0 * rho)).asin() * if ccw { 1.0 } else { -1.0 };
+                let (rz, rr) = ((p.z - center.z) / dc * rho, (p.r - center.r) / dc * rho);
+                let q2 = Pt::new(
+                    center.z + rz * ang.cos() - rr * ang.sin(),
+                    center.r + rz * ang.sin() + rr * ang.cos(),
+                );
+                let q1 = Pt::new(p.z - l * t1.0, p.r - l * t1.1);
+                self.emit(&self.with_point(&base, q1), feed)?;
+                self.emit(&self.with_point(&base, q2), feed)
+            }
+            (Chamfer::Round(_), MoveKind::Arc { .. }) => Err(self.fault(
+                Fault::NotSupported,
+                "corner rounding D between a line and an arc: the manual leaves it \"to be extended\"",
+            )),
+        }
+    }
+}
