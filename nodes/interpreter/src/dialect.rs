@@ -130,8 +130,25 @@ pub enum M {
     CountPart,
     /// GTC2E M52/M53/M65: order of axes in returns.
     ReturnOrder(ReturnOrder),
+    /// Huaxing tool-change macro codes (`000` §4.1.5, §4.3.3).
+    ToolMacro(ToolMacro),
     /// Defined by the manual but not implemented by this controller.
     Unsupported(&'static str),
+}
+
+/// The Huaxing codes a tool-change macro program uses (`000` §4.3.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToolMacro {
+    /// M52 Kn: the current tool number into local variable #n.
+    ReadTool,
+    /// M53 / M53.1 K: make K the active tool-offset number.
+    SetOffset,
+    /// M54: wait until execution has caught up with interpretation.
+    Sync,
+    /// M57 K: the target tool to the PLC with the T strobe.
+    ToolToPlc,
+    /// M58 Kn: raise alarm number n.
+    RaiseAlarm,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -434,7 +451,14 @@ fn huaxing_m(n: u32) -> Option<M> {
         290 => Unsupported("M29 rigid tapping needs a position spindle"),
         500 => Unsupported("M50 bar feed drives outputs directly, not through the PLC"),
         510 => Unsupported("M51 sets the start block in MDI"),
-        520..=580 => Unsupported("M52–M58 belong to tool-change macros"),
+        520 => ToolMacro(self::ToolMacro::ReadTool),
+        530 | 531 => ToolMacro(self::ToolMacro::SetOffset),
+        540 => ToolMacro(self::ToolMacro::Sync),
+        570 => ToolMacro(self::ToolMacro::ToolToPlc),
+        580 => ToolMacro(self::ToolMacro::RaiseAlarm),
+        // M56 moves the turret toward the change position: the PLC's.
+        560 => AuxBefore,
+        550 => Unsupported("M55 writes PLC F026–F029, which the PLC program does not read"),
         590 | 600 | 660 | 850 | 860 | 870 | 880 | 890 => {
             Unsupported("NC-internal M code of multi-channel or live-tool machines")
         }

@@ -13,7 +13,7 @@ use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::Arc;
 
 use crate::canon::{Aux, Canon, Command};
-use crate::dialect::{Dialect, ReturnOrder, Rules, G, M};
+use crate::dialect::{Dialect, ReturnOrder, Rules, ToolMacro, G, M};
 use crate::error::{Fault, ProgramError};
 use crate::expr::{truth, variable_number, EvalError, Expr, Value, Variables};
 use crate::geometry::{self, ArcError, Elem, Pt};
@@ -190,6 +190,10 @@ pub struct Interpreter {
     /// G50 floating shift, G52 local shift and GTC2E cumulative shifts, per axis.
     shift: Vec<f64>,
     tool_offset: Vec<f64>,
+    /// The tool last commanded (T or M57), for M52 and the tool-change macro's #1.
+    tool: u32,
+    /// The frame depth of a running tool-change macro: T words inside it do not call it again.
+    tool_macro_depth: Option<usize>,
     /// Active offset number (0 = none).
     offset_number: u32,
     gang_mode: bool,
@@ -263,6 +267,8 @@ impl Interpreter {
             work_system: setup.work_system.min(5),
             shift: vec![0.0; n],
             tool_offset: vec![0.0; n],
+            tool: 0,
+            tool_macro_depth: None,
             offset_number: 0,
             gang_mode: false,
             return_order: ReturnOrder::XThenZ,
@@ -1200,6 +1206,7 @@ impl Interpreter {
                     self.aux(Aux::M((code / 10) as i32));
                 }
                 M::ReturnOrder(o) => self.return_order = o,
+                M::ToolMacro(op) => self.tool_macro_code(op, &b)?,
                 _ => {}
             }
         }
@@ -1366,9 +1373,60 @@ impl Interpreter {
                 format!("offset number {offset} out of range"),
             ));
         }
+        if let Some(program) = self
+            .setup
+            .tool_change_macro
+            .filter(|_| self.dialect == Dialect::HuaxingLathe && self.tool_macro_depth.is_none())
+        {
+            return self.call_tool_macro(program, tool.unwrap_or(0), offset);
+        }
         if let Some(tool) = tool.filter(|&t| t > 0) {
             self.aux(Aux::T(tool as i32));
+            self.tool = tool;
         }
+        self.apply_offset(offset);
+        Ok(())
+    }
+
+    /// Calls the tool-change macro (`000` §4.3.1–4.3.3) with #1 the current tool, #2 the
+    /// current offset, #3 the target tool, #4 the target offset.
+    fn call_tool_macro(
+        &mut self,
+        program: u32,
+        tool: u32,
+        offset: u32,
+    ) -> Result<(), ProgramError> {
+        if self.frames.len() > MAX_CALL_DEPTH {
+            return Err(self.fault(Fault::Call, "subprograms nested deeper than 4 levels"));
+        }
+        let (name, text) = self.library.get(program).ok_or_else(|| {
+            self.fault(
+                Fault::UndefinedSubprogram,
+                format!("tool-change macro O{program:04} not in the library"),
+            )
+        })?;
+        let name = name.to_string();
+        let mut locals = vec![None; LOCALS];
+        for (i, v) in [self.tool, self.offset_number, tool, offset]
+            .into_iter()
+            .enumerate()
+        {
+            locals[i + 1] = Some(v as f64);
+        }
+        self.frames.push(Frame {
+            text,
+            name,
+            pos: Pos::default(),
+            remaining: 0,
+            repeats: Vec::new(),
+            locals,
+        });
+        self.tool_macro_depth = Some(self.frames.len());
+        Ok(())
+    }
+
+    /// Makes `offset` the active tool offset (0 = none).
+    fn apply_offset(&mut self, offset: u32) {
         // The offset takes effect with the next move (`000` §5.18): the work position shifts.
         self.offset_number = offset;
         let o = self.setup.offsets.tool(offset);
@@ -1383,7 +1441,61 @@ impl Interpreter {
                 }
             };
         }
-        Ok(())
+    }
+
+    /// M52/M53/M54/M57/M58 of a tool-change macro (`000` §4.3.3).
+    fn tool_macro_code(&mut self, op: ToolMacro, b: &Block) -> Result<(), ProgramError> {
+        let k = || {
+            b.get('K')
+                .filter(|v| v.fract() == 0.0 && *v >= 0.0 && *v <= 9999.0)
+                .map(|v| v as u32)
+        };
+        let need_k = |me: &Self| {
+            k().ok_or_else(|| me.fault(Fault::MissingWord, "the code needs K, a whole number"))
+        };
+        match op {
+            ToolMacro::ReadTool => {
+                let n = need_k(self)?;
+                if !(1..=40).contains(&n) {
+                    return Err(self.fault(Fault::OutOfRange, format!("M52 K{n}: #1–#40")));
+                }
+                let tool = self.tool as f64;
+                self.write_var(n as i64, Some(tool))
+            }
+            ToolMacro::SetOffset => {
+                let n = need_k(self)?;
+                if n > MAX_OFFSET {
+                    return Err(
+                        self.fault(Fault::ToolNumber, format!("offset number {n} out of range"))
+                    );
+                }
+                self.apply_offset(n);
+                Ok(())
+            }
+            // Execution follows the program in order here; the tool M52 reads is the one the
+            // PLC confirmed (its FIN comes before motion goes on).
+            ToolMacro::Sync => Ok(()),
+            ToolMacro::ToolToPlc => {
+                let n = need_k(self)?;
+                if n == 0 || n > 99 {
+                    return Err(self.fault(Fault::ToolNumber, format!("M57 K{n}: tool 1–99")));
+                }
+                self.aux(Aux::T(n as i32));
+                self.tool = n;
+                Ok(())
+            }
+            ToolMacro::RaiseAlarm => {
+                let n = need_k(self)?;
+                Err(self.fault(
+                    Fault::ToolNumber,
+                    format!("alarm {n} raised by the tool-change macro (M58 K{n})"),
+                ))
+                .map_err(|mut e| {
+                    e.number = n;
+                    e
+                })
+            }
+        }
     }
 
     fn gtc_offset_shift(&mut self, n: u8) {
@@ -1570,6 +1682,9 @@ impl Interpreter {
             f.repeats.clear();
         } else {
             self.frames.pop();
+            if self.tool_macro_depth.is_some_and(|d| self.frames.len() < d) {
+                self.tool_macro_depth = None;
+            }
         }
         Ok(())
     }

@@ -55,6 +55,7 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     let mut setup = Setup::new(&letters, &cfg.diameter_axes(), start);
     setup.reference = cfg.home();
     setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
+    setup.tool_change_macro = cfg.machine.tool_change_macro;
     for (&n, t) in &cfg.machine.tools {
         setup.offsets.tools.insert(
             n,

@@ -76,6 +76,8 @@ pub struct Setup {
     pub work_system: u8,
     /// The turret is in front of the spindle axis: G41/G42 swap sides (decision D30).
     pub front_tool_post: bool,
+    /// Huaxing S#170: a T word calls this program as the tool-change macro (`000` §4.3.1).
+    pub tool_change_macro: Option<u32>,
 }
 
 impl Setup {
@@ -104,6 +106,7 @@ impl Setup {
             single_pass: true,
             work_system: 0,
             front_tool_post: false,
+            tool_change_macro: None,
         }
     }
 }

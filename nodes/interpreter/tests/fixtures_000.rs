@@ -588,3 +588,64 @@ fn fixtures_with_the_alarm_the_manual_predicts() {
     assert_eq!(e.number, 7);
     assert!(e.text.contains('C'), "{e}");
 }
+
+/// Fixtures 005 and 006: the manual's built-in tool-change macros (`000` §4.3.3), called by a
+/// T word when the machine names a tool-change macro program (S#170).
+#[test]
+fn fixtures_005_006_tool_change_macros_called_by_t() {
+    let mut setup = Setup::lathe(HOME);
+    setup.tool_change_macro = Some(9000);
+    setup.offsets.tools.insert(
+        3,
+        cnc_interpreter::setup::ToolOffset {
+            x: 4.0,
+            z: -2.0,
+            ..Default::default()
+        },
+    );
+    // 006 (electric turret): M57 K[#3] sends the target tool, M53.1 K[#4] takes its offset,
+    // M52 K8 reads the tool back and M99 returns because it is the target.
+    let mut lib = Library::new();
+    lib.insert(
+        9000,
+        "O9000",
+        &fixture("006_toolchange_macro_electric_turret.nc"),
+    );
+    let main = "G00 X100 Z50\nT0203\nG00 X100 Z50\nM30\n";
+    let cmds = cnc_interpreter::check_with_library(Dialect::HuaxingLathe, main, setup.clone(), lib)
+        .unwrap();
+    let t: Vec<&Command> = cmds
+        .iter()
+        .map(|c| &c.command)
+        .filter(|c| matches!(c, Command::Aux(Aux::T(_))))
+        .collect();
+    assert_eq!(t, [&Command::Aux(Aux::T(2))]);
+    // Offset 3 is active after the macro: the same work position is 4 (X) and −2 (Z) away.
+    let at = ends(&cmds);
+    assert!(
+        close(at[1], [at[0][0] + 4.0, at[0][1] - 2.0], 1e-9),
+        "{at:?}"
+    );
+
+    // 005 (gang tool post): no T to the PLC, the offset changes only.
+    let mut lib = Library::new();
+    lib.insert(9000, "O9000", &fixture("005_toolchange_macro_gang_tool.nc"));
+    let cmds = cnc_interpreter::check_with_library(Dialect::HuaxingLathe, main, setup.clone(), lib)
+        .unwrap();
+    assert!(!cmds
+        .iter()
+        .any(|c| matches!(c.command, Command::Aux(Aux::T(_)))));
+    let at = ends(&cmds);
+    assert!(
+        close(at[1], [at[0][0] + 4.0, at[0][1] - 2.0], 1e-9),
+        "{at:?}"
+    );
+
+    // A macro whose M52 reads a tool other than the target raises the manual's alarm 6 by M58.
+    let mut lib = Library::new();
+    let wrong = fixture("006_toolchange_macro_electric_turret.nc").replace("M57 K[#3]", "M57 K9");
+    lib.insert(9000, "O9000", &wrong);
+    let e =
+        cnc_interpreter::check_with_library(Dialect::HuaxingLathe, main, setup, lib).unwrap_err();
+    assert_eq!(e.number, 6, "{e}");
+}

@@ -40,6 +40,10 @@ pub struct MachineConfig {
     /// Work offsets by code (`G54`…`G59`; on GTC2E the offset groups of G54–G57), per axis.
     #[serde(default)]
     pub work_offsets: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Huaxing S#170: a T word calls this program (O number, 1–9999) as the tool-change
+    /// macro; absent: T goes to the PLC.
+    #[serde(default)]
+    pub tool_change_macro: Option<u32>,
 }
 
 /// One row of the offset page (`000` §5.2, `002` §3.7): geometry and wear (X as diameter),
@@ -327,6 +331,13 @@ impl LaunchConfig {
         }
         if self.servo.queue_capacity < 2 || self.servo.queue_capacity > 10_000 {
             return Err("servo.queue_capacity must be 2..10000".into());
+        }
+        if let Some(p) = self.machine.tool_change_macro {
+            if !(1..=9999).contains(&p) {
+                return Err(format!(
+                    "machine.tool_change_macro {p}: a program number 1..9999"
+                ));
+            }
         }
         for (n, t) in &self.machine.tools {
             let finite = [t.x, t.z, t.wear_x, t.wear_z, t.radius]
