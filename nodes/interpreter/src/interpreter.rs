@@ -295,6 +295,20 @@ impl Interpreter {
     }
 
     /// The next canonical command; `Ok(None)` once the program has ended.
+    /// The kept variables and the offset page as the program has left them, for the shell to
+    /// store.
+    pub fn memory(&self) -> crate::setup::Memory {
+        crate::setup::Memory {
+            kept: self
+                .common
+                .iter()
+                .filter(|(n, _)| crate::setup::Memory::KEPT.contains(n))
+                .map(|(&n, &v)| (n, v))
+                .collect(),
+            tools: self.setup.offsets.tools.clone(),
+        }
+    }
+
     pub fn next_command(&mut self) -> Result<Option<Canon>, ProgramError> {
         loop {
             if let Some(e) = &self.error {

@@ -22,6 +22,7 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 
 use cnc_msgs::canon::to_motion_block;
 
+use crate::setup::Memory;
 use crate::{Command, Dialect, Interpreter, Library, Setup};
 
 /// Largest program text accepted, bytes.
@@ -82,6 +83,53 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     setup
 }
 
+/// The machine memory at start: the config's offset page, then what the memory file holds.
+/// A memory file that cannot be read is reported and left alone (it is not overwritten until
+/// a program changes the memory).
+pub fn load_memory(cfg: &LaunchConfig) -> (Memory, Option<String>) {
+    let base = Memory {
+        kept: BTreeMap::new(),
+        tools: setup_from_config(cfg, &cfg.home()).offsets.tools,
+    };
+    let Some(path) = &cfg.machine.memory_file else {
+        return (base, None);
+    };
+    match std::fs::read_to_string(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => (base, None),
+        Err(e) => (base, Some(format!("{}: {e}", path.display()))),
+        Ok(text) => match serde_yaml::from_str::<Memory>(&text) {
+            Ok(m) => (m.sanitized(), None),
+            Err(e) => (base, Some(format!("{}: {e}", path.display()))),
+        },
+    }
+}
+
+/// Writes the machine memory: to a temporary file, then renamed over the old one, so a
+/// power cut leaves either the old or the new memory.
+pub fn save_memory(path: &std::path::Path, memory: &Memory) -> Result<(), String> {
+    let text = serde_yaml::to_string(memory).map_err(|e| e.to_string())?;
+    let tmp = path.with_extension("tmp");
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    std::fs::write(&tmp, text).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Takes what a run left in memory (kept variables, offsets) and stores it if it changed.
+fn remember(run: Option<&Run>, memory: &mut Memory, path: Option<&std::path::Path>) {
+    let Some(r) = run else { return };
+    let now = r.interp.memory();
+    if now != *memory {
+        *memory = now;
+        if let Some(p) = path {
+            if let Err(e) = save_memory(p, memory) {
+                log::error!("interpreter: machine memory not stored: {e}");
+            }
+        }
+    }
+}
+
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let dialect = Dialect::from_name(&cfg.machine.dialect)
         .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
@@ -122,6 +170,11 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         ros.publisher::<MachineState>("machine_state", "cnc_msgs/msg/MachineState", qos::state())?;
     let alarms = AlarmReporter::new(&mut ros, "interpreter")?;
 
+    let (mut memory, memory_error) = load_memory(&cfg);
+    if let Some(e) = memory_error {
+        log::error!("interpreter: machine memory not read, using the config's offsets: {e}");
+    }
+    let memory_path = cfg.machine.memory_file.clone();
     let mut programs: BTreeMap<String, String> = BTreeMap::new();
     let mut run: Option<Run> = None;
     let mut answered: VecDeque<CommandResult> = VecDeque::with_capacity(ANSWERS_KEPT);
@@ -229,7 +282,10 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                             None => (false, "no axis position from motion yet".into()),
                             Some(start) => {
                                 run_counter += 1;
+                                remember(run.as_ref(), &mut memory, memory_path.as_deref());
                                 let mut setup = setup_from_config(&cfg, &start);
+                                setup.kept = memory.kept.clone();
+                                setup.offsets.tools = memory.tools.clone();
                                 // The cell runs programs as the operator would: M99 or G27
                                 // loops go on until stop.
                                 setup.single_pass = false;
@@ -277,6 +333,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     (true, "cycle stop".into())
                 }
                 ProgramCommand::RESET => {
+                    remember(run.as_ref(), &mut memory, memory_path.as_deref());
                     run = None;
                     // Program alarms are cleared by reset; alarms whose cause persists (emergency
                     // stop) stay until their source clears them.
@@ -355,6 +412,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 && execution == MachineState::ACTIVE
             {
                 execution = MachineState::PROGRAM_COMPLETED;
+                remember(Some(r), &mut memory, memory_path.as_deref());
                 run = None;
             }
         }
@@ -406,6 +464,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             std::thread::sleep(Duration::from_millis(1));
         }
     }
+    // A program stopped by shutdown keeps what it had stored so far.
+    remember(run.as_ref(), &mut memory, memory_path.as_deref());
     Ok(())
 }
 
@@ -423,4 +483,51 @@ fn library(programs: &BTreeMap<String, String>) -> Library {
         }
     }
     lib
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(memory_file: &std::path::Path) -> LaunchConfig {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../launch_configs/sim_lathe.yaml"
+        );
+        let mut cfg = LaunchConfig::load(std::path::Path::new(path)).unwrap();
+        cfg.machine.memory_file = Some(memory_file.to_path_buf());
+        cfg
+    }
+
+    #[test]
+    fn machine_memory_survives_a_restart_and_a_bad_file_is_reported() {
+        let dir = std::env::temp_dir().join(format!("cnc_memory_{}", std::process::id()));
+        let file = dir.join("memory.yaml");
+        let _ = std::fs::remove_file(&file);
+        let cfg = config(&file);
+        // No file yet: the config's offset page, no kept variables.
+        let (first, err) = load_memory(&cfg);
+        assert!(err.is_none() && first.kept.is_empty());
+        assert_eq!(first.tools.get(&1).map(|t| t.tip), Some(3));
+        // A program sets #200 and an offset; the shell stores what it left.
+        let text = "#200=5\n#201=[#200*2]\n#150=7\n#4001=1.5\nM30\n";
+        let mut setup = setup_from_config(&cfg, &cfg.home());
+        setup.kept = first.kept.clone();
+        setup.offsets.tools = first.tools.clone();
+        let mut interp = Interpreter::new(Dialect::HuaxingLathe, text, setup);
+        while let Ok(Some(_)) = interp.next_command() {}
+        let left = interp.memory();
+        assert_eq!(left.kept, [(200, 5.0), (201, 10.0)].into_iter().collect());
+        save_memory(&file, &left).unwrap();
+        // After a restart the same memory is there, and a program sees it.
+        let (again, err) = load_memory(&cfg);
+        assert!(err.is_none());
+        assert_eq!(again, left);
+        assert_eq!(again.tools.get(&1).map(|t| t.x), Some(1.5));
+        // A damaged file is reported; the config's values are used.
+        std::fs::write(&file, "kept: [not a map").unwrap();
+        let (fallback, err) = load_memory(&cfg);
+        assert!(err.is_some() && fallback.kept.is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -6,6 +6,37 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use serde::{Deserialize, Serialize};
 
+/// What the control keeps across power-off and between programs (`000` §5.27: #200–#289;
+/// the offset page, which programs write through #4001–#4499). The node shell stores it in
+/// the launch config's `machine.memory_file`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Memory {
+    /// Kept macro variables by number.
+    pub kept: BTreeMap<i64, f64>,
+    /// Tool offsets by offset number.
+    pub tools: BTreeMap<u32, ToolOffset>,
+}
+
+impl Memory {
+    /// The range of macro variables kept across power-off.
+    pub const KEPT: std::ops::RangeInclusive<i64> = 200..=289;
+
+    /// Only what a program may store there, with finite values.
+    pub fn sanitized(mut self) -> Memory {
+        self.kept
+            .retain(|n, v| Memory::KEPT.contains(n) && v.is_finite());
+        self.tools.retain(|n, t| {
+            (1..=99).contains(n)
+                && [t.x, t.z, t.wear_x, t.wear_z, t.radius]
+                    .iter()
+                    .all(|v| v.is_finite())
+                && t.tip <= 9
+        });
+        self
+    }
+}
+
 /// One row of the tool offset table (`000` §5.2: X, Z, R, PH; `002` §4.4: tool setting plus
 /// wear, entered separately and added).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

@@ -40,6 +40,11 @@ pub struct MachineConfig {
     /// Work offsets by code (`G54`…`G59`; on GTC2E the offset groups of G54–G57), per axis.
     #[serde(default)]
     pub work_offsets: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Where the kept variables (#200–#289) and the offset page as programs leave them are
+    /// stored (YAML, relative to the working directory); absent: kept for this run of the
+    /// cell only.
+    #[serde(default)]
+    pub memory_file: Option<std::path::PathBuf>,
     /// Huaxing S#170: a T word calls this program (O number, 1–9999) as the tool-change
     /// macro; absent: T goes to the PLC.
     #[serde(default)]
