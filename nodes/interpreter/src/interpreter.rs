@@ -306,6 +306,7 @@ impl Interpreter {
                 .map(|(&n, &v)| (n, v))
                 .collect(),
             tools: self.setup.offsets.tools.clone(),
+            work: self.setup.offsets.work.clone(),
         }
     }
 
@@ -543,6 +544,22 @@ impl Interpreter {
                     Some(x) => self.common.insert(n, x),
                     None => self.common.remove(&n),
                 };
+                Ok(())
+            }
+            // G54–G59 zero offsets (`000` §6.2): what a program sets is kept (decision D33).
+            5220..=5325 if (n - 5220) % 20 < 6 => {
+                let system = ((n - 5220) / 20) as u8;
+                let letter = ['X', 'Y', 'Z', 'A', 'B', 'C'][((n - 5220) % 20) as usize];
+                let x = v.unwrap_or(0.0);
+                if !x.is_finite() || x.abs() > 99_999.0 {
+                    return Err(self.fault(Fault::Macro, format!("#{n}: offset {x} out of range")));
+                }
+                self.setup
+                    .offsets
+                    .work
+                    .entry(system)
+                    .or_default()
+                    .insert(letter, x);
                 Ok(())
             }
             4001..=4499 => {

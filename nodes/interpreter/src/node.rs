@@ -87,9 +87,11 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
 /// A memory file that cannot be read is reported and left alone (it is not overwritten until
 /// a program changes the memory).
 pub fn load_memory(cfg: &LaunchConfig) -> (Memory, Option<String>) {
+    let offsets = setup_from_config(cfg, &cfg.home()).offsets;
     let base = Memory {
         kept: BTreeMap::new(),
-        tools: setup_from_config(cfg, &cfg.home()).offsets.tools,
+        tools: offsets.tools,
+        work: offsets.work,
     };
     let Some(path) = &cfg.machine.memory_file else {
         return (base, None);
@@ -286,6 +288,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                                 let mut setup = setup_from_config(&cfg, &start);
                                 setup.kept = memory.kept.clone();
                                 setup.offsets.tools = memory.tools.clone();
+                                setup.offsets.work = memory.work.clone();
                                 // The cell runs programs as the operator would: M99 or G27
                                 // loops go on until stop.
                                 setup.single_pass = false;
@@ -510,7 +513,7 @@ mod tests {
         assert!(err.is_none() && first.kept.is_empty());
         assert_eq!(first.tools.get(&1).map(|t| t.tip), Some(3));
         // A program sets #200 and an offset; the shell stores what it left.
-        let text = "#200=5\n#201=[#200*2]\n#150=7\n#4001=1.5\nM30\n";
+        let text = "#200=5\n#201=[#200*2]\n#150=7\n#4001=1.5\n#5242=-80\nM30\n";
         let mut setup = setup_from_config(&cfg, &cfg.home());
         setup.kept = first.kept.clone();
         setup.offsets.tools = first.tools.clone();
@@ -524,6 +527,8 @@ mod tests {
         assert!(err.is_none());
         assert_eq!(again, left);
         assert_eq!(again.tools.get(&1).map(|t| t.x), Some(1.5));
+        // #5242 is G55's Z zero offset.
+        assert_eq!(again.work.get(&1).and_then(|w| w.get(&'Z')), Some(&-80.0));
         // A damaged file is reported; the config's values are used.
         std::fs::write(&file, "kept: [not a map").unwrap();
         let (fallback, err) = load_memory(&cfg);

@@ -16,6 +16,8 @@ pub struct Memory {
     pub kept: BTreeMap<i64, f64>,
     /// Tool offsets by offset number.
     pub tools: BTreeMap<u32, ToolOffset>,
+    /// Work offsets G54–G59 (0–5) per axis letter.
+    pub work: BTreeMap<u8, BTreeMap<char, f64>>,
 }
 
 impl Memory {
@@ -33,6 +35,10 @@ impl Memory {
                     .all(|v| v.is_finite())
                 && t.tip <= 9
         });
+        self.work.retain(|n, _| *n <= 5);
+        for row in self.work.values_mut() {
+            row.retain(|c, v| "XYZABC".contains(*c) && v.is_finite());
+        }
         self
     }
 }

@@ -399,3 +399,24 @@ fn chamfer_and_corner_rounding_in_g01() {
     assert!(hx("G01 Z-10 L2 F100\nZ-20\nM30\n").starts_with("L1 LINEAR X20.0000 Z-10.0000"));
     assert!(hx("G01 Z-10 L2 F100\nG00 X40\nM30\n").starts_with("L1 LINEAR X20.0000 Z-10.0000"));
 }
+
+/// A program sets a work zero through #5220–#5325 (`000` §6.2): the moves after it shift.
+#[test]
+fn system_variables_set_the_work_zero_offsets() {
+    let cmds = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "G54 G00 X50 Z10\n#5222=-100\nG00 X50 Z10\n#5222=#0\nM30\n",
+        Setup::lathe([200.0, 100.0]),
+    )
+    .unwrap();
+    let ends: Vec<Vec<f64>> = cmds.iter().filter_map(|c| end_of(&c.command)).collect();
+    assert_close(&ends[0], &[50.0, 10.0]);
+    assert_close(&ends[1], &[50.0, -90.0]);
+    let e = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "#5221=999999\nM30\n",
+        Setup::lathe([200.0, 100.0]),
+    )
+    .unwrap_err();
+    assert_eq!((e.number, e.line), (20, 1), "{e}");
+}
