@@ -206,3 +206,91 @@ fn mutated_fixtures_never_panic_or_hang_and_every_rejection_has_a_line() {
     );
     eprintln!("{cases} cases, {rejected} rejected with an alarm and a line");
 }
+
+/// Random contours through tool-nose compensation and chamfers (the two features that hold
+/// an element back): no panic, no hang, every rejection an alarm on a program line.
+#[test]
+fn random_compensated_and_chamfered_contours_never_panic() {
+    std::panic::set_hook(Box::new(|_| {}));
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut failures = Vec::new();
+    let (mut cases, mut ran) = (0, 0);
+    for _ in 0..1500 {
+        let mut p = String::from("T0101\nG00 X120 Z20\n");
+        let side = if rng.below(2) == 0 { "G41" } else { "G42" };
+        let mut x = 60.0 + rng.below(40) as f64;
+        let mut z = 10.0;
+        p.push_str(&format!("{side} G01 X{x} Z{z} F100\n"));
+        for _ in 0..2 + rng.below(8) {
+            x = (x + rng.below(41) as f64 - 20.0).clamp(2.0, 200.0);
+            z -= rng.below(30) as f64;
+            let extra = match rng.below(6) {
+                0 => format!(" L{}", 1 + rng.below(5)),
+                1 => format!(" D{}", 1 + rng.below(5)),
+                _ => String::new(),
+            };
+            match rng.below(4) {
+                0 => p.push_str(&format!("G02 X{x} Z{z} R{}\n", 5 + rng.below(60))),
+                1 => p.push_str(&format!("G03 X{x} Z{z} R{}\n", 5 + rng.below(60))),
+                _ => p.push_str(&format!("G01 X{x} Z{z}{extra}\n")),
+            }
+        }
+        p.push_str("G40 G01 X150 Z30\nM30\n");
+        let radius = 0.1 + rng.below(50) as f64 / 10.0;
+        let tip = rng.below(10) as u8;
+        let front = rng.below(2) == 0;
+        cases += 1;
+        let program = p.clone();
+        let lines = program.lines().count() as u32;
+        let outcome = std::panic::catch_unwind(|| {
+            let mut setup = Setup::lathe([200.0, 50.0]);
+            setup.front_tool_post = front;
+            setup.offsets.tools.insert(
+                1,
+                cnc_interpreter::setup::ToolOffset {
+                    radius,
+                    tip,
+                    ..Default::default()
+                },
+            );
+            check_limited(
+                Dialect::HuaxingLathe,
+                &program,
+                setup,
+                Library::new(),
+                LIMIT,
+            )
+        });
+        match outcome {
+            Err(_) => failures.push(format!("panicked (R{radius} tip {tip}):\n{p}")),
+            Ok(Err(e)) if e.line == 0 || e.line > lines || e.number == 0 => {
+                failures.push(format!("{e}:\n{p}"))
+            }
+            Ok(Ok(cmds)) => {
+                ran += 1;
+                // Every move of a finished run ends at a finite point.
+                let finite = cmds.iter().all(|c| match &c.command {
+                    cnc_interpreter::Command::Rapid { end }
+                    | cnc_interpreter::Command::Linear { end, .. }
+                    | cnc_interpreter::Command::Arc { end, .. } => {
+                        end.iter().all(|v| v.is_finite())
+                    }
+                    _ => true,
+                });
+                if !finite {
+                    failures.push(format!("non-finite point:\n{p}"));
+                }
+            }
+            Ok(Err(_)) => {}
+        }
+    }
+    let _ = std::panic::take_hook();
+    assert!(
+        failures.is_empty(),
+        "{} of {cases} failed; first:\n{}",
+        failures.len(),
+        failures[0]
+    );
+    assert!(ran > cases / 10, "only {ran} of {cases} ran");
+    eprintln!("{cases} contours, {ran} ran to the end");
+}
