@@ -420,3 +420,82 @@ fn system_variables_set_the_work_zero_offsets() {
     .unwrap_err();
     assert_eq!((e.number, e.line), (20, 1), "{e}");
 }
+
+/// The Huaxing M codes that go to the PLC (`000` §4.1, decision D6): those that start something
+/// before the block's motion, those that stop something after it, each with its number.
+#[test]
+fn huaxing_plc_m_codes_go_out_before_or_after_the_motion() {
+    let before = "G01 X98 F100 M03\nX97 M04\nX96 M06\nX95 M08\nX94 M10\nX93 M12\nX92 M14\n\
+                  X91 M17\nX90 M18\nX89 M19\nX88 M20\nX87 M22\nX86 M32\nX85 M41\nX84 M42\n\
+                  X83 M43\nX82 M44\nX81 M63\nX80 M64\nX79 M56\nM30\n";
+    let after = "G01 X98 F100 M05\nX97 M09\nX96 M11\nX95 M13\nX94 M15\nX93 M21\nX92 M23\n\
+                 X91 M33\nX90 M65\nX89 M48\nX88 M00\nM30\n";
+    for (text, m_first) in [(before, true), (after, false)] {
+        let cmds = cnc_interpreter::check(Dialect::HuaxingLathe, text, Setup::lathe([100.0, 0.0]))
+            .unwrap_or_else(|e| panic!("{e}"));
+        for line in 1..text.lines().count() as u32 {
+            let of_line: Vec<&Command> = cmds
+                .iter()
+                .filter(|c| c.line == line)
+                .map(|c| &c.command)
+                .collect();
+            let m_at = of_line
+                .iter()
+                .position(|c| matches!(c, Command::Aux(Aux::M(_))))
+                .unwrap_or_else(|| panic!("line {line}: no M code in {of_line:?}"));
+            let move_at = of_line
+                .iter()
+                .position(|c| matches!(c, Command::Linear { .. }))
+                .unwrap_or_else(|| panic!("line {line}: no move in {of_line:?}"));
+            assert_eq!(m_at < move_at, m_first, "line {line}: {of_line:?}");
+            // The number goes out as written.
+            let written: i32 = text
+                .lines()
+                .nth(line as usize - 1)
+                .unwrap()
+                .rsplit('M')
+                .next()
+                .unwrap()
+                .trim()
+                .parse()
+                .unwrap();
+            assert_eq!(of_line[m_at], &Command::Aux(Aux::M(written)));
+        }
+    }
+}
+
+/// Modal and one-shot G codes whose effect is a canonical command or a position: G09/G61/G64
+/// path modes, G98/G99 feed modes, G05 three-point arcs, G18, G28 reference return, G52 local
+/// and G50.x coordinate settings.
+#[test]
+fn huaxing_modal_codes_reach_the_canonical_stream() {
+    let text = "G18 G00 X100 Z50\nG61 G01 X90 F100\nG64 X80\nG09 X70\nG99 G01 X60 F0.2\n\
+                G98 G01 X50 F100\nG05 X50 Z30 I5 K-10\nG52 Z-10\nG00 X40 Z0\nG52 Z10\n\
+                G50.3 U0 W0\nG28 U0 W0\nM30\n";
+    let cmds = cnc_interpreter::check(Dialect::HuaxingLathe, text, Setup::lathe([100.0, 50.0]))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let has = |line: u32, f: &dyn Fn(&Command) -> bool| {
+        cmds.iter().any(|c| c.line == line && f(&c.command))
+    };
+    assert!(has(2, &|c| *c == Command::PathMode { exact_stop: true }));
+    assert!(has(3, &|c| *c == Command::PathMode { exact_stop: false }));
+    // G09 stops this block only: exact stop before its move, blending after.
+    assert!(has(4, &|c| *c == Command::PathMode { exact_stop: true }));
+    assert!(has(5, &|c| *c == Command::FeedMode { per_rev: true }));
+    assert!(has(6, &|c| *c == Command::FeedMode { per_rev: false }));
+    assert!(
+        has(7, &|c| matches!(c, Command::Arc { .. })),
+        "G05 three-point arc"
+    );
+    // G52 Z-10 shifts the work zero: Z0 is machine Z−10 (G52 Z10 shifts it back).
+    assert!(has(
+        9,
+        &|c| matches!(c, Command::Rapid { end } if (end[1] + 10.0).abs() < 1e-9)
+    ));
+    // G28 U0 W0 goes to the reference point (the setup's start, X100 Z50).
+    assert!(has(
+        12,
+        &|c| matches!(c, Command::Rapid { end } if (end[0] - 100.0).abs() < 1e-9
+        && (end[1] - 50.0).abs() < 1e-9)
+    ));
+}
