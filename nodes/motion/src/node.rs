@@ -173,10 +173,19 @@ fn servo_loop(
     let f_out = shm.sender::<FImage>(channel::F_IMAGE, false)?;
     let n = mcfg.axes.len();
     let period_ns = (mcfg.period * 1e9) as u64;
-    // Start from where the drives are.
-    let first = feedback
-        .wait(Duration::from_secs(2))?
-        .ok_or("no feedback from the drives (is io running?)")?;
+    // Start from where the drives are. Drives (io) may come up after motion, and a loaded
+    // machine can take seconds to start them: wait, but not past shutdown or 30 s.
+    let mut first = None;
+    for _ in 0..300 {
+        if shutdown.requested() {
+            return Ok("stopped before the drives reported".into());
+        }
+        first = feedback.wait(Duration::from_millis(100))?;
+        if first.is_some() {
+            break;
+        }
+    }
+    let first = first.ok_or("no feedback from the drives within 30 s (is io running?)")?;
     let mut actual = first.position;
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     let mut g = GImage::default();
