@@ -58,9 +58,12 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 feedback.send(fb)?;
             }
             // No setpoint for 50 ms (no motion node): the drives are off and stay where they
-            // are (`enable` 0); the spindle and devices go on in real time.
+            // are (`enable` 0); the spindle and devices go on in real time. The drives still
+            // report where they are: a motion node that starts (or subscribes) after the
+            // power-on report learns the position from the next one.
             None => {
-                sim.step(&idle, &y, 0.05);
+                let fb = sim.step(&idle, &y, 0.05);
+                feedback.send(fb)?;
             }
         }
         x_out.send(sim.x_image(&y))?;
