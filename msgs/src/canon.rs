@@ -48,6 +48,19 @@ pub enum Command {
     ProgramEnd,
 }
 
+impl Command {
+    /// Where a move ends (display units); `None` for commands that do not move.
+    pub fn end(&self) -> Option<&[f64]> {
+        match self {
+            Command::Rapid { end }
+            | Command::Linear { end, .. }
+            | Command::Arc { end, .. }
+            | Command::Thread { end, .. } => Some(end),
+            _ => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Aux {
     M(i32),

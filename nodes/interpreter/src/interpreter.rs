@@ -917,17 +917,7 @@ impl Interpreter {
                 "G41/G42 while tool-nose compensation is active: cancel with G40 first",
             ));
         }
-        let mut side = if g == G::NoseLeft {
-            nose::Side::Left
-        } else {
-            nose::Side::Right
-        };
-        if self.setup.front_tool_post {
-            // Sides are named as seen from the tool post: with the turret in front (X toward
-            // the operator) they are mirrored against the X-up view compensation works in
-            // (`000` §6.1, decision D30).
-            side = side.other();
-        }
+        let mut side = self.nose_side(g);
         let (radius, tip, startup_line) = if self.dialect == Dialect::Gtc2eLathe {
             let r = b
                 .get('R')
@@ -935,7 +925,7 @@ impl Interpreter {
             if r < 0.0 {
                 side = side.other();
             }
-            (r.abs(), 0, false)
+            (self.nose_radius(r.abs(), "R")?, 0, false)
         } else {
             if !self.compensation_line(b) {
                 return Err(self.fault(
@@ -943,24 +933,47 @@ impl Interpreter {
                     "G41/G42 must be given in a G01 block with X/Z (or U/W)",
                 ));
             }
-            let t = self.setup.offsets.tool(self.nose_offset_number(b));
-            (t.radius, t.tip, true)
+            let offset = self.nose_offset_number(b);
+            let t = self.setup.offsets.tool(offset);
+            (
+                self.nose_radius(t.radius, &format!("offset {offset}"))?,
+                t.tip,
+                true,
+            )
         };
-        if radius.is_nan() || radius <= 0.0 || radius > 1000.0 {
-            return Err(self.fault(
-                Fault::CompRadiusZero,
-                format!(
-                    "tool-nose radius {} of offset {} is not usable",
-                    show(radius),
-                    self.offset_number
-                ),
-            ));
-        }
         let from = self.plane_point(&self.work_position())?;
         self.nose_comp = Some(nose::NoseComp::new(side, radius, tip, from, startup_line));
         self.nose = g;
         self.nose_cancel = false;
         Ok(())
+    }
+
+    /// The side G41/G42 names as compensation sees it: sides are named as seen from the tool
+    /// post, so with the turret in front (X toward the operator) they are mirrored against
+    /// the X-up view compensation works in (`000` §6.1, decision D30).
+    fn nose_side(&self, g: G) -> nose::Side {
+        let side = if g == G::NoseLeft {
+            nose::Side::Left
+        } else {
+            nose::Side::Right
+        };
+        if self.setup.front_tool_post {
+            side.other()
+        } else {
+            side
+        }
+    }
+
+    /// A nose radius compensation can use (alarm 21 otherwise); `of` names where it came from.
+    fn nose_radius(&self, radius: f64, of: &str) -> Result<f64, ProgramError> {
+        if radius > 0.0 && radius <= 1000.0 {
+            Ok(radius)
+        } else {
+            Err(self.fault(
+                Fault::CompRadiusZero,
+                format!("tool-nose radius {} of {of} is not usable", show(radius)),
+            ))
+        }
     }
 
     /// The offset whose nose radius and tip G41/G42 use: a T word in the same block (its
@@ -1025,14 +1038,14 @@ impl Interpreter {
                     "G00 while tool-nose compensation is active: cancel with G40 first",
                 ))
             }
-            MoveKind::Rapid => (nose::Path::Line { a: from, b: to }, nose::Kind::Rapid),
-            MoveKind::Feed(f) => (nose::Path::Line { a: from, b: to }, nose::Kind::Feed(f)),
+            MoveKind::Rapid => (Elem::Line { a: from, b: to }, nose::Kind::Rapid),
+            MoveKind::Feed(f) => (Elem::Line { a: from, b: to }, nose::Kind::Feed(f)),
             MoveKind::Arc { center, ccw, feed } => (
-                nose::Path::Arc {
+                Elem::Arc {
                     a: from,
                     b: to,
                     c: center,
-                    cw: !ccw,
+                    ccw,
                 },
                 nose::Kind::Feed(feed),
             ),
@@ -1064,6 +1077,27 @@ impl Interpreter {
         self.emit_outs(outs, end)
     }
 
+    /// Runs `f`, which queues the moves of an element that was held back (nose compensation,
+    /// chamfer), and moves what it queued to where the element was in program order: before
+    /// the commands of later blocks queued meanwhile. Returns `f`'s result and the index just
+    /// after the moved commands. The source line is restored afterwards.
+    fn queue_held(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> Result<(), ProgramError>,
+    ) -> (Result<(), ProgramError>, usize) {
+        let before = self.pending.len();
+        let at = self.hold_at.take().unwrap_or(before).min(before);
+        let saved_line = self.line;
+        let result = f(self);
+        self.line = saved_line;
+        let moved: Vec<Canon> = self.pending.drain(before..).collect();
+        let n = moved.len();
+        for (k, c) in moved.into_iter().enumerate() {
+            self.pending.insert(at + k, c);
+        }
+        (result, at + n)
+    }
+
     /// Queues compensated moves where they belong in program order (before anything queued
     /// after the element compensation held back), then puts the program's position back on
     /// the programmed end point: incremental words and the next element start there.
@@ -1072,44 +1106,31 @@ impl Interpreter {
         outs: Vec<nose::Out>,
         programmed_end: &[f64],
     ) -> Result<(), ProgramError> {
-        let insert_at = self
-            .hold_at
-            .unwrap_or(self.pending.len())
-            .min(self.pending.len());
-        let before = self.pending.len();
-        let saved_line = self.line;
         self.emitting_comp = true;
-        let mut result = Ok(());
-        for o in outs {
-            self.line = o.line;
-            let base = self.work_position();
-            let end = self.with_point(&base, o.path.end());
-            let kind = match (o.path, o.kind) {
-                (nose::Path::Arc { c, cw, .. }, nose::Kind::Feed(feed)) => MoveKind::Arc {
-                    center: c,
-                    ccw: !cw,
-                    feed,
-                },
-                (_, nose::Kind::Feed(f)) => MoveKind::Feed(f),
-                (_, nose::Kind::Rapid) => MoveKind::Rapid,
-            };
-            result = self.emit(&end, kind);
-            if result.is_err() {
-                break;
+        let (result, held_end) = self.queue_held(|me| {
+            for o in outs {
+                me.line = o.line;
+                let base = me.work_position();
+                let end = me.with_point(&base, o.path.end());
+                let kind = match (o.path, o.kind) {
+                    (Elem::Arc { c, ccw, .. }, nose::Kind::Feed(feed)) => MoveKind::Arc {
+                        center: c,
+                        ccw,
+                        feed,
+                    },
+                    (_, nose::Kind::Feed(f)) => MoveKind::Feed(f),
+                    (_, nose::Kind::Rapid) => MoveKind::Rapid,
+                };
+                me.emit(&end, kind)?;
             }
-        }
+            Ok(())
+        });
         self.emitting_comp = false;
-        self.line = saved_line;
-        let new: Vec<Canon> = self.pending.drain(before..).collect();
-        let n = new.len();
-        for (k, c) in new.into_iter().enumerate() {
-            self.pending.insert(insert_at + k, c);
-        }
         self.hold_at = self
             .nose_comp
             .as_ref()
             .filter(|c| c.holding())
-            .map(|_| insert_at + n);
+            .map(|_| held_end);
         self.pos = self.to_machine(programmed_end);
         result
     }
@@ -1427,16 +1448,6 @@ impl Interpreter {
         tool: u32,
         offset: u32,
     ) -> Result<(), ProgramError> {
-        if self.frames.len() > MAX_CALL_DEPTH {
-            return Err(self.fault(Fault::Call, "subprograms nested deeper than 4 levels"));
-        }
-        let (name, text) = self.library.get(program).ok_or_else(|| {
-            self.fault(
-                Fault::UndefinedSubprogram,
-                format!("tool-change macro O{program:04} not in the library"),
-            )
-        })?;
-        let name = name.to_string();
         let mut locals = vec![None; LOCALS];
         for (i, v) in [self.tool, self.offset_number, tool, offset]
             .into_iter()
@@ -1444,14 +1455,7 @@ impl Interpreter {
         {
             locals[i + 1] = Some(v as f64);
         }
-        self.frames.push(Frame {
-            text,
-            name,
-            pos: Pos::default(),
-            remaining: 0,
-            repeats: Vec::new(),
-            locals,
-        });
+        self.call_program(program, 1, locals, "tool-change macro")?;
         self.tool_macro_depth = Some(self.frames.len());
         Ok(())
     }
@@ -1647,13 +1651,25 @@ impl Interpreter {
         if count == 0 || count > 9999 {
             return Err(self.fault(Fault::Call, format!("repeat count {count} out of 1–9999")));
         }
+        self.call_program(number, count, vec![None; LOCALS], "M98: program")
+    }
+
+    /// Runs library program `number` `count` times as a subprogram with the given locals;
+    /// `what` names the caller in the alarm when the program is missing.
+    fn call_program(
+        &mut self,
+        number: u32,
+        count: u32,
+        locals: Vec<Value>,
+        what: &str,
+    ) -> Result<(), ProgramError> {
         if self.frames.len() > MAX_CALL_DEPTH {
             return Err(self.fault(Fault::Call, "subprograms nested deeper than 4 levels"));
         }
         let (name, text) = self.library.get(number).ok_or_else(|| {
             self.fault(
                 Fault::UndefinedSubprogram,
-                format!("M98: program O{number:04} not in the library"),
+                format!("{what} O{number:04} not in the library"),
             )
         })?;
         let name = name.to_string();
@@ -1661,9 +1677,9 @@ impl Interpreter {
             text,
             name,
             pos: Pos::default(),
-            remaining: count - 1,
+            remaining: count.saturating_sub(1),
             repeats: Vec::new(),
-            locals: vec![None; LOCALS],
+            locals,
         });
         Ok(())
     }
@@ -2436,13 +2452,7 @@ enum MoveKind {
 }
 
 fn is_motion(c: &Canon) -> bool {
-    matches!(
-        c.command,
-        Command::Rapid { .. }
-            | Command::Linear { .. }
-            | Command::Arc { .. }
-            | Command::Thread { .. }
-    )
+    c.command.end().is_some()
 }
 
 /// `value × 10` as an integer code number (G50.1 → 501), if it has at most one decimal.

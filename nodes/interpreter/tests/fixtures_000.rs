@@ -34,13 +34,7 @@ fn run_lib(text: &str, lib: Library) -> Result<Vec<Canon>, ProgramError> {
 }
 
 fn end_of(c: &Command) -> Option<[f64; 2]> {
-    match c {
-        Command::Rapid { end }
-        | Command::Linear { end, .. }
-        | Command::Arc { end, .. }
-        | Command::Thread { end, .. } => Some([end[0], end[1]]),
-        _ => None,
-    }
+    c.end().map(|e| [e[0], e[1]])
 }
 
 fn ends(cmds: &[Canon]) -> Vec<[f64; 2]> {

@@ -56,13 +56,7 @@ fn lines(cmds: &[Canon]) -> Vec<String> {
 fn last_position(cmds: &[Canon]) -> [f64; 2] {
     cmds.iter()
         .rev()
-        .find_map(|c| match &c.command {
-            Command::Rapid { end }
-            | Command::Linear { end, .. }
-            | Command::Arc { end, .. }
-            | Command::Thread { end, .. } => Some([end[0], end[1]]),
-            _ => None,
-        })
+        .find_map(|c| c.command.end().map(|e| [e[0], e[1]]))
         .expect("a move")
 }
 

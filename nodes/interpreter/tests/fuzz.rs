@@ -269,14 +269,10 @@ fn random_compensated_and_chamfered_contours_never_panic() {
             Ok(Ok(cmds)) => {
                 ran += 1;
                 // Every move of a finished run ends at a finite point.
-                let finite = cmds.iter().all(|c| match &c.command {
-                    cnc_interpreter::Command::Rapid { end }
-                    | cnc_interpreter::Command::Linear { end, .. }
-                    | cnc_interpreter::Command::Arc { end, .. } => {
-                        end.iter().all(|v| v.is_finite())
-                    }
-                    _ => true,
-                });
+                let finite = cmds
+                    .iter()
+                    .filter_map(|c| c.command.end())
+                    .all(|end| end.iter().all(|v| v.is_finite()));
                 if !finite {
                     failures.push(format!("non-finite point:\n{p}"));
                 }

@@ -382,19 +382,15 @@ impl Motion {
     /// Turns a block into its active form; soft limits are checked here, before any motion.
     fn activate(&self, block: &Block) -> Result<Active, (u32, String)> {
         let n = self.cfg.axes.len();
-        let bad_len = |v: &Vec<f64>| v.len() != n || v.iter().any(|x| !x.is_finite());
+        let bad_len = |v: &[f64]| v.len() != n || v.iter().any(|x| !x.is_finite());
         match &block.kind {
-            Command::Rapid { end }
-            | Command::Linear { end, .. }
-            | Command::Arc { end, .. }
-            | Command::Thread { end, .. }
-                if bad_len(end) =>
-            {
-                Err((
-                    alarm::BAD_BLOCK,
-                    format!("block has {} axis values, machine has {n}", end.len()),
-                ))
-            }
+            kind if kind.end().is_some_and(bad_len) => Err((
+                alarm::BAD_BLOCK,
+                format!(
+                    "block has {} axis values, machine has {n}",
+                    kind.end().map_or(0, <[f64]>::len)
+                ),
+            )),
             Command::Rapid { end } => {
                 self.check_limits(end)?;
                 let end = self.to_slide(end);

@@ -462,48 +462,29 @@ impl Interpreter {
         here: &[f64],
     ) -> Result<Vec<Elem>, ProgramError> {
         let tool = self.setup.offsets.tool(offset);
-        if !(tool.radius > 0.0 && tool.radius <= 1000.0) {
-            return Err(self.fault(
-                Fault::CompRadiusZero,
-                format!(
-                    "tool-nose radius {} of offset {offset} is not usable",
-                    show(tool.radius)
-                ),
-            ));
-        }
-        let mut side = if g == G::NoseLeft {
-            nose::Side::Left
-        } else {
-            nose::Side::Right
-        };
-        if self.setup.front_tool_post {
-            side = side.other();
-        }
+        let radius = self.nose_radius(tool.radius, &format!("offset {offset}"))?;
+        let side = self.nose_side(g);
         let start = elems
             .get(first)
             .map(|e| e.start())
             .map_or_else(|| self.plane_point(here), Ok)?;
-        let mut comp = nose::NoseComp::new(side, tool.radius, tool.tip, start, true);
+        let mut comp = nose::NoseComp::new(side, radius, tool.tip, start, true);
         let mut outs = Vec::new();
         let mut out_elems: Vec<Elem> = elems[..first.min(elems.len())].to_vec();
         for (i, e) in elems.iter().enumerate().skip(first) {
-            let path = match *e {
-                Elem::Line { a, b } => nose::Path::Line { a, b },
-                Elem::Arc { a, b, c, ccw } => nose::Path::Arc { a, b, c, cw: !ccw },
-            };
             if Some(i) == cancel {
                 outs.extend(comp.cancel(e.end(), nose::Kind::Feed(1.0), 0));
-                out_elems.extend(outs.drain(..).map(elem_of));
+                out_elems.extend(outs.drain(..).map(|o| o.path));
                 out_elems.extend(elems[i + 1..].iter().copied());
                 return Ok(out_elems);
             }
             outs.extend(
-                comp.push(path, nose::Kind::Feed(1.0), 0)
+                comp.push(*e, nose::Kind::Feed(1.0), 0)
                     .map_err(|x| self.comp_fault(x))?,
             );
         }
         outs.extend(comp.flush());
-        out_elems.extend(outs.into_iter().map(elem_of));
+        out_elems.extend(outs.into_iter().map(|o| o.path));
         Ok(out_elems)
     }
 
@@ -631,12 +612,5 @@ impl Interpreter {
             self.emit(&at(x0, z0), MoveKind::Rapid)?;
         }
         Ok(())
-    }
-}
-
-fn elem_of(o: nose::Out) -> Elem {
-    match o.path {
-        nose::Path::Line { a, b } => Elem::Line { a, b },
-        nose::Path::Arc { a, b, c, cw } => Elem::Arc { a, b, c, ccw: !cw },
     }
 }

@@ -89,18 +89,12 @@ impl Interpreter {
         let Some(corner) = self.corner.take() else {
             return Ok(());
         };
-        let insert_at = self.hold_at.take().unwrap_or(self.pending.len());
-        let before = self.pending.len();
-        let saved_line = self.line;
-        self.line = corner.line;
-        let result = self.corner_moves(&corner, next);
-        self.line = saved_line;
-        // The line and the chamfer go where the line was in program order.
-        let new: Vec<Canon> = self.pending.drain(before..).collect();
-        for (k, c) in new.into_iter().enumerate() {
-            self.pending.insert(insert_at + k, c);
-        }
-        result
+        // The line and the chamfer go where the line was in program order, on its line.
+        self.queue_held(|me| {
+            me.line = corner.line;
+            me.corner_moves(&corner, next)
+        })
+        .0
     }
 
     fn corner_moves(
@@ -176,7 +170,6 @@ impl Interpreter {
             (Chamfer::Line(l), MoveKind::Arc { center, ccw, .. }) => {
                 // The chamfer ends on the arc, l from the corner, in the arc's direction.
                 let rho = center.dist(p);
-                let dc = center.dist(p);
                 // The arc's own sweep from the corner to its end, in its direction.
                 let tau = std::f64::consts::TAU;
                 let a0 = (p.r - center.r).atan2(p.z - center.z);
@@ -196,7 +189,7 @@ impl Interpreter {
                 // Points at distance l from p on the circle: p rotated about the centre by
                 // ±2·asin(l / 2ρ); the arc's direction picks the sign.
                 let ang = 2.0 * (l / (2.0 * rho)).asin() * if ccw { 1.0 } else { -1.0 };
-                let (rz, rr) = ((p.z - center.z) / dc * rho, (p.r - center.r) / dc * rho);
+                let (rz, rr) = (p.z - center.z, p.r - center.r);
                 let q2 = Pt::new(
                     center.z + rz * ang.cos() - rr * ang.sin(),
                     center.r + rz * ang.sin() + rr * ang.cos(),

@@ -16,7 +16,7 @@
 //!
 //! Pure geometry: no interpreter state, errors as [`CompError`].
 
-use crate::geometry::Pt;
+use crate::geometry::{Elem, Pt};
 
 const EPS: f64 = 1e-9;
 
@@ -37,13 +37,6 @@ impl Side {
     }
 }
 
-/// A programmed or offset element of the contour.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Path {
-    Line { a: Pt, b: Pt },
-    Arc { a: Pt, b: Pt, c: Pt, cw: bool },
-}
-
 /// How the element is moved: rapid or feed (G02/G03 carry their feed too).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Kind {
@@ -54,7 +47,7 @@ pub enum Kind {
 /// One move for the controlled point (imaginary tip), in the plane, with its source line.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Out {
-    pub path: Path,
+    pub path: Elem,
     pub kind: Kind,
     pub line: u32,
 }
@@ -70,7 +63,7 @@ pub enum CompError {
 #[derive(Debug, Clone, Copy)]
 struct Held {
     /// The offset element, its start already joined to what came before.
-    path: Path,
+    path: Elem,
     kind: Kind,
     line: u32,
 }
@@ -92,7 +85,7 @@ pub struct NoseComp {
     tip: Pt,
     start: Start,
     /// The Huaxing start-up element, waiting for the element after it.
-    startup: Option<(Pt, Path, Kind, u32)>,
+    startup: Option<(Pt, Elem, Kind, u32)>,
     held: Option<Held>,
 }
 
@@ -145,27 +138,19 @@ fn left(a: Pt) -> Pt {
     Pt::new(-a.r, a.z)
 }
 
-impl Path {
-    pub fn start(&self) -> Pt {
-        match *self {
-            Path::Line { a, .. } | Path::Arc { a, .. } => a,
-        }
-    }
-    pub fn end(&self) -> Pt {
-        match *self {
-            Path::Line { b, .. } | Path::Arc { b, .. } => b,
-        }
-    }
+/// What compensation needs of an element beyond `geometry`: tangents, and the element
+/// moved, offset or cut back.
+impl Elem {
     fn tangent_at(&self, p: Pt) -> Pt {
         match *self {
-            Path::Line { a, b } => unit(sub(b, a)),
-            Path::Arc { c, cw, .. } => {
+            Elem::Line { a, b } => unit(sub(b, a)),
+            Elem::Arc { c, ccw, .. } => {
                 let radial = unit(sub(p, c));
                 // Counter-clockwise travel is the radial direction turned left.
-                if cw {
-                    scale(left(radial), -1.0)
-                } else {
+                if ccw {
                     left(radial)
+                } else {
+                    scale(left(radial), -1.0)
                 }
             }
         }
@@ -176,65 +161,65 @@ impl Path {
     fn end_tangent(&self) -> Pt {
         self.tangent_at(self.end())
     }
-    fn translated(&self, d: Pt) -> Path {
+    fn translated(&self, d: Pt) -> Elem {
         match *self {
-            Path::Line { a, b } => Path::Line {
+            Elem::Line { a, b } => Elem::Line {
                 a: add(a, d),
                 b: add(b, d),
             },
-            Path::Arc { a, b, c, cw } => Path::Arc {
+            Elem::Arc { a, b, c, ccw } => Elem::Arc {
                 a: add(a, d),
                 b: add(b, d),
                 c: add(c, d),
-                cw,
+                ccw,
             },
         }
     }
     /// The element moved sideways by `offset` (+ left).
-    fn offset(&self, offset: f64) -> Result<Path, CompError> {
+    fn offset(&self, offset: f64) -> Result<Elem, CompError> {
         match *self {
-            Path::Line { a, b } => {
+            Elem::Line { a, b } => {
                 let n = scale(left(unit(sub(b, a))), offset);
-                Ok(Path::Line {
+                Ok(Elem::Line {
                     a: add(a, n),
                     b: add(b, n),
                 })
             }
-            Path::Arc { a, b, c, cw } => {
+            Elem::Arc { a, b, c, ccw } => {
                 let rho = len(sub(a, c));
-                // The left side of a clockwise arc is its outside.
-                let new = if cw { rho + offset } else { rho - offset };
+                // The left side of a counter-clockwise arc is its inside.
+                let new = if ccw { rho - offset } else { rho + offset };
                 if new <= EPS {
                     return Err(CompError::ArcVanishes);
                 }
                 let k = new / rho;
-                Ok(Path::Arc {
+                Ok(Elem::Arc {
                     a: add(c, scale(sub(a, c), k)),
                     b: add(c, scale(sub(b, c), new / len(sub(b, c)))),
                     c,
-                    cw,
+                    ccw,
                 })
             }
         }
     }
-    fn with_start(&self, p: Pt) -> Path {
+    fn with_start(&self, p: Pt) -> Elem {
         match *self {
-            Path::Line { b, .. } => Path::Line { a: p, b },
-            Path::Arc { b, c, cw, .. } => Path::Arc { a: p, b, c, cw },
+            Elem::Line { b, .. } => Elem::Line { a: p, b },
+            Elem::Arc { b, c, ccw, .. } => Elem::Arc { a: p, b, c, ccw },
         }
     }
-    fn with_end(&self, p: Pt) -> Path {
+    fn with_end(&self, p: Pt) -> Elem {
         match *self {
-            Path::Line { a, .. } => Path::Line { a, b: p },
-            Path::Arc { a, c, cw, .. } => Path::Arc { a, b: p, c, cw },
+            Elem::Line { a, .. } => Elem::Line { a, b: p },
+            Elem::Arc { a, c, ccw, .. } => Elem::Arc { a, b: p, c, ccw },
         }
     }
 }
 
 /// Points where the full line or circle of `p` meets that of `q`.
-fn intersections(p: &Path, q: &Path) -> Vec<Pt> {
+fn intersections(p: &Elem, q: &Elem) -> Vec<Pt> {
     match (*p, *q) {
-        (Path::Line { a, b }, Path::Line { a: c, b: d }) => {
+        (Elem::Line { a, b }, Elem::Line { a: c, b: d }) => {
             let (u, v) = (sub(b, a), sub(d, c));
             let den = cross(u, v);
             if den.abs() < EPS {
@@ -243,9 +228,9 @@ fn intersections(p: &Path, q: &Path) -> Vec<Pt> {
             let t = cross(sub(c, a), v) / den;
             vec![add(a, scale(u, t))]
         }
-        (Path::Line { a, b }, Path::Arc { c, a: s, .. })
-        | (Path::Arc { c, a: s, .. }, Path::Line { a, b }) => line_circle(a, b, c, len(sub(s, c))),
-        (Path::Arc { c: c1, a: s1, .. }, Path::Arc { c: c2, a: s2, .. }) => {
+        (Elem::Line { a, b }, Elem::Arc { c, a: s, .. })
+        | (Elem::Arc { c, a: s, .. }, Elem::Line { a, b }) => line_circle(a, b, c, len(sub(s, c))),
+        (Elem::Arc { c: c1, a: s1, .. }, Elem::Arc { c: c2, a: s2, .. }) => {
             circle_circle(c1, len(sub(s1, c1)), c2, len(sub(s2, c2)))
         }
     }
@@ -298,7 +283,7 @@ impl NoseComp {
         }
     }
 
-    fn out(&self, path: Path, kind: Kind, line: u32) -> Out {
+    fn out(&self, path: Elem, kind: Kind, line: u32) -> Out {
         Out {
             path: path.translated(self.tip),
             kind,
@@ -307,7 +292,7 @@ impl NoseComp {
     }
 
     /// Takes the next programmed element; returns the moves now certain.
-    pub fn push(&mut self, path: Path, kind: Kind, line: u32) -> Result<Vec<Out>, CompError> {
+    pub fn push(&mut self, path: Elem, kind: Kind, line: u32) -> Result<Vec<Out>, CompError> {
         let off = path.offset(self.offset)?;
         let mut out = Vec::new();
         match self.start {
@@ -319,7 +304,7 @@ impl NoseComp {
             }
             Start::Connect(from) => {
                 out.push(Out {
-                    path: Path::Line {
+                    path: Elem::Line {
                         a: from,
                         b: add(off.start(), self.tip),
                     },
@@ -339,7 +324,7 @@ impl NoseComp {
         if let Some((from, _, s_kind, s_line)) = self.startup.take() {
             // Start-up move: to the offset start of this element (perpendicular to it).
             out.push(Out {
-                path: Path::Line {
+                path: Elem::Line {
                     a: from,
                     b: add(off.start(), self.tip),
                 },
@@ -376,11 +361,11 @@ impl NoseComp {
     fn join(
         &self,
         held: Held,
-        path: Path,
-        off: Path,
+        path: Elem,
+        off: Elem,
         kind: Kind,
         line: u32,
-    ) -> Result<(Vec<Out>, Path), CompError> {
+    ) -> Result<(Vec<Out>, Elem), CompError> {
         // An offset element runs parallel to its programmed one: same tangents.
         let t1 = held.path.end_tangent();
         let t2 = path.start_tangent();
@@ -397,11 +382,12 @@ impl NoseComp {
         // The nose is on the outside of the turn when it turns away from the offset side.
         let outside = turn * self.offset < 0.0 || along <= -1.0 + 1e-9;
         if outside {
-            let arc = Path::Arc {
+            let arc = Elem::Arc {
                 a: held.path.end(),
                 b: off.start(),
                 c: corner,
-                cw: self.offset > 0.0,
+                // Around an outer corner the nose turns the way the contour turns.
+                ccw: self.offset < 0.0,
             };
             return Ok((
                 vec![
@@ -434,7 +420,7 @@ impl NoseComp {
             .map(|o| o.path.end())
             .unwrap_or_else(|| self.startup_point().unwrap_or(target));
         out.push(Out {
-            path: Path::Line { a: from, b: target },
+            path: Elem::Line { a: from, b: target },
             kind,
             line,
         });
@@ -460,7 +446,7 @@ impl NoseComp {
             // Only the start-up element was given: it ends offset from its own end.
             let off = path.offset(self.offset).unwrap_or(path);
             out.push(Out {
-                path: Path::Line {
+                path: Elem::Line {
                     a: from,
                     b: add(off.end(), self.tip),
                 },
@@ -494,7 +480,7 @@ mod tests {
         let f = Kind::Feed(100.0);
         let out = c
             .push(
-                Path::Line {
+                Elem::Line {
                     a: p(10.0, 15.0),
                     b: p(-20.0, 15.0),
                 },
@@ -506,7 +492,7 @@ mod tests {
         assert!(close(out[0].path.end(), p(9.0, 15.0)), "{out:?}");
         let out = c
             .push(
-                Path::Line {
+                Elem::Line {
                     a: p(-20.0, 15.0),
                     b: p(-20.0, 20.0),
                 },
@@ -528,7 +514,7 @@ mod tests {
         let mut c = NoseComp::new(Side::Left, 3.0, 0, p(0.0, 0.0), false);
         let f = Kind::Feed(100.0);
         c.push(
-            Path::Line {
+            Elem::Line {
                 a: p(0.0, 0.0),
                 b: p(0.0, 10.0),
             },
@@ -539,7 +525,7 @@ mod tests {
         // Up (+X) then toward +Z: a right turn, so the left offset is outside.
         let out = c
             .push(
-                Path::Line {
+                Elem::Line {
                     a: p(0.0, 10.0),
                     b: p(20.0, 10.0),
                 },
@@ -550,7 +536,7 @@ mod tests {
         assert_eq!(out.len(), 2, "{out:?}");
         let out2 = c
             .push(
-                Path::Line {
+                Elem::Line {
                     a: p(20.0, 10.0),
                     b: p(20.0, 0.0),
                 },
@@ -560,11 +546,11 @@ mod tests {
             .unwrap();
         let all: Vec<Out> = out.into_iter().chain(out2).collect();
         assert!(
-            all.iter().any(|o| matches!(o.path, Path::Arc { .. })),
+            all.iter().any(|o| matches!(o.path, Elem::Arc { .. })),
             "{all:?}"
         );
         for o in &all {
-            if let Path::Arc { a, b, c, .. } = o.path {
+            if let Elem::Arc { a, b, c, .. } = o.path {
                 assert!((len(sub(a, c)) - 3.0).abs() < 1e-9 && (len(sub(b, c)) - 3.0).abs() < 1e-9);
             }
         }
@@ -575,11 +561,11 @@ mod tests {
         let mut c = NoseComp::new(Side::Left, 5.0, 0, p(0.0, 0.0), false);
         // Counter-clockwise arc of radius 2: its left side is inside.
         let e = c.push(
-            Path::Arc {
+            Elem::Arc {
                 a: p(0.0, 0.0),
                 b: p(-4.0, 0.0),
                 c: p(-2.0, 0.0),
-                cw: false,
+                ccw: true,
             },
             Kind::Feed(1.0),
             1,
