@@ -40,16 +40,8 @@ enum Verb {
     },
     /// Interpret a program without running it; report every error with line and alarm number.
     Check {
-        program: PathBuf,
-        #[arg(long, default_value = DEFAULT_CONFIG)]
-        config: PathBuf,
-        /// Dialect (huaxing-lathe, gtc2e-lathe, iso-lathe); default: the config's.
-        #[arg(long)]
-        dialect: Option<String>,
-        /// Folder of subprograms (O number on the first line or file name O1234.nc);
-        /// default: the program's folder.
-        #[arg(long)]
-        library: Option<PathBuf>,
+        #[command(flatten)]
+        program: ProgramArgs,
         /// Print the canonical block stream, one command per line.
         #[arg(long)]
         trace: bool,
@@ -57,19 +49,68 @@ enum Verb {
     /// Run a program through the interpreter and the planner on a simulated clock: prints
     /// `cycle time: <seconds> s` and can draw the tool path over the turned part.
     Simulate {
-        program: PathBuf,
-        #[arg(long, default_value = DEFAULT_CONFIG)]
-        config: PathBuf,
-        /// Dialect (huaxing-lathe, gtc2e-lathe, iso-lathe); default: the config's.
-        #[arg(long)]
-        dialect: Option<String>,
-        /// Folder of subprograms; default: the program's folder.
-        #[arg(long)]
-        library: Option<PathBuf>,
+        #[command(flatten)]
+        program: ProgramArgs,
         /// Write the tool path over the finished 2-D profile as an SVG file.
         #[arg(long)]
         svg: Option<PathBuf>,
     },
+}
+
+/// A part program and what it is read with.
+#[derive(clap::Args)]
+struct ProgramArgs {
+    program: PathBuf,
+    #[arg(long, default_value = DEFAULT_CONFIG)]
+    config: PathBuf,
+    /// Dialect (huaxing-lathe, gtc2e-lathe, iso-lathe); default: the config's.
+    #[arg(long)]
+    dialect: Option<String>,
+    /// Folder of subprograms (O number on the first line or file name O1234.nc);
+    /// default: the program's folder.
+    #[arg(long)]
+    library: Option<PathBuf>,
+}
+
+/// A program ready to interpret: the launch config, its text, the dialect (the command
+/// line's, else the config's) and the subprogram library (the folder given, else the
+/// program's own).
+struct LoadedProgram {
+    cfg: LaunchConfig,
+    text: String,
+    dialect: cnc_interpreter::Dialect,
+    library: cnc_interpreter::Library,
+}
+
+impl ProgramArgs {
+    fn load(&self) -> Result<LoadedProgram, String> {
+        use cnc_interpreter::{Dialect, Library};
+        let cfg = LaunchConfig::load(&self.config)?;
+        let text = read_program(&self.program)?;
+        let name = self.dialect.as_deref().unwrap_or(&cfg.machine.dialect);
+        let dialect = Dialect::from_name(name).ok_or_else(|| {
+            let known: Vec<&str> = Dialect::ALL.iter().map(|d| d.name()).collect();
+            format!("unknown dialect {name:?}; known: {}", known.join(", "))
+        })?;
+        let dir = match &self.library {
+            Some(d) => d.clone(),
+            None => self
+                .program
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."))
+                .to_path_buf(),
+        };
+        // Files that are not programs or repeat a number are left out of the library.
+        let (library, _skipped) =
+            Library::load_dir(&dir).map_err(|e| format!("library {}: {e}", dir.display()))?;
+        Ok(LoadedProgram {
+            cfg,
+            text,
+            dialect,
+            library,
+        })
+    }
 }
 
 static STOP: AtomicBool = AtomicBool::new(false);
@@ -90,32 +131,8 @@ fn main() -> ExitCode {
             program,
             cycles,
         }) => run(&config, program.as_deref(), cycles),
-        Some(Verb::Check {
-            program,
-            config,
-            dialect,
-            library,
-            trace,
-        }) => check(
-            &program,
-            &config,
-            dialect.as_deref(),
-            library.as_deref(),
-            trace,
-        ),
-        Some(Verb::Simulate {
-            program,
-            config,
-            dialect,
-            library,
-            svg,
-        }) => simulate(
-            &program,
-            &config,
-            dialect.as_deref(),
-            library.as_deref(),
-            svg.as_deref(),
-        ),
+        Some(Verb::Check { program, trace }) => check(&program, trace),
+        Some(Verb::Simulate { program, svg }) => simulate(&program, svg.as_deref()),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
     match result {
@@ -127,17 +144,15 @@ fn main() -> ExitCode {
     }
 }
 
-fn check(
-    program: &Path,
-    config: &Path,
-    dialect: Option<&str>,
-    library: Option<&Path>,
-    trace: bool,
-) -> Result<(), String> {
+fn check(args: &ProgramArgs, trace: bool) -> Result<(), String> {
     use cnc_interpreter::diagnose;
-    let cfg = LaunchConfig::load(config)?;
-    let text = read_program(program)?;
-    let (dialect, lib) = dialect_and_library(&cfg, program, dialect, library)?;
+    let LoadedProgram {
+        cfg,
+        text,
+        dialect,
+        library: lib,
+    } = args.load()?;
+    let program = args.program.as_path();
     let letters = cfg.axis_letters();
     let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
     let errors = diagnose(dialect, &text, setup.clone(), lib.clone());
@@ -165,46 +180,10 @@ fn check(
     Err(format!("{} alarm(s)", errors.len()))
 }
 
-/// The dialect (the command line's, else the config's) and the subprogram library (the
-/// folder given, else the program's own).
-fn dialect_and_library(
-    cfg: &LaunchConfig,
-    program: &Path,
-    dialect: Option<&str>,
-    library: Option<&Path>,
-) -> Result<(cnc_interpreter::Dialect, cnc_interpreter::Library), String> {
-    use cnc_interpreter::{Dialect, Library};
-    let name = dialect.unwrap_or(&cfg.machine.dialect);
-    let dialect = Dialect::from_name(name).ok_or_else(|| {
-        let known: Vec<&str> = Dialect::ALL.iter().map(|d| d.name()).collect();
-        format!("unknown dialect {name:?}; known: {}", known.join(", "))
-    })?;
-    let dir = match library {
-        Some(d) => d.to_path_buf(),
-        None => program
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."))
-            .to_path_buf(),
-    };
-    // Files that are not programs or repeat a number are left out of the library.
-    let (lib, _skipped) =
-        Library::load_dir(&dir).map_err(|e| format!("library {}: {e}", dir.display()))?;
-    Ok((dialect, lib))
-}
-
-fn simulate(
-    program: &Path,
-    config: &Path,
-    dialect: Option<&str>,
-    library: Option<&Path>,
-    svg: Option<&Path>,
-) -> Result<(), String> {
-    let cfg = LaunchConfig::load(config)?;
-    let text = read_program(program)?;
-    let (dialect, lib) = dialect_and_library(&cfg, program, dialect, library)?;
-    let sim = cnc::simulate::simulate(&cfg, dialect, &text, lib)
-        .map_err(|e| format!("{}: {e}", program.display()))?;
+fn simulate(args: &ProgramArgs, svg: Option<&Path>) -> Result<(), String> {
+    let p = args.load()?;
+    let sim = cnc::simulate::simulate(&p.cfg, p.dialect, &p.text, p.library)
+        .map_err(|e| format!("{}: {e}", args.program.display()))?;
     println!("cycle time: {:.3} s", sim.cycle_time);
     if let Some(path) = svg {
         std::fs::write(path, cnc::simulate::svg(&sim))

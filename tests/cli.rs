@@ -4,6 +4,8 @@
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// Runs `cnc run` on the program; the run must end by itself within 120 s (a hang fails
+/// here instead of passing as a non-zero exit).
 fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, String) {
     let dir = std::env::temp_dir().join(format!("cnc_cli_{}_{domain}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -31,7 +33,9 @@ fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, Str
         }
         if Instant::now() > deadline {
             let _ = child.kill();
-            break child.wait().unwrap();
+            let _ = child.wait();
+            let out = std::fs::read_to_string(dir.join("out.txt")).unwrap_or_default();
+            panic!("cnc run did not end within 120 s:\n{out}");
         }
         std::thread::sleep(Duration::from_millis(50));
     };

@@ -187,8 +187,11 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     // Cycle start needs the axes' position from motion; until then the machine waits.
     let mut execution = MachineState::WAIT;
     let mut program_name = String::new();
-    let mut last_published: Option<(u8, u32, bool, bool, String)> = None;
-    let mut last_publish_ns = 0u64;
+    let mut state = StateReporter {
+        publisher: state_pub,
+        last: None,
+        last_ns: 0,
+    };
     let mut stop_command_id = 0u64;
 
     while !shutdown.requested() {
@@ -366,6 +369,16 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             }
             answered.push_back(result);
         }
+        // A start is reported before any block of it runs: a program that fails in its first
+        // blocks still shows ACTIVE, then STOPPED, in that order.
+        report_state(
+            &mut state,
+            execution,
+            run.as_ref(),
+            &status,
+            &active_alarms,
+            &program_name,
+        );
         // Feed the motion queue while credit lasts.
         if let Some(r) = run.as_mut() {
             let in_flight = if status.run_id == r.id {
@@ -406,6 +419,15 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                             &r.program,
                             e.line,
                         ));
+                        // The interpreter knows its own alarm at once: it does not wait for the
+                        // event to come back over DDS to stop the program.
+                        let key = ("interpreter".to_string(), e.number);
+                        if !active_alarms.contains(&key) {
+                            active_alarms.push(key);
+                        }
+                        if matches!(execution, MachineState::ACTIVE | MachineState::FEED_HOLD) {
+                            execution = MachineState::STOPPED;
+                        }
                     }
                 }
             }
@@ -433,36 +455,14 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 execution = MachineState::ACTIVE;
             }
         }
-        let line = if run.as_ref().is_some_and(|r| r.id == status.run_id)
-            || !matches!(execution, MachineState::READY | MachineState::WAIT)
-        {
-            status.line
-        } else {
-            0
-        };
-        let estop = active_alarms.iter().any(|(s, n)| s == "plc" && *n == 65);
-        let key = (
+        report_state(
+            &mut state,
             execution,
-            line,
-            estop,
-            !active_alarms.is_empty(),
-            program_name.clone(),
+            run.as_ref(),
+            &status,
+            &active_alarms,
+            &program_name,
         );
-        let now = monotonic_ns();
-        if last_published.as_ref() != Some(&key) || now - last_publish_ns > 500_000_000 {
-            last_publish_ns = now;
-            last_published = Some(key);
-            let _ = state_pub.publish(MachineState {
-                stamp: stamp(),
-                mode: MachineState::MODE_AUTO,
-                execution,
-                execution_name: MachineState::execution_name_of(execution).into(),
-                program: program_name.clone(),
-                line,
-                emergency_stop: estop,
-                alarm_active: !active_alarms.is_empty(),
-            });
-        }
         if !busy {
             std::thread::sleep(Duration::from_millis(1));
         }
@@ -470,6 +470,54 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     // A program stopped by shutdown keeps what it had stored so far.
     remember(run.as_ref(), &mut memory, memory_path.as_deref());
     Ok(())
+}
+
+/// Publishes `/machine_state` on every change, so readers see each transition in order, and
+/// twice a second otherwise.
+struct StateReporter {
+    publisher: ros2_client::dds::Publisher<MachineState>,
+    last: Option<(u8, u32, bool, bool, String)>,
+    last_ns: u64,
+}
+
+fn report_state(
+    state: &mut StateReporter,
+    execution: u8,
+    run: Option<&Run>,
+    status: &MotionStatus,
+    active_alarms: &[(String, u32)],
+    program_name: &str,
+) {
+    let line = if run.is_some_and(|r| r.id == status.run_id)
+        || !matches!(execution, MachineState::READY | MachineState::WAIT)
+    {
+        status.line
+    } else {
+        0
+    };
+    let estop = active_alarms.iter().any(|(s, n)| s == "plc" && *n == 65);
+    let key = (
+        execution,
+        line,
+        estop,
+        !active_alarms.is_empty(),
+        program_name.to_string(),
+    );
+    let now = monotonic_ns();
+    if state.last.as_ref() != Some(&key) || now - state.last_ns > 500_000_000 {
+        state.last_ns = now;
+        state.last = Some(key);
+        let _ = state.publisher.publish(MachineState {
+            stamp: stamp(),
+            mode: MachineState::MODE_AUTO,
+            execution,
+            execution_name: MachineState::execution_name_of(execution).into(),
+            program: program_name.into(),
+            line,
+            emergency_stop: estop,
+            alarm_active: !active_alarms.is_empty(),
+        });
+    }
 }
 
 /// Program memory as a subprogram library: every stored program with an O number on its first

@@ -233,21 +233,23 @@ impl Parser<'_> {
         }
     }
 
-    /// Enters one nesting level (`IF` after `IF`, `##…`, brackets, unary signs): a line can
-    /// nest only so deep, so a hostile line cannot exhaust the stack.
-    fn nest(&mut self) -> Result<(), SyntaxError> {
-        self.depth += 1;
-        if self.depth > MAX_DEPTH {
+    /// Runs `f` one nesting level deeper (`IF` after `IF`, `##…`, brackets, unary signs): a
+    /// line can nest only so deep, so a hostile line cannot exhaust the stack.
+    fn nested<T>(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> Result<T, SyntaxError>,
+    ) -> Result<T, SyntaxError> {
+        if self.depth >= MAX_DEPTH {
             return err(Fault::Macro, "statement or expression nested too deeply");
         }
-        Ok(())
+        self.depth += 1;
+        let r = f(self);
+        self.depth -= 1;
+        r
     }
 
     fn statement(&mut self) -> Result<Stmt, SyntaxError> {
-        self.nest()?;
-        let s = self.statement_inner();
-        self.depth -= 1;
-        s
+        self.nested(Self::statement_inner)
     }
 
     fn statement_inner(&mut self) -> Result<Stmt, SyntaxError> {
@@ -389,10 +391,7 @@ impl Parser<'_> {
 
     /// What follows `#`: a number, another `#…`, or `[expr]`.
     fn var_index(&mut self) -> Result<Expr, SyntaxError> {
-        self.nest()?;
-        let e = self.var_index_inner();
-        self.depth -= 1;
-        e
+        self.nested(Self::var_index_inner)
     }
 
     fn var_index_inner(&mut self) -> Result<Expr, SyntaxError> {
@@ -419,10 +418,7 @@ impl Parser<'_> {
     }
 
     fn expr(&mut self) -> Result<Expr, SyntaxError> {
-        self.nest()?;
-        let e = self.binary(1);
-        self.depth -= 1;
-        e
+        self.nested(|p| p.binary(1))
     }
 
     fn binary(&mut self, min_prec: u8) -> Result<Expr, SyntaxError> {
@@ -481,10 +477,7 @@ impl Parser<'_> {
             _ => return self.primary(),
         };
         self.i += 1;
-        self.nest()?;
-        let inner = self.unary();
-        self.depth -= 1;
-        let inner = inner?;
+        let inner = self.nested(Self::unary)?;
         Ok(match op {
             Some(op) => Expr::Unary(op, Box::new(inner)),
             None => inner,
