@@ -174,7 +174,6 @@ pub struct Interpreter {
     /// GTC2E G96: the rpm and |X| where G96 was given (linear rpm rule, decision D18).
     gtc_css_from: (f64, f64),
     spindle: SpindleDir,
-    nose: G,
     /// Tool-nose radius compensation while G41/G42 is in force.
     nose_comp: Option<nose::NoseComp>,
     /// G40 given: the next move leaves compensation.
@@ -258,7 +257,6 @@ impl Interpreter {
             max_rpm: None,
             gtc_css_from: (0.0, 0.0),
             spindle: SpindleDir::Stopped,
-            nose: G::NoseCancel,
             nose_comp: None,
             nose_cancel: false,
             corner: None,
@@ -413,7 +411,6 @@ impl Interpreter {
             let outs = comp.flush();
             let here = self.work_position();
             let _ = self.emit_outs(outs, &here);
-            self.nose = G::NoseCancel;
         }
         self.hold_at = None;
         self.push(Command::ProgramEnd);
@@ -943,7 +940,6 @@ impl Interpreter {
         };
         let from = self.plane_point(&self.work_position())?;
         self.nose_comp = Some(nose::NoseComp::new(side, radius, tip, from, startup_line));
-        self.nose = g;
         self.nose_cancel = false;
         Ok(())
     }
@@ -1059,7 +1055,6 @@ impl Interpreter {
         let line = self.line;
         let outs = if self.nose_cancel {
             self.nose_cancel = false;
-            self.nose = G::NoseCancel;
             match self.nose_comp.take() {
                 Some(mut comp) => comp.cancel(to, ck, line),
                 None => Vec::new(),

@@ -271,7 +271,7 @@ impl Interpreter {
             }
             return Ok(());
         }
-        if self.nose != G::NoseCancel {
+        if self.nose_comp.is_some() {
             return Err(self.fault(
                 Fault::CompInCycle,
                 "tool-nose compensation active on entering the cycle",
