@@ -2,6 +2,10 @@
 
 use cnc_runtime::LaunchConfig;
 
+use crate::path::MAX_AXES;
+use crate::planner::{AxisLimits, PlannerConfig};
+use crate::profile::Shape;
+
 /// One axis, as the launch config describes it (limits in display units, X in diameter).
 pub use cnc_runtime::config::AxisEntry as AxisConfig;
 
@@ -14,6 +18,11 @@ pub struct MotionConfig {
     pub queue_capacity: usize,
     /// Arc plane as (horizontal, vertical) axis indices: G02 turns clockwise seen this way.
     pub arc_plane: (usize, usize),
+    /// Blocks the planner looks ahead.
+    pub lookahead: usize,
+    /// Path tolerance of blended corners, mm.
+    pub tolerance: f64,
+    pub shape: Shape,
 }
 
 impl MotionConfig {
@@ -27,6 +36,31 @@ impl MotionConfig {
                 idx(&cfg.machine.arc_plane[0]),
                 idx(&cfg.machine.arc_plane[1]),
             ),
+            lookahead: cfg.servo.lookahead,
+            tolerance: cfg.servo.tolerance,
+            shape: cfg.servo.profile,
+        }
+    }
+
+    /// The planner's view: limits per axis in slide travel, mm/s.
+    pub fn planner(&self) -> PlannerConfig {
+        let mut limits = AxisLimits {
+            velocity: [0.0; MAX_AXES],
+            acceleration: [0.0; MAX_AXES],
+            jerk: [0.0; MAX_AXES],
+            axes: self.axes.len().min(MAX_AXES),
+        };
+        for (i, a) in self.axes.iter().take(MAX_AXES).enumerate() {
+            limits.velocity[i] = a.max_velocity / 60.0;
+            limits.acceleration[i] = a.max_acceleration;
+            limits.jerk[i] = a.jerk();
+        }
+        PlannerConfig {
+            limits,
+            shape: self.shape,
+            period: self.period,
+            tolerance: self.tolerance,
+            lookahead: self.lookahead.max(1),
         }
     }
 }

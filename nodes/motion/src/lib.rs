@@ -8,6 +8,8 @@ pub mod block;
 pub mod config;
 pub mod motion;
 pub mod node;
+pub mod path;
+pub mod planner;
 pub mod profile;
 pub mod servo;
 

@@ -11,7 +11,9 @@ use cnc_msgs::signals::{FImage, GImage};
 
 use crate::block::{Aux, Block, Command};
 use crate::config::MotionConfig;
-use crate::profile::Profile;
+use crate::path::{Point, Segment, MAX_AXES};
+use crate::planner::{Done, Planner};
+use crate::profile::{Ahead, Limits, Mover};
 
 /// Alarm numbers raised by motion (`000` Appendix 1, inventory §11.2).
 pub mod alarm {
@@ -42,18 +44,17 @@ pub enum RunState {
     Alarm,
 }
 
-#[derive(Debug, Clone)]
 enum Active {
-    /// Straight line or arc along one path profile.
+    /// Lines and arcs through the look-ahead planner. `chain`: further path blocks join it
+    /// as they arrive (a thread runs alone).
     Path {
-        path: Path,
-        profile: Profile,
+        chain: bool,
     },
     /// Each axis on its own profile (dog-leg rapid).
     Rapid {
-        start: Vec<f64>,
-        end: Vec<f64>,
-        profiles: Vec<Profile>,
+        start: Point,
+        end: Point,
+        axes: [RapidAxis; MAX_AXES],
     },
     Dwell {
         remaining: f64,
@@ -66,20 +67,12 @@ enum Active {
     End,
 }
 
-#[derive(Debug, Clone)]
-enum Path {
-    Line {
-        start: Vec<f64>,
-        end: Vec<f64>,
-    },
-    Arc {
-        start: Vec<f64>,
-        end: Vec<f64>,
-        center: (f64, f64),
-        radius: f64,
-        start_angle: f64,
-        sweep: f64,
-    },
+/// One axis of a rapid: its travel and where it is on it.
+#[derive(Debug, Clone, Copy)]
+struct RapidAxis {
+    length: f64,
+    travelled: f64,
+    mover: Mover,
 }
 
 pub struct Motion {
@@ -104,6 +97,12 @@ pub struct Motion {
     /// until motion follows the spindle encoder (issue 4).
     spindle_rpm: f64,
     feed_per_rev: bool,
+    /// G09/G61 in force: path blocks end at rest.
+    exact_stop: bool,
+    /// The look-ahead window: built once, so the servo thread allocates nothing per block.
+    planner: Planner,
+    /// Blocks the planner finished this tick (kept to avoid allocating every tick).
+    finished: Vec<Done>,
 }
 
 impl Motion {
@@ -113,7 +112,15 @@ impl Motion {
         let commanded: Vec<f64> = (0..n)
             .map(|i| start.get(i).copied().unwrap_or(0.0))
             .collect();
+        let planner = Planner::new(cfg.planner(), {
+            let mut p = [0.0; MAX_AXES];
+            for (dst, src) in p.iter_mut().zip(&commanded) {
+                *dst = *src;
+            }
+            p
+        });
         Motion {
+            planner,
             cfg,
             queue: VecDeque::new(),
             run_id: 0,
@@ -129,6 +136,8 @@ impl Motion {
             strobe_seq: 0,
             spindle_rpm: 0.0,
             feed_per_rev: false,
+            exact_stop: false,
+            finished: Vec::with_capacity(64),
             f: FImage::default(),
             events: Vec::new(),
         }
@@ -144,6 +153,8 @@ impl Motion {
             self.run_id = block.run_id;
             self.queue.clear();
             self.active = None;
+            let here = self.commanded_point();
+            self.planner.reset(here);
             self.accepted_seq = 0;
             self.done_seq = 0;
             self.feed_hold = false;
@@ -192,6 +203,8 @@ impl Motion {
         self.cycle_stop = false;
         self.clear_strobe();
         self.commanded.clone_from(&self.actual);
+        let here = self.commanded_point();
+        self.planner.reset(here);
     }
 
     pub fn run_id(&self) -> u64 {
@@ -264,9 +277,7 @@ impl Motion {
             // Servo off: hold where the slides are, drop the run. The PLC raises the alarm.
             if !self.alarm {
                 self.alarm = true;
-                self.queue.clear();
-                self.active = None;
-                self.clear_strobe();
+                self.drop_run();
             }
             self.commanded.clone_from(&self.actual);
             self.update_f();
@@ -285,8 +296,10 @@ impl Motion {
                     break;
                 };
                 self.line = block.line;
-                if let Command::FeedMode { per_rev } = block.kind {
-                    self.feed_per_rev = per_rev;
+                match block.kind {
+                    Command::FeedMode { per_rev } => self.feed_per_rev = per_rev,
+                    Command::PathMode { exact_stop } => self.exact_stop = exact_stop,
+                    _ => {}
                 }
                 match self.activate(&block) {
                     Ok(a) => self.active = Some((block, a)),
@@ -297,13 +310,18 @@ impl Motion {
                     }
                 }
             }
+            if let Err((number, text, line)) = self.extend_chain() {
+                self.raise(number, text, line);
+                self.queue.clear();
+                break;
+            }
             if self.advance(dt, plc) {
                 let moved = matches!(
                     self.active,
                     Some((_, Active::Path { .. } | Active::Rapid { .. }))
                 );
                 if let Some((block, _)) = self.active.take() {
-                    self.done_seq = block.seq;
+                    self.done_seq = self.done_seq.max(block.seq);
                 }
                 // A finished move used this tick; aux, dwell and end chain on within it.
                 if moved {
@@ -315,21 +333,62 @@ impl Motion {
         }
         // Cycle stop: once the axes stand on the path, the rest of the run is dropped.
         if self.cycle_stop && self.stopped_on_path() {
-            self.queue.clear();
-            self.active = None;
+            self.drop_run();
             self.cycle_stop = false;
             self.feed_hold = false;
-            self.clear_strobe();
         }
         self.update_f();
         &self.commanded
     }
 
+    /// Forgets the queue and whatever is moving; the axes keep their commanded position.
+    fn drop_run(&mut self) {
+        self.queue.clear();
+        self.active = None;
+        let here = self.commanded_point();
+        self.planner.reset(here);
+        self.clear_strobe();
+    }
+
+    /// Path blocks waiting in the queue join the planner's window while it has room, so
+    /// corners between them are blended and the speed carries over.
+    fn extend_chain(&mut self) -> Result<(), (u32, String, u32)> {
+        if !matches!(self.active, Some((_, Active::Path { chain: true }))) {
+            return Ok(());
+        }
+        while self.planner.has_room() {
+            let Some(next) = self.queue.front() else {
+                break;
+            };
+            let (seq, line) = (next.seq, next.line);
+            match &next.kind {
+                Command::Linear { .. } | Command::Arc { .. } => {
+                    let (seg, feed) = self
+                        .segment_for(next, &self.planner.end())
+                        .map_err(|(n, t)| (n, t, line))?;
+                    let blend = !self.exact_stop;
+                    self.planner.push(seg, feed, seq, line, blend);
+                }
+                Command::FeedMode { per_rev } => {
+                    self.feed_per_rev = *per_rev;
+                    self.planner.push_marker(seq, line);
+                }
+                Command::PathMode { exact_stop } => {
+                    self.exact_stop = *exact_stop;
+                    self.planner.push_marker(seq, line);
+                }
+                _ => break,
+            }
+            self.queue.pop_front();
+        }
+        Ok(())
+    }
+
     fn stopped_on_path(&self) -> bool {
         match &self.active {
             None => true,
-            Some((_, Active::Path { profile, .. })) => profile.velocity == 0.0,
-            Some((_, Active::Rapid { profiles, .. })) => profiles.iter().all(|p| p.velocity == 0.0),
+            Some((_, Active::Path { .. })) => self.planner.velocity() == 0.0,
+            Some((_, Active::Rapid { axes, .. })) => axes.iter().all(|a| a.mover.velocity == 0.0),
             Some(_) => true,
         }
     }
@@ -337,6 +396,8 @@ impl Motion {
     fn raise(&mut self, number: u32, text: String, line: u32) {
         self.alarm = true;
         self.active = None;
+        let here = self.commanded_point();
+        self.planner.reset(here);
         self.clear_strobe();
         self.events.push(MotionEvent::Alarm { number, text, line });
     }
@@ -352,13 +413,31 @@ impl Motion {
         self.f.alarm = u32::from(self.alarm);
     }
 
+    /// The commanded slide position as a planner point.
+    fn commanded_point(&self) -> Point {
+        let mut p = [0.0; MAX_AXES];
+        for (dst, src) in p.iter_mut().zip(&self.commanded) {
+            *dst = *src;
+        }
+        p
+    }
+
     /// Slide positions of a display-unit point.
-    fn to_slide(&self, p: &[f64]) -> Vec<f64> {
+    fn to_slide(&self, p: &[f64]) -> Point {
+        let mut out = [0.0; MAX_AXES];
+        for (i, a) in self.cfg.axes.iter().take(MAX_AXES).enumerate() {
+            out[i] = p.get(i).copied().unwrap_or(0.0) * a.scale();
+        }
+        out
+    }
+
+    /// Display units of a slide point.
+    fn to_display(&self, p: &Point) -> Vec<f64> {
         self.cfg
             .axes
             .iter()
             .enumerate()
-            .map(|(i, a)| p.get(i).copied().unwrap_or(0.0) * a.scale())
+            .map(|(i, a)| p[i] / a.scale())
             .collect()
     }
 
@@ -380,178 +459,36 @@ impl Motion {
     }
 
     /// Turns a block into its active form; soft limits are checked here, before any motion.
-    fn activate(&self, block: &Block) -> Result<Active, (u32, String)> {
+    fn activate(&mut self, block: &Block) -> Result<Active, (u32, String)> {
         let n = self.cfg.axes.len();
-        let bad_len = |v: &[f64]| v.len() != n || v.iter().any(|x| !x.is_finite());
+        let start = self.commanded_point();
         match &block.kind {
-            kind if kind.end().is_some_and(bad_len) => Err((
-                alarm::BAD_BLOCK,
-                format!(
-                    "block has {} axis values, machine has {n}",
-                    kind.end().map_or(0, <[f64]>::len)
-                ),
-            )),
             Command::Rapid { end } => {
+                self.check_block(&block.kind)?;
                 self.check_limits(end)?;
                 let end = self.to_slide(end);
-                let start = self.commanded.clone();
-                let profiles = (0..n)
-                    .map(|i| {
-                        let a = &self.cfg.axes[i];
-                        Profile::new(
-                            (end[i] - start[i]).abs(),
-                            a.max_velocity / 60.0,
-                            a.max_acceleration,
-                        )
-                    })
-                    .collect();
-                Ok(Active::Rapid {
-                    start,
-                    end,
-                    profiles,
-                })
+                let mut axes = [RapidAxis {
+                    length: 0.0,
+                    travelled: 0.0,
+                    mover: Mover::default(),
+                }; MAX_AXES];
+                for (i, ax) in axes.iter_mut().enumerate().take(n) {
+                    ax.length = (end[i] - start[i]).abs();
+                }
+                Ok(Active::Rapid { start, end, axes })
             }
-            Command::Thread { end, lead, .. } => {
-                // Until motion follows the encoder (issue 4) a thread runs as a straight move
-                // at lead × commanded speed along the long axis.
-                let start = self.commanded_display();
-                let long = (0..n)
-                    .map(|i| (end[i] - start[i]).abs() * self.cfg.axes[i].scale())
-                    .fold(0.0, f64::max);
-                let length = (0..n)
-                    .map(|i| ((end[i] - start[i]) * self.cfg.axes[i].scale()).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                let rpm = self.spindle_rpm_for("thread cutting")?;
-                let feed = if long > 0.0 {
-                    lead * rpm * length / long
-                } else {
-                    lead * rpm
-                };
-                self.activate(&Block {
-                    kind: Command::Linear {
-                        end: end.clone(),
-                        feed,
-                    },
-                    ..block.clone()
-                })
-            }
-            Command::Linear { end, feed } => {
-                let feed = &self.feed_mm_per_min(*feed)?;
-                self.check_limits(end)?;
-                let end = self.to_slide(end);
-                let start = self.commanded.clone();
-                let d: Vec<f64> = end.iter().zip(&start).map(|(e, s)| e - s).collect();
-                let length = d.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let (mut vmax, mut acc) = (feed / 60.0, f64::INFINITY);
-                for (i, a) in self.cfg.axes.iter().enumerate() {
-                    if length > 0.0 && d[i] != 0.0 {
-                        let u = d[i].abs() / length;
-                        vmax = vmax.min(a.max_velocity / 60.0 / u);
-                        acc = acc.min(a.max_acceleration / u);
-                    }
-                }
-                let acc = if acc.is_finite() { acc } else { 1.0 };
-                Ok(Active::Path {
-                    path: Path::Line { start, end },
-                    profile: Profile::new(length, vmax, acc),
-                })
-            }
-            Command::Arc {
-                end,
-                center,
-                clockwise,
-                feed,
-            } => {
-                let feed = &self.feed_mm_per_min(*feed)?;
-                if bad_len(center) {
-                    return Err((
-                        alarm::BAD_BLOCK,
-                        "arc centre has the wrong number of axes".into(),
-                    ));
-                }
-                self.check_limits(end)?;
-                let (h, v) = self.cfg.arc_plane;
-                let start = self.commanded.clone();
-                let end = self.to_slide(end);
-                let c = self.to_slide(center);
-                let radius = ((start[h] - c[h]).powi(2) + (start[v] - c[v]).powi(2)).sqrt();
-                let a0 = (start[v] - c[v]).atan2(start[h] - c[h]);
-                let a1 = (end[v] - c[v]).atan2(end[h] - c[h]);
-                let mut sweep = a1 - a0;
-                if *clockwise {
-                    while sweep >= -1e-12 {
-                        sweep -= TAU;
-                    }
-                    if sweep < -TAU + 1e-9
-                        && ((end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9)
-                    {
-                        sweep += TAU;
-                    }
-                } else {
-                    while sweep <= 1e-12 {
-                        sweep += TAU;
-                    }
-                    if sweep > TAU - 1e-9
-                        && ((end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9)
-                    {
-                        sweep -= TAU;
-                    }
-                }
-                // Soft limits at the arc's extreme points (every quadrant crossing).
-                let mut k = (a0 / (TAU / 4.0)).floor() as i64;
-                loop {
-                    let ang = if sweep > 0.0 {
-                        (k + 1) as f64 * TAU / 4.0
-                    } else {
-                        k as f64 * TAU / 4.0
-                    };
-                    let passed = if sweep > 0.0 {
-                        ang - a0 < sweep
-                    } else {
-                        ang - a0 > sweep && ang < a0
-                    };
-                    if !passed || (k - (a0 / (TAU / 4.0)).floor() as i64).abs() > 5 {
-                        break;
-                    }
-                    let mut p = self.commanded_display();
-                    p[h] = (c[h] + radius * ang.cos()) / self.cfg.axes[h].scale();
-                    p[v] = (c[v] + radius * ang.sin()) / self.cfg.axes[v].scale();
-                    self.check_limits(&p)?;
-                    k += if sweep > 0.0 { 1 } else { -1 };
-                }
-                let length = radius * sweep.abs();
-                let amin = self
-                    .cfg
-                    .axes
-                    .iter()
-                    .map(|a| a.max_acceleration)
-                    .fold(f64::INFINITY, f64::min);
-                let vmin = self
-                    .cfg
-                    .axes
-                    .iter()
-                    .map(|a| a.max_velocity / 60.0)
-                    .fold(f64::INFINITY, f64::min);
-                // Half the acceleration for the path, the rest for the centripetal part.
-                let vmax = (feed / 60.0).min(vmin).min((0.5 * amin * radius).sqrt());
-                Ok(Active::Path {
-                    path: Path::Arc {
-                        start,
-                        end,
-                        center: (c[h], c[v]),
-                        radius,
-                        start_angle: a0,
-                        sweep,
-                    },
-                    profile: Profile::new(length, vmax, 0.5 * amin),
-                })
+            Command::Linear { .. } | Command::Arc { .. } | Command::Thread { .. } => {
+                let (seg, feed) = self.segment_for(block, &start)?;
+                self.planner.reset(start);
+                let chain = !matches!(block.kind, Command::Thread { .. });
+                self.planner
+                    .push(seg, feed, block.seq, block.line, !self.exact_stop && chain);
+                Ok(Active::Path { chain })
             }
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),
-            // Feed mode was taken over when the block was popped; this planner stops exactly
-            // at every block end, so G64 blending waits for the look-ahead planner (issue 4).
+            // Feed and path mode were taken over when the block was popped.
             Command::FeedMode { .. } | Command::PathMode { .. } => {
                 Ok(Active::Dwell { remaining: 0.0 })
             }
@@ -560,6 +497,154 @@ impl Motion {
                 strobe: None,
             }),
             Command::ProgramEnd => Ok(Active::End),
+        }
+    }
+
+    /// A block's end point and arc centre must name every axis with a finite value.
+    fn check_block(&self, kind: &Command) -> Result<(), (u32, String)> {
+        let n = self.cfg.axes.len();
+        let bad_len = |v: &[f64]| v.len() != n || v.iter().any(|x| !x.is_finite());
+        if let Some(end) = kind.end() {
+            if bad_len(end) {
+                return Err((
+                    alarm::BAD_BLOCK,
+                    format!("block has {} axis values, machine has {n}", end.len()),
+                ));
+            }
+        }
+        if let Command::Arc { center, .. } = kind {
+            if bad_len(center) {
+                return Err((
+                    alarm::BAD_BLOCK,
+                    "arc centre has the wrong number of axes".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The path segment of a line, arc or thread starting at `start` (slide units), and its
+    /// feed in mm/s. Soft limits are checked here, before the block joins the plan.
+    fn segment_for(&self, block: &Block, start: &Point) -> Result<(Segment, f64), (u32, String)> {
+        self.check_block(&block.kind)?;
+        let n = self.cfg.axes.len();
+        match &block.kind {
+            Command::Thread { end, lead, .. } => {
+                // Until motion follows the encoder, a thread runs as a straight move at
+                // lead × commanded speed along the long axis.
+                let e = self.to_slide(end);
+                let long = (0..n).map(|i| (e[i] - start[i]).abs()).fold(0.0, f64::max);
+                let length = (0..n)
+                    .map(|i| (e[i] - start[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let rpm = self.spindle_rpm_for("thread cutting")?;
+                // The lead is in display units of the long axis; slide travel per rev:
+                let feed = if long > 0.0 {
+                    lead * rpm * length / long
+                } else {
+                    lead * rpm
+                };
+                self.check_limits(end)?;
+                Ok((
+                    Segment::Line {
+                        start: *start,
+                        end: e,
+                    },
+                    feed / 60.0,
+                ))
+            }
+            Command::Linear { end, feed } => {
+                let feed = self.feed_mm_per_min(*feed)?;
+                self.check_limits(end)?;
+                let end = self.to_slide(end);
+                Ok((Segment::Line { start: *start, end }, feed / 60.0))
+            }
+            Command::Arc {
+                end,
+                center,
+                clockwise,
+                feed,
+            } => {
+                let feed = self.feed_mm_per_min(*feed)?;
+                self.check_limits(end)?;
+                let (h, v) = self.cfg.arc_plane;
+                let end = self.to_slide(end);
+                let c = self.to_slide(center);
+                let radius = (start[h] - c[h]).hypot(start[v] - c[v]);
+                if !(radius > 1e-9) {
+                    return Err((alarm::BAD_BLOCK, "arc of zero radius".into()));
+                }
+                let a0 = (start[v] - c[v]).atan2(start[h] - c[h]);
+                let a1 = (end[v] - c[v]).atan2(end[h] - c[h]);
+                let moves = (end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9;
+                let mut sweep = a1 - a0;
+                if *clockwise {
+                    while sweep >= -1e-12 {
+                        sweep -= TAU;
+                    }
+                    if sweep < -TAU + 1e-9 && moves {
+                        sweep += TAU;
+                    }
+                } else {
+                    while sweep <= 1e-12 {
+                        sweep += TAU;
+                    }
+                    if sweep > TAU - 1e-9 && moves {
+                        sweep -= TAU;
+                    }
+                }
+                // Soft limits at the arc's extreme points (every quadrant crossing).
+                let quarter = TAU / 4.0;
+                let first = (a0 / quarter).floor() as i64;
+                let mut k = first;
+                loop {
+                    let ang = if sweep > 0.0 {
+                        (k + 1) as f64 * quarter
+                    } else {
+                        k as f64 * quarter
+                    };
+                    let passed = if sweep > 0.0 {
+                        ang - a0 < sweep
+                    } else {
+                        ang - a0 > sweep && ang < a0
+                    };
+                    if !passed || (k - first).abs() > 5 {
+                        break;
+                    }
+                    let mut p = self.to_display(start);
+                    p[h] = (c[h] + radius * ang.cos()) / self.cfg.axes[h].scale();
+                    p[v] = (c[v] + radius * ang.sin()) / self.cfg.axes[v].scale();
+                    self.check_limits(&p)?;
+                    k += if sweep > 0.0 { 1 } else { -1 };
+                }
+                let mut e1 = [0.0; MAX_AXES];
+                let mut e2 = [0.0; MAX_AXES];
+                e1[h] = 1.0;
+                e2[v] = 1.0;
+                let mut center_pt = *start;
+                center_pt[h] = c[h];
+                center_pt[v] = c[v];
+                let mut lift = [0.0; MAX_AXES];
+                for i in 0..n {
+                    if i != h && i != v {
+                        lift[i] = end[i] - start[i];
+                    }
+                }
+                Ok((
+                    Segment::Arc {
+                        center: center_pt,
+                        e1,
+                        e2,
+                        radius,
+                        a0,
+                        sweep,
+                        lift,
+                    },
+                    feed / 60.0,
+                ))
+            }
+            _ => Err((alarm::BAD_BLOCK, "not a path block".into())),
         }
     }
 
@@ -595,64 +680,58 @@ impl Motion {
     fn advance(&mut self, dt: f64, plc: &GImage) -> bool {
         let hold = self.feed_hold;
         let in_pos = self.in_position();
+        let n = self.commanded.len().min(MAX_AXES);
+        let shape = self.cfg.shape;
         let Some((_, active)) = self.active.as_mut() else {
             return false;
         };
         match active {
-            Active::Path { path, profile } => {
-                profile.step(dt, hold);
-                let s = profile.position;
-                let total = profile.length;
-                let (h, v) = self.cfg.arc_plane;
-                match path {
-                    Path::Line { start, end } => {
-                        let f = if total > 0.0 { s / total } else { 1.0 };
-                        for i in 0..self.commanded.len() {
-                            self.commanded[i] = if profile.done() {
-                                end[i]
-                            } else {
-                                start[i] + (end[i] - start[i]) * f
-                            };
-                        }
-                    }
-                    Path::Arc {
-                        start,
-                        end,
-                        center,
-                        radius,
-                        start_angle,
-                        sweep,
-                    } => {
-                        let f = if total > 0.0 { s / total } else { 1.0 };
-                        if profile.done() {
-                            self.commanded.clone_from(end);
-                        } else {
-                            let ang = *start_angle + *sweep * f;
-                            for i in 0..self.commanded.len() {
-                                self.commanded[i] = start[i] + (end[i] - start[i]) * f;
-                            }
-                            self.commanded[h] = center.0 + *radius * ang.cos();
-                            self.commanded[v] = center.1 + *radius * ang.sin();
-                        }
-                    }
+            Active::Path { .. } => {
+                let mut out = [0.0; MAX_AXES];
+                self.finished.clear();
+                let end = self.planner.step(hold, 1.0, &mut self.finished, &mut out);
+                self.commanded[..n].copy_from_slice(&out[..n]);
+                for &(seq, _) in &self.finished {
+                    self.done_seq = self.done_seq.max(seq);
                 }
-                profile.done()
+                if let Some(line) = self.planner.line() {
+                    self.line = line;
+                }
+                end
             }
-            Active::Rapid {
-                start,
-                end,
-                profiles,
-            } => {
-                for (i, p) in profiles.iter_mut().enumerate() {
-                    p.step(dt, hold);
+            Active::Rapid { start, end, axes } => {
+                let lim = self.planner.config().limits;
+                let mut all = true;
+                for (i, ax) in axes.iter_mut().enumerate().take(n) {
+                    if ax.travelled < ax.length {
+                        let limits = Limits {
+                            velocity: lim.velocity[i],
+                            acceleration: lim.acceleration[i],
+                            jerk: lim.jerk[i],
+                        };
+                        let ahead = [Ahead {
+                            distance: ax.length - ax.travelled,
+                            velocity: 0.0,
+                            acceleration: lim.acceleration[i],
+                        }];
+                        ax.travelled += ax.mover.step(dt, shape, limits, hold, &ahead);
+                        let rest = ax.mover.velocity < 1e-3 && ax.mover.acceleration <= 0.0;
+                        if ax.travelled >= ax.length - 1e-9
+                            || (rest && ax.length - ax.travelled < 1e-4)
+                        {
+                            ax.travelled = ax.length;
+                            ax.mover = Mover::default();
+                        }
+                    }
                     let dir = (end[i] - start[i]).signum();
-                    self.commanded[i] = if p.done() {
+                    self.commanded[i] = if ax.travelled >= ax.length {
                         end[i]
                     } else {
-                        start[i] + dir * p.position
+                        start[i] + dir * ax.travelled
                     };
+                    all &= ax.travelled >= ax.length;
                 }
-                profiles.iter().all(Profile::done)
+                all
             }
             Active::Dwell { remaining } => {
                 if !hold {

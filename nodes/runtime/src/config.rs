@@ -95,6 +95,10 @@ pub struct AxisEntry {
     pub max_velocity: f64,
     /// mm/s² of slide travel.
     pub max_acceleration: f64,
+    /// mm/s³ of slide travel, for S-curve profiles; default: the acceleration reached in
+    /// [`DEFAULT_JERK_TIME`].
+    #[serde(default)]
+    pub max_jerk: Option<f64>,
     #[serde(default = "default_in_position")]
     pub in_position: f64,
     /// Simulated drive time constant, s.
@@ -115,11 +119,20 @@ impl AxisEntry {
         }
     }
 
+    /// Jerk limit, mm/s³ of slide travel.
+    pub fn jerk(&self) -> f64 {
+        self.max_jerk
+            .unwrap_or(self.max_acceleration / DEFAULT_JERK_TIME)
+    }
+
     /// The axis's address letter (names are validated to be one letter).
     pub fn letter(&self) -> char {
         self.name.chars().next().unwrap_or('?')
     }
 }
+
+/// Time to ramp up to full acceleration when an axis names no jerk limit, s.
+pub const DEFAULT_JERK_TIME: f64 = 0.05;
 
 fn default_in_position() -> f64 {
     0.0005
@@ -187,16 +200,42 @@ pub struct ServoConfig {
     /// Servo period, ms (1..8).
     #[serde(default = "default_period")]
     pub period_ms: f64,
-    /// Blocks motion queues ahead.
+    /// Blocks motion accepts ahead of the one being cut (at least `lookahead`).
     #[serde(default = "default_queue")]
     pub queue_capacity: usize,
+    /// Blocks the planner plans ahead.
+    #[serde(default = "default_lookahead")]
+    pub lookahead: usize,
+    /// Largest distance a blended (G64) corner may leave the programmed path, mm.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Velocity profile: `s_curve` (jerk limited) or `trapezoidal` (acceleration limited).
+    #[serde(default)]
+    pub profile: ProfileShape,
+}
+
+/// How speed changes along the path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProfileShape {
+    /// Acceleration limited: the acceleration jumps between +a, 0 and −a.
+    Trapezoidal,
+    /// Jerk limited: the acceleration ramps, so the drives see no steps in force.
+    #[default]
+    SCurve,
 }
 
 fn default_period() -> f64 {
     4.0
 }
 fn default_queue() -> usize {
-    32
+    256
+}
+fn default_lookahead() -> usize {
+    200
+}
+fn default_tolerance() -> f64 {
+    0.01
 }
 
 impl Default for ServoConfig {
@@ -204,6 +243,9 @@ impl Default for ServoConfig {
         ServoConfig {
             period_ms: default_period(),
             queue_capacity: default_queue(),
+            lookahead: default_lookahead(),
+            tolerance: default_tolerance(),
+            profile: ProfileShape::default(),
         }
     }
 }
@@ -316,9 +358,10 @@ impl LaunchConfig {
                 && a.max_velocity > 0.0
                 && a.max_acceleration > 0.0
                 && a.in_position > 0.0
-                && a.drive_lag >= 0.0;
+                && a.drive_lag >= 0.0
+                && a.max_jerk.is_none_or(|j| j > 0.0);
             if !ok || a.home < a.min || a.home > a.max {
-                return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, in_position", a.name));
+                return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, jerk, in_position", a.name));
             }
         }
         for p in &self.machine.arc_plane {
@@ -336,6 +379,12 @@ impl LaunchConfig {
         }
         if self.servo.queue_capacity < 2 || self.servo.queue_capacity > 10_000 {
             return Err("servo.queue_capacity must be 2..10000".into());
+        }
+        if self.servo.lookahead < 1 || self.servo.lookahead > self.servo.queue_capacity {
+            return Err("servo.lookahead must be 1..queue_capacity".into());
+        }
+        if !(self.servo.tolerance > 0.0 && self.servo.tolerance <= 10.0) {
+            return Err("servo.tolerance must be in (0, 10] mm".into());
         }
         if let Some(p) = self.machine.tool_change_macro {
             if !(1..=9999).contains(&p) {
