@@ -1,6 +1,7 @@
 //! The `cnc` launcher library: starts a cell's nodes in one process ([`cell`]) and talks to a
 //! running cell over ROS 2 ([`client`]), as a supervisor or a robot would.
 
+pub mod bench_paths;
 pub mod cell;
 pub mod client;
 pub mod simulate;

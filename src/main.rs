@@ -51,9 +51,15 @@ enum Verb {
     Simulate {
         #[command(flatten)]
         program: ProgramArgs,
-        /// Write the tool path over the finished 2-D profile as an SVG file.
+        /// Write the tool path over the finished 2-D profile as an SVG file (lathes).
         #[arg(long)]
         svg: Option<PathBuf>,
+        /// Velocity profile (trapezoidal, s-curve); default: the config's servo.profile.
+        #[arg(long)]
+        profile: Option<ProfileArg>,
+        /// Also print motion's CPU time per servo tick (p50, p99, max).
+        #[arg(long)]
+        timing: bool,
     },
 }
 
@@ -61,7 +67,8 @@ enum Verb {
 #[derive(clap::Args)]
 struct ProgramArgs {
     program: PathBuf,
-    #[arg(long, default_value = DEFAULT_CONFIG)]
+    /// The launch config that describes the machine.
+    #[arg(long, visible_alias = "launch", default_value = DEFAULT_CONFIG)]
     config: PathBuf,
     /// Dialect (huaxing-lathe, gtc2e-lathe, iso-lathe); default: the config's.
     #[arg(long)]
@@ -132,7 +139,19 @@ fn main() -> ExitCode {
             cycles,
         }) => run(&config, program.as_deref(), cycles),
         Some(Verb::Check { program, trace }) => check(&program, trace),
-        Some(Verb::Simulate { program, svg }) => simulate(&program, svg.as_deref()),
+        Some(Verb::Simulate {
+            program,
+            svg,
+            profile,
+            timing,
+        }) => simulate(
+            &program,
+            svg.as_deref(),
+            cnc::simulate::Options {
+                profile: profile.map(ProfileArg::shape),
+                timing,
+            },
+        ),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
     match result {
@@ -180,12 +199,34 @@ fn check(args: &ProgramArgs, trace: bool) -> Result<(), String> {
     Err(format!("{} alarm(s)", errors.len()))
 }
 
-fn simulate(args: &ProgramArgs, svg: Option<&Path>) -> Result<(), String> {
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ProfileArg {
+    Trapezoidal,
+    SCurve,
+}
+
+impl ProfileArg {
+    fn shape(self) -> cnc_runtime::config::ProfileShape {
+        match self {
+            ProfileArg::Trapezoidal => cnc_runtime::config::ProfileShape::Trapezoidal,
+            ProfileArg::SCurve => cnc_runtime::config::ProfileShape::SCurve,
+        }
+    }
+}
+
+fn simulate(
+    args: &ProgramArgs,
+    svg: Option<&Path>,
+    options: cnc::simulate::Options,
+) -> Result<(), String> {
     let p = args.load()?;
-    let sim = cnc::simulate::simulate(&p.cfg, p.dialect, &p.text, p.library)
+    let sim = cnc::simulate::simulate(&p.cfg, p.dialect, &p.text, p.library, options)
         .map_err(|e| format!("{}: {e}", args.program.display()))?;
-    println!("cycle time: {:.3} s", sim.cycle_time);
+    print!("{}", cnc::simulate::report(&sim));
     if let Some(path) = svg {
+        if sim.path.is_empty() {
+            return Err("--svg draws turned parts: the machine needs X and Z axes".into());
+        }
         std::fs::write(path, cnc::simulate::svg(&sim))
             .map_err(|e| format!("{}: {e}", path.display()))?;
         eprintln!("tool path and part drawn in {}", path.display());

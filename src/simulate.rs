@@ -8,9 +8,14 @@
 //! indexing, chuck), which are answered at once here; the simulated machine of `cnc run`
 //! includes them.
 
+use std::collections::VecDeque;
+use std::time::Instant;
+
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
+use cnc_motion::path::{self, Point, Segment, MAX_AXES};
 use cnc_motion::{Aux, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
 use cnc_msgs::signals::GImage;
+use cnc_runtime::config::ProfileShape;
 use cnc_runtime::LaunchConfig;
 
 /// Simulated time after which a program is taken as endless (a real cycle is minutes).
@@ -25,14 +30,114 @@ pub struct PathPoint {
     pub cutting: bool,
 }
 
+/// What to change for one simulation, besides the launch config.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Options {
+    /// Velocity profile instead of the config's `servo.profile`.
+    pub profile: Option<ProfileShape>,
+    /// Measure the planner's CPU time per servo tick.
+    pub timing: bool,
+}
+
+/// Figures measured from the setpoint trace, each axis against its own limits.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TraceStats {
+    /// Largest |Δp/dt| over the axis's rapid rate.
+    pub max_velocity_ratio: f64,
+    /// Largest |Δ²p/dt²| over the axis's acceleration limit.
+    pub max_acceleration_ratio: f64,
+    /// Largest distance of a setpoint of a feed move from the programmed path, mm.
+    pub max_deviation: f64,
+    /// Time spent in feed moves, s, and the same at the programmed feed with no
+    /// acceleration (length / feed).
+    pub cutting_time: f64,
+    pub ideal_cutting_time: f64,
+}
+
 #[derive(Debug, Clone)]
 pub struct Simulation {
     /// Seconds from cycle start to the end of the program.
     pub cycle_time: f64,
-    /// The tool path, one point per servo period in which the tool moved.
+    /// The tool path in the turning plane, one point per servo period in which the tool moved
+    /// (lathes only: machines with X and Z).
     pub path: Vec<PathPoint>,
     /// Canonical commands executed.
     pub commands: usize,
+    pub stats: TraceStats,
+    /// Motion's CPU time per servo tick, ns (with `Options::timing`).
+    pub tick_nanos: Vec<u64>,
+}
+
+/// Programmed feed moves near the one being cut, to measure how far the setpoints leave them.
+struct ProgrammedPath {
+    segments: VecDeque<(u64, Segment)>,
+    end: Point,
+    ideal_time: f64,
+}
+
+impl ProgrammedPath {
+    /// Takes in a command sent to motion (positions in slide units).
+    fn push(
+        &mut self,
+        seq: u64,
+        command: &Command,
+        slide: &dyn Fn(&[f64]) -> Point,
+        plane: (usize, usize),
+    ) {
+        let (seg, feed) = match command {
+            Command::Linear { end, feed } => (
+                Some(Segment::Line {
+                    start: self.end,
+                    end: slide(end),
+                }),
+                *feed,
+            ),
+            Command::Thread { end, .. } => (
+                Some(Segment::Line {
+                    start: self.end,
+                    end: slide(end),
+                }),
+                0.0,
+            ),
+            Command::Arc {
+                end,
+                center,
+                clockwise,
+                feed,
+            } => (
+                path::arc(&self.end, &slide(end), &slide(center), plane, *clockwise),
+                *feed,
+            ),
+            Command::Rapid { end } => {
+                self.end = slide(end);
+                return;
+            }
+            _ => return,
+        };
+        if let Some(seg) = seg {
+            if feed > 0.0 {
+                self.ideal_time += seg.length() / (feed / 60.0);
+            }
+            self.end = seg.end();
+            self.segments.push_back((seq, seg));
+        }
+    }
+
+    /// Distance of `p` from the programmed moves around block `done + 1`.
+    fn deviation(&mut self, done: u64, p: &Point) -> f64 {
+        while self
+            .segments
+            .front()
+            .is_some_and(|(seq, _)| *seq + 2 < done)
+        {
+            self.segments.pop_front();
+        }
+        self.segments
+            .iter()
+            .take_while(|(seq, _)| *seq <= done + 4)
+            .map(|(_, seg)| path::distance_to(seg, p))
+            .fold(f64::INFINITY, f64::min)
+    }
 }
 
 /// Interprets `text` and runs its blocks through the planner from the config's home position.
@@ -41,14 +146,28 @@ pub fn simulate(
     dialect: Dialect,
     text: &str,
     library: Library,
+    options: Options,
 ) -> Result<Simulation, String> {
-    let (xi, zi) = match (cfg.axis_index("X"), cfg.axis_index("Z")) {
-        (Some(x), Some(z)) => (x, z),
-        _ => return Err("simulate needs a lathe with X and Z axes".into()),
+    let lathe_plane = match (cfg.axis_index("X"), cfg.axis_index("Z")) {
+        (Some(x), Some(z)) if dialect.is_lathe() => Some((x, z)),
+        _ => None,
     };
     let setup = cnc_interpreter::node::setup_from_config(cfg, &cfg.home());
     let mut interp = Interpreter::with_library(dialect, text, setup, library);
-    let mcfg = MotionConfig::from_launch(cfg);
+    let mut mcfg = MotionConfig::from_launch(cfg);
+    if let Some(shape) = options.profile {
+        mcfg.shape = shape;
+    }
+    let axes = mcfg.axes.clone();
+    let n = axes.len().min(MAX_AXES);
+    let plane = mcfg.arc_plane;
+    let slide = |p: &[f64]| -> Point {
+        let mut out = [0.0; MAX_AXES];
+        for i in 0..n {
+            out[i] = p.get(i).copied().unwrap_or(0.0) * axes[i].scale();
+        }
+        out
+    };
     let start: Vec<f64> = cfg
         .home()
         .iter()
@@ -64,10 +183,19 @@ pub fn simulate(
     let mut sent = 0u64;
     let mut finished = false;
     let mut ticks = 0u64;
-    let mut path = Vec::new();
+    let mut lathe_path = Vec::new();
     let mut last = motion.commanded_display();
     let mut spindle_rpm = 0.0;
     let max_ticks = (MAX_SIMULATED_SECONDS / period) as u64;
+    let mut programmed = ProgrammedPath {
+        segments: VecDeque::new(),
+        end: slide(&cfg.home()),
+        ideal_time: 0.0,
+    };
+    let mut stats = TraceStats::default();
+    let mut tick_nanos = Vec::new();
+    // The last two setpoints, for velocity and acceleration.
+    let (mut p1, mut p2) = (start.clone(), start.clone());
     loop {
         // Keep motion's queue full, as the interpreter node does.
         while !finished && sent - motion.done_seq() < capacity {
@@ -80,6 +208,7 @@ pub fn simulate(
                     if command == Command::ProgramEnd {
                         finished = true;
                     }
+                    programmed.push(sent, &command, &slide, plane);
                     motion.push(Block {
                         run_id: 1,
                         seq: sent,
@@ -104,7 +233,11 @@ pub fn simulate(
         g.spindle_actual_rpm = spindle_rpm;
         // The move of this period belongs to the block active when it began.
         let before = motion.active_cutting();
+        let clock = options.timing.then(Instant::now);
         let commanded = motion.tick(Some(&actual), &g);
+        if let Some(t) = clock {
+            tick_nanos.push(t.elapsed().as_nanos() as u64);
+        }
         actual.copy_from_slice(commanded);
         ticks += 1;
         if let Some(MotionEvent::Alarm { number, text, line }) =
@@ -113,21 +246,88 @@ pub fn simulate(
             return Err(format!("motion alarm {number} at line {line}: {text}"));
         }
         let cutting = before.or(motion.active_cutting()).unwrap_or(false);
-        let now = motion.commanded_display();
-        if now != last {
-            path.push(PathPoint {
-                z: now[zi],
-                x: now[xi],
-                cutting,
-            });
-            last = now;
+        for (i, a) in axes.iter().enumerate() {
+            let v = (actual[i] - p1[i]) / period;
+            let acc = (actual[i] - 2.0 * p1[i] + p2[i]) / (period * period);
+            stats.max_velocity_ratio = stats
+                .max_velocity_ratio
+                .max(v.abs() / (a.max_velocity / 60.0));
+            stats.max_acceleration_ratio = stats
+                .max_acceleration_ratio
+                .max(acc.abs() / a.max_acceleration);
+        }
+        let moved = actual != p1;
+        p2.clone_from(&p1);
+        p1.clone_from(&actual);
+        if cutting {
+            stats.cutting_time += period;
+            if moved {
+                let d = programmed.deviation(motion.done_seq(), &slide_of(&actual));
+                if d.is_finite() {
+                    stats.max_deviation = stats.max_deviation.max(d);
+                }
+            }
+        }
+        if let Some((xi, zi)) = lathe_plane {
+            let now = motion.commanded_display();
+            if now != last {
+                lathe_path.push(PathPoint {
+                    z: now[zi],
+                    x: now[xi],
+                    cutting,
+                });
+                last = now;
+            }
         }
     }
+    stats.ideal_cutting_time = programmed.ideal_time;
     Ok(Simulation {
         cycle_time: ticks as f64 * period,
-        path,
+        path: lathe_path,
         commands: sent as usize,
+        stats,
+        tick_nanos,
     })
+}
+
+/// The figures `cnc simulate` prints, one per line.
+pub fn report(sim: &Simulation) -> String {
+    let st = &sim.stats;
+    let mut out = format!(
+        "cycle time: {:.3} s\n\
+         max axis velocity / limit: {:.4}\n\
+         max axis acceleration / limit: {:.4}\n\
+         max path deviation: {:.5} mm\n",
+        sim.cycle_time, st.max_velocity_ratio, st.max_acceleration_ratio, st.max_deviation
+    );
+    if st.ideal_cutting_time > 0.0 {
+        out.push_str(&format!(
+            "feed moves: {:.3} s, {:.3} s at the programmed feed without acceleration\n",
+            st.cutting_time, st.ideal_cutting_time
+        ));
+    }
+    if !sim.tick_nanos.is_empty() {
+        let mut t = sim.tick_nanos.clone();
+        t.sort_unstable();
+        let at = |q: f64| t[((t.len() - 1) as f64 * q).round() as usize] as f64 / 1000.0;
+        out.push_str(&format!(
+            "motion CPU per servo tick: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs over {} ticks\n",
+            at(0.5),
+            at(0.99),
+            at(1.0),
+            t.len()
+        ));
+    }
+    out
+}
+
+/// Slide positions as a planner point.
+fn slide_of(p: &[f64]) -> Point {
+    let mut out = [0.0; MAX_AXES];
+    for (dst, src) in out.iter_mut().zip(p) {
+        *dst = *src;
+    }
+    out
 }
 
 /// The finished outside profile: for each Z step, the smallest diameter the tool reached
@@ -254,7 +454,14 @@ mod tests {
         let cfg = config();
         // 100 mm at 600 mm/min = 10 s, plus the rapids and the accelerations.
         let text = "G00 X50 Z5\nG01 Z-95 F600\nG00 X100\nM30\n";
-        let sim = simulate(&cfg, Dialect::HuaxingLathe, text, Library::new()).unwrap();
+        let sim = simulate(
+            &cfg,
+            Dialect::HuaxingLathe,
+            text,
+            Library::new(),
+            Options::default(),
+        )
+        .unwrap();
         assert!(
             sim.cycle_time > 10.0 && sim.cycle_time < 13.0,
             "{}",
@@ -276,6 +483,7 @@ mod tests {
             Dialect::HuaxingLathe,
             "G00 X50\nG02 X60 Z-10 R1\nM30\n",
             Library::new(),
+            Options::default(),
         )
         .unwrap_err();
         assert!(e.contains("line 2"), "{e}");

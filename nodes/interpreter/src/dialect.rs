@@ -45,6 +45,8 @@ pub enum G {
     PlaneXy,
     PlaneZx,
     PlaneYz,
+    /// G21 on the mill: millimetre input (the only input unit here).
+    MetricInput,
     NoseCancel,
     NoseLeft,
     NoseRight,
@@ -164,6 +166,9 @@ pub enum Dialect {
     HuaxingLathe,
     Gtc2eLathe,
     IsoLathe,
+    /// FANUC 0-M-style mill (`003`): for now the subset the motion benchmarks use (issue 7
+    /// brings the full manual).
+    FanucMill,
 }
 
 /// Dialect properties the core needs besides the code tables.
@@ -186,11 +191,17 @@ pub struct Rules {
 }
 
 impl Dialect {
-    pub const ALL: [Dialect; 3] = [
+    pub const ALL: [Dialect; 4] = [
         Dialect::HuaxingLathe,
         Dialect::Gtc2eLathe,
         Dialect::IsoLathe,
+        Dialect::FanucMill,
     ];
+
+    /// Lathe dialects: X in diameter, the Z-X plane, U/W incremental words.
+    pub fn is_lathe(self) -> bool {
+        self != Dialect::FanucMill
+    }
 
     pub fn from_name(name: &str) -> Option<Dialect> {
         Dialect::ALL.into_iter().find(|d| d.name() == name)
@@ -201,6 +212,7 @@ impl Dialect {
             Dialect::HuaxingLathe => "huaxing-lathe",
             Dialect::Gtc2eLathe => "gtc2e-lathe",
             Dialect::IsoLathe => "iso-lathe",
+            Dialect::FanucMill => "fanuc-mill",
         }
     }
 
@@ -221,6 +233,16 @@ impl Dialect {
                 increment: 0.001,
                 max_coordinate: 99999.999,
                 max_feed: 15000.0,
+                initial_motion: G::Rapid,
+                initial_feed: 0.0,
+                needs_end: false,
+            },
+            // `003` §7.2.2: least input increment 0.001 mm, ±99999.999; power-on G00.
+            Dialect::FanucMill => Rules {
+                macros: false,
+                increment: 0.001,
+                max_coordinate: 99999.999,
+                max_feed: 24000.0,
                 initial_motion: G::Rapid,
                 initial_feed: 0.0,
                 needs_end: false,
@@ -251,6 +273,7 @@ impl Dialect {
             Dialect::HuaxingLathe => huaxing_g(number_x10),
             Dialect::Gtc2eLathe => gtc2e_g(number_x10),
             Dialect::IsoLathe => iso_g(number_x10),
+            Dialect::FanucMill => mill_g(number_x10),
         }
     }
 
@@ -258,6 +281,7 @@ impl Dialect {
     pub fn m_code(self, number_x10: u32) -> Option<M> {
         match self {
             Dialect::Gtc2eLathe => gtc2e_m(number_x10),
+            Dialect::FanucMill => mill_m(number_x10),
             _ => huaxing_m(number_x10),
         }
     }
@@ -431,6 +455,58 @@ fn iso_g(n: u32) -> Option<GCode> {
         _ => return None,
     };
     Some(GCode { group, meaning })
+}
+
+/// The FANUC 0-M codes of `003` Table 1.1 that the motion benchmarks need; the rest of the
+/// table comes with issue 7.
+fn mill_g(n: u32) -> Option<GCode> {
+    use G::*;
+    let (group, meaning) = match n {
+        0 => (1, Rapid),
+        10 => (1, Linear),
+        20 => (1, ArcCw),
+        30 => (1, ArcCcw),
+        40 => (0, Dwell),
+        90 => (0, ExactStopBlock),
+        170 => (2, PlaneXy),
+        180 => (
+            2,
+            Unsupported("G18: arcs in the Z-X plane on the mill come with issue 7"),
+        ),
+        190 => (
+            2,
+            Unsupported("G19: arcs in the Y-Z plane on the mill come with issue 7"),
+        ),
+        200 => (
+            6,
+            Unsupported("G20 inch input: this controller works in millimetres"),
+        ),
+        210 => (6, MetricInput),
+        540..=590 if n.is_multiple_of(10) => (14, WorkSystem(((n - 540) / 10) as u8)),
+        610 => (15, ExactStopMode),
+        640 => (15, ContinuousMode),
+        900 => (3, Absolute),
+        910 => (3, Incremental),
+        940 => (5, FeedPerMinute),
+        950 => (5, FeedPerRevolution),
+        _ => return None,
+    };
+    Some(GCode { group, meaning })
+}
+
+/// `003` §6: M00/M01/M02/M30, spindle M03–M05, coolant M08/M09, M98/M99.
+fn mill_m(n: u32) -> Option<M> {
+    use M::*;
+    Some(match n {
+        0 => Stop,
+        10 => OptionalStop,
+        20 | 300 => ProgramEnd,
+        30 | 40 | 60 | 80 => AuxBefore,
+        50 | 90 => AuxAfter,
+        980 => SubprogramCall,
+        990 => SubprogramReturn,
+        _ => return None,
+    })
 }
 
 fn huaxing_m(n: u32) -> Option<M> {

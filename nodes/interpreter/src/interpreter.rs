@@ -636,13 +636,15 @@ impl Interpreter {
                     .setup
                     .axes
                     .iter()
-                    .any(|&a| incremental_letter(a) == Some(c));
+                    .any(|&a| self.inc_letter(a) == Some(c));
             let known = axis_word
                 || matches!(
                     c,
                     'F' | 'S' | 'T' | 'P' | 'Q' | 'R' | 'I' | 'J' | 'K' | 'L' | 'D' | 'E'
                 )
-                || (c == 'U' || c == 'W') && self.dialect != Dialect::IsoLathe;
+                || (c == 'U' || c == 'W')
+                    && self.dialect.is_lathe()
+                    && self.dialect != Dialect::IsoLathe;
             if !known {
                 return Err(self.fault(
                     Fault::UndefinedCode,
@@ -734,7 +736,7 @@ impl Interpreter {
     fn end_point(&self, b: &Block) -> Result<Vec<f64>, ProgramError> {
         let mut end = self.work_position();
         for (i, &letter) in self.setup.axes.iter().enumerate() {
-            let inc = incremental_letter(letter);
+            let inc = self.inc_letter(letter);
             let (abs, rel) = (b.get(letter), inc.and_then(|c| b.get(c)));
             if abs.is_some() && rel.is_some() {
                 return Err(self.fault(
@@ -755,7 +757,7 @@ impl Interpreter {
         self.setup
             .axes
             .iter()
-            .any(|&a| b.has(a) || incremental_letter(a).is_some_and(|c| b.has(c)))
+            .any(|&a| b.has(a) || self.inc_letter(a).is_some_and(|c| b.has(c)))
     }
 
     fn xz(&self) -> Result<(usize, usize), ProgramError> {
@@ -765,10 +767,59 @@ impl Interpreter {
         }
     }
 
-    /// Work position as a plane point (radius).
+    /// The incremental address of an axis (U for X, W for Z, ...): lathe dialects only; on
+    /// the mill U, V, W are not addresses and G91 gives incremental moves.
+    fn inc_letter(&self, axis: char) -> Option<char> {
+        if self.dialect.is_lathe() {
+            incremental_letter(axis)
+        } else {
+            None
+        }
+    }
+
+    /// The working plane as (horizontal, vertical) axis indices: the lathe's Z-X plane, the
+    /// mill's G17 X-Y plane (G18/G19 come with issue 7).
+    fn plane_axes(&self) -> Result<(usize, usize), ProgramError> {
+        if self.dialect.is_lathe() {
+            let (xi, zi) = self.xz()?;
+            Ok((zi, xi))
+        } else {
+            match (self.axis('X'), self.axis('Y')) {
+                (Some(x), Some(y)) => Ok((x, y)),
+                _ => Err(self.fault(Fault::AxisAddress, "G17 needs the X and Y axes")),
+            }
+        }
+    }
+
+    /// Display units → plane units: a diameter axis counts half.
+    fn axis_scale(&self, i: usize) -> f64 {
+        if self.setup.diameter.get(i) == Some(&true) {
+            0.5
+        } else {
+            1.0
+        }
+    }
+
+    /// Work position as a plane point (`z` horizontal, `r` vertical; X as radius).
     fn plane_point(&self, work: &[f64]) -> Result<Pt, ProgramError> {
-        let (xi, zi) = self.xz()?;
-        Ok(Pt::new(work[zi], work[xi] * self.x_scale()))
+        let (h, v) = self.plane_axes()?;
+        Ok(Pt::new(
+            work[h] * self.axis_scale(h),
+            work[v] * self.axis_scale(v),
+        ))
+    }
+
+    /// The centre-offset addresses of the plane's axes (I for X, J for Y, K for Z).
+    fn center_letters(&self) -> (char, char) {
+        let letter = |i: usize| match self.setup.axes.get(i) {
+            Some('X') => 'I',
+            Some('Y') => 'J',
+            _ => 'K',
+        };
+        match self.plane_axes() {
+            Ok((h, v)) => (letter(h), letter(v)),
+            Err(_) => ('K', 'I'),
+        }
     }
 
     fn x_scale(&self) -> f64 {
@@ -780,18 +831,15 @@ impl Interpreter {
 
     /// Sets the plane axes of work position `w` to the plane point `p`.
     fn set_plane_point(&self, w: &mut [f64], p: Pt) {
-        if let Ok((xi, zi)) = self.xz() {
-            w[xi] = p.r / self.x_scale();
-            w[zi] = p.z;
+        if let Ok((h, v)) = self.plane_axes() {
+            w[v] = p.r / self.axis_scale(v);
+            w[h] = p.z / self.axis_scale(h);
         }
     }
 
     fn with_point(&self, base: &[f64], p: Pt) -> Vec<f64> {
         let mut w = base.to_vec();
-        if let Ok((xi, zi)) = self.xz() {
-            w[xi] = p.r / self.x_scale();
-            w[zi] = p.z;
-        }
+        self.set_plane_point(&mut w, p);
         w
     }
 
@@ -1218,6 +1266,8 @@ impl Interpreter {
                     // Keep the machine position; the work coordinates change.
                     self.work_system = n;
                 }
+                G::PlaneXy if !self.dialect.is_lathe() => {}
+                G::MetricInput => {}
                 G::PlaneXy | G::PlaneYz => {
                     return Err(self.fault(
                         Fault::NotSupported,
@@ -1951,7 +2001,7 @@ impl Interpreter {
             .map(|i| {
                 (mid[i] - here[i]).abs() > 0.0 || {
                     let a = self.setup.axes[i];
-                    b.has(a) || incremental_letter(a).is_some_and(|c| b.has(c))
+                    b.has(a) || self.inc_letter(a).is_some_and(|c| b.has(c))
                 }
             })
             .collect();
@@ -2082,20 +2132,22 @@ impl Interpreter {
         let here = self.work_position();
         let (a, e) = (self.plane_point(&here)?, self.plane_point(&end)?);
         let ccw = self.motion == G::ArcCcw;
-        let ik = b.has('I') || b.has('K');
+        // Centre offsets of the plane's axes: K, I on the lathe (Z-X), I, J on the mill (G17).
+        let (lh, lv) = self.center_letters();
+        let ik = b.has(lh) || b.has(lv);
         let center = match (b.get('R'), ik) {
             (Some(_), true) => return Err(self.fault(Fault::ArcRAndIk, "arc with both R and I/K")),
             (Some(r), false) => geometry::center_from_radius(a, e, r, ccw),
             (None, true) => {
-                // I: the centre's X offset from the start; GTC2E gives it in diameter
-                // (`002` §4.3.2-3), Huaxing in radius (decision D3).
-                let i = b.get('I').unwrap_or(0.0);
+                // The lathe's I is the centre's X offset from the start; GTC2E gives it in
+                // diameter (`002` §4.3.2-3), Huaxing in radius (decision D3).
+                let i = b.get(lv).unwrap_or(0.0);
                 let i = if self.dialect == Dialect::Gtc2eLathe {
                     i * self.x_scale()
                 } else {
                     i
                 };
-                let c = Pt::new(a.z + b.get('K').unwrap_or(0.0), a.r + i);
+                let c = Pt::new(a.z + b.get(lh).unwrap_or(0.0), a.r + i);
                 geometry::check_center(a, e, c)
             }
             (None, false) => return Err(self.fault(Fault::ArcRadius, "arc needs R or I/K")),

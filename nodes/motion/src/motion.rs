@@ -11,7 +11,7 @@ use cnc_msgs::signals::{FImage, GImage};
 
 use crate::block::{Aux, Block, Command};
 use crate::config::MotionConfig;
-use crate::path::{Point, Segment, MAX_AXES};
+use crate::path::{self, Point, Segment, MAX_AXES};
 use crate::planner::{Done, Planner};
 use crate::profile::{Ahead, Limits, Mover};
 
@@ -44,6 +44,9 @@ pub enum RunState {
     Alarm,
 }
 
+// The rapid's per-axis state is inline on purpose: boxing it would allocate on the servo
+// thread for every rapid.
+#[allow(clippy::large_enum_variant)]
 enum Active {
     /// Lines and arcs through the look-ahead planner. `chain`: further path blocks join it
     /// as they arrive (a thread runs alone).
@@ -571,29 +574,14 @@ impl Motion {
                 let (h, v) = self.cfg.arc_plane;
                 let end = self.to_slide(end);
                 let c = self.to_slide(center);
-                let radius = (start[h] - c[h]).hypot(start[v] - c[v]);
-                if !(radius > 1e-9) {
-                    return Err((alarm::BAD_BLOCK, "arc of zero radius".into()));
-                }
-                let a0 = (start[v] - c[v]).atan2(start[h] - c[h]);
-                let a1 = (end[v] - c[v]).atan2(end[h] - c[h]);
-                let moves = (end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9;
-                let mut sweep = a1 - a0;
-                if *clockwise {
-                    while sweep >= -1e-12 {
-                        sweep -= TAU;
-                    }
-                    if sweep < -TAU + 1e-9 && moves {
-                        sweep += TAU;
-                    }
-                } else {
-                    while sweep <= 1e-12 {
-                        sweep += TAU;
-                    }
-                    if sweep > TAU - 1e-9 && moves {
-                        sweep -= TAU;
-                    }
-                }
+                let seg = path::arc(start, &end, &c, (h, v), *clockwise)
+                    .ok_or((alarm::BAD_BLOCK, "arc of zero radius".to_string()))?;
+                let Segment::Arc {
+                    radius, a0, sweep, ..
+                } = seg
+                else {
+                    return Err((alarm::BAD_BLOCK, "not an arc".into()));
+                };
                 // Soft limits at the arc's extreme points (every quadrant crossing).
                 let quarter = TAU / 4.0;
                 let first = (a0 / quarter).floor() as i64;
@@ -618,31 +606,7 @@ impl Motion {
                     self.check_limits(&p)?;
                     k += if sweep > 0.0 { 1 } else { -1 };
                 }
-                let mut e1 = [0.0; MAX_AXES];
-                let mut e2 = [0.0; MAX_AXES];
-                e1[h] = 1.0;
-                e2[v] = 1.0;
-                let mut center_pt = *start;
-                center_pt[h] = c[h];
-                center_pt[v] = c[v];
-                let mut lift = [0.0; MAX_AXES];
-                for i in 0..n {
-                    if i != h && i != v {
-                        lift[i] = end[i] - start[i];
-                    }
-                }
-                Ok((
-                    Segment::Arc {
-                        center: center_pt,
-                        e1,
-                        e2,
-                        radius,
-                        a0,
-                        sweep,
-                        lift,
-                    },
-                    feed / 60.0,
-                ))
+                Ok((seg, feed / 60.0))
             }
             _ => Err((alarm::BAD_BLOCK, "not a path block".into())),
         }

@@ -199,6 +199,61 @@ impl Segment {
     }
 }
 
+/// The circular arc (helical if other axes move) from `start` to `end` around `center`,
+/// turning in the plane of axes `(h, v)`: clockwise seen with h to the right and v up.
+/// `end == start` in the plane is a full circle. None for a zero radius.
+pub fn arc(
+    start: &Point,
+    end: &Point,
+    center: &Point,
+    (h, v): (usize, usize),
+    clockwise: bool,
+) -> Option<Segment> {
+    use std::f64::consts::TAU;
+    let radius = (start[h] - center[h]).hypot(start[v] - center[v]);
+    if radius.is_nan() || radius <= 1e-9 {
+        return None;
+    }
+    let a0 = (start[v] - center[v]).atan2(start[h] - center[h]);
+    let a1 = (end[v] - center[v]).atan2(end[h] - center[h]);
+    let moves = (end[h] - start[h]).abs() > 1e-9 || (end[v] - start[v]).abs() > 1e-9;
+    let mut sweep = a1 - a0;
+    if clockwise {
+        while sweep >= -1e-12 {
+            sweep -= TAU;
+        }
+        if sweep < -TAU + 1e-9 && moves {
+            sweep += TAU;
+        }
+    } else {
+        while sweep <= 1e-12 {
+            sweep += TAU;
+        }
+        if sweep > TAU - 1e-9 && moves {
+            sweep -= TAU;
+        }
+    }
+    let mut e1 = [0.0; MAX_AXES];
+    let mut e2 = [0.0; MAX_AXES];
+    e1[h] = 1.0;
+    e2[v] = 1.0;
+    let mut c = *start;
+    c[h] = center[h];
+    c[v] = center[v];
+    let mut lift = sub(end, start);
+    lift[h] = 0.0;
+    lift[v] = 0.0;
+    Some(Segment::Arc {
+        center: c,
+        e1,
+        e2,
+        radius,
+        a0,
+        sweep,
+        lift,
+    })
+}
+
 /// Deflection angle between two unit directions (0 = straight on, π = reversal).
 pub fn deflection(u1: &Point, u2: &Point) -> f64 {
     dot(u1, u2).clamp(-1.0, 1.0).acos()

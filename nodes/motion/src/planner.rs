@@ -199,7 +199,7 @@ impl Planner {
         let mut room = prev.length - if k == 0 { self.s } else { 0.0 };
         room = room.min(prev.programmed_length / 2.0);
         let t = from_tol.min(room).min(next.length() / 2.0);
-        if !(t > 1e-9) {
+        if t.is_nan() || t <= 1e-9 {
             return None;
         }
         let arc = fillet(&vertex, &u1, &u2, t)?;
@@ -294,11 +294,11 @@ impl Planner {
         let lim = &self.cfg.limits;
         let share = seg.axis_share();
         let (mut v, mut a, mut j) = (feed, f64::INFINITY, f64::INFINITY);
-        for i in 0..lim.axes {
-            if share[i] > 1e-12 {
-                v = v.min(lim.velocity[i] / share[i]);
-                a = a.min(lim.acceleration[i] / share[i]);
-                j = j.min(lim.jerk[i] / share[i]);
+        for (i, &share) in share.iter().enumerate().take(lim.axes) {
+            if share > 1e-12 {
+                v = v.min(lim.velocity[i] / share);
+                a = a.min(lim.acceleration[i] / share);
+                j = j.min(lim.jerk[i] / share);
             }
         }
         if let Segment::Arc { e1, e2, .. } = seg {
@@ -406,10 +406,12 @@ impl Planner {
         let ds = self.mover.step(dt, self.cfg.shape, lim, hold, &self.ahead);
         self.s += ds;
         while let Some(p) = self.segs.front().copied() {
-            let last = self.segs.len() == 1;
-            if last {
-                // The end of the window: the mover brakes onto it; a jerk-limited stop may
-                // come to rest a hair short of it.
+            // The tool comes to rest at the end of this segment: the window ends there, or a
+            // corner that cannot be blended follows. It must not turn through the stop within
+            // a tick, so the next segment starts on the next tick.
+            let stop_after = self.segs.get(1).is_none_or(|q| q.entry == 0.0);
+            if stop_after {
+                // A jerk-limited stop may come to rest a hair short of the point.
                 let at_rest = self.mover.velocity < 1e-3 && self.mover.acceleration <= 0.0;
                 if self.s < p.length - 1e-9 && !(at_rest && p.length - self.s < 1e-4) {
                     break;
@@ -422,12 +424,15 @@ impl Planner {
                 self.blocks = self.blocks.saturating_sub(1);
             }
             self.segs.pop_front();
-            if last {
+            if stop_after {
                 self.s = 0.0;
-                self.blocks = 0;
                 self.mover = Mover::default();
-                *out = self.end;
-                return true;
+                if self.segs.is_empty() {
+                    self.blocks = 0;
+                    *out = self.end;
+                    return true;
+                }
+                break;
             }
             self.s -= p.length;
         }

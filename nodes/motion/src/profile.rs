@@ -78,6 +78,10 @@ impl Mover {
         };
         let ahead_ok = |(v1, a1, ds): (f64, f64, f64)| {
             ahead.iter().all(|c| {
+                if c.distance <= ds {
+                    // Passed within this tick: the speed there is between v0 and v1.
+                    return v0.max(v1) <= c.velocity + 1e-9;
+                }
                 let brake = c.acceleration.min(a_max);
                 stop_distance(v1, a1, c.velocity, brake, j_max) <= c.distance - ds + 1e-9
             })
@@ -165,14 +169,17 @@ impl Mover {
 /// (trapezoidal integration, exact for a ramp) still arrives at `c.distance` no faster than
 /// `c.velocity`: (v0+v1)/2·dt + (v1² − ve²)/2a ≤ d.
 fn braking_speed(v0: f64, c: &Ahead, dt: f64) -> f64 {
+    // Already no faster than the limit: ending the tick at it meets it whether the point is
+    // passed within the tick or later.
+    let floor = if v0 <= c.velocity { c.velocity } else { 0.0 };
     let a = c.acceleration;
     let room = c.distance - 0.5 * v0 * dt;
     let half = 0.5 * a * dt;
     let disc = half * half + c.velocity * c.velocity + 2.0 * a * room;
     if disc <= 0.0 {
-        0.0
+        floor
     } else {
-        (-half + disc.sqrt()).max(0.0)
+        (-half + disc.sqrt()).max(floor)
     }
 }
 

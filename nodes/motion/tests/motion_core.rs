@@ -309,3 +309,92 @@ fn a_block_for_another_axis_set_is_refused_with_an_alarm() {
         matches!(&m.take_events()[..], [MotionEvent::Alarm { number, line: 4, .. }] if *number == alarm::BAD_BLOCK)
     );
 }
+
+/// A full circle of radius 10 (slide units) around X50 Z-20 at F1200, from X70 Z-20.
+fn circle_program(m: &mut Motion) {
+    m.push(block(
+        1,
+        1,
+        Command::Arc {
+            end: vec![70.0, -20.0],
+            center: vec![50.0, -20.0],
+            clockwise: true,
+            feed: 1200.0,
+        },
+    ));
+    m.push(block(2, 2, Command::ProgramEnd));
+}
+
+/// Path length travelled over a trace of display points (X diameter → slide radius).
+fn travelled(trace: &[Vec<f64>]) -> f64 {
+    trace
+        .windows(2)
+        .map(|w| ((w[1][0] - w[0][0]) / 2.0).hypot(w[1][1] - w[0][1]))
+        .sum()
+}
+
+#[test]
+fn feed_hold_mid_arc_stops_within_the_braking_distance_and_resumes_on_the_same_path() {
+    for shape in [
+        cnc_motion::profile::Shape::Trapezoidal,
+        cnc_motion::profile::Shape::SCurve,
+    ] {
+        let mut cfg = lathe();
+        cfg.shape = shape;
+        let start = [35.0, -20.0];
+        // Without hold: the reference trace.
+        let mut plain = Motion::new(cfg.clone(), &start);
+        circle_program(&mut plain);
+        let mut reference = vec![plain.commanded_display()];
+        reference.extend(run(&mut plain, 100_000).0);
+        let length = travelled(&reference);
+        assert!(
+            (length - std::f64::consts::TAU * 10.0).abs() < 1e-3,
+            "{length}"
+        );
+
+        let mut m = Motion::new(cfg.clone(), &start);
+        circle_program(&mut m);
+        let g = GImage::default();
+        let mut trace = vec![m.commanded_display()];
+        for _ in 0..100 {
+            let actual = m.commanded().to_vec();
+            m.tick(Some(&actual), &g);
+            trace.push(m.commanded_display());
+        }
+        let at_hold = travelled(&trace);
+        m.feed_hold();
+        for _ in 0..300 {
+            let actual = m.commanded().to_vec();
+            m.tick(Some(&actual), &g);
+            trace.push(m.commanded_display());
+        }
+        assert_eq!(m.state(), RunState::Hold);
+        // Braking from 20 mm/s: v²/2a (+ v·a/2j for the S-curve, with j = a / 0.05 s) plus a
+        // tick of travel.
+        let v: f64 = 20.0;
+        let a = 1000.0 * cnc_runtime::config::DEFAULT_JERK_TIME;
+        let allowed = v * v / 2000.0 + v * a / 2.0 / 1000.0 + v * 0.004;
+        let braked = travelled(&trace) - at_hold;
+        assert!(
+            braked > 0.0 && braked <= allowed,
+            "{shape:?}: {braked} > {allowed}"
+        );
+        m.cycle_start();
+        let (rest, _) = run(&mut m, 100_000);
+        trace.extend(rest);
+        assert_eq!(m.state(), RunState::Idle);
+        // The same path: every point on the circle, the same length, the same end.
+        for p in &trace {
+            let r = (p[0] / 2.0 - 25.0).hypot(p[1] + 20.0);
+            assert!((r - 10.0).abs() < 1e-9, "{shape:?}: {p:?} off the circle");
+        }
+        let total = travelled(&trace);
+        // Chords of different samplings differ from the arc by a few nanometres.
+        assert!(
+            (total - length).abs() < 1e-5,
+            "{shape:?}: {total} vs {length}"
+        );
+        assert_eq!(trace.last(), reference.last());
+    }
+}
