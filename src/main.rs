@@ -38,6 +38,9 @@ enum Verb {
         #[arg(long, default_value_t = 1)]
         cycles: u32,
     },
+    /// Run one node of the cell in this process (the others run in their own processes or on
+    /// other hosts), until Ctrl-C or SIGTERM.
+    Node { node: NodeName, config: PathBuf },
     /// Interpret a program without running it; report every error with line and alarm number.
     Check {
         #[command(flatten)]
@@ -139,6 +142,7 @@ fn main() -> ExitCode {
             cycles,
         }) => run(&config, program.as_deref(), cycles),
         Some(Verb::Check { program, trace }) => check(&program, trace),
+        Some(Verb::Node { node, config }) => run_node(node, &config),
         Some(Verb::Simulate {
             program,
             svg,
@@ -246,6 +250,44 @@ fn program_name(path: &Path) -> String {
         .chars()
         .filter(|c| c.is_ascii_alphanumeric() || "._-".contains(*c))
         .collect()
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum NodeName {
+    Io,
+    Plc,
+    Motion,
+    Interpreter,
+    HmiBridge,
+}
+
+fn run_node(node: NodeName, config: &Path) -> Result<(), String> {
+    let cfg = LaunchConfig::load(config)?;
+    // SAFETY: installing a handler that only stores to an atomic.
+    unsafe {
+        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
+    }
+    let inst =
+        cnc_runtime::shm::instance(&cfg.machine.namespace, cfg.network.effective_domain_id()?);
+    let shutdown = cnc_runtime::Shutdown::default();
+    let s = shutdown.clone();
+    let worker = std::thread::spawn(move || match node {
+        NodeName::Io => cnc_io::node::run(cfg, inst, s).map(|_| String::new()),
+        NodeName::Plc => cnc_plc::node::run(cfg, inst, s).map(|_| String::new()),
+        NodeName::Motion => cnc_motion::node::run(cfg, inst, s),
+        NodeName::Interpreter => cnc_interpreter::node::run(cfg, s).map(|_| String::new()),
+        NodeName::HmiBridge => cnc_hmi_bridge::node::run(cfg, s).map(|_| String::new()),
+    });
+    while !STOP.load(Ordering::SeqCst) && !worker.is_finished() {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    shutdown.request();
+    let summary = worker.join().map_err(|_| "node panicked".to_string())??;
+    if !summary.is_empty() {
+        println!("{summary}");
+    }
+    Ok(())
 }
 
 fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String> {

@@ -23,6 +23,8 @@ pub struct MotionConfig {
     /// Path tolerance of blended corners, mm.
     pub tolerance: f64,
     pub shape: Shape,
+    /// Ticks without drive feedback before the lost-feedback alarm.
+    pub feedback_lost_ticks: u32,
 }
 
 impl MotionConfig {
@@ -39,6 +41,7 @@ impl MotionConfig {
             lookahead: cfg.servo.lookahead,
             tolerance: cfg.servo.tolerance,
             shape: cfg.servo.profile,
+            feedback_lost_ticks: cfg.servo.feedback_lost_ticks,
         }
     }
 

@@ -23,6 +23,12 @@ pub mod alarm {
     pub const BAD_BLOCK: u32 = 111;
     /// Feed per revolution or threading with the spindle stopped (`000` alarm 36).
     pub const SPINDLE_NOT_TURNING: u32 = 36;
+    /// A slide lags its setpoint by more than its following-error limit: the servo alarm of
+    /// that axis (`000` alarm 69, "bus servo alarm on physical axis #", inventory §11.3).
+    pub const FOLLOWING_ERROR: u32 = 69;
+    /// No feedback from the drives for `servo.feedback_lost_ticks` ticks: the drive link
+    /// is down (`000` alarm 68, "bus communication line error", inventory §11.3).
+    pub const FEEDBACK_LOST: u32 = 68;
 }
 
 /// Something the shell must publish.
@@ -104,6 +110,10 @@ pub struct Motion {
     exact_stop: bool,
     /// The look-ahead window: built once, so the servo thread allocates nothing per block.
     planner: Planner,
+    /// Consecutive ticks without drive feedback.
+    missed_feedback: u32,
+    /// Servo off after a drive fault (lost feedback, following error) until reset.
+    servo_off: bool,
     /// Blocks the planner finished this tick (kept to avoid allocating every tick).
     finished: Vec<Done>,
 }
@@ -140,6 +150,8 @@ impl Motion {
             spindle_rpm: 0.0,
             feed_per_rev: false,
             exact_stop: false,
+            missed_feedback: 0,
+            servo_off: false,
             finished: Vec::with_capacity(64),
             f: FImage::default(),
             events: Vec::new(),
@@ -200,6 +212,8 @@ impl Motion {
     /// Reset: clears the alarm state and the queue; the axes stop where they are.
     pub fn reset(&mut self) {
         self.alarm = false;
+        self.servo_off = false;
+        self.missed_feedback = 0;
         self.queue.clear();
         self.active = None;
         self.feed_hold = false;
@@ -275,6 +289,24 @@ impl Motion {
             for (dst, src) in self.actual.iter_mut().zip(a) {
                 *dst = *src;
             }
+            self.missed_feedback = 0;
+            self.check_following_error();
+        } else {
+            self.missed_feedback += 1;
+            if self.missed_feedback >= self.cfg.feedback_lost_ticks && !self.servo_off {
+                self.drive_fault(
+                    alarm::FEEDBACK_LOST,
+                    format!(
+                        "no feedback from the drives for {} servo ticks",
+                        self.missed_feedback
+                    ),
+                );
+            }
+        }
+        if self.servo_off {
+            // Setpoints stay where they were; the drives are disabled (see `servo_enabled`).
+            self.update_f();
+            return &self.commanded;
         }
         if plc.emergency_stop != 0 {
             // Servo off: hold where the slides are, drop the run. The PLC raises the alarm.
@@ -342,6 +374,56 @@ impl Motion {
         }
         self.update_f();
         &self.commanded
+    }
+
+    /// Whether the drives may be enabled: false after a drive fault until reset.
+    pub fn servo_enabled(&self) -> bool {
+        !self.servo_off
+    }
+
+    /// Compares each slide with the setpoint it was given (the one sent last tick).
+    fn check_following_error(&mut self) {
+        if self.servo_off {
+            return;
+        }
+        let worst = self
+            .cfg
+            .axes
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                let lag = (self.commanded[i] - self.actual[i]).abs();
+                (lag / a.following_error_limit(), i, lag)
+            })
+            .fold(None, |best: Option<(f64, usize, f64)>, x| match best {
+                Some(b) if b.0 >= x.0 => Some(b),
+                _ => Some(x),
+            });
+        if let Some((ratio, i, lag)) = worst {
+            if ratio > 1.0 {
+                let a = &self.cfg.axes[i];
+                self.drive_fault(
+                    alarm::FOLLOWING_ERROR,
+                    format!(
+                        "following error: {} lags its setpoint by {lag:.3} mm (limit {:.3})",
+                        a.name,
+                        a.following_error_limit()
+                    ),
+                );
+            }
+        }
+    }
+
+    /// A drive fault: servo off, the run dropped, the setpoints held where the slides are
+    /// (`000` §11.2: servo alarms switch the servo off).
+    fn drive_fault(&mut self, number: u32, text: String) {
+        let line = self.line;
+        self.raise(number, text, line);
+        self.queue.clear();
+        self.servo_off = true;
+        self.commanded.clone_from(&self.actual);
+        let here = self.commanded_point();
+        self.planner.reset(here);
     }
 
     /// Forgets the queue and whatever is moving; the axes keep their commanded position.

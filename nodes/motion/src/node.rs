@@ -232,7 +232,7 @@ fn servo_loop(
             sent_ns: monotonic_ns(),
             position: commanded,
             axis_count: n as u32,
-            enable: 1,
+            enable: u32::from(motion.servo_enabled()),
         })?;
         // The answer to this setpoint, within half a period; a late answer to an earlier one
         // still updates the position but is not a round trip of this tick.

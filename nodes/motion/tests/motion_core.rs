@@ -15,6 +15,7 @@ fn lathe() -> MotionConfig {
         max_velocity: 6000.0,
         max_acceleration: 1000.0,
         max_jerk: None,
+        following_error: None,
         in_position: 0.0005,
         drive_lag: 0.008,
         home: 0.0,
@@ -30,6 +31,7 @@ fn lathe() -> MotionConfig {
         lookahead: 16,
         tolerance: 0.01,
         shape: cnc_motion::profile::Shape::SCurve,
+        feedback_lost_ticks: 3,
     }
 }
 
@@ -397,4 +399,74 @@ fn feed_hold_mid_arc_stops_within_the_braking_distance_and_resumes_on_the_same_p
         );
         assert_eq!(trace.last(), reference.last());
     }
+}
+
+#[test]
+fn lost_drive_feedback_stops_the_output_within_three_ticks() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(
+        1,
+        1,
+        Command::Linear {
+            end: vec![50.0, -50.0],
+            feed: 1200.0,
+        },
+    ));
+    let g = GImage::default();
+    ticks(&mut m, &g, 50);
+    assert_eq!(m.state(), RunState::Running);
+    // The drives stop answering.
+    let mut outputs = vec![];
+    for _ in 0..10 {
+        outputs.push(m.tick(None, &g).to_vec());
+    }
+    assert_eq!(m.state(), RunState::Alarm);
+    assert!(!m.servo_enabled());
+    let events = m.take_events();
+    assert!(
+        matches!(&events[..], [MotionEvent::Alarm { number, .. }] if *number == alarm::FEEDBACK_LOST),
+        "{events:?}"
+    );
+    // From the third tick without feedback the setpoint no longer moves.
+    assert!(outputs[2..].windows(2).all(|w| w[0] == w[1]), "{outputs:?}");
+    // Reset (after the drives are back) re-enables the servo.
+    let actual = m.commanded().to_vec();
+    m.tick(Some(&actual), &g);
+    m.reset();
+    assert!(m.servo_enabled());
+    assert_eq!(m.state(), RunState::Idle);
+}
+
+#[test]
+fn a_stalled_drive_raises_the_following_error_alarm() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(
+        1,
+        1,
+        Command::Rapid {
+            end: vec![50.0, -200.0],
+        },
+    ));
+    let g = GImage::default();
+    // Z is stuck at 0 while its setpoint runs away.
+    let mut raised = None;
+    for tick in 0..2000 {
+        let mut actual = m.commanded().to_vec();
+        actual[1] = 0.0;
+        m.tick(Some(&actual), &g);
+        if m.state() == RunState::Alarm {
+            raised = Some(tick);
+            break;
+        }
+    }
+    assert!(raised.is_some(), "no alarm");
+    let events = m.take_events();
+    assert!(
+        matches!(&events[..], [MotionEvent::Alarm { number, text, .. }]
+            if *number == alarm::FOLLOWING_ERROR && text.contains('Z')),
+        "{events:?}"
+    );
+    assert!(!m.servo_enabled());
+    // The setpoint is put back where the slide is: no jump when the servo comes back.
+    assert_eq!(m.commanded()[1], 0.0);
 }

@@ -101,6 +101,11 @@ pub struct AxisEntry {
     pub max_jerk: Option<f64>,
     #[serde(default = "default_in_position")]
     pub in_position: f64,
+    /// Largest distance the slide may lag its setpoint, mm; default: 1.5 × what the rapid
+    /// rate gives over the drive lag and ten servo periods of 4 ms (feedback may come a few
+    /// ticks late on a machine without a real-time kernel), at least 1 mm.
+    #[serde(default)]
+    pub following_error: Option<f64>,
     /// Simulated drive time constant, s.
     #[serde(default = "default_drive_lag")]
     pub drive_lag: f64,
@@ -117,6 +122,13 @@ impl AxisEntry {
         } else {
             1.0
         }
+    }
+
+    /// Following-error limit, mm of slide travel.
+    pub fn following_error_limit(&self) -> f64 {
+        self.following_error.unwrap_or_else(|| {
+            (1.5 * self.max_velocity / 60.0 * (self.drive_lag + 10.0 * 0.004)).max(1.0)
+        })
     }
 
     /// Jerk limit, mm/s³ of slide travel.
@@ -212,6 +224,14 @@ pub struct ServoConfig {
     /// Velocity profile: `s_curve` (jerk limited) or `trapezoidal` (acceleration limited).
     #[serde(default)]
     pub profile: ProfileShape,
+    /// Servo ticks without drive feedback after which motion switches the servo off with
+    /// an alarm.
+    #[serde(default = "default_feedback_lost")]
+    pub feedback_lost_ticks: u32,
+}
+
+fn default_feedback_lost() -> u32 {
+    3
 }
 
 /// How speed changes along the path.
@@ -246,6 +266,7 @@ impl Default for ServoConfig {
             lookahead: default_lookahead(),
             tolerance: default_tolerance(),
             profile: ProfileShape::default(),
+            feedback_lost_ticks: default_feedback_lost(),
         }
     }
 }
@@ -359,7 +380,8 @@ impl LaunchConfig {
                 && a.max_acceleration > 0.0
                 && a.in_position > 0.0
                 && a.drive_lag >= 0.0
-                && a.max_jerk.is_none_or(|j| j > 0.0);
+                && a.max_jerk.is_none_or(|j| j > 0.0)
+                && a.following_error.is_none_or(|f| f > 0.0);
             if !ok || a.home < a.min || a.home > a.max {
                 return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, jerk, in_position", a.name));
             }
@@ -382,6 +404,9 @@ impl LaunchConfig {
         }
         if self.servo.lookahead < 1 || self.servo.lookahead > self.servo.queue_capacity {
             return Err("servo.lookahead must be 1..queue_capacity".into());
+        }
+        if !(1..=1000).contains(&self.servo.feedback_lost_ticks) {
+            return Err("servo.feedback_lost_ticks must be 1..1000".into());
         }
         if !(self.servo.tolerance > 0.0 && self.servo.tolerance <= 10.0) {
             return Err("servo.tolerance must be in (0, 10] mm".into());
