@@ -171,16 +171,13 @@ impl Planner {
                     entry_limit = f64::INFINITY;
                 }
             }
-        } else if self.segs.is_empty() && self.mover.velocity == 0.0 {
-            entry_limit = 0.0;
         }
         self.push_segment(seg, feed, seq, line, entry_limit, blend);
     }
 
-    /// Index of the last segment that moves, if it may still be changed (not yet passed).
+    /// Index of the last segment that moves (the one a new block's corner joins).
     fn last_moving(&self) -> Option<usize> {
-        let k = self.segs.iter().rposition(|p| p.length > 1e-12)?;
-        Some(k)
+        self.segs.iter().rposition(|p| p.length > 1e-12)
     }
 
     /// Rounds the corner between line `k` and the new line `next`: trims both, inserts the blend
