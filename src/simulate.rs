@@ -262,7 +262,7 @@ pub fn simulate(
         if cutting {
             stats.cutting_time += period;
             if moved {
-                let d = programmed.deviation(motion.done_seq(), &slide_of(&actual));
+                let d = programmed.deviation(motion.done_seq(), &path::point_from(&actual));
                 if d.is_finite() {
                     stats.max_deviation = stats.max_deviation.max(d);
                 }
@@ -317,15 +317,6 @@ pub fn report(sim: &Simulation) -> String {
             at(1.0),
             t.len()
         ));
-    }
-    out
-}
-
-/// Slide positions as a planner point.
-fn slide_of(p: &[f64]) -> Point {
-    let mut out = [0.0; MAX_AXES];
-    for (dst, src) in out.iter_mut().zip(p) {
-        *dst = *src;
     }
     out
 }

@@ -98,8 +98,7 @@ fn killing_io_stops_the_motion_output_within_three_ticks() {
         &mut last_answered,
     );
     shutdown.request();
-    let summary = motion.join().expect("motion thread").expect("motion node");
-    assert!(!summary.is_empty());
+    motion.join().expect("motion thread").expect("motion node");
 
     // The setpoint answered last is L; L+1 is computed with its answer, L+2 and L+3 are the
     // first and second ticks without one, L+4 the third: from there the servo is off.

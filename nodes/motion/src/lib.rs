@@ -1,7 +1,8 @@
-//! Motion: block queue, per-block velocity profiles, interpolation at the servo period.
+//! Motion: block queue, look-ahead planning, interpolation at the servo period.
 //!
 //! A block's path: [`block`] (what arrives) → [`motion`] (queue, limits, handshake) →
-//! [`profile`] (velocity along the block) → setpoint. [`servo`] measures the loop;
+//! [`planner`] (look-ahead window, corner blends) → [`profile`] (speed this tick) →
+//! [`path`] (the point on the path) → setpoint. [`servo`] measures the loop;
 //! [`node`] runs it on its own thread against iceoryx2.
 
 pub mod block;

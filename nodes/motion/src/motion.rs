@@ -1,4 +1,5 @@
-//! The motion core: block queue, per-block profiles, soft limits, M/S/T handshake with the PLC.
+//! The motion core: block queue, the look-ahead planner's window, rapids, dwells, soft limits,
+//! drive faults, M/S/T handshake with the PLC.
 //!
 //! Pure: the shell calls [`Motion::tick`] every servo period with the latest drive feedback and
 //! PLC image and sends the returned setpoint to the drives. Positions inside are slide travel
@@ -125,13 +126,7 @@ impl Motion {
         let commanded: Vec<f64> = (0..n)
             .map(|i| start.get(i).copied().unwrap_or(0.0))
             .collect();
-        let planner = Planner::new(cfg.planner(), {
-            let mut p = [0.0; MAX_AXES];
-            for (dst, src) in p.iter_mut().zip(&commanded) {
-                *dst = *src;
-            }
-            p
-        });
+        let planner = Planner::new(cfg.planner(), path::point_from(&commanded));
         Motion {
             planner,
             cfg,
@@ -386,31 +381,18 @@ impl Motion {
         if self.servo_off {
             return;
         }
-        let worst = self
-            .cfg
-            .axes
-            .iter()
-            .enumerate()
-            .map(|(i, a)| {
-                let lag = (self.commanded[i] - self.actual[i]).abs();
-                (lag / a.following_error_limit(), i, lag)
+        let lagging = self.cfg.axes.iter().enumerate().find_map(|(i, a)| {
+            let lag = (self.commanded[i] - self.actual[i]).abs();
+            let limit = a.following_error_limit();
+            (lag > limit).then(|| {
+                format!(
+                    "following error: {} lags its setpoint by {lag:.3} mm (limit {limit:.3})",
+                    a.name
+                )
             })
-            .fold(None, |best: Option<(f64, usize, f64)>, x| match best {
-                Some(b) if b.0 >= x.0 => Some(b),
-                _ => Some(x),
-            });
-        if let Some((ratio, i, lag)) = worst {
-            if ratio > 1.0 {
-                let a = &self.cfg.axes[i];
-                self.drive_fault(
-                    alarm::FOLLOWING_ERROR,
-                    format!(
-                        "following error: {} lags its setpoint by {lag:.3} mm (limit {:.3})",
-                        a.name,
-                        a.following_error_limit()
-                    ),
-                );
-            }
+        });
+        if let Some(text) = lagging {
+            self.drive_fault(alarm::FOLLOWING_ERROR, text);
         }
     }
 
@@ -500,11 +482,7 @@ impl Motion {
 
     /// The commanded slide position as a planner point.
     fn commanded_point(&self) -> Point {
-        let mut p = [0.0; MAX_AXES];
-        for (dst, src) in p.iter_mut().zip(&self.commanded) {
-            *dst = *src;
-        }
-        p
+        path::point_from(&self.commanded)
     }
 
     /// Slide positions of a display-unit point.
@@ -624,7 +602,7 @@ impl Motion {
                     .sum::<f64>()
                     .sqrt();
                 let rpm = self.spindle_rpm_for("thread cutting")?;
-                // The lead is in display units of the long axis; slide travel per rev:
+                // Path feed that moves the long axis `lead` per revolution.
                 let feed = if long > 0.0 {
                     lead * rpm * length / long
                 } else {
@@ -737,7 +715,7 @@ impl Motion {
                 self.finished.clear();
                 let end = self.planner.step(hold, 1.0, &mut self.finished, &mut out);
                 self.commanded[..n].copy_from_slice(&out[..n]);
-                for &(seq, _) in &self.finished {
+                for &seq in &self.finished {
                     self.done_seq = self.done_seq.max(seq);
                 }
                 if let Some(line) = self.planner.line() {

@@ -88,22 +88,27 @@ impl Segment {
                     std::array::from_fn(|i| start[i] + (end[i] - start[i]) * f)
                 }
             }
-            Segment::Arc {
-                center,
-                e1,
-                e2,
-                radius,
-                a0,
-                sweep,
-                lift,
-            } => {
-                let ang = a0 + sweep * f;
-                let (sin, cos) = ang.sin_cos();
-                std::array::from_fn(|i| {
-                    center[i] + radius * (cos * e1[i] + sin * e2[i]) + f * lift[i]
-                })
-            }
+            Segment::Arc { sweep, .. } => self.arc_point(sweep * f),
         }
+    }
+
+    /// The arc's point `turned` radians (signed like the sweep) from its start.
+    fn arc_point(&self, turned: f64) -> Point {
+        let Segment::Arc {
+            center,
+            e1,
+            e2,
+            radius,
+            a0,
+            sweep,
+            lift,
+        } = self
+        else {
+            return self.end();
+        };
+        let f = if *sweep != 0.0 { turned / sweep } else { 1.0 };
+        let (sin, cos) = (a0 + turned).sin_cos();
+        std::array::from_fn(|i| center[i] + radius * (cos * e1[i] + sin * e2[i]) + f * lift[i])
     }
 
     pub fn start(&self) -> Point {
@@ -282,6 +287,15 @@ pub fn fillet(vertex: &Point, u1: &Point, u2: &Point, tangent: f64) -> Option<Se
     })
 }
 
+/// A point from the first axes of a position (the rest zero).
+pub fn point_from(p: &[f64]) -> Point {
+    let mut out = [0.0; MAX_AXES];
+    for (dst, src) in out.iter_mut().zip(p) {
+        *dst = *src;
+    }
+    out
+}
+
 /// Distance from `p` to the segment (used to measure path deviation).
 pub fn distance_to(seg: &Segment, p: &Point) -> f64 {
     match seg {
@@ -299,13 +313,12 @@ pub fn distance_to(seg: &Segment, p: &Point) -> f64 {
             center,
             e1,
             e2,
-            radius,
             a0,
             sweep,
-            lift,
+            ..
         } => {
-            // Angle of p in the plane, then the nearest point of the swept range; the helical
-            // part is followed by sampling around that angle.
+            // Angle of p in the plane, then the nearest point of the swept range (the
+            // helical part follows the angle).
             let q = sub(p, center);
             let ang = dot(&q, e2).atan2(dot(&q, e1));
             let mut rel = ang - a0;
@@ -321,15 +334,7 @@ pub fn distance_to(seg: &Segment, p: &Point) -> f64 {
                     rel = if sweep - rel < tau + rel { *sweep } else { 0.0 };
                 }
             }
-            let at = |r: f64| {
-                let (sin, cos) = (a0 + r).sin_cos();
-                let f = if *sweep != 0.0 { r / sweep } else { 1.0 };
-                let pt: Point = std::array::from_fn(|i| {
-                    center[i] + radius * (cos * e1[i] + sin * e2[i]) + f * lift[i]
-                });
-                norm(&sub(p, &pt))
-            };
-            at(rel)
+            norm(&sub(p, &seg.arc_point(rel)))
         }
     }
 }

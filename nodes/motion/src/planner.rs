@@ -59,8 +59,8 @@ struct Planned {
     counts: bool,
 }
 
-/// A finished block, reported by [`Planner::step`].
-pub type Done = (u64, u32);
+/// The sequence number of a finished block, reported by [`Planner::step`].
+pub type Done = u64;
 
 pub struct Planner {
     cfg: PlannerConfig,
@@ -416,7 +416,7 @@ impl Planner {
             } else if self.s < p.length - 1e-12 {
                 break;
             }
-            done.push((p.seq, p.line));
+            done.push(p.seq);
             if p.counts {
                 self.blocks = self.blocks.saturating_sub(1);
             }
@@ -435,10 +435,5 @@ impl Planner {
         }
         *out = self.position();
         false
-    }
-
-    /// Total path length still to go.
-    pub fn remaining(&self) -> f64 {
-        self.segs.iter().map(|p| p.length).sum::<f64>() - self.s
     }
 }
