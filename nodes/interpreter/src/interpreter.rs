@@ -1437,15 +1437,12 @@ impl Interpreter {
     /// T word: Huaxing `Tmmnn` (tool mm, offset nn; `T1` = tool 1 offset 1, decision D16);
     /// GTC2E `T0x` (index station x and apply offset x) or `Tx0` (offset x only).
     fn tool_word(&mut self, t: f64) -> Result<(), ProgramError> {
-        let code = code_x10(t)
-            .filter(|c| c % 10 == 0)
-            .map(|c| c / 10)
-            .ok_or_else(|| {
-                self.fault(
-                    Fault::ToolNumber,
-                    format!("tool word T{} must be an integer", show(t)),
-                )
-            })?;
+        let code = integer_word(t).ok_or_else(|| {
+            self.fault(
+                Fault::ToolNumber,
+                format!("tool word T{} must be an integer", show(t)),
+            )
+        })?;
         let (tool, offset) = if self.dialect == Dialect::Gtc2eLathe {
             match code {
                 1..=8 => (if self.gang_mode { None } else { Some(code) }, code),
@@ -1638,7 +1635,7 @@ impl Interpreter {
         let p = b
             .get('P')
             .ok_or_else(|| self.fault(Fault::MissingWord, "P (line number) missing"))?;
-        let n = code_x10(p).filter(|c| c % 10 == 0).map(|c| c / 10);
+        let n = integer_word(p);
         let (text, here) = self
             .frames
             .last()
@@ -1673,15 +1670,12 @@ impl Interpreter {
         let p = b
             .get('P')
             .ok_or_else(|| self.fault(Fault::MissingWord, "M98 needs P (program number)"))?;
-        let p = code_x10(p)
-            .filter(|c| c % 10 == 0)
-            .map(|c| c / 10)
-            .ok_or_else(|| {
-                self.fault(
-                    Fault::Call,
-                    format!("M98 P{}: not a program number", show(p)),
-                )
-            })?;
+        let p = integer_word(p).ok_or_else(|| {
+            self.fault(
+                Fault::Call,
+                format!("M98 P{}: not a program number", show(p)),
+            )
+        })?;
         // P up to 4 digits: the program; 5–8 digits: repeat count then program (decision D20).
         let (mut count, number) = if p > 9999 {
             (p / 10000, p % 10000)
@@ -2506,6 +2500,12 @@ fn is_motion(c: &Canon) -> bool {
 fn code_x10(v: f64) -> Option<u32> {
     let x10 = (v * 10.0).round();
     ((v * 10.0 - x10).abs() < 1e-6 && (0.0..1e8).contains(&x10)).then_some(x10 as u32)
+}
+
+/// A word that must be a whole number 0..10⁷ (T, M98 P, GTC2E line P): None for fractions and
+/// negatives.
+fn integer_word(v: f64) -> Option<u32> {
+    code_x10(v).filter(|c| c % 10 == 0).map(|c| c / 10)
 }
 
 fn whole(v: f64) -> u32 {
