@@ -3,7 +3,8 @@
 //! cutting it.
 //!
 //! What the estimate includes: every move as motion plans it (acceleration, per-axis rapids,
-//! feed per revolution and threads at the programmed spindle speed), dwells and program end.
+//! feed per revolution and threads at the programmed spindle speed, threads waiting for the
+//! spindle's index pulse), dwells and program end.
 //! What it leaves out: the PLC's own time for M, S and T codes (spindle ramps, turret
 //! indexing, chuck), which are answered at once here; the simulated machine of `cnc run`
 //! includes them.
@@ -186,6 +187,8 @@ pub fn simulate(
     let mut lathe_path = Vec::new();
     let mut last = motion.commanded_display();
     let mut spindle_rpm = 0.0;
+    // The spindle as an ideal encoder sees it: at the commanded speed at once.
+    let (mut spindle_dir, mut spindle_angle) = (1.0, 0.0);
     let max_ticks = (MAX_SIMULATED_SECONDS / period) as u64;
     let mut programmed = ProgrammedPath {
         segments: VecDeque::new(),
@@ -232,6 +235,18 @@ pub fn simulate(
         g.fin_seq = motion.f_image().strobe_seq;
         g.spindle_actual_rpm = spindle_rpm;
         // The move of this period belongs to the block active when it began.
+        let f = *motion.f_image();
+        if f.mf != 0 {
+            match f.m_code {
+                3 => spindle_dir = 1.0,
+                4 => spindle_dir = -1.0,
+                5 => spindle_dir = 0.0,
+                _ => {}
+            }
+        }
+        let rpm = f.s_value * spindle_dir;
+        spindle_angle = (spindle_angle + rpm / 60.0 * 360.0 * period).rem_euclid(360.0);
+        motion.spindle_feedback(rpm, spindle_angle);
         let before = motion.active_cutting();
         let clock = options.timing.then(Instant::now);
         let commanded = motion.tick(Some(&actual), &g);

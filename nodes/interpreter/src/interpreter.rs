@@ -1314,7 +1314,8 @@ impl Interpreter {
                     self.track_spindle(code);
                     self.aux(Aux::M((code / 10) as i32));
                 }
-                M::OptionalStop if self.setup.optional_stop => self.aux(Aux::M(1)),
+                // Motion stops on M01 if the optional-stop switch is on when it gets there.
+                M::OptionalStop => self.aux(Aux::M(1)),
                 _ => {}
             }
         }
@@ -1369,6 +1370,12 @@ impl Interpreter {
                     );
                 }
                 self.max_rpm = Some(s);
+                // Decision D37: a G50 block that starts the spindle under G97 with no speed
+                // yet commanded also runs it at S (the §5.23.6 example threads that way).
+                let starts = b.m.iter().any(|&(_, code)| code == 30 || code == 40);
+                if starts && !self.css && self.rpm == 0.0 {
+                    self.set_rpm(s);
+                }
             }
             return Ok(());
         }
@@ -2266,9 +2273,20 @@ impl Interpreter {
                 &self.with_point(&here, mid),
                 MoveKind::Thread { lead, angle },
             )?;
+            // The thread's long axis keeps its lead through the run-out (`000` §5.23.5: "the
+            // long axis continues"); motion reads a lead along the piece's own long axis, which
+            // is the short axis when the retract J is longer than K.
+            let runout_lead = if j.abs() > k {
+                lead * j.abs() / k
+            } else {
+                lead
+            };
             self.emit(
                 &self.with_point(&here, out),
-                MoveKind::Thread { lead, angle },
+                MoveKind::Thread {
+                    lead: runout_lead,
+                    angle,
+                },
             )?;
         } else {
             self.emit(end, MoveKind::Thread { lead, angle })?;

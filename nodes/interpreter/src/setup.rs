@@ -104,8 +104,6 @@ pub struct Setup {
     pub inputs: BTreeSet<(u32, u8)>,
     /// Block skip switch: blocks starting with `/` are skipped.
     pub block_skip: bool,
-    /// Optional stop switch: M01 stops.
-    pub optional_stop: bool,
     /// Stop where the program would start over (M99 in a main program, G27 without L,
     /// GTC2E M20): for checks and simulation, which must end.
     pub single_pass: bool,
@@ -139,7 +137,6 @@ impl Setup {
             kept: BTreeMap::new(),
             inputs: BTreeSet::new(),
             block_skip: true,
-            optional_stop: false,
             single_pass: true,
             work_system: 0,
             front_tool_post: false,

@@ -25,6 +25,8 @@ pub struct MotionConfig {
     pub shape: Shape,
     /// Ticks without drive feedback before the lost-feedback alarm.
     pub feedback_lost_ticks: u32,
+    /// Feed under dry run, mm/min.
+    pub dry_run_feed: f64,
 }
 
 impl MotionConfig {
@@ -42,6 +44,7 @@ impl MotionConfig {
             tolerance: cfg.servo.tolerance,
             shape: cfg.servo.profile,
             feedback_lost_ticks: cfg.servo.feedback_lost_ticks,
+            dry_run_feed: cfg.servo.dry_run_feed,
         }
     }
 

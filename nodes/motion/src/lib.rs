@@ -2,7 +2,8 @@
 //!
 //! A block's path: [`block`] (what arrives) → [`motion`] (queue, limits, handshake) →
 //! [`planner`] (look-ahead window, corner blends) → [`profile`] (speed this tick) →
-//! [`path`] (the point on the path) → setpoint. [`servo`] measures the loop;
+//! [`path`] (the point on the path) → setpoint; threads go through [`thread`], locked to the
+//! spindle encoder instead. [`servo`] measures the loop;
 //! [`node`] runs it on its own thread against iceoryx2.
 
 pub mod block;
@@ -13,7 +14,8 @@ pub mod path;
 pub mod planner;
 pub mod profile;
 pub mod servo;
+pub mod thread;
 
 pub use block::{Aux, Block, Command};
 pub use config::{AxisConfig, MotionConfig};
-pub use motion::{Motion, MotionEvent, RunState};
+pub use motion::{Motion, MotionEvent, Panel, RunState};

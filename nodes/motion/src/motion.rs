@@ -15,6 +15,7 @@ use crate::config::MotionConfig;
 use crate::path::{self, Point, Segment, MAX_AXES};
 use crate::planner::{Done, Planner};
 use crate::profile::{Ahead, Limits, Mover};
+use crate::thread::{Piece, ThreadChain};
 
 /// Alarm numbers raised by motion (`000` Appendix 1, inventory §11.2).
 pub mod alarm {
@@ -30,6 +31,10 @@ pub mod alarm {
     /// No feedback from the drives for `servo.feedback_lost_ticks` ticks: the drive link
     /// is down (`000` alarm 68, "bus communication line error", inventory §11.3).
     pub const FEEDBACK_LOST: u32 = 68;
+    /// A thread the axes cannot follow at the spindle's speed: too short for the run-in and
+    /// run-out, or faster than an axis may move (`000` alarm 52, "thread acceleration length
+    /// insufficient").
+    pub const THREAD_RUN_IN: u32 = 52;
 }
 
 /// Something the shell must publish.
@@ -40,6 +45,33 @@ pub enum MotionEvent {
         text: String,
         line: u32,
     },
+}
+
+/// The operator's switches as motion sees them (`000` §7.3, §7.4), read every tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Panel {
+    /// Feed override, 0–1.5 (the manual's steps 0–150 %). Threads ignore it.
+    pub feed_override: f64,
+    /// Rapid override, 0–1 (the manual's F0 = 0 %, 25 %, 50 %, 100 %).
+    pub rapid_override: f64,
+    /// Single block: stop after each program line (a cycle is one line).
+    pub single_block: bool,
+    /// Dry run: feed moves at `servo.dry_run_feed` instead of F (threads stay locked).
+    pub dry_run: bool,
+    /// Optional stop: M01 stops like M00.
+    pub optional_stop: bool,
+}
+
+impl Default for Panel {
+    fn default() -> Self {
+        Panel {
+            feed_override: 1.0,
+            rapid_override: 1.0,
+            single_block: false,
+            dry_run: false,
+            optional_stop: false,
+        }
+    }
 }
 
 /// Run state reported to the interpreter.
@@ -55,10 +87,13 @@ pub enum RunState {
 // thread for every rapid.
 #[allow(clippy::large_enum_variant)]
 enum Active {
-    /// Lines and arcs through the look-ahead planner. `chain`: further path blocks join it
-    /// as they arrive (a thread runs alone).
-    Path {
-        chain: bool,
+    /// Lines and arcs through the look-ahead planner; further path blocks join it as they
+    /// arrive.
+    Path,
+    /// A thread chain, locked to the spindle encoder; `shift`: start angle after the index
+    /// pulse, degrees.
+    Thread {
+        shift: f64,
     },
     /// Each axis on its own profile (dog-leg rapid).
     Rapid {
@@ -117,6 +152,59 @@ pub struct Motion {
     servo_off: bool,
     /// Blocks the planner finished this tick (kept to avoid allocating every tick).
     finished: Vec<Done>,
+    /// The thread being cut (built once, like the planner).
+    thread: ThreadChain,
+    encoder: Encoder,
+    panel: Panel,
+    /// Stopped between blocks (single block, M00, M01) until cycle start; holds the line of
+    /// the block after which it stopped.
+    block_stop: Option<u32>,
+    /// Line of the block finished last (single block stops when the line changes).
+    last_line: Option<u32>,
+    /// Per axis, how far ahead of the encoder reading a thread's setpoint is computed, s:
+    /// one servo period (the setpoint is reached at the end of the coming period) plus the
+    /// drive lag (the slide trails a moving setpoint by it).
+    thread_lead_time: [f64; MAX_AXES],
+}
+
+/// The spindle as its encoder reports it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Encoder {
+    rpm: f64,
+    /// Degrees after the index pulse, counted in the direction of rotation.
+    angle: f64,
+    /// Revolutions turned since start-up, in either direction.
+    revs: f64,
+    /// Last raw angle and direction (+1 CW, −1 CCW).
+    raw: Option<f64>,
+    direction: f64,
+}
+
+impl Encoder {
+    /// Takes in one reading. Between two readings the spindle turns less than half a
+    /// revolution (7500 rpm at 4 ms).
+    fn read(&mut self, rpm: f64, raw_angle: f64) {
+        if !rpm.is_finite() || !raw_angle.is_finite() {
+            return;
+        }
+        if rpm != 0.0 {
+            self.direction = rpm.signum();
+        } else if self.direction == 0.0 {
+            self.direction = 1.0;
+        }
+        if let Some(prev) = self.raw {
+            let delta = (raw_angle - prev + 180.0).rem_euclid(360.0) - 180.0;
+            self.revs += delta * self.direction / 360.0;
+        }
+        self.raw = Some(raw_angle);
+        self.rpm = rpm;
+        self.angle = (raw_angle * self.direction).rem_euclid(360.0);
+    }
+
+    /// Revolutions per second, whatever the direction.
+    fn omega(&self) -> f64 {
+        self.rpm.abs() / 60.0
+    }
 }
 
 impl Motion {
@@ -127,7 +215,18 @@ impl Motion {
             .map(|i| start.get(i).copied().unwrap_or(0.0))
             .collect();
         let planner = Planner::new(cfg.planner(), path::point_from(&commanded));
+        let mut thread_lead_time = [0.0; MAX_AXES];
+        for (l, a) in thread_lead_time.iter_mut().zip(&cfg.axes) {
+            *l = cfg.period + a.drive_lag.max(0.0);
+        }
+        let thread = ThreadChain::new(cfg.lookahead.max(1), cfg.planner().limits);
         Motion {
+            thread,
+            encoder: Encoder::default(),
+            panel: Panel::default(),
+            block_stop: None,
+            last_line: None,
+            thread_lead_time,
             planner,
             cfg,
             queue: VecDeque::new(),
@@ -169,6 +268,8 @@ impl Motion {
             self.done_seq = 0;
             self.feed_hold = false;
             self.cycle_stop = false;
+            self.block_stop = None;
+            self.last_line = None;
             self.clear_strobe();
         }
         if self.alarm || block.seq <= self.accepted_seq {
@@ -189,13 +290,41 @@ impl Motion {
         self.queue.push_back(block);
     }
 
+    /// The spindle encoder's reading this tick: speed (negative counter-clockwise) and
+    /// angle after the index pulse in degrees.
+    pub fn spindle_feedback(&mut self, rpm: f64, angle_deg: f64) {
+        self.encoder.read(rpm, angle_deg);
+    }
+
+    /// The operator's switches; overrides take effect on the next tick.
+    pub fn set_panel(&mut self, panel: Panel) {
+        let clean = |v: f64, max: f64| {
+            if v.is_finite() {
+                v.clamp(0.0, max)
+            } else {
+                1.0
+            }
+        };
+        self.panel = Panel {
+            feed_override: clean(panel.feed_override, crate::planner::MAX_FEED_OVERRIDE),
+            rapid_override: clean(panel.rapid_override, 1.0),
+            ..panel
+        };
+    }
+
+    pub fn panel(&self) -> Panel {
+        self.panel
+    }
+
     /// Feed hold: decelerate on the path and wait for [`Motion::cycle_start`].
     pub fn feed_hold(&mut self) {
         self.feed_hold = true;
     }
 
+    /// Cycle start: resumes after feed hold, and after a single-block, M00 or M01 stop.
     pub fn cycle_start(&mut self) {
         self.feed_hold = false;
+        self.block_stop = None;
     }
 
     /// Cycle stop: decelerate on the path, then drop the rest of the run.
@@ -213,6 +342,8 @@ impl Motion {
         self.active = None;
         self.feed_hold = false;
         self.cycle_stop = false;
+        self.block_stop = None;
+        self.last_line = None;
         self.clear_strobe();
         self.commanded.clone_from(&self.actual);
         let here = self.commanded_point();
@@ -247,7 +378,9 @@ impl Motion {
     pub fn state(&self) -> RunState {
         if self.alarm {
             RunState::Alarm
-        } else if self.feed_hold && (self.active.is_some() || !self.queue.is_empty()) {
+        } else if self.block_stop.is_some()
+            || self.feed_hold && (self.active.is_some() || !self.queue.is_empty())
+        {
             RunState::Hold
         } else if self.active.is_some() || !self.queue.is_empty() {
             RunState::Running
@@ -261,7 +394,7 @@ impl Motion {
     pub fn active_cutting(&self) -> Option<bool> {
         self.active
             .as_ref()
-            .map(|(_, a)| matches!(a, Active::Path { .. }))
+            .map(|(_, a)| matches!(a, Active::Path | Active::Thread { .. }))
     }
 
     pub fn take_events(&mut self) -> Vec<MotionEvent> {
@@ -319,7 +452,16 @@ impl Motion {
             budget -= 1;
             if self.active.is_none() {
                 // A cycle stop starts nothing new; it ends below once the axes stand.
-                if self.cycle_stop {
+                if self.cycle_stop || self.block_stop.is_some() {
+                    break;
+                }
+                let Some(next_line) = self.queue.front().map(|b| b.line) else {
+                    break;
+                };
+                // Single block: the next line waits for cycle start (`000` §7.4).
+                if self.panel.single_block && self.last_line.is_some_and(|l| l != next_line) {
+                    self.block_stop = self.last_line;
+                    self.last_line = None;
                     break;
                 }
                 let Some(block) = self.queue.pop_front() else {
@@ -340,7 +482,9 @@ impl Motion {
                     }
                 }
             }
-            if let Err((number, text, line)) = self.extend_chain() {
+            if let Err((number, text, line)) =
+                self.extend_chain().and_then(|_| self.extend_thread())
+            {
                 self.raise(number, text, line);
                 self.queue.clear();
                 break;
@@ -348,10 +492,22 @@ impl Motion {
             if self.advance(dt, plc) {
                 let moved = matches!(
                     self.active,
-                    Some((_, Active::Path { .. } | Active::Rapid { .. }))
+                    Some((
+                        _,
+                        Active::Path | Active::Rapid { .. } | Active::Thread { .. }
+                    ))
                 );
                 if let Some((block, _)) = self.active.take() {
                     self.done_seq = self.done_seq.max(block.seq);
+                    self.last_line = Some(self.line);
+                    // M00, and M01 with the optional-stop switch on, stop after their FIN.
+                    match block.kind {
+                        Command::Aux(Aux::M(0)) => self.block_stop = Some(block.line),
+                        Command::Aux(Aux::M(1)) if self.panel.optional_stop => {
+                            self.block_stop = Some(block.line)
+                        }
+                        _ => {}
+                    }
                 }
                 // A finished move used this tick; aux, dwell and end chain on within it.
                 if moved {
@@ -420,7 +576,7 @@ impl Motion {
     /// Path blocks waiting in the queue join the planner's window while it has room, so
     /// corners between them are blended and the speed carries over.
     fn extend_chain(&mut self) -> Result<(), (u32, String, u32)> {
-        if !matches!(self.active, Some((_, Active::Path { chain: true }))) {
+        if !matches!(self.active, Some((_, Active::Path))) {
             return Ok(());
         }
         while self.planner.has_room() {
@@ -428,6 +584,9 @@ impl Motion {
                 break;
             };
             let (seq, line) = (next.seq, next.line);
+            if self.panel.single_block && line != self.line {
+                break;
+            }
             match &next.kind {
                 Command::Linear { .. } | Command::Arc { .. } => {
                     let (seg, feed) = self
@@ -451,10 +610,83 @@ impl Motion {
         Ok(())
     }
 
+    /// Thread blocks that follow the one being cut join its chain (continuous threading,
+    /// `000` §5.23.1); once the chain is complete enough, it is synchronised to the spindle.
+    fn extend_thread(&mut self) -> Result<(), (u32, String, u32)> {
+        let Some((first, Active::Thread { shift })) = &self.active else {
+            return Ok(());
+        };
+        let (shift, line) = (*shift, first.line);
+        while self.thread.accepts() {
+            let Some(next) = self.queue.front() else {
+                break;
+            };
+            if !matches!(next.kind, Command::Thread { .. }) {
+                break;
+            }
+            let start = self.thread_end();
+            let piece = self
+                .thread_piece(next, &start)
+                .map_err(|(n, t)| (n, t, next.line))?;
+            self.thread.push(piece);
+            self.queue.pop_front();
+        }
+        // Under feed hold the thread does not start; once started, it is cut to its end.
+        if self.thread.synchronised() || self.feed_hold {
+            return Ok(());
+        }
+        // `000` §5.23: the thread starts only with the spindle turning (alarm 36).
+        let omega = self.encoder.omega();
+        if omega * 60.0 < 1.0 {
+            return Err((
+                alarm::SPINDLE_NOT_TURNING,
+                "thread cutting with the spindle stopped".into(),
+                line,
+            ));
+        }
+        if let Some((axis, v)) = self.thread.too_fast(omega) {
+            return Err((
+                alarm::THREAD_RUN_IN,
+                format!(
+                    "thread feed {:.0} mm/min on {} at {:.0} rpm exceeds the axis's rapid rate",
+                    v * 60.0,
+                    self.cfg.axes.get(axis).map_or("?", |a| a.name.as_str()),
+                    self.encoder.rpm.abs()
+                ),
+                line,
+            ));
+        }
+        let ramp = self.thread.ramp_for(omega);
+        if self.thread.total() < ramp {
+            return Err((
+                alarm::THREAD_RUN_IN,
+                format!(
+                    "thread of {:.2} revolutions too short: run-in and run-out need {ramp:.2} at {:.0} rpm",
+                    self.thread.total(),
+                    self.encoder.rpm.abs()
+                ),
+                line,
+            ));
+        }
+        let lead_time = self.thread_lead_time.iter().copied().fold(0.0, f64::max);
+        let e = self.encoder;
+        self.thread
+            .synchronise(e.revs, e.angle, shift, omega, ramp, lead_time);
+        Ok(())
+    }
+
+    /// Where the last piece of the thread chain ends (slide coordinates).
+    fn thread_end(&self) -> Point {
+        self.thread
+            .last_end()
+            .unwrap_or_else(|| self.commanded_point())
+    }
+
     fn stopped_on_path(&self) -> bool {
         match &self.active {
             None => true,
-            Some((_, Active::Path { .. })) => self.planner.velocity() == 0.0,
+            Some((_, Active::Path)) => self.planner.velocity() == 0.0,
+            Some((_, Active::Thread { .. })) => false,
             Some((_, Active::Rapid { axes, .. })) => axes.iter().all(|a| a.mover.velocity == 0.0),
             Some(_) => true,
         }
@@ -540,13 +772,20 @@ impl Motion {
                 }
                 Ok(Active::Rapid { start, end, axes })
             }
-            Command::Linear { .. } | Command::Arc { .. } | Command::Thread { .. } => {
+            Command::Linear { .. } | Command::Arc { .. } => {
                 let (seg, feed) = self.segment_for(block, &start)?;
                 self.planner.reset(start);
-                let chain = !matches!(block.kind, Command::Thread { .. });
                 self.planner
-                    .push(seg, feed, block.seq, block.line, !self.exact_stop && chain);
-                Ok(Active::Path { chain })
+                    .push(seg, feed, block.seq, block.line, !self.exact_stop);
+                Ok(Active::Path)
+            }
+            Command::Thread { start_angle, .. } => {
+                let piece = self.thread_piece(block, &start)?;
+                self.thread.clear();
+                self.thread.push(piece);
+                Ok(Active::Thread {
+                    shift: *start_angle,
+                })
             }
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
@@ -590,33 +829,7 @@ impl Motion {
     /// feed in mm/s. Soft limits are checked here, before the block joins the plan.
     fn segment_for(&self, block: &Block, start: &Point) -> Result<(Segment, f64), (u32, String)> {
         self.check_block(&block.kind)?;
-        let n = self.cfg.axes.len();
         match &block.kind {
-            Command::Thread { end, lead, .. } => {
-                // Until motion follows the encoder, a thread runs as a straight move at
-                // lead × commanded speed along the long axis.
-                let e = self.to_slide(end);
-                let long = (0..n).map(|i| (e[i] - start[i]).abs()).fold(0.0, f64::max);
-                let length = (0..n)
-                    .map(|i| (e[i] - start[i]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                let rpm = self.spindle_rpm_for("thread cutting")?;
-                // Path feed that moves the long axis `lead` per revolution.
-                let feed = if long > 0.0 {
-                    lead * rpm * length / long
-                } else {
-                    lead * rpm
-                };
-                self.check_limits(end)?;
-                Ok((
-                    Segment::Line {
-                        start: *start,
-                        end: e,
-                    },
-                    feed / 60.0,
-                ))
-            }
             Command::Linear { end, feed } => {
                 let feed = self.feed_mm_per_min(*feed)?;
                 self.check_limits(end)?;
@@ -672,6 +885,28 @@ impl Motion {
         }
     }
 
+    /// A thread block as a piece of a thread chain starting at `start` (slide units): the
+    /// long axis (X as radius, `000` §5.23.1) advances one lead per spindle revolution.
+    fn thread_piece(&self, block: &Block, start: &Point) -> Result<Piece, (u32, String)> {
+        self.check_block(&block.kind)?;
+        let Command::Thread { end, lead, .. } = &block.kind else {
+            return Err((alarm::BAD_BLOCK, "not a thread block".into()));
+        };
+        self.check_limits(end)?;
+        let n = self.cfg.axes.len().min(MAX_AXES);
+        let end = self.to_slide(end);
+        let long = (0..n)
+            .map(|i| (end[i] - start[i]).abs())
+            .fold(0.0, f64::max);
+        Ok(Piece {
+            start: *start,
+            end,
+            revs: long / lead,
+            seq: block.seq,
+            line: block.line,
+        })
+    }
+
     fn spindle_rpm_for(&self, what: &str) -> Result<f64, (u32, String)> {
         if self.spindle_rpm > 0.0 {
             Ok(self.spindle_rpm)
@@ -683,9 +918,11 @@ impl Motion {
         }
     }
 
-    /// A programmed feed in mm/min, from mm/rev under G99.
+    /// A programmed feed in mm/min, from mm/rev under G99; the dry-run feed under dry run.
     fn feed_mm_per_min(&self, feed: f64) -> Result<f64, (u32, String)> {
-        if self.feed_per_rev {
+        if self.panel.dry_run {
+            Ok(self.cfg.dry_run_feed)
+        } else if self.feed_per_rev {
             Ok(feed * self.spindle_rpm_for("feed per revolution")?)
         } else {
             Ok(feed)
@@ -710,10 +947,34 @@ impl Motion {
             return false;
         };
         match active {
-            Active::Path { .. } => {
+            Active::Thread { .. } => {
+                // Feed hold and override do not apply: the thread is cut to its end
+                // (`000` §5.23.1).
+                let mut out = path::point_from(&self.commanded);
+                self.finished.clear();
+                let e = self.encoder;
+                let end = self.thread.step(
+                    e.revs,
+                    e.omega(),
+                    &self.thread_lead_time[..n],
+                    &mut out,
+                    &mut self.finished,
+                );
+                self.commanded[..n].copy_from_slice(&out[..n]);
+                for &seq in &self.finished {
+                    self.done_seq = self.done_seq.max(seq);
+                }
+                if let Some(line) = self.thread.line() {
+                    self.line = line;
+                }
+                end
+            }
+            Active::Path => {
                 let mut out = [0.0; MAX_AXES];
                 self.finished.clear();
-                let end = self.planner.step(hold, 1.0, &mut self.finished, &mut out);
+                let end =
+                    self.planner
+                        .step(hold, self.panel.feed_override, &mut self.finished, &mut out);
                 self.commanded[..n].copy_from_slice(&out[..n]);
                 for &seq in &self.finished {
                     self.done_seq = self.done_seq.max(seq);
@@ -729,7 +990,7 @@ impl Motion {
                 for (i, ax) in axes.iter_mut().enumerate().take(n) {
                     if ax.travelled < ax.length {
                         let limits = Limits {
-                            velocity: lim.velocity[i],
+                            velocity: lim.velocity[i] * self.panel.rapid_override,
                             acceleration: lim.acceleration[i],
                             jerk: lim.jerk[i],
                         };

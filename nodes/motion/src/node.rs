@@ -187,6 +187,7 @@ fn servo_loop(
     }
     let first = first.ok_or("no feedback from the drives within 30 s (is io running?)")?;
     let mut actual = first.position;
+    let mut spindle = (first.spindle_rpm, first.spindle_angle_deg);
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     let mut g = GImage::default();
     let mut stats = ServoStatistics::default();
@@ -223,6 +224,9 @@ fn servo_loop(
         if let Some(latest) = g_in.latest()? {
             g = latest;
         }
+        if have_feedback {
+            motion.spindle_feedback(spindle.0, spindle.1);
+        }
         let mut commanded = [0.0; MAX_AXES];
         commanded[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
         f_out.send(*motion.f_image())?;
@@ -242,6 +246,7 @@ fn servo_loop(
             deadline.saturating_sub(monotonic_ns()),
         ))? {
             actual = fb.position;
+            spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
             have_feedback = true;
             if fb.seq == seq {
                 stats
@@ -288,5 +293,10 @@ fn servo_loop(
         }
     }
     let _ = reports.send(Report::Stats(stats.message(mcfg.period)));
-    Ok(stats.summary(mcfg.period * 1e6))
+    let period_us = mcfg.period * 1e6;
+    Ok(format!(
+        "{}\n{}",
+        stats.summary(period_us),
+        stats.interval_histogram(period_us).trim_end()
+    ))
 }

@@ -18,6 +18,9 @@ use crate::profile::{stop_distance, Ahead, Limits, Mover, Shape};
 const CENTRIPETAL_SHARE: f64 = 0.8;
 /// Deflection below which two segments are taken as tangent (rad).
 const TANGENT: f64 = 1e-3;
+/// Highest feed override (`000` §7.3: 150 %). Segments are planned for it, so turning the
+/// override up needs no re-planning; each tick caps the speed at feed × override.
+pub const MAX_FEED_OVERRIDE: f64 = 1.5;
 
 /// Per-axis limits of slide travel, mm/s, mm/s², mm/s³.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,6 +48,9 @@ struct Planned {
     length: f64,
     seq: u64,
     line: u32,
+    /// Programmed feed, mm/s.
+    feed: f64,
+    /// Speed limit from the axes and the curvature, and the feed at the highest override.
     vmax: f64,
     accel: f64,
     jerk: f64,
@@ -203,7 +209,7 @@ impl Planner {
         let trimmed_prev = prev.seg.trimmed(0.0, t);
         let trimmed_next = next.trimmed(t, 0.0);
         // The blend's speed limit must still be reachable from where the tool is now.
-        let (vmax, accel, jerk) = self.segment_limits(&arc, feed);
+        let (vmax, accel, jerk) = self.segment_limits(&arc, feed * MAX_FEED_OVERRIDE);
         let next_len = trimmed_next.length();
         let (_, next_accel, _) = self.segment_limits(&trimmed_next, feed);
         let next_entry = (2.0 * next_accel * next_len).sqrt();
@@ -234,6 +240,7 @@ impl Planner {
             length: arc.length(),
             seq: prev.seq,
             line: prev.line,
+            feed,
             vmax,
             accel,
             jerk,
@@ -262,7 +269,7 @@ impl Planner {
         entry_limit: f64,
         blend_end: bool,
     ) {
-        let (vmax, accel, jerk) = self.segment_limits(&seg, feed);
+        let (vmax, accel, jerk) = self.segment_limits(&seg, feed * MAX_FEED_OVERRIDE);
         let length = seg.length();
         let programmed_length = match seg {
             Segment::Line { .. } => length,
@@ -274,6 +281,7 @@ impl Planner {
             length,
             seq,
             line,
+            feed,
             vmax,
             accel,
             jerk,
@@ -376,11 +384,12 @@ impl Planner {
         let mut k = 1;
         while k < self.segs.len() && dist <= horizon {
             let p = &self.segs[k];
-            if p.entry < lowest {
-                lowest = p.entry;
+            let entry = p.entry.min(p.feed * feed_scale);
+            if entry < lowest {
+                lowest = entry;
                 self.ahead.push(Ahead {
                     distance: dist,
-                    velocity: p.entry,
+                    velocity: entry,
                     acceleration: amin,
                 });
             }
@@ -396,7 +405,7 @@ impl Planner {
             });
         }
         let lim = Limits {
-            velocity: front.vmax * feed_scale,
+            velocity: front.vmax.min(front.feed * feed_scale),
             acceleration: front.accel,
             jerk,
         };

@@ -1,8 +1,8 @@
 //! Servo loop statistics: tick interval and iceoryx2 round trip, kept as fixed histograms so
 //! the loop allocates nothing after start-up.
 
-/// 1 µs bins up to 20 ms; slower values land in the last bin (the maximum is kept exactly).
-const BINS: usize = 20_000;
+/// 1 µs bins up to 100 ms; slower values land in the last bin (the maximum is kept exactly).
+const BINS: usize = 100_000;
 
 pub struct Histogram {
     bins: Vec<u32>,
@@ -54,6 +54,13 @@ impl Histogram {
         self.max_us
     }
 
+    /// Samples in `lo_us..hi_us` (1 µs resolution; the last bin holds everything slower).
+    pub fn count_between(&self, lo_us: f64, hi_us: f64) -> u64 {
+        let lo = (lo_us.max(0.0) as usize).min(BINS);
+        let hi = (hi_us.max(0.0) as usize).min(BINS);
+        self.bins[lo..hi.max(lo)].iter().map(|&c| c as u64).sum()
+    }
+
     pub fn min(&self) -> f64 {
         if self.count == 0 {
             0.0
@@ -96,6 +103,28 @@ impl ServoStatistics {
         }
     }
 
+    /// The tick intervals as a histogram around the period, one line per bucket: what the
+    /// loop's timing looked like, late ticks included.
+    pub fn interval_histogram(&self, period_us: f64) -> String {
+        const EDGES: [f64; 12] = [
+            0.0, 0.875, 0.975, 0.9975, 1.0025, 1.025, 1.125, 1.25, 1.5, 2.0, 3.0, 5.0,
+        ];
+        let total = self.interval.count().max(1) as f64;
+        let mut out = String::from("tick interval histogram (us: ticks, share):\n");
+        for (k, lo) in EDGES.iter().enumerate() {
+            let lo_us = lo * period_us;
+            let hi_us = EDGES.get(k + 1).map_or(f64::INFINITY, |h| h * period_us);
+            let n = self.interval.count_between(lo_us, hi_us.min(BINS as f64));
+            let label = if hi_us.is_finite() {
+                format!("{lo_us:>7.0} - {hi_us:<7.0}")
+            } else {
+                format!("{lo_us:>7.0} and up  ")
+            };
+            out += &format!("  {label} {n:>10} {:>8.4} %\n", n as f64 / total * 100.0);
+        }
+        out
+    }
+
     pub fn summary(&self, period_us: f64) -> String {
         format!(
             "servo loop: {} ticks of {:.0} us, {} late; interval us min/p50/p99/max {:.0}/{:.0}/{:.0}/{:.0}; iceoryx2 round trip us min/p50/p99/max {:.1}/{:.0}/{:.0}/{:.0} ({} samples)",
@@ -118,6 +147,24 @@ impl ServoStatistics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_histogram_counts_every_interval_once() {
+        let mut s = ServoStatistics::default();
+        for us in [4000.0, 4001.0, 3990.0, 4300.0, 9000.0, 30000.0] {
+            s.interval.record(us);
+        }
+        let text = s.interval_histogram(4000.0);
+        let counts: Vec<u64> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split_whitespace().rev().nth(2).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(counts.iter().sum::<u64>(), 6, "{text}");
+        // 3990 and 4000 and 4001 lie within ±0.25 %: bucket 3 (3990..4010).
+        assert_eq!(counts[3], 3, "{text}");
+        assert_eq!(counts[11], 1, "{text}"); // 30 ms: 5 periods and up
+    }
 
     #[test]
     fn quantiles_of_a_known_distribution() {

@@ -2,7 +2,8 @@
 //! (actual = commanded) and a simple PLC that answers strobes.
 
 use cnc_motion::{
-    motion::alarm, Aux, AxisConfig, Block, Command, Motion, MotionConfig, MotionEvent, RunState,
+    motion::alarm, Aux, AxisConfig, Block, Command, Motion, MotionConfig, MotionEvent, Panel,
+    RunState,
 };
 use cnc_msgs::signals::GImage;
 
@@ -32,6 +33,7 @@ fn lathe() -> MotionConfig {
         tolerance: 0.01,
         shape: cnc_motion::profile::Shape::SCurve,
         feedback_lost_ticks: 3,
+        dry_run_feed: 1000.0,
     }
 }
 
@@ -469,4 +471,170 @@ fn a_stalled_drive_raises_the_following_error_alarm() {
     assert!(!m.servo_enabled());
     // The setpoint is put back where the slide is: no jump when the servo comes back.
     assert_eq!(m.commanded()[1], 0.0);
+}
+
+/// Three lines at F600 on Z from Z0, each 10 mm long, then program end.
+fn three_lines(m: &mut Motion) {
+    for k in 1..=3u64 {
+        m.push(block(
+            k,
+            k as u32 * 10,
+            Command::Linear {
+                end: vec![50.0, -10.0 * k as f64],
+                feed: 600.0,
+            },
+        ));
+    }
+    m.push(block(4, 40, Command::ProgramEnd));
+}
+
+/// Largest Z speed in a run of ticks, mm/min.
+fn top_speed(m: &mut Motion, ticks: usize) -> f64 {
+    let g = GImage::default();
+    let mut top: f64 = 0.0;
+    for _ in 0..ticks {
+        let before = m.commanded_display()[1];
+        let actual = m.commanded().to_vec();
+        m.tick(Some(&actual), &g);
+        top = top.max((m.commanded_display()[1] - before).abs() / 0.004 * 60.0);
+    }
+    top
+}
+
+#[test]
+fn single_block_stops_after_each_line_until_cycle_start() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.set_panel(Panel {
+        single_block: true,
+        ..Panel::default()
+    });
+    three_lines(&mut m);
+    let g = GImage::default();
+    let mut stops = vec![];
+    for _ in 0..20 {
+        ticks(&mut m, &g, 2000);
+        if m.state() == RunState::Idle {
+            break;
+        }
+        // Stopped at rest, at the end of a line, holding.
+        assert_eq!(m.state(), RunState::Hold);
+        let z = m.commanded_display()[1];
+        let before = m.commanded().to_vec();
+        ticks(&mut m, &g, 50);
+        assert_eq!(m.commanded(), &before[..], "moved while stopped");
+        stops.push(z);
+        m.cycle_start();
+    }
+    assert_eq!(stops, vec![-10.0, -20.0, -30.0]);
+    assert_eq!(m.done_seq(), 4);
+}
+
+#[test]
+fn feed_override_scales_the_feed_and_zero_stops_it() {
+    let mut speeds = vec![];
+    for ov in [0.5, 1.0, 1.5] {
+        let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+        m.set_panel(Panel {
+            feed_override: ov,
+            ..Panel::default()
+        });
+        three_lines(&mut m);
+        speeds.push(top_speed(&mut m, 3000));
+    }
+    for (got, want) in speeds.iter().zip([300.0, 600.0, 900.0]) {
+        assert!((got - want).abs() < 1e-6, "{speeds:?}");
+    }
+    // Turned down mid-move: the tool slows to the new feed without leaving the line.
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    three_lines(&mut m);
+    top_speed(&mut m, 500);
+    m.set_panel(Panel {
+        feed_override: 0.2,
+        ..Panel::default()
+    });
+    top_speed(&mut m, 200);
+    let late = top_speed(&mut m, 200);
+    assert!((late - 120.0).abs() < 1e-6, "{late}");
+    assert_eq!(m.commanded_display()[0], 50.0);
+    // 0 % stops the feed; raising it resumes.
+    m.set_panel(Panel {
+        feed_override: 0.0,
+        ..Panel::default()
+    });
+    top_speed(&mut m, 200);
+    assert_eq!(top_speed(&mut m, 100), 0.0);
+    m.set_panel(Panel::default());
+    run(&mut m, 100_000);
+    assert_eq!(m.commanded_display(), vec![50.0, -30.0]);
+}
+
+#[test]
+fn rapid_override_scales_the_rapid_rate() {
+    let mut times = vec![];
+    for ov in [1.0, 0.5, 0.25] {
+        let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+        m.set_panel(Panel {
+            rapid_override: ov,
+            ..Panel::default()
+        });
+        m.push(block(
+            1,
+            1,
+            Command::Rapid {
+                end: vec![50.0, -300.0],
+            },
+        ));
+        m.push(block(2, 2, Command::ProgramEnd));
+        let (trace, _) = run(&mut m, 100_000);
+        times.push(trace.len() as f64 * 0.004);
+    }
+    // 300 mm at 6000 mm/min × override, plus less than 0.2 s of ramps.
+    for (t, ov) in times.iter().zip([1.0, 0.5, 0.25]) {
+        let cruise = 300.0 / (100.0 * ov);
+        assert!(*t > cruise && *t < cruise + 0.2, "{times:?}");
+    }
+}
+
+#[test]
+fn dry_run_runs_feed_moves_at_the_dry_run_feed() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.set_panel(Panel {
+        dry_run: true,
+        ..Panel::default()
+    });
+    three_lines(&mut m);
+    let top = top_speed(&mut m, 3000);
+    assert!((top - 1000.0).abs() < 1e-6, "{top}");
+    assert_eq!(m.commanded_display(), vec![50.0, -30.0]);
+}
+
+#[test]
+fn m00_always_and_m01_with_the_switch_stop_until_cycle_start() {
+    for (code, switch, stops) in [(0, false, true), (1, false, false), (1, true, true)] {
+        let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+        m.set_panel(Panel {
+            optional_stop: switch,
+            ..Panel::default()
+        });
+        m.push(block(1, 1, Command::Aux(Aux::M(code))));
+        m.push(block(
+            2,
+            2,
+            Command::Linear {
+                end: vec![50.0, -10.0],
+                feed: 600.0,
+            },
+        ));
+        m.push(block(3, 3, Command::ProgramEnd));
+        run(&mut m, 1000);
+        let moved = m.commanded_display()[1] != 0.0;
+        assert_eq!(moved, !stops, "M{code} switch {switch}");
+        if stops {
+            assert_eq!(m.state(), RunState::Hold);
+            m.cycle_start();
+            run(&mut m, 10_000);
+        }
+        assert_eq!(m.state(), RunState::Idle, "M{code} switch {switch}");
+        assert_eq!(m.commanded_display(), vec![50.0, -10.0]);
+    }
 }

@@ -228,10 +228,16 @@ pub struct ServoConfig {
     /// an alarm.
     #[serde(default = "default_feedback_lost")]
     pub feedback_lost_ticks: u32,
+    /// Feed of every feed move under dry run, mm/min (`000` S#45, default 1000).
+    #[serde(default = "default_dry_run_feed")]
+    pub dry_run_feed: f64,
 }
 
 fn default_feedback_lost() -> u32 {
     3
+}
+fn default_dry_run_feed() -> f64 {
+    1000.0
 }
 
 /// How speed changes along the path.
@@ -267,6 +273,7 @@ impl Default for ServoConfig {
             tolerance: default_tolerance(),
             profile: ProfileShape::default(),
             feedback_lost_ticks: default_feedback_lost(),
+            dry_run_feed: default_dry_run_feed(),
         }
     }
 }
@@ -407,6 +414,9 @@ impl LaunchConfig {
         }
         if !(1..=1000).contains(&self.servo.feedback_lost_ticks) {
             return Err("servo.feedback_lost_ticks must be 1..1000".into());
+        }
+        if !(self.servo.dry_run_feed.is_finite() && self.servo.dry_run_feed > 0.0) {
+            return Err("servo.dry_run_feed must be a positive feed in mm/min".into());
         }
         if !(self.servo.tolerance > 0.0 && self.servo.tolerance <= 10.0) {
             return Err("servo.tolerance must be in (0, 10] mm".into());

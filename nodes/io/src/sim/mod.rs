@@ -1,4 +1,6 @@
-//! The simulated lathe: axes that follow setpoints with a first-order drive lag, a spindle that
+//! The simulated lathe: axes that follow setpoints with a first-order drive lag (interpolating
+//! linearly between setpoints, as drives do, so a slide at constant speed lags its setpoint by
+//! exactly speed × time constant), a spindle that
 //! ramps to its commanded speed, coolant with a pressure switch, a chuck, an emergency-stop input.
 //!
 //! Pure: [`SimLathe::step`] advances the machine by `dt` seconds.
@@ -23,6 +25,8 @@ pub struct SimConfig {
 pub struct SimLathe {
     cfg: SimConfig,
     position: [f64; MAX_AXES],
+    /// The setpoint of the previous step, where this step's interpolation starts.
+    last_setpoint: [f64; MAX_AXES],
     spindle_rpm: f64,
     spindle_angle: f64,
     coolant_time: f64,
@@ -41,6 +45,7 @@ impl SimLathe {
         SimLathe {
             cfg,
             position,
+            last_setpoint: position,
             spindle_rpm: 0.0,
             spindle_angle: 0.0,
             coolant_time: 0.0,
@@ -72,13 +77,25 @@ impl SimLathe {
                     continue;
                 }
                 let tau = self.cfg.drive_lag[i];
-                let k = if tau > 0.0 {
-                    1.0 - (-dt / tau).exp()
+                // Exact response of the lag to a ramp from the last setpoint to this one.
+                self.position[i] = if tau > 0.0 && dt > 0.0 {
+                    let v = (target - self.last_setpoint[i]) / dt;
+                    let settled = target - v * tau;
+                    let off = self.position[i] - (self.last_setpoint[i] - v * tau);
+                    settled + off * (-dt / tau).exp()
                 } else {
-                    1.0
+                    target
                 };
-                self.position[i] += (target - self.position[i]) * k;
             }
+        }
+        // A disabled drive starts interpolating from where its slide stands.
+        let enabled = setpoint.enable != 0 && !self.emergency_stop;
+        for i in 0..n {
+            self.last_setpoint[i] = if enabled && setpoint.position[i].is_finite() {
+                setpoint.position[i]
+            } else {
+                self.position[i]
+            };
         }
         // Spindle: ramp toward the signed command; stops on emergency stop.
         let command = if self.emergency_stop {
@@ -158,8 +175,16 @@ mod tests {
         sp.position[0] = 11.0;
         sp.position[1] = 20.0;
         let fb = m.step(&sp, &YImage::default(), 0.008);
-        // One time constant: 63.2 % of the step.
-        assert!((fb.position[0] - (10.0 + (1.0 - (-1.0f64).exp()))).abs() < 1e-12);
+        // A ramp of 1 mm over one time constant: 1 − τ(1 − e⁻¹)/τ of it.
+        assert!((fb.position[0] - (10.0 + (-1.0f64).exp())).abs() < 1e-12);
+        // A steady ramp: the slide lags by exactly speed × time constant.
+        for k in 1..=200 {
+            sp.position[0] = 11.0 + 0.1 * k as f64;
+            m.step(&sp, &YImage::default(), 0.004);
+        }
+        let lag = sp.position[0] - m.position()[0];
+        assert!((lag - 0.1 / 0.004 * 0.008).abs() < 1e-9, "{lag}");
+        sp.position[0] = 11.0;
         for _ in 0..200 {
             m.step(&sp, &YImage::default(), 0.004);
         }
