@@ -241,3 +241,33 @@ fn g76_passes_land_in_the_same_groove_at_changing_speed() {
         6,
     );
 }
+
+#[test]
+fn g34_lead_grows_by_r_every_revolution() {
+    // `000` §5.23.2: lead 2 mm growing by R0.2 mm per revolution.
+    let program = "O0001;\nM3 S300 G0 X40 Z5 T0101;\nG34 Z-40 F2 R0.2;\nG0 X50;\nZ5;\nM30;\n";
+    let passes = run(program, &[1.0]);
+    assert_eq!(passes.len(), 1);
+    let samples = &passes[0].samples;
+    // Z at spindle count r, between samples.
+    let z_at = |r: f64| -> Option<f64> {
+        let i = samples.iter().position(|s| s.revs >= r)?;
+        let (a, b) = (samples.get(i.checked_sub(1)?)?, &samples[i]);
+        Some(a.z + (b.z - a.z) * (r - a.revs) / (b.revs - a.revs))
+    };
+    // Advance over one revolution from r; it grows by R per revolution on the locked part.
+    let advance = |r: f64| Some(z_at(r)? - z_at(r + 1.0)?);
+    let (first, last) = (samples[0].revs, samples[samples.len() - 1].revs);
+    let mut checked = 0;
+    let mut r = first + 3.0;
+    while r + 5.0 < last {
+        let (a0, a1) = (advance(r).unwrap(), advance(r + 1.0).unwrap());
+        assert!(
+            (a1 - a0 - 0.2).abs() <= 1e-4,
+            "advance {a0:.6} then {a1:.6} mm per revolution at {r:.3}"
+        );
+        checked += 1;
+        r += 0.37;
+    }
+    assert!(checked > 10, "{checked} revolutions checked");
+}

@@ -2273,7 +2273,7 @@ impl Interpreter {
                 &self.with_point(&here, mid),
                 MoveKind::Thread { lead, angle },
             )?;
-            // The thread's long axis keeps its lead through the run-out (`000` §5.23.5: "the
+            // The thread's long axis keeps its lead through the run-out (D36; `000` §5.23.5: "the
             // long axis continues"); motion reads a lead along the piece's own long axis, which
             // is the short axis when the retract J is longer than K.
             let runout_lead = if j.abs() > k {

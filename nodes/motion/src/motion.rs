@@ -47,7 +47,7 @@ pub enum MotionEvent {
     },
 }
 
-/// The operator's switches as motion sees them (`000` §7.3, §7.4), read every tick.
+/// The operator's switches as motion sees them (`000` §7.3, §7.4; decision D38).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Panel {
     /// Feed override, 0–1.5 (the manual's steps 0–150 %). Threads ignore it.
