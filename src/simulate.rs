@@ -124,18 +124,20 @@ impl ProgrammedPath {
         }
     }
 
-    /// Distance of `p` from the programmed moves around block `done + 1`.
+    /// Distance of `p` from the programmed moves around block `done + 1`. Motion cuts up to
+    /// 32 merged lines as one chord and reports them done when the blend into the next chord
+    /// begins, so 40 blocks either side are looked at.
     fn deviation(&mut self, done: u64, p: &Point) -> f64 {
         while self
             .segments
             .front()
-            .is_some_and(|(seq, _)| *seq + 2 < done)
+            .is_some_and(|(seq, _)| *seq + 40 < done)
         {
             self.segments.pop_front();
         }
         self.segments
             .iter()
-            .take_while(|(seq, _)| *seq <= done + 4)
+            .take_while(|(seq, _)| *seq <= done + 40)
             .map(|(_, seg)| path::distance_to(seg, p))
             .fold(f64::INFINITY, f64::min)
     }

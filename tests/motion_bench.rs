@@ -65,11 +65,19 @@ fn benchmark_paths_beat_linuxcnc_within_limits_and_tolerance() {
 
 #[test]
 fn many_tiny_segments_run_near_the_programmed_feed() {
+    // 100 mm of 0.02 mm chords with coordinates rounded to 0.0001 mm: the chords are merged
+    // (D34), so only the start and the stop cost time: 50 mm/s at 2000 mm/s² takes 25 ms each
+    // way, 25 ms lost in all, 1.25 % of the 2 s with the trapezoid; jerk-limited starts and
+    // stops take longer (the 50,000-chord run of `cargo bench` is within 0.6 %).
     let text = spiral_program(5_000);
-    for shape in [ProfileShape::Trapezoidal, ProfileShape::SCurve] {
+    for (shape, limit) in [
+        (ProfileShape::Trapezoidal, 1.015),
+        (ProfileShape::SCurve, 1.08),
+    ] {
         let sim = run(&text, shape);
         within_limits("spiral", &sim);
         let ratio = sim.stats.cutting_time / sim.stats.ideal_cutting_time;
-        assert!(ratio < 1.1, "{shape:?}: {ratio}");
+        eprintln!("{shape:?}: feed moves / (length / feed) = {ratio:.4}");
+        assert!(ratio < limit, "{shape:?}: {ratio}");
     }
 }

@@ -161,10 +161,29 @@ pub struct Motion {
     block_stop: Option<u32>,
     /// Line of the block finished last (single block stops when the line changes).
     last_line: Option<u32>,
+    /// End points of lines being merged into one chord (built once).
+    merge_points: Vec<Point>,
     /// Per axis, how far ahead of the encoder reading a thread's setpoint is computed, s:
     /// one servo period (the setpoint is reached at the end of the coming period) plus the
     /// drive lag (the slide trails a moving setpoint by it).
     thread_lead_time: [f64; MAX_AXES],
+}
+
+/// Most lines merged into one chord.
+const MAX_MERGE: usize = 32;
+/// Share of the path tolerance merging may use; blends at the chord's ends use the rest.
+const MERGE_SHARE: f64 = 0.5;
+/// Blocks the planner must hold before a merge waits for more lines from the interpreter.
+const MERGE_WAIT_BLOCKS: usize = 8;
+
+/// Lines merged into one chord.
+struct Merged {
+    end: Point,
+    /// Block number of the last line merged.
+    seq: u64,
+    blocks: usize,
+    /// Largest distance of a programmed point from the chord, mm.
+    deviation: f64,
 }
 
 /// The spindle as its encoder reports it.
@@ -224,6 +243,7 @@ impl Motion {
             thread,
             encoder: Encoder::default(),
             panel: Panel::default(),
+            merge_points: Vec::with_capacity(MAX_MERGE),
             block_stop: None,
             last_line: None,
             thread_lead_time,
@@ -588,12 +608,31 @@ impl Motion {
                 break;
             }
             match &next.kind {
+                Command::Linear { .. } if !self.exact_stop => {
+                    let start = self.planner.end();
+                    let (seg, feed) = self
+                        .segment_for(next, &start)
+                        .map_err(|(n, t)| (n, t, line))?;
+                    let Some(merged) = self.merge_lines(&start, seg.end()) else {
+                        break; // wait for more blocks to merge with
+                    };
+                    let seg = Segment::Line {
+                        start,
+                        end: merged.end,
+                    };
+                    self.planner
+                        .push(seg, feed, merged.seq, line, true, merged.deviation);
+                    for _ in 0..merged.blocks {
+                        self.queue.pop_front();
+                    }
+                    continue;
+                }
                 Command::Linear { .. } | Command::Arc { .. } => {
                     let (seg, feed) = self
                         .segment_for(next, &self.planner.end())
                         .map_err(|(n, t)| (n, t, line))?;
                     let blend = !self.exact_stop;
-                    self.planner.push(seg, feed, seq, line, blend);
+                    self.planner.push(seg, feed, seq, line, blend, 0.0);
                 }
                 Command::FeedMode { per_rev } => {
                     self.feed_per_rev = *per_rev;
@@ -608,6 +647,64 @@ impl Motion {
             self.queue.pop_front();
         }
         Ok(())
+    }
+
+    /// Lines at the front of the queue that lie within half the path tolerance of one chord
+    /// from `start` are cut as that chord (issue 4: "collinear short segments merged"), so a
+    /// curve given as short chords with rounded coordinates is not a string of kinks. The
+    /// first line (ending at `first_end`) is always taken. `None`: the queue ran out while more
+    /// lines might still merge and the planner has enough ahead to wait for them.
+    fn merge_lines(&mut self, start: &Point, first_end: Point) -> Option<Merged> {
+        let tolerance = self.cfg.tolerance * MERGE_SHARE;
+        let first = self.queue.front()?;
+        let (feed, line) = match &first.kind {
+            Command::Linear { feed, .. } => (*feed, first.line),
+            _ => return None,
+        };
+        let mut merged = Merged {
+            end: first_end,
+            seq: first.seq,
+            blocks: 1,
+            deviation: 0.0,
+        };
+        self.merge_points.clear();
+        loop {
+            if merged.blocks >= MAX_MERGE {
+                return Some(merged);
+            }
+            let Some(b) = self.queue.get(merged.blocks) else {
+                // More lines may come: wait for them while the window has plenty to cut.
+                let open = self.planner.blocks() >= MERGE_WAIT_BLOCKS;
+                return (!open || self.interpreter_done()).then_some(merged);
+            };
+            let same = matches!(&b.kind, Command::Linear { feed: f, .. } if *f == feed)
+                && !(self.panel.single_block && b.line != line);
+            if !same || self.check_block(&b.kind).is_err() {
+                return Some(merged);
+            }
+            let Some(end) = b.kind.end().filter(|e| self.check_limits(e).is_ok()) else {
+                return Some(merged);
+            };
+            let candidate = self.to_slide(end);
+            self.merge_points.push(merged.end);
+            match path::chord_deviation(start, &candidate, &self.merge_points) {
+                Some(d) if d <= tolerance => {
+                    merged.end = candidate;
+                    merged.seq = b.seq;
+                    merged.blocks += 1;
+                    merged.deviation = d;
+                }
+                _ => return Some(merged),
+            }
+        }
+    }
+
+    /// Whether the queue ends the run: its last block is the program end.
+    fn interpreter_done(&self) -> bool {
+        matches!(
+            self.queue.back().map(|b| &b.kind),
+            Some(Command::ProgramEnd)
+        )
     }
 
     /// Thread blocks that follow the one being cut join its chain (continuous threading,
@@ -776,7 +873,7 @@ impl Motion {
                 let (seg, feed) = self.segment_for(block, &start)?;
                 self.planner.reset(start);
                 self.planner
-                    .push(seg, feed, block.seq, block.line, !self.exact_stop);
+                    .push(seg, feed, block.seq, block.line, !self.exact_stop, 0.0);
                 Ok(Active::Path)
             }
             Command::Thread { start_angle, .. } => {

@@ -339,6 +339,40 @@ pub fn distance_to(seg: &Segment, p: &Point) -> f64 {
     }
 }
 
+/// Largest distance of `points` from the chord `start`–`end`, if they lie along it in order
+/// (each projects further along than the one before, inside the chord): how far replacing
+/// the polyline through them by the chord moves the path.
+pub fn chord_deviation(start: &Point, end: &Point, points: &[Point]) -> Option<f64> {
+    let mut u = [0.0; MAX_AXES];
+    let mut len2 = 0.0;
+    for i in 0..MAX_AXES {
+        u[i] = end[i] - start[i];
+        len2 += u[i] * u[i];
+    }
+    if len2 <= 1e-24 {
+        return None;
+    }
+    let mut last = 0.0;
+    let mut worst: f64 = 0.0;
+    for p in points {
+        let (mut along, mut d2) = (0.0, 0.0);
+        for i in 0..MAX_AXES {
+            along += (p[i] - start[i]) * u[i];
+        }
+        let t = along / len2;
+        if t <= last || t >= 1.0 {
+            return None;
+        }
+        last = t;
+        for i in 0..MAX_AXES {
+            let off = p[i] - start[i] - t * u[i];
+            d2 += off * off;
+        }
+        worst = worst.max(d2.sqrt());
+    }
+    Some(worst)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -385,5 +419,18 @@ mod tests {
             end: p(10.0, 0.0),
         };
         assert!((distance_to(&line, &p(5.0, 2.0)) - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn chord_deviation_measures_points_in_order_along_the_chord() {
+        let p = |x: f64, y: f64| point_from(&[x, y]);
+        let (a, b) = (p(0.0, 0.0), p(4.0, 0.0));
+        assert_eq!(
+            chord_deviation(&a, &b, &[p(1.0, 0.1), p(3.0, -0.2)]),
+            Some(0.2)
+        );
+        // Out of order or beyond the end: not a chord of them.
+        assert_eq!(chord_deviation(&a, &b, &[p(3.0, 0.0), p(1.0, 0.0)]), None);
+        assert_eq!(chord_deviation(&a, &b, &[p(5.0, 0.0)]), None);
     }
 }

@@ -61,6 +61,9 @@ struct Planned {
     programmed_length: f64,
     /// Blend corners at this segment's end (G64); false under G09/G61.
     blend_end: bool,
+    /// How far the segment already leaves the programmed path (merged lines), mm: a blend at
+    /// its ends may use only the rest of the tolerance.
+    deviation: f64,
     /// The segment that stands for its block in the look-ahead count (not a blend or mode).
     counts: bool,
 }
@@ -148,6 +151,7 @@ impl Planner {
             line,
             f64::INFINITY,
             true,
+            0.0,
         );
         if let Some(p) = self.segs.back_mut() {
             p.counts = false;
@@ -155,13 +159,22 @@ impl Planner {
     }
 
     /// Appends a line or arc starting at [`Planner::end`] at up to `feed` mm/s. `blend`: the
-    /// corner before it may be rounded (G64) rather than passed at rest.
-    pub fn push(&mut self, seg: Segment, feed: f64, seq: u64, line: u32, blend: bool) {
+    /// corner before it may be rounded (G64) rather than passed at rest. `deviation`: how far
+    /// the segment leaves the programmed path (a chord standing for merged lines), mm.
+    pub fn push(
+        &mut self,
+        seg: Segment,
+        feed: f64,
+        seq: u64,
+        line: u32,
+        blend: bool,
+        deviation: f64,
+    ) {
         let len = seg.length();
         let (mut seg, mut entry_limit) = (seg, 0.0);
         self.blocks += 1;
         if len <= 1e-12 {
-            self.push_segment(seg, feed, seq, line, f64::INFINITY, blend);
+            self.push_segment(seg, feed, seq, line, f64::INFINITY, blend, deviation);
             return;
         }
         if let Some(k) = self.last_moving() {
@@ -172,13 +185,18 @@ impl Planner {
             if phi < TANGENT {
                 entry_limit = f64::INFINITY;
             } else if blend && prev.blend_end {
-                if let Some(new_seg) = self.try_blend(k, &seg, feed) {
+                if let Some(new_seg) = self.try_blend(k, &seg, feed, deviation) {
                     seg = new_seg;
                     entry_limit = f64::INFINITY;
                 }
             }
         }
-        self.push_segment(seg, feed, seq, line, entry_limit, blend);
+        self.push_segment(seg, feed, seq, line, entry_limit, blend, deviation);
+    }
+
+    /// Blocks in the window (lines and arcs as programmed, not blends or mode changes).
+    pub fn blocks(&self) -> usize {
+        self.blocks
     }
 
     /// Index of the last segment that moves (the one a new block's corner joins).
@@ -188,7 +206,13 @@ impl Planner {
 
     /// Rounds the corner between line `k` and the new line `next`: trims both, inserts the blend
     /// arc. Returns the trimmed new line, or None when the corner must be passed at rest.
-    fn try_blend(&mut self, k: usize, next: &Segment, feed: f64) -> Option<Segment> {
+    fn try_blend(
+        &mut self,
+        k: usize,
+        next: &Segment,
+        feed: f64,
+        next_deviation: f64,
+    ) -> Option<Segment> {
         let prev = self.segs[k];
         let (Segment::Line { end: vertex, .. }, Segment::Line { .. }) = (prev.seg, next) else {
             return None;
@@ -197,7 +221,11 @@ impl Planner {
         let phi = deflection(&u1, &u2);
         let half = (phi / 2.0).tan();
         // Tangent length from the tolerance: the arc passes the vertex at R·(1/cos(φ/2) − 1).
-        let from_tol = self.cfg.tolerance / (1.0 / (phi / 2.0).cos() - 1.0) * half;
+        let tolerance = self.cfg.tolerance - prev.deviation.max(next_deviation);
+        if tolerance <= 0.0 {
+            return None;
+        }
+        let from_tol = tolerance / (1.0 / (phi / 2.0).cos() - 1.0) * half;
         // What is left of the previous line, and not behind the tool if it is being cut.
         let mut room = prev.length - if k == 0 { self.s } else { 0.0 };
         room = room.min(prev.programmed_length / 2.0);
@@ -248,6 +276,7 @@ impl Planner {
             entry: 0.0,
             programmed_length: 0.0,
             blend_end: true,
+            deviation: 0.0,
             counts: false,
         });
         Some(trimmed_next)
@@ -260,6 +289,8 @@ impl Planner {
         }
     }
 
+    // The block's identity and its corner attributes travel together only here.
+    #[allow(clippy::too_many_arguments)]
     fn push_segment(
         &mut self,
         seg: Segment,
@@ -268,6 +299,7 @@ impl Planner {
         line: u32,
         entry_limit: f64,
         blend_end: bool,
+        deviation: f64,
     ) {
         let (vmax, accel, jerk) = self.segment_limits(&seg, feed * MAX_FEED_OVERRIDE);
         let length = seg.length();
@@ -289,6 +321,7 @@ impl Planner {
             entry: 0.0,
             programmed_length,
             blend_end,
+            deviation,
             counts: true,
         });
         self.backward_pass();
