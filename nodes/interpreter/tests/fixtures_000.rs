@@ -325,8 +325,17 @@ fn fixture_039_g92_threads_in_four_passes_with_lead_3() {
             }
         })
         .collect();
-    assert!(threads.iter().all(|t| (t.0 - 3.0).abs() < 1e-12));
-    // Each pass: thread to Z-27 (K1 run-out start), then run-out J3 (radius) to Z-28.
+    // Each pass: thread to Z-27 (K1 run-out start) at lead 3, then run-out J3 (radius) to
+    // Z-28. The run-out's long axis is X (3 mm against 1 mm), so its lead is stated along X
+    // as 9: Z keeps advancing 3 mm per revolution (D36).
+    for t in &threads {
+        let want = if (t.1[1] + 28.0).abs() < 1e-9 {
+            9.0
+        } else {
+            3.0
+        };
+        assert!((t.0 - want).abs() < 1e-12, "{t:?}");
+    }
     let bottoms: Vec<f64> = threads
         .iter()
         .filter(|t| (t.1[1] + 27.0).abs() < 1e-9)

@@ -650,7 +650,7 @@ impl Motion {
     }
 
     /// Lines at the front of the queue that lie within half the path tolerance of one chord
-    /// from `start` are cut as that chord (issue 4: "collinear short segments merged"), so a
+    /// from `start` are cut as that chord (decision D34: "collinear short segments merged"), so a
     /// curve given as short chords with rounded coordinates is not a string of kinks. The
     /// first line (ending at `first_end`) is always taken. `None`: the queue ran out while more
     /// lines might still merge and the planner has enough ahead to wait for them.
