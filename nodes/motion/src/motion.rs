@@ -673,9 +673,9 @@ impl Motion {
                 return Some(merged);
             }
             let Some(b) = self.queue.get(merged.blocks) else {
-                // More lines may come: wait for them while the window has plenty to cut.
-                let open = self.planner.blocks() >= MERGE_WAIT_BLOCKS;
-                return (!open || self.interpreter_done()).then_some(merged);
+                // More lines may come: wait for them while the window has plenty to cut (a
+                // program's last line is followed by its end, which closes the merge).
+                return (self.planner.blocks() < MERGE_WAIT_BLOCKS).then_some(merged);
             };
             let same = matches!(&b.kind, Command::Linear { feed: f, .. } if *f == feed)
                 && !(self.panel.single_block && b.line != line);
@@ -697,14 +697,6 @@ impl Motion {
                 _ => return Some(merged),
             }
         }
-    }
-
-    /// Whether the queue ends the run: its last block is the program end.
-    fn interpreter_done(&self) -> bool {
-        matches!(
-            self.queue.back().map(|b| &b.kind),
-            Some(Command::ProgramEnd)
-        )
     }
 
     /// Thread blocks that follow the one being cut join its chain (continuous threading,
