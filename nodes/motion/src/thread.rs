@@ -302,8 +302,9 @@ impl ThreadChain {
             return false;
         };
         let x = revs - begin;
-        if x > self.total - self.ramp / 2.0 {
-            // The run-out is under way for the leading axis: the chain is what it is.
+        let lead = lead_time.iter().copied().fold(0.0, f64::max);
+        if x + omega * lead > self.total - self.ramp / 2.0 {
+            // The run-out is near for the leading axis: the chain is what it is.
             self.closed = true;
         }
         let mut slowest = f64::INFINITY;
