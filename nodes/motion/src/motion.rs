@@ -156,9 +156,8 @@ pub struct Motion {
     thread: ThreadChain,
     encoder: Encoder,
     panel: Panel,
-    /// Stopped between blocks (single block, M00, M01) until cycle start; holds the line of
-    /// the block after which it stopped.
-    block_stop: Option<u32>,
+    /// Stopped between blocks (single block, M00, M01) until cycle start.
+    block_stop: bool,
     /// Line of the block finished last (single block stops when the line changes).
     last_line: Option<u32>,
     /// End points of lines being merged into one chord (built once).
@@ -168,6 +167,9 @@ pub struct Motion {
     /// drive lag (the slide trails a moving setpoint by it).
     thread_lead_time: [f64; MAX_AXES],
 }
+
+/// Most spindle revolutions one thread block may take (a million: 2 h at 8000 rpm).
+const MAX_THREAD_REVS: f64 = 1e6;
 
 /// Most lines merged into one chord.
 const MAX_MERGE: usize = 32;
@@ -244,7 +246,7 @@ impl Motion {
             encoder: Encoder::default(),
             panel: Panel::default(),
             merge_points: Vec::with_capacity(MAX_MERGE),
-            block_stop: None,
+            block_stop: false,
             last_line: None,
             thread_lead_time,
             planner,
@@ -288,7 +290,7 @@ impl Motion {
             self.done_seq = 0;
             self.feed_hold = false;
             self.cycle_stop = false;
-            self.block_stop = None;
+            self.block_stop = false;
             self.last_line = None;
             self.clear_strobe();
         }
@@ -332,10 +334,6 @@ impl Motion {
         };
     }
 
-    pub fn panel(&self) -> Panel {
-        self.panel
-    }
-
     /// Feed hold: decelerate on the path and wait for [`Motion::cycle_start`].
     pub fn feed_hold(&mut self) {
         self.feed_hold = true;
@@ -344,7 +342,7 @@ impl Motion {
     /// Cycle start: resumes after feed hold, and after a single-block, M00 or M01 stop.
     pub fn cycle_start(&mut self) {
         self.feed_hold = false;
-        self.block_stop = None;
+        self.block_stop = false;
     }
 
     /// Cycle stop: decelerate on the path, then drop the rest of the run.
@@ -362,7 +360,7 @@ impl Motion {
         self.active = None;
         self.feed_hold = false;
         self.cycle_stop = false;
-        self.block_stop = None;
+        self.block_stop = false;
         self.last_line = None;
         self.clear_strobe();
         self.commanded.clone_from(&self.actual);
@@ -398,7 +396,7 @@ impl Motion {
     pub fn state(&self) -> RunState {
         if self.alarm {
             RunState::Alarm
-        } else if self.block_stop.is_some()
+        } else if self.block_stop
             || self.feed_hold && (self.active.is_some() || !self.queue.is_empty())
         {
             RunState::Hold
@@ -472,7 +470,7 @@ impl Motion {
             budget -= 1;
             if self.active.is_none() {
                 // A cycle stop starts nothing new; it ends below once the axes stand.
-                if self.cycle_stop || self.block_stop.is_some() {
+                if self.cycle_stop || self.block_stop {
                     break;
                 }
                 let Some(next_line) = self.queue.front().map(|b| b.line) else {
@@ -480,7 +478,7 @@ impl Motion {
                 };
                 // Single block: the next line waits for cycle start (`000` §7.4).
                 if self.panel.single_block && self.last_line.is_some_and(|l| l != next_line) {
-                    self.block_stop = self.last_line;
+                    self.block_stop = true;
                     self.last_line = None;
                     break;
                 }
@@ -521,13 +519,11 @@ impl Motion {
                     self.done_seq = self.done_seq.max(block.seq);
                     self.last_line = Some(self.line);
                     // M00, and M01 with the optional-stop switch on, stop after their FIN.
-                    match block.kind {
-                        Command::Aux(Aux::M(0)) => self.block_stop = Some(block.line),
-                        Command::Aux(Aux::M(1)) if self.panel.optional_stop => {
-                            self.block_stop = Some(block.line)
-                        }
-                        _ => {}
-                    }
+                    self.block_stop = match block.kind {
+                        Command::Aux(Aux::M(0)) => true,
+                        Command::Aux(Aux::M(1)) => self.panel.optional_stop,
+                        _ => false,
+                    };
                 }
                 // A finished move used this tick; aux, dwell and end chain on within it.
                 if moved {
@@ -987,10 +983,19 @@ impl Motion {
         let long = (0..n)
             .map(|i| (end[i] - start[i]).abs())
             .fold(0.0, f64::max);
+        // Blocks come from anyone on the DDS domain: a lead so small that the thread would
+        // take longer than any spindle could turn is refused, not waited for.
+        let revs = long / lead;
+        if !(revs.is_finite() && revs <= MAX_THREAD_REVS) {
+            return Err((
+                alarm::BAD_BLOCK,
+                format!("thread of lead {lead} mm over {long:.4} mm: {revs:e} revolutions"),
+            ));
+        }
         Ok(Piece {
             start: *start,
             end,
-            revs: long / lead,
+            revs,
             seq: block.seq,
             line: block.line,
         })

@@ -343,32 +343,20 @@ pub fn distance_to(seg: &Segment, p: &Point) -> f64 {
 /// (each projects further along than the one before, inside the chord): how far replacing
 /// the polyline through them by the chord moves the path.
 pub fn chord_deviation(start: &Point, end: &Point, points: &[Point]) -> Option<f64> {
-    let mut u = [0.0; MAX_AXES];
-    let mut len2 = 0.0;
-    for i in 0..MAX_AXES {
-        u[i] = end[i] - start[i];
-        len2 += u[i] * u[i];
-    }
+    let chord = sub(end, start);
+    let len2 = dot(&chord, &chord);
     if len2 <= 1e-24 {
         return None;
     }
     let mut last = 0.0;
     let mut worst: f64 = 0.0;
     for p in points {
-        let (mut along, mut d2) = (0.0, 0.0);
-        for i in 0..MAX_AXES {
-            along += (p[i] - start[i]) * u[i];
-        }
-        let t = along / len2;
+        let t = dot(&sub(p, start), &chord) / len2;
         if t <= last || t >= 1.0 {
             return None;
         }
         last = t;
-        for i in 0..MAX_AXES {
-            let off = p[i] - start[i] - t * u[i];
-            d2 += off * off;
-        }
-        worst = worst.max(d2.sqrt());
+        worst = worst.max(norm(&sub(p, &add_scaled(start, &chord, t))));
     }
     Some(worst)
 }

@@ -218,10 +218,9 @@ impl ThreadChain {
             self.blend_corner(k);
         }
         let run_in = ramp / 2.0 + omega * lead_time;
-        let mut sync = revs + ((shift - angle) / 360.0).rem_euclid(1.0);
-        while sync - run_in < revs {
-            sync += 1.0;
-        }
+        // The first sync angle ahead, then as many whole turns later as the run-in needs.
+        let first = revs + ((shift - angle) / 360.0).rem_euclid(1.0);
+        let sync = first + (revs + run_in - first).max(0.0).ceil();
         self.begin = Some(sync - ramp / 2.0);
     }
 

@@ -638,3 +638,27 @@ fn m00_always_and_m01_with_the_switch_stop_until_cycle_start() {
         assert_eq!(m.commanded_display(), vec![50.0, -10.0]);
     }
 }
+
+#[test]
+fn a_thread_too_fine_to_finish_is_refused_with_an_alarm() {
+    // A block off the DDS domain with a lead of 1e-300 mm: 1e301 revolutions.
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.spindle_feedback(300.0, 0.0);
+    m.push(block(
+        1,
+        7,
+        Command::Thread {
+            end: vec![50.0, -10.0],
+            lead: 1e-300,
+            start_angle: 0.0,
+        },
+    ));
+    ticks(&mut m, &GImage::default(), 3);
+    assert_eq!(m.state(), RunState::Alarm);
+    let events = m.take_events();
+    assert!(
+        matches!(&events[..], [MotionEvent::Alarm { number, line: 7, .. }] if *number == alarm::BAD_BLOCK),
+        "{events:?}"
+    );
+    assert_eq!(m.commanded_display(), vec![50.0, 0.0]);
+}
