@@ -15,7 +15,7 @@ use std::time::Instant;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_motion::path::{self, Point, Segment, MAX_AXES};
 use cnc_motion::{Aux, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
-use cnc_msgs::signals::GImage;
+use cnc_msgs::signals::{f, g, GImage, SignalTable};
 use cnc_runtime::config::ProfileShape;
 use cnc_runtime::LaunchConfig;
 
@@ -182,7 +182,7 @@ pub fn simulate(
     let mut motion = Motion::new(mcfg, &start);
     // Ideal drives: each axis is where it was commanded one period earlier.
     let mut actual = start.clone();
-    let mut g = GImage::default();
+    let mut plc = GImage::released();
     let mut sent = 0u64;
     let mut finished = false;
     let mut ticks = 0u64;
@@ -234,24 +234,22 @@ pub fn simulate(
             ));
         }
         // The simulated PLC answers every strobe at once and the spindle is at speed.
-        g.fin_seq = motion.f_image().strobe_seq;
-        g.spindle_actual_rpm = spindle_rpm;
-        // The move of this period belongs to the block active when it began.
-        let f = *motion.f_image();
-        if f.mf != 0 {
-            match f.m_code {
+        let fi = *motion.f_image();
+        plc.set(g::FIN, fi.get(f::MF) || fi.get(f::SF) || fi.get(f::TF));
+        if fi.get(f::MF) {
+            match fi.read_i32(f::M_CODE) {
                 3 => spindle_dir = 1.0,
                 4 => spindle_dir = -1.0,
                 5 => spindle_dir = 0.0,
                 _ => {}
             }
         }
-        let rpm = f.s_value * spindle_dir;
+        let rpm = spindle_rpm * spindle_dir;
         spindle_angle = (spindle_angle + rpm / 60.0 * 360.0 * period).rem_euclid(360.0);
         motion.spindle_feedback(rpm, spindle_angle);
         let before = motion.active_cutting();
         let clock = options.timing.then(Instant::now);
-        let commanded = motion.tick(Some(&actual), &g);
+        let commanded = motion.tick(Some(&actual), &plc);
         if let Some(t) = clock {
             tick_nanos.push(t.elapsed().as_nanos() as u64);
         }

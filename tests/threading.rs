@@ -10,7 +10,7 @@ use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
 use cnc_motion::{Block, Command, Motion, MotionConfig, MotionEvent, Panel, RunState};
 use cnc_msgs::servo::{ServoSetpoint, MAX_AXES};
-use cnc_msgs::signals::{GImage, YImage};
+use cnc_msgs::signals::{f, g, y as out, GImage, SignalTable, YImage};
 use cnc_runtime::LaunchConfig;
 
 fn fixture(name: &str) -> String {
@@ -65,7 +65,8 @@ fn run(program: &str, factors: &[f64]) -> Vec<Pass> {
     let mut sim = SimLathe::new(sim_config(&cfg), &start);
     let mut y = YImage::default();
     let (mut s_command, mut factor_index) = (0.0, 0);
-    let mut g = GImage::default();
+    let mut plc = GImage::released();
+    let mut direction = 0;
     let mut sent = 0u64;
     let mut finished = false;
     let mut passes: Vec<Pass> = Vec::new();
@@ -93,31 +94,33 @@ fn run(program: &str, factors: &[f64]) -> Vec<Pass> {
             return passes;
         }
         // A PLC that answers M and S at once, M03/M04 once the spindle is at speed.
-        let f = *motion.f_image();
-        if f.strobe_seq != g.fin_seq {
+        let fi = *motion.f_image();
+        if !(fi.get(f::MF) || fi.get(f::SF) || fi.get(f::TF)) {
+            plc.set(g::FIN, false);
+        } else if !plc.get(g::FIN) {
             let mut fin = true;
-            if f.mf != 0 {
-                match f.m_code {
-                    3 => y.spindle_direction = 1,
-                    4 => y.spindle_direction = 2,
-                    5 => y.spindle_direction = 0,
+            if fi.get(f::MF) {
+                match fi.read_i32(f::M_CODE) {
+                    3 => direction = 1,
+                    4 => direction = 2,
+                    5 => direction = 0,
                     _ => {}
                 }
+                y.set(out::SPINDLE_CW, direction == 1);
+                y.set(out::SPINDLE_CCW, direction == 2);
                 fin = (sim.spindle_rpm().abs() - y.spindle_rpm).abs() <= 0.01 * y.spindle_rpm
-                    || y.spindle_direction == 0;
+                    || direction == 0;
             }
-            if f.sf != 0 {
-                s_command = f.s_value;
+            if fi.get(f::SF) {
+                s_command = f64::from(fi.read_i32(f::S_CODE));
             }
-            if fin {
-                g.fin_seq = f.strobe_seq;
-            }
+            plc.set(g::FIN, fin);
         }
         y.spindle_rpm = s_command * factors[factor_index % factors.len()];
         let mut actual = [0.0; MAX_AXES];
         actual[..n].copy_from_slice(&fb.position[..n]);
         motion.spindle_feedback(fb.spindle_rpm, fb.spindle_angle_deg);
-        let commanded = motion.tick(Some(&actual[..n]), &g).to_vec();
+        let commanded = motion.tick(Some(&actual[..n]), &plc).to_vec();
         if let Some(MotionEvent::Alarm { number, text, line }) =
             motion.take_events().into_iter().next()
         {

@@ -172,6 +172,22 @@ ros_message! {
 }
 
 ros_message! {
+    /// The PLC's scan: which program runs, how long a scan takes, whether it stopped itself.
+    pub struct PlcStatus("cnc_msgs/msg/PlcStatus") {
+        consts {}
+        stamp: Time,
+        program: String,
+        steps: u32,
+        scans: u64,
+        level2_divisions: u32,
+        scan_time_last_us: f64,
+        scan_time_p99_us: f64,
+        scan_time_max_us: f64,
+        fault: String,
+    }
+}
+
+ros_message! {
     /// One canonical block from the interpreter to motion.
     pub struct MotionBlock("cnc_msgs/msg/MotionBlock") {
         consts {
@@ -243,7 +259,20 @@ ros_message! {
 ros_message! {
     /// Operator or test input to the simulated machine.
     pub struct SimInput("cnc_msgs/msg/SimInput") {
-        consts { EMERGENCY_STOP: u8 = 1 }
+        consts {
+            EMERGENCY_STOP: u8 = 1,
+            TURRET_STUCK: u8 = 2,
+            AIR_LOST: u8 = 3,
+            DOOR_FORCED_OPEN: u8 = 4,
+            ROBOT_CLEAR: u8 = 5,
+            ROBOT_CHUCK_OPEN: u8 = 6,
+            ROBOT_CHUCK_CLOSE: u8 = 7,
+            ROBOT_DOOR_OPEN: u8 = 8,
+            ROBOT_DOOR_CLOSE: u8 = 9,
+            ROBOT_CYCLE_START: u8 = 10,
+            CYCLE_START_KEY: u8 = 11,
+            RESET_KEY: u8 = 12
+        }
         input: u8,
         value: bool,
     }

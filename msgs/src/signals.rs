@@ -1,71 +1,334 @@
-//! Signal images exchanged over iceoryx2: F (NC → PLC) and G (PLC → NC) between motion and plc,
-//! Y (PLC → machine) and X (machine → PLC) between plc and io.
+//! Signal images exchanged over iceoryx2 every PLC scan: F (NC → PLC) and G (PLC → NC) between
+//! motion and plc, Y (PLC → machine) and X (machine → PLC) between plc and io.
 //!
-//! For now the images are typed fields; the ladder engine will map them onto the byte addresses
-//! of the manual's F/G/X/Y tables.
+//! Each image is the byte table of the Huaxing manual (`000` §18.1, inventory §9.1): F0–F255,
+//! G0–G255, X0–X19, Y0–Y19, bit 0 the lowest. Multi-byte values (M code at F10, S at F22, T at
+//! F26) are binary, least significant byte first, as in a FANUC PMC. The bit assignments the NC
+//! uses are named in [`f`] and [`g`]; the wiring of the standard lathe in [`x`] and [`y`].
 
 use iceoryx2::prelude::ZeroCopySend;
 
-/// NC → PLC: the M/S/T strobes and the NC's state.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[repr(C)]
-#[type_name("cnc_msgs::FImage")]
-pub struct FImage {
-    /// Increments with every new strobe, so a repeated `M08` is a new request.
-    pub strobe_seq: u64,
-    /// MF/SF/TF strobes (1 = set) and their codes.
-    pub mf: u32,
-    pub m_code: i32,
-    pub sf: u32,
-    pub s_value: f64,
-    pub tf: u32,
-    pub t_code: i32,
-    /// 1 while a program runs (cycle start lamp, OP signal).
-    pub op: u32,
-    /// 1 while motion holds an alarm.
-    pub alarm: u32,
+pub const F_BYTES: usize = 256;
+pub const G_BYTES: usize = 256;
+pub const X_BYTES: usize = 20;
+pub const Y_BYTES: usize = 20;
+
+/// One bit of a signal table: byte number and bit 0–7.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Bit {
+    pub byte: u16,
+    pub bit: u8,
 }
 
-/// PLC → NC: the answer to the strobes and the machine's requests to the NC.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[repr(C)]
-#[type_name("cnc_msgs::GImage")]
-pub struct GImage {
-    /// `strobe_seq` of the strobe that is finished (FIN).
-    pub fin_seq: u64,
-    /// 1 = emergency stop: the NC stops at once and turns servos off.
-    pub emergency_stop: u32,
-    /// 1 = feed hold requested by the machine.
-    pub feed_hold: u32,
-    /// Spindle speed measured by the machine, rpm (for feed per revolution and display).
-    pub spindle_actual_rpm: f64,
+pub const fn bit(byte: u16, bit: u8) -> Bit {
+    Bit { byte, bit }
 }
 
-/// PLC → machine outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[repr(C)]
-#[type_name("cnc_msgs::YImage")]
-pub struct YImage {
-    /// 0 stop, 1 CW, 2 CCW.
-    pub spindle_direction: u32,
-    /// Speed command to the spindle drive, rpm.
-    pub spindle_rpm: f64,
-    pub coolant: u32,
-    pub chuck_clamp: u32,
+impl std::fmt::Display for Bit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}.{}", self.byte, self.bit)
+    }
 }
 
-/// Machine inputs → PLC.
-#[derive(Debug, Clone, Copy, PartialEq, Default, ZeroCopySend)]
-#[repr(C)]
-#[type_name("cnc_msgs::XImage")]
-pub struct XImage {
-    pub seq: u64,
-    /// 1 = emergency-stop button pressed (the input is normally closed; 1 means open circuit).
-    pub emergency_stop: u32,
-    pub spindle_actual_rpm: f64,
-    /// 1 = spindle drive reports speed reached.
-    pub spindle_at_speed: u32,
-    /// 1 = coolant pressure switch made.
-    pub coolant_pressure: u32,
-    pub chuck_clamped: u32,
+/// Bit and word access shared by the four images.
+pub trait SignalTable {
+    fn bytes(&self) -> &[u8];
+    fn bytes_mut(&mut self) -> &mut [u8];
+
+    /// False for a bit outside the table.
+    fn get(&self, b: Bit) -> bool {
+        self.bytes()
+            .get(b.byte as usize)
+            .is_some_and(|v| v >> (b.bit & 7) & 1 == 1)
+    }
+    /// A bit outside the table is ignored.
+    fn set(&mut self, b: Bit, on: bool) {
+        if let Some(v) = self.bytes_mut().get_mut(b.byte as usize) {
+            let mask = 1u8 << (b.bit & 7);
+            if on {
+                *v |= mask;
+            } else {
+                *v &= !mask;
+            }
+        }
+    }
+    /// Four bytes from `byte`, least significant first (0 past the end).
+    fn read_i32(&self, byte: usize) -> i32 {
+        let mut v = [0u8; 4];
+        for (i, d) in v.iter_mut().enumerate() {
+            *d = self.bytes().get(byte + i).copied().unwrap_or(0);
+        }
+        i32::from_le_bytes(v)
+    }
+    fn write_i32(&mut self, byte: usize, value: i32) {
+        for (i, s) in value.to_le_bytes().into_iter().enumerate() {
+            if let Some(d) = self.bytes_mut().get_mut(byte + i) {
+                *d = s;
+            }
+        }
+    }
+}
+
+macro_rules! image {
+    ($(#[$doc:meta])* $name:ident, $type_name:literal, $size:ident, { $($(#[$fdoc:meta])* $field:ident: $ty:ty),* }) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+        #[repr(C)]
+        #[type_name($type_name)]
+        pub struct $name {
+            /// Increments with every image the sender writes.
+            pub seq: u64,
+            $($(#[$fdoc])* pub $field: $ty,)*
+            pub bytes: [u8; $size],
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                $name { seq: 0, $($field: Default::default(),)* bytes: [0; $size] }
+            }
+        }
+
+        impl SignalTable for $name {
+            fn bytes(&self) -> &[u8] {
+                &self.bytes
+            }
+            fn bytes_mut(&mut self) -> &mut [u8] {
+                &mut self.bytes
+            }
+        }
+    };
+}
+
+image!(
+    /// NC → PLC.
+    FImage, "cnc_msgs::FImage", F_BYTES, {}
+);
+image!(
+    /// PLC → NC. All zero (as before the PLC's first scan) means emergency stop: `*ESP` is
+    /// active low, so a PLC that never answered cannot let the machine move.
+    GImage, "cnc_msgs::GImage", G_BYTES, {}
+);
+image!(
+    /// Machine → PLC.
+    XImage, "cnc_msgs::XImage", X_BYTES, {
+        /// Spindle speed from the encoder, rpm (negative counter-clockwise), for display.
+        spindle_actual_rpm: f64
+    }
+);
+image!(
+    /// PLC → machine.
+    YImage, "cnc_msgs::YImage", Y_BYTES, {
+        /// The spindle drive's speed command (the analog output SPLCNT writes), rpm.
+        spindle_rpm: f64
+    }
+);
+
+impl GImage {
+    /// The image of a running PLC with no key pressed: emergency stop and feed hold released
+    /// (both active low), overrides at 100 %.
+    pub fn released() -> Self {
+        let mut g = GImage::default();
+        g.set(g::ESP_N, true);
+        g.set(g::SP_N, true);
+        g.bytes[g::FEED_OVERRIDE as usize] = 100;
+        g.bytes[g::SPINDLE_OVERRIDE as usize] = 100;
+        g
+    }
+
+    /// Feed override as a fraction: G12 is the percentage in binary (0–200).
+    pub fn feed_override(&self) -> f64 {
+        f64::from(self.bytes[g::FEED_OVERRIDE as usize]) / 100.0
+    }
+
+    /// Rapid override from ROV1/ROV2 (G14.0/G14.1): 100 %, 50 %, 25 % or F0 (0 %, D38).
+    pub fn rapid_override(&self) -> f64 {
+        match (self.get(g::ROV1), self.get(g::ROV2)) {
+            (false, false) => 1.0,
+            (true, false) => 0.5,
+            (false, true) => 0.25,
+            (true, true) => 0.0,
+        }
+    }
+}
+
+/// F signals the NC writes (`000` App.2, inventory §9.4).
+pub mod f {
+    use super::{bit, Bit};
+    /// Automatic operation in progress.
+    pub const OP: Bit = bit(0, 7);
+    /// Servo ready.
+    pub const SA: Bit = bit(0, 6);
+    /// Cycle start lamp: automatic operation starting.
+    pub const STL: Bit = bit(0, 5);
+    /// Feed hold lamp.
+    pub const SPL: Bit = bit(0, 4);
+    /// CNC ready.
+    pub const MA: Bit = bit(1, 7);
+    /// Distribution end: no motion commanded, the axes in position.
+    pub const DEN: Bit = bit(1, 3);
+    /// Resetting.
+    pub const RST: Bit = bit(1, 1);
+    /// NC alarm.
+    pub const AL: Bit = bit(1, 0);
+    pub const DRUR: Bit = bit(2, 7);
+    /// Cutting feed in progress.
+    pub const CUT: Bit = bit(2, 6);
+    pub const THRD: Bit = bit(2, 3);
+    /// Automatic mode (the only mode of the cell's NC so far).
+    pub const MCYC: Bit = bit(3, 5);
+    pub const MSBK: Bit = bit(4, 3);
+    pub const TF: Bit = bit(7, 3);
+    pub const SF: Bit = bit(7, 2);
+    pub const MF: Bit = bit(7, 0);
+    pub const DM00: Bit = bit(9, 7);
+    pub const DM01: Bit = bit(9, 6);
+    pub const DM02: Bit = bit(9, 5);
+    pub const DM30: Bit = bit(9, 4);
+    /// M code, 4 bytes binary.
+    pub const M_CODE: usize = 10;
+    /// S code (rpm), 4 bytes binary.
+    pub const S_CODE: usize = 22;
+    /// T code (target tool and offset, `0303`), 4 bytes binary.
+    pub const T_CODE: usize = 26;
+}
+
+/// G signals the NC reads (`000` App.2, inventory §9.5).
+pub mod g {
+    use super::{bit, Bit};
+    /// Completion of the M/S/T function.
+    pub const FIN: Bit = bit(4, 3);
+    /// Cycle start (the NC acts on its rising edge).
+    pub const ST: Bit = bit(7, 2);
+    /// External reset.
+    pub const ERS: Bit = bit(8, 7);
+    /// Feed hold, active low.
+    pub const SP_N: Bit = bit(8, 5);
+    /// Emergency stop, active low.
+    pub const ESP_N: Bit = bit(8, 4);
+    /// Feed override, percent in binary (FANUC's `*FV` bits in positive logic).
+    pub const FEED_OVERRIDE: u16 = 12;
+    pub const ROV1: Bit = bit(14, 0);
+    pub const ROV2: Bit = bit(14, 1);
+    /// Spindle override, percent in binary.
+    pub const SPINDLE_OVERRIDE: u16 = 30;
+    /// Optional stop switch: not in the manual's G table (the key lamp is PLC-only there), so
+    /// it takes the free bit G44.2 next to block skip BDT1 (G44.0).
+    pub const MOPS: Bit = bit(44, 2);
+    pub const BDT1: Bit = bit(44, 0);
+    pub const DRN: Bit = bit(46, 7);
+    pub const SBK: Bit = bit(46, 1);
+    /// Current tool number of turret 1, binary.
+    pub const NTOL: u16 = 68;
+}
+
+/// Inputs of the standard lathe (`000` §19.1.7, inventory §9.3). Bits the manual leaves as
+/// expansion carry the cell's devices (turret lock, door, air, robot), listed in
+/// `docs/plc.md`.
+pub mod x {
+    use super::{bit, Bit};
+    /// Spindle at the commanded speed (the manual's "spindle reached").
+    pub const SPINDLE_AT_SPEED: Bit = bit(0, 1);
+    pub const CHUCK_CLAMPED: Bit = bit(0, 3);
+    pub const CHUCK_UNCLAMPED: Bit = bit(0, 5);
+    /// Spindle drive alarm (1 = alarm).
+    pub const SPINDLE_ALARM: Bit = bit(0, 6);
+    /// Emergency stop, normally closed: 1 = released.
+    pub const ESP_N: Bit = bit(1, 0);
+    pub const EXTERNAL_FEED_HOLD: Bit = bit(1, 1);
+    pub const EXTERNAL_CYCLE_START: Bit = bit(1, 3);
+    /// Turret position sensors, tool 1 … 8.
+    pub const TOOL: [Bit; 8] = [
+        bit(2, 7),
+        bit(3, 7),
+        bit(3, 6),
+        bit(3, 5),
+        bit(3, 4),
+        bit(3, 3),
+        bit(3, 2),
+        bit(3, 1),
+    ];
+    pub const TAILSTOCK_FORWARD: Bit = bit(4, 0);
+    pub const TAILSTOCK_BACK: Bit = bit(4, 1);
+    pub const TURRET_LOCKED: Bit = bit(4, 2);
+    pub const DOOR_CLOSED: Bit = bit(4, 3);
+    pub const DOOR_OPEN: Bit = bit(4, 4);
+    /// Air pressure switch: 1 = pressure good.
+    pub const AIR_OK: Bit = bit(4, 5);
+    pub const COOLANT_PRESSURE: Bit = bit(4, 6);
+    /// Lubrication pressure / level good.
+    pub const LUBE_OK: Bit = bit(4, 7);
+    /// Robot: clear of the work area.
+    pub const ROBOT_CLEAR: Bit = bit(8, 0);
+    pub const ROBOT_CHUCK_OPEN: Bit = bit(8, 1);
+    pub const ROBOT_CHUCK_CLOSE: Bit = bit(8, 2);
+    pub const ROBOT_DOOR_OPEN: Bit = bit(8, 3);
+    pub const ROBOT_DOOR_CLOSE: Bit = bit(8, 4);
+    pub const ROBOT_CYCLE_START: Bit = bit(8, 5);
+    /// Panel keys (X10–X15 of the manual).
+    pub const KEY_CYCLE_START: Bit = bit(13, 1);
+    pub const KEY_FEED_HOLD: Bit = bit(15, 3);
+    pub const KEY_RESET: Bit = bit(15, 6);
+    pub const KEY_COOLANT: Bit = bit(10, 4);
+    pub const KEY_OPTIONAL_STOP: Bit = bit(10, 5);
+    pub const KEY_SINGLE_BLOCK: Bit = bit(10, 3);
+    /// Feed override switch, percent in binary (a coded rotary switch on the panel).
+    pub const FEED_OVERRIDE_SWITCH: u16 = 16;
+}
+
+/// Outputs of the standard lathe (`000` §19.1.6, inventory §9.3).
+pub mod y {
+    use super::{bit, Bit};
+    pub const COOLANT: Bit = bit(1, 3);
+    pub const LAMP_GREEN: Bit = bit(1, 4);
+    pub const LAMP_YELLOW: Bit = bit(1, 6);
+    pub const CHUCK_CLAMP: Bit = bit(1, 7);
+    pub const TAILSTOCK_BACK: Bit = bit(2, 0);
+    pub const LAMP_RED: Bit = bit(2, 1);
+    pub const CHUCK_UNCLAMP: Bit = bit(2, 2);
+    pub const SPINDLE_BRAKE: Bit = bit(2, 3);
+    pub const TAILSTOCK_FORWARD: Bit = bit(2, 4);
+    pub const TURRET_CW: Bit = bit(2, 5);
+    pub const TURRET_CCW: Bit = bit(2, 6);
+    pub const SPINDLE_CW: Bit = bit(3, 0);
+    pub const SPINDLE_CCW: Bit = bit(3, 1);
+    pub const SPINDLE_ENABLE: Bit = bit(3, 5);
+    pub const LUBRICATION: Bit = bit(3, 6);
+    /// Releases the turret lock (0 = locked: a turret without power stays locked).
+    pub const TURRET_UNLOCK: Bit = bit(4, 0);
+    pub const CHIP_CONVEYOR: Bit = bit(4, 1);
+    pub const DOOR_OPEN: Bit = bit(4, 2);
+    pub const DOOR_CLOSE: Bit = bit(4, 3);
+    /// Cell: the machine waits for the robot to load a part.
+    pub const READY_FOR_LOAD: Bit = bit(5, 0);
+    /// Cell: the last cycle ended with M30/M02.
+    pub const CYCLE_COMPLETE: Bit = bit(5, 1);
+    /// Gear range outputs S1/S2/S3 (shared with the tailstock pins on the manual's map, so
+    /// the cell lathe drives them from expansion bits).
+    pub const GEAR: [Bit; 3] = [bit(5, 4), bit(5, 5), bit(5, 6)];
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bits_and_words_round_trip() {
+        let mut f = FImage::default();
+        f.set(f::MF, true);
+        f.write_i32(f::M_CODE, 1234);
+        assert!(f.get(f::MF));
+        assert_eq!(f.bytes[7], 1);
+        assert_eq!(f.read_i32(f::M_CODE), 1234);
+        assert_eq!(f.bytes[10..14], [0xd2, 0x04, 0, 0]);
+        f.set(f::MF, false);
+        assert_eq!(f.bytes[7], 0);
+        // Out of the table: ignored, reads false.
+        f.set(bit(999, 0), true);
+        assert!(!f.get(bit(999, 0)));
+        let g = GImage::released();
+        assert!(g.get(g::ESP_N) && g.get(g::SP_N));
+        assert_eq!(g.feed_override(), 1.0);
+        assert_eq!(g.rapid_override(), 1.0);
+        assert!(!GImage::default().get(g::ESP_N));
+    }
 }

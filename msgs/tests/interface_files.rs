@@ -122,6 +122,7 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<ProgramCommand>("ProgramCommand.msg");
     check_msg::<CommandResult>("CommandResult.msg");
     check_msg::<SimInput>("SimInput.msg");
+    check_msg::<PlcStatus>("PlcStatus.msg");
 }
 
 #[test]
@@ -150,6 +151,7 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "ProgramCommand",
         "CommandResult",
         "SimInput",
+        "PlcStatus",
         "LoadProgram",
         "StartProgram",
         "Stop",

@@ -110,12 +110,7 @@ pub fn load_memory(cfg: &LaunchConfig) -> (Memory, Option<String>) {
 /// power cut leaves either the old or the new memory.
 pub fn save_memory(path: &std::path::Path, memory: &Memory) -> Result<(), String> {
     let text = serde_yaml::to_string(memory).map_err(|e| e.to_string())?;
-    let tmp = path.with_extension("tmp");
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    std::fs::write(&tmp, text).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+    cnc_runtime::persist::write_atomic(path, &text)
 }
 
 /// Takes what a run left in memory (kept variables, offsets) and stores it if it changed.

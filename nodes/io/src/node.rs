@@ -1,26 +1,62 @@
 //! io node shell: steps the simulated lathe once per servo setpoint and answers with feedback.
 //!
 //! The simulated machine's time advances one servo period per setpoint, so it runs exactly as
-//! fast as motion drives it. Emergency stop can be pressed from DDS (`/<ns>/sim/input`).
+//! fast as motion drives it. Emergency stop, robot signals, panel keys and faults come from
+//! DDS (`/<ns>/sim/input`).
 
 use std::time::Duration;
 
 use cnc_msgs::msg::SimInput;
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint};
-use cnc_msgs::signals::{XImage, YImage};
+use cnc_msgs::signals::{x, Bit, SignalTable, XImage, YImage};
 use cnc_runtime::dds::{qos, RosNode};
 use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::{LaunchConfig, Shutdown};
 
-use crate::sim::{SimConfig, SimLathe};
+use crate::sim::{DeviceConfig, SimConfig, SimLathe};
 
 pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
     SimConfig {
         drive_lag: cfg.machine.axes.iter().map(|a| a.drive_lag).collect(),
         spindle_acceleration: cfg.sim.spindle_acceleration,
         at_speed_tolerance: cfg.sim.at_speed_tolerance,
-        coolant_delay: cfg.sim.coolant_delay,
+        devices: DeviceConfig {
+            turret_stations: cfg.sim.turret_stations,
+            coolant_delay: cfg.sim.coolant_delay,
+            ..DeviceConfig::default()
+        },
     }
+}
+
+/// The X bit a robot signal or panel key of [`SimInput`] sets.
+fn input_bit(input: u8) -> Option<Bit> {
+    Some(match input {
+        SimInput::ROBOT_CLEAR => x::ROBOT_CLEAR,
+        SimInput::ROBOT_CHUCK_OPEN => x::ROBOT_CHUCK_OPEN,
+        SimInput::ROBOT_CHUCK_CLOSE => x::ROBOT_CHUCK_CLOSE,
+        SimInput::ROBOT_DOOR_OPEN => x::ROBOT_DOOR_OPEN,
+        SimInput::ROBOT_DOOR_CLOSE => x::ROBOT_DOOR_CLOSE,
+        SimInput::ROBOT_CYCLE_START => x::ROBOT_CYCLE_START,
+        SimInput::CYCLE_START_KEY => x::KEY_CYCLE_START,
+        SimInput::RESET_KEY => x::KEY_RESET,
+        _ => return None,
+    })
+}
+
+/// Applies one input to the simulated machine; false if the input is unknown.
+pub fn apply_input(sim: &mut SimLathe, input: &SimInput) -> bool {
+    let d = &mut sim.devices;
+    match input.input {
+        SimInput::EMERGENCY_STOP => sim.set_emergency_stop(input.value),
+        SimInput::TURRET_STUCK => d.turret_stuck = input.value,
+        SimInput::AIR_LOST => d.air_lost = input.value,
+        SimInput::DOOR_FORCED_OPEN => d.door_forced_open = input.value,
+        other => match input_bit(other) {
+            Some(bit) => d.inputs.set(bit, input.value),
+            None => return false,
+        },
+    }
+    true
 }
 
 /// Runs the io node until shutdown (blocking).
@@ -41,12 +77,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     feedback.send(sim.step(&idle, &y, 0.0))?;
     while !shutdown.requested() {
         while let Ok(Some((input, _))) = inputs.take() {
-            if input.input == SimInput::EMERGENCY_STOP {
-                log::warn!(
-                    "simulated emergency stop {}",
-                    if input.value { "pressed" } else { "released" }
-                );
-                sim.set_emergency_stop(input.value);
+            if apply_input(&mut sim, &input) {
+                log::info!("simulated input {} = {}", input.input, input.value);
+            } else {
+                log::warn!("unknown simulated input {} ignored", input.input);
             }
         }
         if let Some(latest) = outputs.latest()? {

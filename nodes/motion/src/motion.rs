@@ -8,7 +8,7 @@
 use std::collections::VecDeque;
 use std::f64::consts::TAU;
 
-use cnc_msgs::signals::{FImage, GImage};
+use cnc_msgs::signals::{f, g, FImage, GImage, SignalTable};
 
 use crate::block::{Aux, Block, Command};
 use crate::config::MotionConfig;
@@ -35,6 +35,8 @@ pub mod alarm {
     /// run-out, or faster than an axis may move (`000` alarm 52, "thread acceleration length
     /// insufficient").
     pub const THREAD_RUN_IN: u32 = 52;
+    /// The PLC stopped sending its G image (the PLC's own alarms are 1000–1091).
+    pub const PLC_SILENT: u32 = 1092;
 }
 
 /// Something the shell must publish.
@@ -107,7 +109,8 @@ enum Active {
     /// Waits for the axes to settle, then sends the strobe and waits for FIN.
     Aux {
         code: Aux,
-        strobe: Option<u64>,
+        /// The strobe is up, waiting for FIN.
+        raised: bool,
     },
     End,
 }
@@ -134,8 +137,12 @@ pub struct Motion {
     actual: Vec<f64>,
     feed_hold: bool,
     cycle_stop: bool,
+    /// Emergency stop from the PLC (`*ESP` low): servo hold, the run dropped. Releasing it
+    /// returns the NC to the reset state, as on a FANUC control, but blocks of the dropped run
+    /// stay refused (`dead_run`).
+    emergency_stop: bool,
+    dead_run: u64,
     alarm: bool,
-    strobe_seq: u64,
     f: FImage,
     events: Vec<MotionEvent>,
     /// Last spindle speed sent to the PLC, rpm: the base of feed per revolution and threads
@@ -261,8 +268,9 @@ impl Motion {
             commanded,
             feed_hold: false,
             cycle_stop: false,
+            emergency_stop: false,
+            dead_run: 0,
             alarm: false,
-            strobe_seq: 0,
             spindle_rpm: 0.0,
             feed_per_rev: false,
             exact_stop: false,
@@ -294,7 +302,11 @@ impl Motion {
             self.last_line = None;
             self.clear_strobe();
         }
-        if self.alarm || block.seq <= self.accepted_seq {
+        if self.alarm
+            || self.emergency_stop
+            || block.run_id <= self.dead_run
+            || block.seq <= self.accepted_seq
+        {
             return;
         }
         if self.queue.len() >= self.cfg.queue_capacity {
@@ -394,7 +406,7 @@ impl Motion {
     }
 
     pub fn state(&self) -> RunState {
-        if self.alarm {
+        if self.alarm || self.emergency_stop {
             RunState::Alarm
         } else if self.block_stop
             || self.feed_hold && (self.active.is_some() || !self.queue.is_empty())
@@ -454,15 +466,23 @@ impl Motion {
             self.update_f();
             return &self.commanded;
         }
-        if plc.emergency_stop != 0 {
-            // Servo off: hold where the slides are, drop the run. The PLC raises the alarm.
-            if !self.alarm {
-                self.alarm = true;
+        if !plc.get(g::ESP_N) {
+            // Servo hold where the slides are, the run dropped. The PLC raises the alarm.
+            if !self.emergency_stop {
+                self.emergency_stop = true;
+                self.dead_run = self.run_id;
                 self.drop_run();
+                self.feed_hold = false;
+                self.cycle_stop = false;
+                self.block_stop = false;
             }
             self.commanded.clone_from(&self.actual);
             self.update_f();
             return &self.commanded;
+        }
+        if self.emergency_stop {
+            self.emergency_stop = false;
+            self.planner.reset(self.commanded_point());
         }
         let dt = self.cfg.period;
         let mut budget = 8; // blocks that can finish within one tick (zero-length moves, aux)
@@ -787,14 +807,41 @@ impl Motion {
     }
 
     fn clear_strobe(&mut self) {
-        self.f.mf = 0;
-        self.f.sf = 0;
-        self.f.tf = 0;
+        for b in [f::MF, f::SF, f::TF, f::DM00, f::DM01, f::DM02, f::DM30] {
+            self.f.set(b, false);
+        }
     }
 
+    /// The NC's state signals (`000` App.2, inventory §9.4).
     fn update_f(&mut self) {
-        self.f.op = u32::from(self.active.is_some() || !self.queue.is_empty());
-        self.f.alarm = u32::from(self.alarm);
+        let running = self.active.is_some() || !self.queue.is_empty();
+        let distributing = matches!(
+            self.active,
+            Some((
+                _,
+                Active::Path | Active::Thread { .. } | Active::Rapid { .. }
+            ))
+        );
+        let hold = self.state() == RunState::Hold;
+        let fi = &mut self.f;
+        fi.set(f::OP, running);
+        fi.set(f::STL, running && !hold);
+        fi.set(f::SPL, hold);
+        fi.set(f::SA, !self.servo_off);
+        fi.set(f::MA, !self.alarm && !self.servo_off);
+        fi.set(f::AL, self.alarm);
+        fi.set(f::DEN, !distributing);
+        fi.set(
+            f::CUT,
+            matches!(self.active, Some((_, Active::Path | Active::Thread { .. }))),
+        );
+        fi.set(
+            f::THRD,
+            matches!(self.active, Some((_, Active::Thread { .. }))),
+        );
+        fi.set(f::MCYC, true);
+        fi.set(f::MSBK, self.panel.single_block);
+        fi.set(f::DRUR, self.panel.dry_run);
     }
 
     /// The commanded slide position as a planner point.
@@ -881,7 +928,7 @@ impl Motion {
             }
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
-                strobe: None,
+                raised: false,
             }),
             Command::ProgramEnd => Ok(Active::End),
         }
@@ -1118,37 +1165,39 @@ impl Motion {
                 }
                 *remaining <= 0.0
             }
-            Active::Aux { code, strobe } => match strobe {
-                None => {
-                    if !in_pos || hold {
+            // The M/S/T handshake (`000` §4.2.1): code and strobe up, wait for FIN, strobe
+            // down; the next strobe waits until the PLC has dropped FIN again.
+            Active::Aux { code, raised } => match raised {
+                false => {
+                    if !in_pos || hold || plc.get(g::FIN) {
                         return false;
                     }
-                    self.strobe_seq += 1;
-                    let seq = self.strobe_seq;
-                    *strobe = Some(seq);
-                    self.f.strobe_seq = seq;
+                    *raised = true;
+                    let fi = &mut self.f;
                     match *code {
                         Aux::M(m) => {
-                            self.f.m_code = m;
-                            self.f.mf = 1;
+                            fi.write_i32(f::M_CODE, m);
+                            fi.set(f::DM00, m == 0);
+                            fi.set(f::DM01, m == 1);
+                            fi.set(f::DM02, m == 2);
+                            fi.set(f::DM30, m == 30);
+                            fi.set(f::MF, true);
                         }
                         Aux::S(s) => {
                             self.spindle_rpm = s;
-                            self.f.s_value = s;
-                            self.f.sf = 1;
+                            fi.write_i32(f::S_CODE, s.round().clamp(0.0, i32::MAX as f64) as i32);
+                            fi.set(f::SF, true);
                         }
                         Aux::T(t) => {
-                            self.f.t_code = t;
-                            self.f.tf = 1;
+                            fi.write_i32(f::T_CODE, t);
+                            fi.set(f::TF, true);
                         }
                     }
                     false
                 }
-                Some(seq) => {
-                    if plc.fin_seq == *seq {
-                        self.f.mf = 0;
-                        self.f.sf = 0;
-                        self.f.tf = 0;
+                true => {
+                    if plc.get(g::FIN) {
+                        self.clear_strobe();
                         true
                     } else {
                         false

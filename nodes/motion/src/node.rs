@@ -12,7 +12,7 @@ use cnc_msgs::msg::{
     Alarm, Axis, AxisState, MotionBlock, MotionStatus, ProgramCommand, ServoStats,
 };
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
-use cnc_msgs::signals::{FImage, GImage};
+use cnc_msgs::signals::{g, FImage, GImage, SignalTable};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -21,7 +21,10 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::motion::alarm;
 use crate::servo::ServoStatistics;
-use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
+use crate::{Block, Motion, MotionConfig, MotionEvent, Panel, RunState};
+
+/// The PLC must answer within this time, else motion takes it as an emergency stop.
+const PLC_TIMEOUT_NS: u64 = 500_000_000;
 
 enum Input {
     Block(Block),
@@ -153,6 +156,46 @@ fn dds_loop(
     Ok(())
 }
 
+/// The G image's operator signals, applied to motion every tick: overrides and switches as
+/// levels, cycle start on its rising edge, feed hold while `*SP` is low.
+#[derive(Default)]
+struct PlcLink {
+    last_heard: Option<u64>,
+    reported: bool,
+    cycle_start: bool,
+}
+
+impl PlcLink {
+    fn heard(&mut self, now: u64) {
+        self.last_heard = Some(now);
+        self.reported = false;
+    }
+
+    /// True once the PLC, having answered before, has been quiet for [`PLC_TIMEOUT_NS`].
+    fn silent(&self, now: u64) -> bool {
+        self.last_heard
+            .is_some_and(|t| now.saturating_sub(t) > PLC_TIMEOUT_NS)
+    }
+
+    fn apply(&mut self, g: &GImage, motion: &mut Motion) {
+        motion.set_panel(Panel {
+            feed_override: g.feed_override(),
+            rapid_override: g.rapid_override(),
+            single_block: g.get(g::SBK),
+            dry_run: g.get(g::DRN),
+            optional_stop: g.get(g::MOPS),
+        });
+        if !g.get(g::SP_N) && g.get(g::ESP_N) {
+            motion.feed_hold();
+        }
+        let start = g.get(g::ST);
+        if start && !self.cycle_start && g.get(g::SP_N) {
+            motion.cycle_start();
+        }
+        self.cycle_start = start;
+    }
+}
+
 fn publish<M: ros2_client::Message + std::fmt::Debug>(p: &ros2_client::dds::Publisher<M>, m: M) {
     if let Err(e) = p.publish(m) {
         log::warn!("motion: publish failed: {e:?}");
@@ -189,7 +232,9 @@ fn servo_loop(
     let mut actual = first.position;
     let mut spindle = (first.spindle_rpm, first.spindle_angle_deg);
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
+    // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
     let mut g = GImage::default();
+    let mut plc = PlcLink::default();
     let mut stats = ServoStatistics::default();
     let mut seq = 0u64;
     let mut last_status = None;
@@ -223,13 +268,28 @@ fn servo_loop(
         }
         if let Some(latest) = g_in.latest()? {
             g = latest;
+            plc.heard(now);
         }
+        if plc.silent(now) {
+            if !plc.reported {
+                plc.reported = true;
+                let _ = reports.send(Report::Alarm(
+                    alarm::PLC_SILENT,
+                    "the PLC stopped answering: emergency stop".into(),
+                    motion.line(),
+                ));
+            }
+            g = GImage::default();
+        }
+        plc.apply(&g, &mut motion);
         if have_feedback {
             motion.spindle_feedback(spindle.0, spindle.1);
         }
         let mut commanded = [0.0; MAX_AXES];
         commanded[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
-        f_out.send(*motion.f_image())?;
+        let mut fi = *motion.f_image();
+        fi.seq = seq + 1;
+        f_out.send(fi)?;
         seq += 1;
         setpoints.send(ServoSetpoint {
             seq,

@@ -5,7 +5,7 @@ use cnc_motion::{
     motion::alarm, Aux, AxisConfig, Block, Command, Motion, MotionConfig, MotionEvent, Panel,
     RunState,
 };
-use cnc_msgs::signals::GImage;
+use cnc_msgs::signals::{f, g, GImage, SignalTable};
 
 fn lathe() -> MotionConfig {
     let axis = |name: &str, diameter, min, max| AxisConfig {
@@ -58,14 +58,17 @@ fn ticks(m: &mut Motion, g: &GImage, n: usize) {
 fn run(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(u64, i32)>) {
     let mut trace = vec![];
     let mut strobes = vec![];
-    let mut g = GImage::default();
+    let mut g = GImage::released();
     for _ in 0..max_ticks {
         let actual = m.commanded().to_vec();
         m.tick(Some(&actual), &g);
-        let f = *m.f_image();
-        if f.mf == 1 && g.fin_seq != f.strobe_seq {
-            strobes.push((f.strobe_seq, f.m_code));
-            g.fin_seq = f.strobe_seq;
+        let fi = *m.f_image();
+        if fi.get(f::MF) && !g.get(g::FIN) {
+            strobes.push((strobes.len() as u64 + 1, fi.read_i32(f::M_CODE)));
+            g.set(g::FIN, true);
+        }
+        if !(fi.get(f::MF) || fi.get(f::SF) || fi.get(f::TF)) {
+            g.set(g::FIN, false);
         }
         trace.push(m.commanded_display());
         if matches!(m.state(), RunState::Idle | RunState::Alarm) {
@@ -195,7 +198,7 @@ fn feed_hold_stops_on_the_path_and_cycle_start_resumes() {
         },
     ));
     m.push(block(2, 2, Command::ProgramEnd));
-    let g = GImage::default();
+    let g = GImage::released();
     ticks(&mut m, &g, 200);
     m.feed_hold();
     ticks(&mut m, &g, 200);
@@ -221,9 +224,9 @@ fn emergency_stop_drops_the_run_and_holds_position() {
             feed: 1200.0,
         },
     ));
-    let mut g = GImage::default();
+    let mut g = GImage::released();
     ticks(&mut m, &g, 50);
-    g.emergency_stop = 1;
+    g.set(g::ESP_N, false);
     ticks(&mut m, &g, 1);
     let stopped = m.commanded_display();
     ticks(&mut m, &g, 10);
@@ -272,7 +275,7 @@ fn cycle_stop_stops_on_the_path_and_drops_the_rest_of_the_run() {
             end: vec![80.0, 0.0],
         },
     ));
-    let g = GImage::default();
+    let g = GImage::released();
     ticks(&mut m, &g, 100);
     m.cycle_stop();
     ticks(&mut m, &g, 200);
@@ -359,7 +362,7 @@ fn feed_hold_mid_arc_stops_within_the_braking_distance_and_resumes_on_the_same_p
 
         let mut m = Motion::new(cfg.clone(), &start);
         circle_program(&mut m);
-        let g = GImage::default();
+        let g = GImage::released();
         let mut trace = vec![m.commanded_display()];
         for _ in 0..100 {
             let actual = m.commanded().to_vec();
@@ -414,7 +417,7 @@ fn lost_drive_feedback_stops_the_output_within_three_ticks() {
             feed: 1200.0,
         },
     ));
-    let g = GImage::default();
+    let g = GImage::released();
     ticks(&mut m, &g, 50);
     assert_eq!(m.state(), RunState::Running);
     // The drives stop answering.
@@ -449,7 +452,7 @@ fn a_stalled_drive_raises_the_following_error_alarm() {
             end: vec![50.0, -200.0],
         },
     ));
-    let g = GImage::default();
+    let g = GImage::released();
     // Z is stuck at 0 while its setpoint runs away.
     let mut raised = None;
     for tick in 0..2000 {
@@ -490,7 +493,7 @@ fn three_lines(m: &mut Motion) {
 
 /// Largest Z speed in a run of ticks, mm/min.
 fn top_speed(m: &mut Motion, ticks: usize) -> f64 {
-    let g = GImage::default();
+    let g = GImage::released();
     let mut top: f64 = 0.0;
     for _ in 0..ticks {
         let before = m.commanded_display()[1];
@@ -509,7 +512,7 @@ fn single_block_stops_after_each_line_until_cycle_start() {
         ..Panel::default()
     });
     three_lines(&mut m);
-    let g = GImage::default();
+    let g = GImage::released();
     let mut stops = vec![];
     for _ in 0..20 {
         ticks(&mut m, &g, 2000);
@@ -653,7 +656,7 @@ fn a_thread_too_fine_to_finish_is_refused_with_an_alarm() {
             start_angle: 0.0,
         },
     ));
-    ticks(&mut m, &GImage::default(), 3);
+    ticks(&mut m, &GImage::released(), 3);
     assert_eq!(m.state(), RunState::Alarm);
     let events = m.take_events();
     assert!(

@@ -1,7 +1,19 @@
-//! plc: the machine logic. [`logic`] is the scanned core; [`node`] binds it to iceoryx2 images
-//! and ROS 2 topics.
+//! plc: the machine logic as a ladder program, FANUC-PMC style (`000` §18, inventory §9).
+//!
+//! [`program`] parses and checks the mnemonic text, [`engine`] executes its instructions over
+//! [`memory`], [`scan`] is the two-level scan cycle with the NC and machine images; [`node`]
+//! binds it to iceoryx2 images and ROS 2 topics. `programs/lathe_standard.plc` is the standard
+//! lathe logic.
 
-pub mod logic;
+pub mod address;
+pub mod engine;
+pub mod memory;
 pub mod node;
+pub mod program;
+pub mod scan;
 
-pub use logic::{Plc, PlcEvent};
+pub use program::{LoadError, Program};
+pub use scan::{Plc, PlcEvent, Value};
+
+/// The standard lathe program, built in so a machine runs without a PLC file.
+pub const LATHE_STANDARD: &str = include_str!("../programs/lathe_standard.plc");

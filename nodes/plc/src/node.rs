@@ -1,45 +1,91 @@
-//! plc node shell: scans the logic every `plc.scan_ms` over the F/G and X/Y images (iceoryx2)
-//! and publishes spindle, part count and PLC alarms on DDS.
+//! plc node shell: scans the ladder every `plc.scan_ms` over the F/G and X/Y images
+//! (iceoryx2), and publishes spindle, part count, PLC messages and scan statistics on DDS.
+//!
+//! The program is `plc.program` (default: the built-in standard lathe program). The node
+//! reloads it when the file changes; a program with an error is refused with its line and
+//! reason, and the running program goes on. Keep relays, data registers and presets are
+//! saved to `plc.memory_file` (atomically) when they change.
 
-use cnc_msgs::msg::{Alarm, PartCount, SpindleState};
-use cnc_msgs::signals::{FImage, GImage, XImage, YImage};
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
+
+use cnc_msgs::msg::{Alarm, PartCount, PlcStatus, SpindleState};
+use cnc_msgs::signals::{f, x, y, FImage, SignalTable, XImage};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
 use cnc_runtime::dds::{qos, stamp, RosNode};
 use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::{LaunchConfig, Shutdown};
 
-use crate::logic::{Plc, PlcEvent};
+use crate::memory::Retained;
+use crate::scan::{PlcEvent, PLC_FAULT_ALARM};
+use crate::{Plc, Program, LATHE_STANDARD};
+
+/// Alarm raised (as a warning) when a new program is refused.
+pub const PROGRAM_REFUSED_ALARM: u32 = 1091;
+/// The symbol a program names its part counter with (4 bytes).
+pub const PART_COUNT_SYMBOL: &str = "PART_COUNT";
+
+/// Reads the program text: the configured file, or the built-in standard program.
+pub fn program_text(path: Option<&Path>) -> Result<String, String> {
+    match path {
+        None => Ok(LATHE_STANDARD.to_string()),
+        Some(p) => std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display())),
+    }
+}
+
+fn load_retained(path: Option<&Path>) -> Option<Retained> {
+    let text = std::fs::read_to_string(path?).ok()?;
+    match serde_yaml::from_str(&text) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            log::warn!("PLC memory file ignored: {e}");
+            None
+        }
+    }
+}
+
+fn modified(path: &Path) -> Option<SystemTime> {
+    std::fs::metadata(path).and_then(|m| m.modified()).ok()
+}
 
 pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
+    let program_path: Option<PathBuf> = cfg.plc.program.clone();
+    let text = program_text(program_path.as_deref())?;
+    // The first program must be good: a machine without machine logic does not start.
+    let program = Program::parse(&text).map_err(|e| {
+        format!(
+            "PLC program {}: {e}",
+            program_path
+                .as_ref()
+                .map_or("(built in)".into(), |p| p.display().to_string())
+        )
+    })?;
+    let memory_file = cfg.plc.memory_file.clone();
+    let mut saved = load_retained(memory_file.as_deref());
+    let mut plc = Plc::new(program, saved.as_ref(), cfg.plc.level2_divisions as usize);
+    let mut program_mtime = program_path.as_deref().and_then(modified);
+
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "plc")?;
     let spindle_pub =
         ros.publisher::<SpindleState>("spindle", "cnc_msgs/msg/SpindleState", qos::state())?;
     let parts_pub =
         ros.publisher::<PartCount>("part_count", "cnc_msgs/msg/PartCount", qos::state())?;
+    let status_pub =
+        ros.publisher::<PlcStatus>("plc/status", "cnc_msgs/msg/PlcStatus", qos::state())?;
     let alarms = AlarmReporter::new(&mut ros, "plc")?;
     let shm = ShmNode::new(&instance, "plc")?;
     let f_in = shm.receiver::<FImage>(channel::F_IMAGE, false)?;
     let x_in = shm.receiver::<XImage>(channel::X_IMAGE, false)?;
-    let g_out = shm.sender::<GImage>(channel::G_IMAGE, false)?;
-    let y_out = shm.sender::<YImage>(channel::Y_IMAGE, false)?;
-    let mut plc = Plc::new(0);
-    let (mut f, mut x) = (FImage::default(), XImage::default());
+    let g_out = shm.sender::<cnc_msgs::signals::GImage>(channel::G_IMAGE, false)?;
+    let y_out = shm.sender::<cnc_msgs::signals::YImage>(channel::Y_IMAGE, false)?;
+    let (mut fi, mut xi) = (FImage::default(), XImage::default());
     let period = (cfg.plc.scan_ms * 1e6) as u64;
     let t0 = monotonic_ns();
     let mut next = t0;
-    let mut scans = 0u64;
-    let mut last_cycle_time = 0.0;
-    let publish_parts = |count: u32, last: f64| {
-        let _ = parts_pub.publish(PartCount {
-            stamp: stamp(),
-            count,
-            target: 0,
-            last_cycle_time: last,
-        });
-    };
-    publish_parts(0, 0.0);
-    let mut last_spindle: Option<(f64, u32, bool, i64)> = None;
+    let mut scan_times = ScanTimes::default();
+    let mut parts = PartCounter::default();
+    let mut last_spindle = None;
     while !shutdown.requested() {
         next += period;
         sleep_until_ns(next);
@@ -47,56 +93,216 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             next = monotonic_ns();
         }
         if let Some(v) = f_in.latest()? {
-            f = v;
+            fi = v;
         }
         if let Some(v) = x_in.latest()? {
-            x = v;
+            xi = v;
         }
-        plc.scan(&f, &x, (monotonic_ns() - t0) as f64 * 1e-9);
+        let start = monotonic_ns();
+        plc.scan(&fi, &xi, (start - t0) / 1_000_000);
+        scan_times.record((monotonic_ns() - start) as f64 / 1000.0);
         g_out.send(*plc.to_nc())?;
         y_out.send(*plc.outputs())?;
         for e in plc.take_events() {
             match e {
-                PlcEvent::AlarmRaised { number, text } => {
-                    alarms.raise(alarms.alarm(number, Alarm::SEVERITY_FATAL, &text, "", 0))
+                PlcEvent::MessageOn {
+                    number,
+                    address,
+                    text,
+                    alarm,
+                } => {
+                    let severity = if alarm {
+                        Alarm::SEVERITY_ERROR
+                    } else {
+                        Alarm::SEVERITY_INFO
+                    };
+                    alarms.raise(alarms.alarm(
+                        number,
+                        severity,
+                        &format!("{address} {text}"),
+                        "",
+                        0,
+                    ))
                 }
-                PlcEvent::AlarmCleared { number } => alarms.clear(number),
-                PlcEvent::PartCounted { count, cycle_time } => {
-                    last_cycle_time = cycle_time;
-                    publish_parts(count, cycle_time);
+                PlcEvent::MessageOff { number } => alarms.clear(number),
+                PlcEvent::Fault { text } => {
+                    alarms.raise(alarms.alarm(PLC_FAULT_ALARM, Alarm::SEVERITY_FATAL, &text, "", 0))
                 }
             }
         }
-        scans += 1;
-        // Spindle state on change (to the rpm) and at least every 100 ms.
-        let y = plc.outputs();
-        let key = (
-            plc.commanded_rpm(),
-            y.spindle_direction,
-            x.spindle_at_speed != 0,
-            x.spindle_actual_rpm.round() as i64,
-        );
-        if last_spindle != Some(key) || scans.is_multiple_of(10) {
-            last_spindle = Some(key);
-            let direction = match y.spindle_direction {
-                1 => SpindleState::DIRECTION_CW,
-                2 => SpindleState::DIRECTION_CCW,
-                _ => SpindleState::DIRECTION_STOP,
-            };
-            let _ = spindle_pub.publish(SpindleState {
-                stamp: stamp(),
-                commanded_rpm: plc.commanded_rpm(),
-                actual_rpm: x.spindle_actual_rpm.abs(),
-                direction,
-                // The simulated spindle models no cutting load yet.
-                load: 0.0,
-                override_percent: 100.0,
-                at_speed: x.spindle_at_speed != 0 && direction != SpindleState::DIRECTION_STOP,
-            });
+        let scans = plc.scans();
+        let now_s = (monotonic_ns() - t0) as f64 * 1e-9;
+        if let Some(msg) = parts.update(&plc, &fi, now_s, scans.is_multiple_of(500)) {
+            let _ = parts_pub.publish(msg);
         }
-        if scans.is_multiple_of(500) {
-            publish_parts(plc.part_count(), last_cycle_time);
+        publish_spindle(&spindle_pub, plc.outputs(), &xi, &mut last_spindle, scans);
+        if scans.is_multiple_of(100) {
+            // Once a second at 10 ms: status, program file, parameters.
+            let _ = status_pub.publish(scan_times.message(
+                &plc,
+                &program_path,
+                cfg.plc.level2_divisions,
+            ));
+            if let Some(p) = program_path.as_deref() {
+                let m = modified(p);
+                if m != program_mtime {
+                    program_mtime = m;
+                    reload(&mut plc, p, &alarms);
+                }
+            }
+            if let Some(path) = memory_file.as_deref() {
+                let now = plc.retained();
+                if saved.as_ref() != Some(&now) {
+                    match serde_yaml::to_string(&now)
+                        .map_err(|e| e.to_string())
+                        .and_then(|t| cnc_runtime::persist::write_atomic(path, &t))
+                    {
+                        Ok(()) => saved = Some(now),
+                        Err(e) => log::warn!("PLC memory not saved: {e}"),
+                    }
+                }
+            }
         }
     }
     Ok(())
+}
+
+fn reload(plc: &mut Plc, path: &Path, alarms: &AlarmReporter) {
+    let result = program_text(Some(path)).and_then(|t| plc.load(&t).map_err(|e| e.to_string()));
+    match result {
+        Ok(()) => {
+            log::info!("PLC program {} loaded", path.display());
+            alarms.clear(PROGRAM_REFUSED_ALARM);
+        }
+        Err(e) => {
+            let text = format!(
+                "PLC program {} refused, the previous program runs on: {e}",
+                path.display()
+            );
+            log::warn!("{text}");
+            alarms.raise(alarms.alarm(
+                PROGRAM_REFUSED_ALARM,
+                Alarm::SEVERITY_WARNING,
+                &text,
+                "",
+                0,
+            ));
+        }
+    }
+}
+
+/// Scan durations for the status topic.
+#[derive(Default)]
+struct ScanTimes {
+    recent: Vec<f64>,
+    last: f64,
+    max: f64,
+}
+
+impl ScanTimes {
+    fn record(&mut self, us: f64) {
+        self.last = us;
+        self.max = self.max.max(us);
+        if self.recent.len() >= 1000 {
+            self.recent.remove(0);
+        }
+        self.recent.push(us);
+    }
+
+    fn message(&self, plc: &Plc, path: &Option<PathBuf>, divisions: u32) -> PlcStatus {
+        let mut sorted = self.recent.clone();
+        sorted.sort_by(f64::total_cmp);
+        let p99 = sorted
+            .get((sorted.len() * 99 / 100).min(sorted.len().saturating_sub(1)))
+            .copied()
+            .unwrap_or(0.0);
+        PlcStatus {
+            stamp: stamp(),
+            program: path
+                .as_ref()
+                .map_or("lathe_standard.plc (built in)".into(), |p| {
+                    p.display().to_string()
+                }),
+            steps: plc.program().steps.len() as u32,
+            scans: plc.scans(),
+            level2_divisions: divisions,
+            scan_time_last_us: self.last,
+            scan_time_p99_us: p99,
+            scan_time_max_us: self.max,
+            fault: plc.fault().unwrap_or_default().to_string(),
+        }
+    }
+}
+
+/// The part count the program keeps at `PART_COUNT`, and the time of each cycle (from the
+/// NC's OP signal coming on to the count going up).
+#[derive(Default)]
+struct PartCounter {
+    last: Option<i64>,
+    cycle_started: Option<f64>,
+    last_cycle_time: f64,
+}
+
+impl PartCounter {
+    fn update(&mut self, plc: &Plc, fi: &FImage, now: f64, every: bool) -> Option<PartCount> {
+        let count = plc.read_value(PART_COUNT_SYMBOL, 4).unwrap_or(0);
+        if fi.get(f::OP) && self.cycle_started.is_none() {
+            self.cycle_started = Some(now);
+        }
+        let changed = self.last != Some(count);
+        if changed && self.last.is_some() {
+            self.last_cycle_time = self.cycle_started.map_or(0.0, |t| now - t);
+            self.cycle_started = None;
+        }
+        if !fi.get(f::OP) && changed {
+            self.cycle_started = None;
+        }
+        self.last = Some(count);
+        (changed || every).then(|| PartCount {
+            stamp: stamp(),
+            count: count.clamp(0, i64::from(u32::MAX)) as u32,
+            target: 0,
+            last_cycle_time: self.last_cycle_time,
+        })
+    }
+}
+
+/// Spindle state on change (to the rpm) and at least every 100 scans.
+fn publish_spindle(
+    publisher: &ros2_client::dds::Publisher<SpindleState>,
+    yi: &cnc_msgs::signals::YImage,
+    xi: &XImage,
+    last: &mut Option<(i64, u8, bool, i64)>,
+    scans: u64,
+) {
+    let direction = match (yi.get(y::SPINDLE_CW), yi.get(y::SPINDLE_CCW)) {
+        (true, false) => SpindleState::DIRECTION_CW,
+        (false, true) => SpindleState::DIRECTION_CCW,
+        _ => SpindleState::DIRECTION_STOP,
+    };
+    let commanded = if direction == SpindleState::DIRECTION_STOP {
+        0.0
+    } else {
+        yi.spindle_rpm
+    };
+    let at_speed = xi.get(x::SPINDLE_AT_SPEED) && direction != SpindleState::DIRECTION_STOP;
+    let key = (
+        commanded.round() as i64,
+        direction,
+        at_speed,
+        xi.spindle_actual_rpm.round() as i64,
+    );
+    if *last != Some(key) || scans.is_multiple_of(100) {
+        *last = Some(key);
+        let _ = publisher.publish(SpindleState {
+            stamp: stamp(),
+            commanded_rpm: commanded,
+            actual_rpm: xi.spindle_actual_rpm.abs(),
+            direction,
+            // The simulated spindle models no cutting load yet.
+            load: 0.0,
+            override_percent: 100.0,
+            at_speed,
+        });
+    }
 }

@@ -287,6 +287,13 @@ pub struct SimConfig {
     pub at_speed_tolerance: f64,
     #[serde(default = "default_coolant_delay")]
     pub coolant_delay: f64,
+    /// Stations of the electric turret (4, 6 or 8).
+    #[serde(default = "default_turret_stations")]
+    pub turret_stations: u8,
+}
+
+fn default_turret_stations() -> u8 {
+    8
 }
 
 fn default_spindle_acc() -> f64 {
@@ -305,6 +312,7 @@ impl Default for SimConfig {
             spindle_acceleration: default_spindle_acc(),
             at_speed_tolerance: default_at_speed(),
             coolant_delay: default_coolant_delay(),
+            turret_stations: default_turret_stations(),
         }
     }
 }
@@ -315,6 +323,21 @@ pub struct PlcConfig {
     /// Level-1 scan period, ms.
     #[serde(default = "default_scan")]
     pub scan_ms: f64,
+    /// Level 2 runs in this many slices, one per scan.
+    #[serde(default = "default_level2_divisions")]
+    pub level2_divisions: u32,
+    /// The ladder program (mnemonic text); default: the built-in standard lathe program.
+    /// The node reloads it when the file changes; a program with an error is refused and the
+    /// running one stays.
+    #[serde(default)]
+    pub program: Option<std::path::PathBuf>,
+    /// Keep relays, data registers and timer/counter presets (the PLC parameter page).
+    #[serde(default)]
+    pub memory_file: Option<std::path::PathBuf>,
+}
+
+fn default_level2_divisions() -> u32 {
+    2
 }
 
 fn default_scan() -> f64 {
@@ -325,6 +348,9 @@ impl Default for PlcConfig {
     fn default() -> Self {
         PlcConfig {
             scan_ms: default_scan(),
+            level2_divisions: default_level2_divisions(),
+            program: None,
+            memory_file: None,
         }
     }
 }
@@ -452,6 +478,18 @@ impl LaunchConfig {
         }
         if self.network.interfaces.is_empty() {
             return Err("network.interfaces must name at least one interface address".into());
+        }
+        if !(1..=16).contains(&self.plc.level2_divisions) {
+            return Err(format!(
+                "plc.level2_divisions {} outside 1..16",
+                self.plc.level2_divisions
+            ));
+        }
+        if ![4, 6, 8].contains(&self.sim.turret_stations) {
+            return Err(format!(
+                "sim.turret_stations {}: 4, 6 or 8",
+                self.sim.turret_stations
+            ));
         }
         if !(1.0..=100.0).contains(&self.plc.scan_ms) {
             return Err(format!("plc.scan_ms {} outside 1..100", self.plc.scan_ms));

@@ -1,12 +1,17 @@
 //! The simulated lathe: axes that follow setpoints with a first-order drive lag (interpolating
 //! linearly between setpoints, as drives do, so a slide at constant speed lags its setpoint by
 //! exactly speed × time constant), a spindle that
-//! ramps to its commanded speed, coolant with a pressure switch, a chuck, an emergency-stop input.
+//! ramps to its commanded speed with a brake, an emergency-stop input, and the [`devices`] the
+//! PLC drives (turret, chuck, door, tailstock, coolant, air).
 //!
 //! Pure: [`SimLathe::step`] advances the machine by `dt` seconds.
 
+pub mod devices;
+
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
-use cnc_msgs::signals::{XImage, YImage};
+use cnc_msgs::signals::{x, y, SignalTable, XImage, YImage};
+
+pub use devices::{DeviceConfig, Devices};
 
 /// Simulation parameters.
 #[derive(Debug, Clone, PartialEq)]
@@ -17,8 +22,7 @@ pub struct SimConfig {
     pub spindle_acceleration: f64,
     /// "At speed" window, fraction of the commanded speed.
     pub at_speed_tolerance: f64,
-    /// Coolant pressure builds this long after the pump starts, s.
-    pub coolant_delay: f64,
+    pub devices: DeviceConfig,
 }
 
 #[derive(Debug, Clone)]
@@ -29,8 +33,7 @@ pub struct SimLathe {
     last_setpoint: [f64; MAX_AXES],
     spindle_rpm: f64,
     spindle_angle: f64,
-    coolant_time: f64,
-    chuck_clamped: bool,
+    pub devices: Devices,
     emergency_stop: bool,
     x_seq: u64,
 }
@@ -43,13 +46,12 @@ impl SimLathe {
             *p = *s;
         }
         SimLathe {
+            devices: Devices::new(cfg.devices.clone()),
             cfg,
             position,
             last_setpoint: position,
             spindle_rpm: 0.0,
             spindle_angle: 0.0,
-            coolant_time: 0.0,
-            chuck_clamped: false,
             emergency_stop: false,
             x_seq: 0,
         }
@@ -97,26 +99,19 @@ impl SimLathe {
                 self.position[i]
             };
         }
-        // Spindle: ramp toward the signed command; stops on emergency stop.
+        // Spindle: ramp toward the signed command, three times as fast with the brake on;
+        // stops on emergency stop.
         let command = if self.emergency_stop {
             0.0
         } else {
-            match y.spindle_direction {
-                1 => y.spindle_rpm.max(0.0),
-                2 => -y.spindle_rpm.max(0.0),
-                _ => 0.0,
-            }
+            spindle_command(y)
         };
-        let step = self.cfg.spindle_acceleration * dt;
+        let brake = if y.get(y::SPINDLE_BRAKE) { 3.0 } else { 1.0 };
+        let step = self.cfg.spindle_acceleration * brake * dt;
         self.spindle_rpm += (command - self.spindle_rpm).clamp(-step, step);
         self.spindle_angle =
             (self.spindle_angle + self.spindle_rpm / 60.0 * 360.0 * dt).rem_euclid(360.0);
-        self.coolant_time = if y.coolant != 0 && !self.emergency_stop {
-            self.coolant_time + dt
-        } else {
-            0.0
-        };
-        self.chuck_clamped = y.chuck_clamp != 0;
+        self.devices.step(y, dt);
         ServoFeedback {
             seq: setpoint.seq,
             setpoint_sent_ns: setpoint.sent_ns,
@@ -131,20 +126,30 @@ impl SimLathe {
     /// The machine's inputs as the PLC reads them.
     pub fn x_image(&mut self, y: &YImage) -> XImage {
         self.x_seq += 1;
-        let commanded = match y.spindle_direction {
-            1 => y.spindle_rpm,
-            2 => -y.spindle_rpm,
-            _ => 0.0,
-        };
+        let commanded = spindle_command(y);
         let tol = (commanded.abs() * self.cfg.at_speed_tolerance).max(1.0);
-        XImage {
+        let mut xi = XImage {
             seq: self.x_seq,
-            emergency_stop: u32::from(self.emergency_stop),
             spindle_actual_rpm: self.spindle_rpm,
-            spindle_at_speed: u32::from((self.spindle_rpm - commanded).abs() <= tol),
-            coolant_pressure: u32::from(self.coolant_time >= self.cfg.coolant_delay),
-            chuck_clamped: u32::from(self.chuck_clamped),
-        }
+            ..Default::default()
+        };
+        xi.set(x::ESP_N, !self.emergency_stop);
+        xi.set(
+            x::SPINDLE_AT_SPEED,
+            (self.spindle_rpm - commanded).abs() <= tol,
+        );
+        self.devices.sensors(&mut xi);
+        xi
+    }
+}
+
+/// The signed speed the PLC commands: the analog value with the direction of the CW/CCW
+/// contactors (none or both: stop).
+fn spindle_command(yi: &YImage) -> f64 {
+    match (yi.get(y::SPINDLE_CW), yi.get(y::SPINDLE_CCW)) {
+        (true, false) => yi.spindle_rpm.max(0.0),
+        (false, true) => -yi.spindle_rpm.max(0.0),
+        _ => 0.0,
     }
 }
 
@@ -158,7 +163,7 @@ mod tests {
                 drive_lag: vec![0.008, 0.008],
                 spindle_acceleration: 2000.0,
                 at_speed_tolerance: 0.02,
-                coolant_delay: 0.2,
+                devices: DeviceConfig::default(),
             },
             &[10.0, 20.0],
         )
@@ -199,26 +204,26 @@ mod tests {
     #[test]
     fn spindle_ramps_and_reports_at_speed() {
         let mut m = sim();
-        let y = YImage {
-            spindle_direction: 1,
+        let mut y = YImage {
             spindle_rpm: 1000.0,
             ..Default::default()
         };
+        y.set(y::SPINDLE_CW, true);
         let sp = ServoSetpoint::default();
         for _ in 0..100 {
             m.step(&sp, &y, 0.004); // 0.4 s at 2000 rpm/s = 800 rpm
         }
         assert!((m.spindle_rpm() - 800.0).abs() < 1e-6);
-        assert_eq!(m.x_image(&y).spindle_at_speed, 0);
+        assert!(!m.x_image(&y).get(x::SPINDLE_AT_SPEED));
         for _ in 0..100 {
             m.step(&sp, &y, 0.004);
         }
-        assert_eq!(m.x_image(&y).spindle_at_speed, 1);
+        assert!(m.x_image(&y).get(x::SPINDLE_AT_SPEED));
         m.set_emergency_stop(true);
         for _ in 0..300 {
             m.step(&sp, &y, 0.004);
         }
         assert_eq!(m.spindle_rpm(), 0.0);
-        assert_eq!(m.x_image(&y).emergency_stop, 1);
+        assert!(!m.x_image(&y).get(x::ESP_N));
     }
 }

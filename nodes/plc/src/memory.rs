@@ -1,0 +1,175 @@
+//! The PLC's memory: the byte tables, timers, counters and edge detectors, and the part of it
+//! that survives a restart (keep relays K, data registers D, timer and counter presets).
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+use crate::address::{
+    BitAddr, ByteAddr, Space, COUNTERS, EDGES, FIXED_COUNTERS, FIXED_TIMERS, TIMERS,
+};
+
+/// An on-delay timer: running since a scan time, ms.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Timer {
+    pub preset_ms: u32,
+    pub since: Option<u64>,
+}
+
+impl Timer {
+    /// The timer's contact after a scan at `now_ms` with input `act`.
+    pub fn run(&mut self, act: bool, now_ms: u64) -> bool {
+        if act {
+            let since = *self.since.get_or_insert(now_ms);
+            now_ms.saturating_sub(since) >= u64::from(self.preset_ms)
+        } else {
+            self.since = None;
+            false
+        }
+    }
+
+    /// Elapsed time while running, ms.
+    pub fn elapsed(&self, now_ms: u64) -> u64 {
+        self.since.map_or(0, |s| now_ms.saturating_sub(s))
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Counter {
+    pub preset: i64,
+    pub current: i64,
+}
+
+#[derive(Debug, Clone)]
+pub struct Memory {
+    tables: Vec<Vec<u8>>,
+    pub timers: Vec<Timer>,
+    pub fixed_timers: Vec<Timer>,
+    pub counters: Vec<Counter>,
+    pub fixed_counters: Vec<Counter>,
+    /// DIFU/DIFD: ACT of the previous scan.
+    pub edges: Vec<bool>,
+    /// Per step: ACT of the previous execution (counters and shift registers count edges).
+    pub step_act: Vec<bool>,
+}
+
+impl Default for Memory {
+    fn default() -> Self {
+        Memory {
+            tables: Space::ALL.iter().map(|s| vec![0; s.size()]).collect(),
+            timers: vec![Timer::default(); TIMERS as usize],
+            fixed_timers: vec![Timer::default(); FIXED_TIMERS as usize],
+            counters: vec![Counter::default(); COUNTERS as usize],
+            fixed_counters: vec![Counter::default(); FIXED_COUNTERS as usize],
+            edges: vec![false; EDGES as usize],
+            step_act: Vec::new(),
+        }
+    }
+}
+
+fn slot(s: Space) -> usize {
+    Space::ALL.iter().position(|x| *x == s).unwrap_or(0)
+}
+
+impl Memory {
+    pub fn table(&self, s: Space) -> &[u8] {
+        &self.tables[slot(s)]
+    }
+    pub fn table_mut(&mut self, s: Space) -> &mut [u8] {
+        &mut self.tables[slot(s)]
+    }
+
+    pub fn byte(&self, a: ByteAddr) -> u8 {
+        self.table(a.space)
+            .get(a.index as usize)
+            .copied()
+            .unwrap_or(0)
+    }
+
+    pub fn set_byte(&mut self, a: ByteAddr, v: u8) {
+        if let Some(d) = self.table_mut(a.space).get_mut(a.index as usize) {
+            *d = v;
+        }
+    }
+
+    pub fn bit(&self, b: BitAddr) -> bool {
+        self.byte(b.byte) >> b.bit & 1 == 1
+    }
+
+    pub fn set_bit(&mut self, b: BitAddr, on: bool) {
+        let v = self.byte(b.byte);
+        let m = 1u8 << b.bit;
+        self.set_byte(b.byte, if on { v | m } else { v & !m });
+    }
+
+    /// A binary value of `format` bytes, least significant first. One byte reads unsigned
+    /// (0–255: codes, tool numbers, masks); two and four bytes read signed.
+    pub fn read(&self, a: ByteAddr, format: u8) -> i64 {
+        let t = self.table(a.space);
+        let i = a.index as usize;
+        let b = |k: usize| t.get(i + k).copied().unwrap_or(0);
+        match format {
+            1 => i64::from(b(0)),
+            2 => i64::from(i16::from_le_bytes([b(0), b(1)])),
+            _ => i64::from(i32::from_le_bytes([b(0), b(1), b(2), b(3)])),
+        }
+    }
+
+    /// Writes the low `format` bytes of `v`.
+    pub fn write(&mut self, a: ByteAddr, format: u8, v: i64) {
+        let bytes = v.to_le_bytes();
+        let i = a.index as usize;
+        let t = self.table_mut(a.space);
+        for (k, byte) in bytes.iter().take(format as usize).enumerate() {
+            if let Some(d) = t.get_mut(i + k) {
+                *d = *byte;
+            }
+        }
+    }
+
+    /// What survives a restart.
+    pub fn retained(&self) -> Retained {
+        Retained {
+            k: self.table(Space::K).to_vec(),
+            d: self.table(Space::D).to_vec(),
+            timer_presets: (0..TIMERS)
+                .map(|n| (n, self.timers[n as usize].preset_ms))
+                .collect(),
+            counter_presets: (0..COUNTERS)
+                .map(|n| (n, self.counters[n as usize].preset))
+                .collect(),
+        }
+    }
+
+    /// Restores what a previous run kept; sizes that do not match are cut or padded.
+    pub fn restore(&mut self, r: &Retained) {
+        for (space, data) in [(Space::K, &r.k), (Space::D, &r.d)] {
+            for (d, s) in self.table_mut(space).iter_mut().zip(data) {
+                *d = *s;
+            }
+        }
+        for (n, v) in &r.timer_presets {
+            if let Some(t) = self.timers.get_mut(*n as usize) {
+                t.preset_ms = *v;
+            }
+        }
+        for (n, v) in &r.counter_presets {
+            if let Some(c) = self.counters.get_mut(*n as usize) {
+                c.preset = (*v).clamp(0, 32767);
+            }
+        }
+    }
+}
+
+/// Keep relays, data registers and presets, as stored in the PLC memory file.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct Retained {
+    #[serde(default)]
+    pub k: Vec<u8>,
+    #[serde(default)]
+    pub d: Vec<u8>,
+    #[serde(default)]
+    pub timer_presets: BTreeMap<u16, u32>,
+    #[serde(default)]
+    pub counter_presets: BTreeMap<u16, i64>,
+}
