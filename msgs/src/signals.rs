@@ -188,7 +188,7 @@ pub mod f {
     pub const M_CODE: usize = 10;
     /// S code (rpm), 4 bytes binary.
     pub const S_CODE: usize = 22;
-    /// T code (target tool and offset, `0303`), 4 bytes binary.
+    /// The target tool of the T code (3 for `T0303`), 4 bytes binary.
     pub const T_CODE: usize = 26;
 }
 

@@ -123,6 +123,9 @@ struct RapidAxis {
     mover: Mover,
 }
 
+/// Servo ticks the reset signal RST stays on: 100 ms, ten PLC scans.
+const RESET_SIGNAL_TICKS: u32 = 25;
+
 pub struct Motion {
     cfg: MotionConfig,
     queue: VecDeque<Block>,
@@ -142,6 +145,10 @@ pub struct Motion {
     /// stay refused (`dead_run`).
     emergency_stop: bool,
     dead_run: u64,
+    /// ST of the last G image, for its rising edge.
+    plc_start: bool,
+    /// Ticks left of the NC's reset signal RST (F1.1), long enough for the PLC to see it.
+    reset_ticks: u32,
     alarm: bool,
     f: FImage,
     events: Vec<MotionEvent>,
@@ -270,6 +277,8 @@ impl Motion {
             cycle_stop: false,
             emergency_stop: false,
             dead_run: 0,
+            plc_start: false,
+            reset_ticks: 0,
             alarm: false,
             spindle_rpm: 0.0,
             feed_per_rev: false,
@@ -346,6 +355,26 @@ impl Motion {
         };
     }
 
+    /// The operator's signals in the PLC's G image, applied every tick: overrides and
+    /// switches as levels, feed hold while `*SP` is low, cycle start on the rising edge of ST.
+    pub fn plc_signals(&mut self, plc: &GImage) {
+        self.set_panel(Panel {
+            feed_override: plc.feed_override(),
+            rapid_override: plc.rapid_override(),
+            single_block: plc.get(g::SBK),
+            dry_run: plc.get(g::DRN),
+            optional_stop: plc.get(g::MOPS),
+        });
+        if !plc.get(g::SP_N) && plc.get(g::ESP_N) {
+            self.feed_hold();
+        }
+        let start = plc.get(g::ST);
+        if start && !self.plc_start && plc.get(g::SP_N) {
+            self.cycle_start();
+        }
+        self.plc_start = start;
+    }
+
     /// Feed hold: decelerate on the path and wait for [`Motion::cycle_start`].
     pub fn feed_hold(&mut self) {
         self.feed_hold = true;
@@ -365,6 +394,7 @@ impl Motion {
 
     /// Reset: clears the alarm state and the queue; the axes stop where they are.
     pub fn reset(&mut self) {
+        self.reset_ticks = RESET_SIGNAL_TICKS;
         self.alarm = false;
         self.servo_off = false;
         self.missed_feedback = 0;
@@ -842,6 +872,8 @@ impl Motion {
         fi.set(f::MCYC, true);
         fi.set(f::MSBK, self.panel.single_block);
         fi.set(f::DRUR, self.panel.dry_run);
+        fi.set(f::RST, self.reset_ticks > 0);
+        self.reset_ticks = self.reset_ticks.saturating_sub(1);
     }
 
     /// The commanded slide position as a planner point.

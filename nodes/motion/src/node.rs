@@ -12,7 +12,7 @@ use cnc_msgs::msg::{
     Alarm, Axis, AxisState, MotionBlock, MotionStatus, ProgramCommand, ServoStats,
 };
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
-use cnc_msgs::signals::{g, FImage, GImage, SignalTable};
+use cnc_msgs::signals::{FImage, GImage};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -21,7 +21,7 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::motion::alarm;
 use crate::servo::ServoStatistics;
-use crate::{Block, Motion, MotionConfig, MotionEvent, Panel, RunState};
+use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 
 /// The PLC must answer within this time, else motion takes it as an emergency stop.
 const PLC_TIMEOUT_NS: u64 = 500_000_000;
@@ -156,13 +156,11 @@ fn dds_loop(
     Ok(())
 }
 
-/// The G image's operator signals, applied to motion every tick: overrides and switches as
-/// levels, cycle start on its rising edge, feed hold while `*SP` is low.
+/// Whether the PLC keeps answering: motion takes its silence as an emergency stop.
 #[derive(Default)]
 struct PlcLink {
     last_heard: Option<u64>,
     reported: bool,
-    cycle_start: bool,
 }
 
 impl PlcLink {
@@ -175,24 +173,6 @@ impl PlcLink {
     fn silent(&self, now: u64) -> bool {
         self.last_heard
             .is_some_and(|t| now.saturating_sub(t) > PLC_TIMEOUT_NS)
-    }
-
-    fn apply(&mut self, g: &GImage, motion: &mut Motion) {
-        motion.set_panel(Panel {
-            feed_override: g.feed_override(),
-            rapid_override: g.rapid_override(),
-            single_block: g.get(g::SBK),
-            dry_run: g.get(g::DRN),
-            optional_stop: g.get(g::MOPS),
-        });
-        if !g.get(g::SP_N) && g.get(g::ESP_N) {
-            motion.feed_hold();
-        }
-        let start = g.get(g::ST);
-        if start && !self.cycle_start && g.get(g::SP_N) {
-            motion.cycle_start();
-        }
-        self.cycle_start = start;
     }
 }
 
@@ -281,7 +261,7 @@ fn servo_loop(
             }
             g = GImage::default();
         }
-        plc.apply(&g, &mut motion);
+        motion.plc_signals(&g);
         if have_feedback {
             motion.spindle_feedback(spindle.0, spindle.1);
         }

@@ -18,7 +18,7 @@ use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::memory::Retained;
-use crate::scan::{PlcEvent, PLC_FAULT_ALARM};
+use crate::scan::{PlcEvent, EMERGENCY_STOP_ALARM, PLC_FAULT_ALARM};
 use crate::{Plc, Program, LATHE_STANDARD};
 
 /// Alarm raised (as a warning) when a new program is refused.
@@ -125,6 +125,14 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                     ))
                 }
                 PlcEvent::MessageOff { number } => alarms.clear(number),
+                PlcEvent::EmergencyStop(true) => alarms.raise(alarms.alarm(
+                    EMERGENCY_STOP_ALARM,
+                    Alarm::SEVERITY_FATAL,
+                    "emergency stop",
+                    "",
+                    0,
+                )),
+                PlcEvent::EmergencyStop(false) => alarms.clear(EMERGENCY_STOP_ALARM),
                 PlcEvent::Fault { text } => {
                     alarms.raise(alarms.alarm(PLC_FAULT_ALARM, Alarm::SEVERITY_FATAL, &text, "", 0))
                 }

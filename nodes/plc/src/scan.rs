@@ -32,7 +32,12 @@ pub enum PlcEvent {
     Fault {
         text: String,
     },
+    /// The NC's emergency stop (`*ESP`) went active (true) or was released.
+    EmergencyStop(bool),
 }
+
+/// The emergency-stop alarm (`000` Appendix 1, inventory §11.5).
+pub const EMERGENCY_STOP_ALARM: u32 = 65;
 
 /// One address's value for a monitor: a bit, a byte, or a timer/counter.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,6 +68,8 @@ pub struct Plc {
     /// Steps executed by the last scan.
     pub last_steps: usize,
     last_now: u64,
+    /// `*ESP` low at the end of the last scan.
+    emergency_stop: bool,
 }
 
 impl Plc {
@@ -96,6 +103,7 @@ impl Plc {
             scans: 0,
             last_steps: 0,
             last_now: 0,
+            emergency_stop: false,
         }
     }
 
@@ -260,6 +268,11 @@ impl Plc {
             self.y.bytes = [0; signals::Y_BYTES];
             self.y.spindle_rpm = 0.0;
             self.g.set(signals::g::ESP_N, false);
+        }
+        let esp = !self.g.get(signals::g::ESP_N);
+        if esp != self.emergency_stop {
+            self.emergency_stop = esp;
+            self.events.push(PlcEvent::EmergencyStop(esp));
         }
         self.y.seq = self.scans;
         self.g.seq = self.scans;

@@ -1,0 +1,399 @@
+//! The standard PLC program end to end in simulation: the interpreter, motion, the ladder PLC
+//! and the simulated lathe with its devices, each core as the cell runs it, stepped together on
+//! one simulated clock (servo 4 ms, PLC scan 10 ms). Deterministic and fast; the same cores run
+//! in the nodes over DDS and iceoryx2 (`cell_end_to_end.rs`).
+
+use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
+use cnc_io::node::sim_config;
+use cnc_io::sim::SimLathe;
+use cnc_motion::{Block, Command, Motion, MotionConfig, RunState};
+use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
+use cnc_msgs::signals::{f, g, x, y, FImage, GImage, SignalTable, XImage, YImage};
+use cnc_plc::memory::Retained;
+use cnc_plc::{Plc, PlcEvent, Program, Value};
+use cnc_runtime::LaunchConfig;
+
+const DT: f64 = 0.004;
+const SCAN: f64 = 0.010;
+
+struct Rig {
+    interp: Interpreter,
+    motion: Motion,
+    plc: Plc,
+    sim: SimLathe,
+    t: f64,
+    next_scan: f64,
+    gi: GImage,
+    yi: YImage,
+    xi: XImage,
+    fb: ServoFeedback,
+    sent: u64,
+    finished: bool,
+    events: Vec<(f64, PlcEvent)>,
+    n: usize,
+    /// Cycle start given: the interpreter feeds motion.
+    started: bool,
+}
+
+fn config() -> LaunchConfig {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/launch_configs/sim_lathe.yaml"
+    ))
+    .unwrap();
+    LaunchConfig::from_yaml(&text).unwrap()
+}
+
+impl Rig {
+    fn new(program: &str, retained: Option<&Retained>) -> Rig {
+        let cfg = config();
+        let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
+        let dialect = Dialect::from_name(&cfg.machine.dialect).unwrap();
+        let interp = Interpreter::with_library(dialect, program, setup, Library::new());
+        let mcfg = MotionConfig::from_launch(&cfg);
+        let n = mcfg.axes.len();
+        let start: Vec<f64> = cfg
+            .home()
+            .iter()
+            .zip(&mcfg.axes)
+            .map(|(p, a)| p * a.scale())
+            .collect();
+        let mut sim = SimLathe::new(sim_config(&cfg), &start);
+        let fb = sim.step(&ServoSetpoint::default(), &YImage::default(), 0.0);
+        let plc = Plc::new(
+            Program::parse(cnc_plc::LATHE_STANDARD).unwrap(),
+            retained,
+            2,
+        );
+        Rig {
+            interp,
+            motion: Motion::new(mcfg, &start),
+            plc,
+            sim,
+            t: 0.0,
+            next_scan: 0.0,
+            gi: GImage::default(),
+            yi: YImage::default(),
+            xi: XImage::default(),
+            fb,
+            sent: 0,
+            finished: false,
+            events: Vec::new(),
+            n,
+            started: false,
+        }
+    }
+
+    /// One servo period; the PLC scans when its 10 ms are due.
+    fn tick(&mut self) {
+        while self.started && !self.finished && self.sent - self.motion.done_seq() < 32 {
+            match self.interp.next_command() {
+                Ok(Some(Canon { line, command })) => {
+                    self.sent += 1;
+                    self.finished = command == Command::ProgramEnd;
+                    self.motion.push(Block {
+                        run_id: 1,
+                        seq: self.sent,
+                        line,
+                        kind: command,
+                    });
+                }
+                Ok(None) => self.finished = true,
+                Err(e) => panic!("alarm {} at line {}: {}", e.number, e.line, e.text),
+            }
+        }
+        let mut actual = [0.0; MAX_AXES];
+        actual[..self.n].copy_from_slice(&self.fb.position[..self.n]);
+        self.motion.plc_signals(&self.gi);
+        self.motion
+            .spindle_feedback(self.fb.spindle_rpm, self.fb.spindle_angle_deg);
+        let mut sp = ServoSetpoint {
+            axis_count: self.n as u32,
+            ..Default::default()
+        };
+        sp.position[..self.n].copy_from_slice(self.motion.tick(Some(&actual[..self.n]), &self.gi));
+        sp.enable = u32::from(self.motion.servo_enabled());
+        self.fb = self.sim.step(&sp, &self.yi, DT);
+        self.t += DT;
+        if self.t + 1e-9 >= self.next_scan {
+            self.next_scan += SCAN;
+            self.xi = self.sim.x_image(&self.yi);
+            self.plc.scan(
+                self.motion.f_image(),
+                &self.xi,
+                (self.t * 1000.0).round() as u64,
+            );
+            self.gi = *self.plc.to_nc();
+            self.yi = *self.plc.outputs();
+            let t = self.t;
+            self.events
+                .extend(self.plc.take_events().into_iter().map(|e| (t, e)));
+        }
+    }
+
+    /// Ticks until `done` or `seconds` pass; true if `done`.
+    fn run_until(&mut self, seconds: f64, mut done: impl FnMut(&Rig) -> bool) -> bool {
+        let end = self.t + seconds;
+        while self.t < end {
+            self.tick();
+            if done(self) {
+                return true;
+            }
+        }
+        false
+    }
+
+    fn program_done(&self) -> bool {
+        self.finished
+            && self.motion.done_seq() == self.sent
+            && self.motion.state() == RunState::Idle
+    }
+
+    fn nc(&self) -> &FImage {
+        self.motion.f_image()
+    }
+
+    fn turret_station(&self) -> Option<u8> {
+        self.sim.devices.turret_station()
+    }
+
+    fn message(&self, address: &str) -> Option<f64> {
+        self.events.iter().find_map(|(t, e)| match e {
+            PlcEvent::MessageOn { address: a, .. } if a == address => Some(*t),
+            _ => None,
+        })
+    }
+
+    fn bit(&self, name: &str) -> bool {
+        matches!(self.plc.read(name), Ok(Value::Bit(true)))
+    }
+}
+
+/// Power-on: the PLC's first scans release the emergency stop and the machine settles.
+fn powered(program: &str) -> Rig {
+    let mut r = Rig::new(program, None);
+    r.run_until(0.1, |_| false);
+    assert!(r.gi.get(g::ESP_N), "E-stop released after power-on");
+    r.started = true;
+    r
+}
+
+#[test]
+fn t0303_turns_the_short_way_locks_fins_and_the_program_goes_on() {
+    // From tool 1: T0303 is 2 stations forward (CW); then T0808 from 3 is 3 back (CCW), not
+    // 5 forward.
+    let mut r = powered("O0001\nT0303\nG00 X150 Z50\nT0808\nG00 X160\nM30\n");
+    assert_eq!(r.turret_station(), Some(1));
+    let mut outputs = vec![];
+    let mut stations = vec![1u8];
+    let mut fin_at = None;
+    let ok = r.run_until(20.0, |r| {
+        if r.yi.get(y::TURRET_CW) || r.yi.get(y::TURRET_CCW) {
+            let o = (r.yi.get(y::TURRET_CW), r.yi.get(y::TURRET_CCW));
+            if outputs.last() != Some(&o) {
+                outputs.push(o);
+            }
+        }
+        if let Some(s) = r.turret_station() {
+            if stations.last() != Some(&s) {
+                stations.push(s);
+            }
+        }
+        if r.nc().get(f::TF) && r.gi.get(g::FIN) && fin_at.is_none() {
+            fin_at = Some((r.t, r.xi.get(x::TURRET_LOCKED), r.turret_station()));
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    assert_eq!(
+        outputs,
+        [(true, false), (false, true)],
+        "CW for T0303, CCW for T0808"
+    );
+    assert_eq!(stations, [1, 2, 3, 2, 1, 8]);
+    let (_, locked, station) = fin_at.expect("FIN for the T code");
+    assert!(locked, "FIN only once the turret is locked");
+    assert_eq!(station, Some(3));
+    assert_eq!(r.gi.bytes[g::NTOL as usize], 8, "current tool for the NC");
+    let pos = r.motion.commanded_display();
+    assert!(
+        (pos[0] - 160.0).abs() < 1e-9 && (pos[1] - 50.0).abs() < 1e-9,
+        "{pos:?}"
+    );
+    assert!(r.message("A0.1").is_none() && r.message("A0.3").is_none());
+}
+
+#[test]
+fn a_stuck_turret_raises_a0_1_after_the_timer_and_the_program_stops() {
+    let mut r = powered("O0001\nT0303\nG00 X150 Z50\nM30\n");
+    r.sim.devices.turret_stuck = true;
+    let mut strobe_at = None;
+    r.run_until(8.0, |r| {
+        if r.nc().get(f::TF) && strobe_at.is_none() {
+            strobe_at = Some(r.t);
+        }
+        r.message("A0.1").is_some()
+    });
+    let strobe = strobe_at.expect("TF strobe");
+    let alarm = r.message("A0.1").expect("A0.1 raised");
+    let preset = match r.plc.read("T1").unwrap() {
+        Value::Timer { preset_ms, .. } => preset_ms as f64 / 1000.0,
+        v => panic!("{v:?}"),
+    };
+    assert!(
+        alarm - strobe >= preset && alarm - strobe <= preset + 0.05,
+        "A0.1 {:.3} s after the strobe, preset {preset} s",
+        alarm - strobe
+    );
+    // The program stops: no FIN, feed hold, the axes stay where they were.
+    let before = r.motion.commanded_display();
+    r.run_until(3.0, |_| false);
+    assert!(!r.gi.get(g::FIN));
+    assert!(!r.gi.get(g::SP_N), "feed hold");
+    assert!(r.nc().get(f::TF), "still waiting on the T code");
+    assert_eq!(r.motion.commanded_display(), before);
+    assert!(
+        !r.yi.get(y::TURRET_CW) && !r.yi.get(y::TURRET_CCW),
+        "motor off"
+    );
+    assert!(r.yi.get(y::LAMP_RED));
+}
+
+#[test]
+fn m03_s1200_fins_only_once_the_spindle_is_at_speed() {
+    let mut r = powered("O0001\nG97 S1200 M03\nG01 W-1 F100\nM30\n");
+    let mut first_move = None;
+    let mut fin_rpm = None;
+    let z0 = r.motion.commanded_display()[1];
+    r.run_until(5.0, |r| {
+        let m03 = r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 3;
+        if m03 && r.gi.get(g::FIN) && fin_rpm.is_none() {
+            fin_rpm = Some(r.sim.spindle_rpm());
+        }
+        if r.motion.commanded_display()[1] != z0 && first_move.is_none() {
+            first_move = Some(r.sim.spindle_rpm());
+        }
+        r.program_done()
+    });
+    let rpm = fin_rpm.expect("FIN for M03");
+    assert!(rpm >= 1200.0 * 0.98, "FIN at {rpm} rpm");
+    assert!(first_move.expect("moved") >= 1200.0 * 0.98);
+}
+
+#[test]
+fn opening_the_door_during_a_cycle_stops_it_with_the_door_alarm() {
+    let mut r = powered("O0001\nS500 M03\nG01 W-40 F300\nM30\n");
+    r.run_until(2.0, |r| r.motion.active_cutting() == Some(true));
+    r.run_until(0.5, |_| false);
+    r.sim.devices.door_forced_open = true;
+    let opened = r.t;
+    assert!(
+        r.run_until(0.1, |r| r.message("A3.0").is_some()),
+        "door alarm"
+    );
+    assert!(
+        r.message("A3.0").unwrap() - opened <= 0.03,
+        "within a scan or two"
+    );
+    r.run_until(0.5, |_| false);
+    assert_eq!(r.motion.state(), RunState::Hold);
+    let held = r.motion.commanded_display();
+    assert!(!r.yi.get(y::SPINDLE_CW), "spindle off");
+    // Closing the door again does not restart the cycle: the alarm holds until reset.
+    r.sim.devices.door_forced_open = false;
+    r.run_until(2.0, |_| false);
+    assert_eq!(r.motion.commanded_display(), held);
+    assert!(!r.gi.get(g::SP_N));
+}
+
+#[test]
+fn emergency_stop_turns_every_output_off_within_one_scan() {
+    let mut r = powered("O0001\nS800 M03\nM08\nG01 W-40 F300\nM30\n");
+    r.run_until(3.0, |r| r.motion.active_cutting() == Some(true));
+    assert!(r.yi.get(y::SPINDLE_CW) && r.yi.get(y::COOLANT));
+    r.sim.set_emergency_stop(true);
+    let scans = r.plc.scans();
+    r.run_until(0.1, |r| r.plc.scans() > scans);
+    assert!(!r.xi.get(x::ESP_N), "the scan read the pressed button");
+    assert_eq!(r.yi.bytes, [0; 20], "every output off in that scan");
+    assert_eq!(r.yi.spindle_rpm, 0.0);
+    assert!(!r.gi.get(g::ESP_N));
+    r.tick();
+    assert_eq!(r.motion.state(), RunState::Alarm);
+    assert!(r
+        .events
+        .iter()
+        .any(|(_, e)| *e == PlcEvent::EmergencyStop(true)));
+    // Released: the spindle and coolant stay off (their latches were reset).
+    r.sim.set_emergency_stop(false);
+    r.run_until(0.2, |_| false);
+    assert!(!r.yi.get(y::SPINDLE_CW) && !r.yi.get(y::COOLANT));
+    assert!(r.gi.get(g::ESP_N));
+}
+
+#[test]
+fn robot_handshake_from_cycle_complete_to_the_next_cycle_start() {
+    // A robot cell: the keep relay K1.0 makes the door open at the end of a cycle.
+    let retained = Retained {
+        k: vec![0b1000, 0b1],
+        d: {
+            let mut d = vec![0; 1000];
+            d[16] = 8;
+            d
+        },
+        ..Default::default()
+    };
+    let mut r = Rig::new("O0001\nS500 M03\nG01 W-2 F300\nM05\nM30\n", Some(&retained));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let set = |r: &mut Rig, bit, on| r.sim.devices.inputs.set(bit, on);
+    assert!(r.run_until(10.0, |r| r.program_done()), "cycle");
+    // Cycle complete -> the door opens by itself -> ready for load.
+    assert!(
+        r.run_until(3.0, |r| r.yi.get(y::READY_FOR_LOAD)),
+        "ready for load"
+    );
+    assert!(r.yi.get(y::CYCLE_COMPLETE) && r.xi.get(x::DOOR_OPEN));
+    assert_eq!(r.plc.read_value("PART_COUNT", 4).unwrap(), 1);
+    // The robot reaches in and asks for the chuck to open.
+    set(&mut r, x::ROBOT_CLEAR, false);
+    set(&mut r, x::ROBOT_CHUCK_OPEN, true);
+    assert!(
+        r.run_until(2.0, |r| r.xi.get(x::CHUCK_UNCLAMPED)),
+        "chuck opened"
+    );
+    set(&mut r, x::ROBOT_CHUCK_OPEN, false);
+    // Cycle start while the robot is in the machine: refused with a message.
+    set(&mut r, x::ROBOT_CYCLE_START, true);
+    r.run_until(0.1, |_| false);
+    assert!(!r.gi.get(g::ST), "cycle start refused");
+    assert!(r.message("A4.0").is_some(), "robot not clear");
+    set(&mut r, x::ROBOT_CYCLE_START, false);
+    // The robot asks for the chuck to close on the new part and reports clear.
+    set(&mut r, x::ROBOT_CHUCK_CLOSE, true);
+    assert!(
+        r.run_until(2.0, |r| r.xi.get(x::CHUCK_CLAMPED)),
+        "chuck closed"
+    );
+    set(&mut r, x::ROBOT_CHUCK_CLOSE, false);
+    // The door will not close on a robot that has not reported clear.
+    set(&mut r, x::ROBOT_DOOR_CLOSE, true);
+    r.run_until(1.5, |_| false);
+    assert!(!r.xi.get(x::DOOR_CLOSED));
+    set(&mut r, x::ROBOT_DOOR_CLOSE, false);
+    set(&mut r, x::ROBOT_CLEAR, true);
+    set(&mut r, x::ROBOT_DOOR_CLOSE, true);
+    assert!(
+        r.run_until(2.0, |r| r.xi.get(x::DOOR_CLOSED)),
+        "door closed"
+    );
+    set(&mut r, x::ROBOT_DOOR_CLOSE, false);
+    // Now cycle start is accepted: ST to the NC, cycle complete and the messages cleared.
+    set(&mut r, x::ROBOT_CYCLE_START, true);
+    assert!(
+        r.run_until(0.1, |r| r.gi.get(g::ST)),
+        "cycle start accepted"
+    );
+    r.run_until(0.05, |_| false);
+    assert!(!r.yi.get(y::CYCLE_COMPLETE) && !r.bit("A4.0"));
+}
