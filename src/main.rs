@@ -64,6 +64,13 @@ enum Verb {
         #[arg(long)]
         timing: bool,
     },
+    /// Check a PLC ladder program (mnemonic text): prints its size, or the first error with
+    /// its line and reason; `--rungs` lists the program rung by rung.
+    PlcCheck {
+        file: PathBuf,
+        #[arg(long)]
+        rungs: bool,
+    },
 }
 
 /// A part program and what it is read with.
@@ -156,6 +163,7 @@ fn main() -> ExitCode {
                 timing,
             },
         ),
+        Some(Verb::PlcCheck { file, rungs }) => plc_check(&file, rungs),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
     match result {
@@ -165,6 +173,31 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn plc_check(file: &Path, rungs: bool) -> Result<(), String> {
+    let text = std::fs::read_to_string(file).map_err(|e| format!("{}: {e}", file.display()))?;
+    let program =
+        cnc_plc::Program::parse(&text).map_err(|e| format!("{}: refused: {e}", file.display()))?;
+    let all = program.rungs();
+    println!(
+        "{}: {} steps, {} rungs (level 1: {} steps, level 2: {} steps), {} subroutines",
+        file.display(),
+        program.steps.len(),
+        all.len(),
+        program.level1().len(),
+        program.level2().len(),
+        program.subroutines.len()
+    );
+    if rungs {
+        for (k, r) in all.iter().enumerate() {
+            let steps = &program.steps[r.clone()];
+            let line = steps.first().map_or(0, |s| s.line);
+            let text: Vec<&str> = steps.iter().map(|s| s.text.as_str()).collect();
+            println!("{k:4} (line {line}): {}", text.join(" | "));
+        }
+    }
+    Ok(())
 }
 
 fn check(args: &ProgramArgs, trace: bool) -> Result<(), String> {

@@ -18,6 +18,8 @@ fn config(domain: u16) -> LaunchConfig {
     .unwrap();
     let mut cfg = LaunchConfig::from_yaml(&text).unwrap();
     cfg.network.domain_id = Some(domain);
+    // Each test starts from a PLC with no kept memory (part count 0).
+    cfg.plc.memory_file = None;
     cfg
 }
 
@@ -209,4 +211,61 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
     );
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
+}
+
+#[test]
+fn a_malformed_plc_program_is_refused_and_the_running_one_keeps_the_machine() {
+    let dir = std::env::temp_dir().join(format!("cnc_plc_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("machine.plc");
+    std::fs::write(&file, cnc_plc::LATHE_STANDARD).unwrap();
+    let mut cfg = config(48);
+    cfg.plc.program = Some(file.clone());
+    let cell = Cell::start(&cfg).unwrap();
+    let mut client = CellClient::new(
+        &cfg.network,
+        "lathe1",
+        "test_supervisor",
+        ServiceMapping::Enhanced,
+    )
+    .unwrap();
+    client.wait_ready(Duration::from_secs(20)).unwrap();
+    // The machine builder saves a program with a write to an input on line 4.
+    std::fs::write(&file, "RD X1.0\nWRT G8.4\nRD X0.0\nWRT X0.1\nEND1\nEND2\n").unwrap();
+    let (ok, _) = wait_for(&mut client, Duration::from_secs(10), |c| {
+        c.alarms
+            .as_ref()
+            .is_some_and(|a| a.alarms.iter().any(|x| x.number == 1091))
+    });
+    assert!(ok, "no refusal alarm: {:?}", client.alarms);
+    let alarm = client
+        .alarms
+        .as_ref()
+        .and_then(|a| a.alarms.iter().find(|x| x.number == 1091).cloned())
+        .unwrap();
+    assert!(
+        alarm.text.contains("line 4") && alarm.text.contains("X0.1 cannot be written"),
+        "{}",
+        alarm.text
+    );
+    // The standard program still runs the machine: spindle to speed, part counted.
+    let program = "G00 X100 Z20\nS900 M03\nG01 Z10 F2000\nM05\nM30\n";
+    assert!(client.load_program("p.nc", program).unwrap().accepted);
+    assert!(client.start_program("p.nc").unwrap().accepted);
+    let mut max_rpm: f64 = 0.0;
+    let (ok, _) = wait_for(&mut client, Duration::from_secs(30), |c| {
+        if let Some(sp) = &c.spindle {
+            max_rpm = max_rpm.max(sp.actual_rpm);
+        }
+        c.part_count.as_ref().is_some_and(|p| p.count == 1)
+    });
+    assert!(
+        ok,
+        "program did not complete: {:?} {:?}",
+        client.state, client.alarms
+    );
+    assert!((max_rpm - 900.0).abs() <= 18.0, "spindle {max_rpm} rpm");
+    let (_, errors) = cell.stop();
+    assert!(errors.is_empty(), "{errors:?}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -171,3 +171,32 @@ fn check_uses_the_offset_page_of_the_launch_config() {
         "{err}"
     );
 }
+
+#[test]
+fn plc_check_reports_the_standard_program_and_refuses_a_bad_one() {
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args([
+            "plc-check",
+            "nodes/plc/programs/lathe_standard.plc",
+            "--rungs",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success() && text.contains(" steps, "), "{text}");
+    assert!(text.contains("RD.NOT ESTOP_OK | WRT ESTOP"), "{text}");
+    let bad = std::env::temp_dir().join(format!("cnc_bad_{}.plc", std::process::id()));
+    std::fs::write(&bad, "RD X0.0\nAND.STK\nEND1\nEND2\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("plc-check")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("line 2: AND.STK needs two stack entries"),
+        "{err}"
+    );
+    let _ = std::fs::remove_file(&bad);
+}

@@ -205,6 +205,11 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             }
         }
         while let Ok(Some((e, _))) = alarm_sub.take() {
+            // Messages and warnings (a refused request, a refused PLC file) inform; errors
+            // and fatal alarms stop the run and block the next start until they clear.
+            if e.kind == AlarmEvent::RAISED && e.alarm.severity < Alarm::SEVERITY_ERROR {
+                continue;
+            }
             let key = (e.alarm.source.clone(), e.alarm.number);
             if e.kind == AlarmEvent::RAISED {
                 if !active_alarms.contains(&key) {

@@ -489,14 +489,14 @@ impl Program {
 
     fn out_bit(&self, word: &str) -> Result<BitAddr, String> {
         let b = self.bit(word)?;
-        writable(b.byte)?;
+        writable(b.byte, &b.to_string())?;
         Ok(b)
     }
 
     /// A destination of `count` bytes.
     fn out_bytes(&self, word: &str, count: usize) -> Result<ByteAddr, String> {
         let b = self.byte(word)?;
-        writable(b)?;
+        writable(b, &b.to_string())?;
         b.span(count)?;
         Ok(b)
     }
@@ -929,10 +929,8 @@ impl Program {
                         "after END2 only subroutines (SP … SPE) may follow".into(),
                     ))
                 }
-                Instr::Lbl(n) => {
-                    if self.labels.insert((scope, n), i).is_some() {
-                        return Err(err(line, format!("label L{n} twice in one level")));
-                    }
+                Instr::Lbl(n) if self.labels.insert((scope, n), i).is_some() => {
+                    return Err(err(line, format!("label L{n} twice in one level")));
                 }
                 _ => {}
             }
@@ -1060,12 +1058,13 @@ impl Program {
     }
 }
 
-fn writable(b: ByteAddr) -> Result<(), String> {
+/// `name` is the address as written (a bit or a byte).
+fn writable(b: ByteAddr, name: &str) -> Result<(), String> {
     if b.writable() {
         Ok(())
     } else {
         Err(format!(
-            "{b} cannot be written by the program ({})",
+            "{name} cannot be written by the program ({})",
             match b.space {
                 Space::X => "X is the machine's inputs",
                 Space::F => "F is written by the NC",
