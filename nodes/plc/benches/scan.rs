@@ -26,7 +26,7 @@ fn inputs(k: usize) -> (FImage, XImage) {
     xi.set(x::TURRET_LOCKED, k % 50 > 10);
     xi.set(x::TOOL[(k / 50) % 8], k % 50 > 5);
     xi.set(x::SPINDLE_AT_SPEED, k % 40 > 20);
-    xi.set(x::KEY_SINGLE_BLOCK, k % 300 == 0);
+    xi.set(x::KEY_SINGLE_BLOCK, k.is_multiple_of(300));
     xi.bytes[x::FEED_OVERRIDE_SWITCH as usize] = 100;
     let phase = k % 200;
     fi.set(f::OP, true);
