@@ -202,7 +202,8 @@ fn reload(plc: &mut Plc, path: &Path, alarms: &AlarmReporter) {
 /// Scan durations for the status topic.
 #[derive(Default)]
 struct ScanTimes {
-    recent: Vec<f64>,
+    /// The last 1000 scans, µs.
+    recent: std::collections::VecDeque<f64>,
     last: f64,
     max: f64,
 }
@@ -212,13 +213,13 @@ impl ScanTimes {
         self.last = us;
         self.max = self.max.max(us);
         if self.recent.len() >= 1000 {
-            self.recent.remove(0);
+            self.recent.pop_front();
         }
-        self.recent.push(us);
+        self.recent.push_back(us);
     }
 
     fn message(&self, plc: &Plc, path: &Option<PathBuf>, divisions: u32) -> PlcStatus {
-        let mut sorted = self.recent.clone();
+        let mut sorted: Vec<f64> = self.recent.iter().copied().collect();
         sorted.sort_by(f64::total_cmp);
         let p99 = sorted
             .get((sorted.len() * 99 / 100).min(sorted.len().saturating_sub(1)))
