@@ -311,11 +311,9 @@ impl Motion {
             self.last_line = None;
             self.clear_strobe();
         }
-        if self.alarm
-            || self.emergency_stop
-            || block.run_id <= self.dead_run
-            || block.seq <= self.accepted_seq
-        {
+        // Blocks of a run started during an emergency stop (before the PLC's first scan at
+        // power-on) wait in the queue; those of the run the stop dropped are refused.
+        if self.alarm || block.run_id <= self.dead_run || block.seq <= self.accepted_seq {
             return;
         }
         if self.queue.len() >= self.cfg.queue_capacity {

@@ -98,6 +98,11 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         if let Some(v) = x_in.latest()? {
             xi = v;
         }
+        if xi.seq == 0 {
+            // The machine's inputs have not arrived yet: no scan, so no emergency stop is
+            // reported for a machine that is only starting (G stays all zero: `*ESP`).
+            continue;
+        }
         let start = monotonic_ns();
         plc.scan(&fi, &xi, (start - t0) / 1_000_000);
         scan_times.record((monotonic_ns() - start) as f64 / 1000.0);
