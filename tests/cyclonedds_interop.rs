@@ -23,6 +23,8 @@ fn cyclone_dds_peer_reads_topics_and_calls_services() {
     let text = std::fs::read_to_string(root.join("launch_configs/sim_lathe.yaml")).unwrap();
     let mut cfg = LaunchConfig::from_yaml(&text).unwrap();
     cfg.network.domain_id = Some(43);
+    // A PLC with no kept memory: the part count starts at 0.
+    cfg.plc.memory_file = None;
     let cell = Cell::start(&cfg).unwrap();
     let out = Command::new(&python)
         .arg(root.join("tests/interop/cyclone_peer.py"))
