@@ -209,6 +209,39 @@ pub fn parse(text: &str) -> Result<Address, String> {
     }
 }
 
+/// A numbered timer or counter with a preset (`T1`, `C0`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    Timer(u16),
+    Counter(u16),
+}
+
+impl Unit {
+    /// Parses `T0`–`T39` or `C0`–`C39`; anything else is an error naming the text.
+    pub fn parse(text: &str) -> Result<Unit, String> {
+        let mut chars = text.trim().chars();
+        let kind = chars.next().map(|c| c.to_ascii_uppercase());
+        let n: Option<u16> = chars.as_str().parse().ok();
+        match (kind, n) {
+            (Some('T'), Some(n)) if n < TIMERS => Ok(Unit::Timer(n)),
+            (Some('C'), Some(n)) if n < COUNTERS => Ok(Unit::Counter(n)),
+            _ => Err(format!(
+                "{text:?} is not a timer T0–T{} or counter C0–C{}",
+                TIMERS - 1,
+                COUNTERS - 1
+            )),
+        }
+    }
+
+    /// Whether `value` is a valid preset: ms for a timer, a count 0–32767 for a counter.
+    pub fn preset_ok(self, value: i64) -> bool {
+        match self {
+            Unit::Timer(_) => (0..=i64::from(u32::MAX)).contains(&value),
+            Unit::Counter(_) => (0..=32767).contains(&value),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -244,5 +277,16 @@ mod tests {
             r.span(4).is_err(),
             "a word may not run into the system relays"
         );
+    }
+
+    #[test]
+    fn units_parse_without_panicking_on_any_text() {
+        assert_eq!(Unit::parse("t39"), Ok(Unit::Timer(39)));
+        assert_eq!(Unit::parse("C0"), Ok(Unit::Counter(0)));
+        for bad in ["T40", "C", "", "中1", "X1", "T-1", "T1.0"] {
+            assert!(Unit::parse(bad).is_err(), "{bad}");
+        }
+        assert!(Unit::Counter(0).preset_ok(32767) && !Unit::Counter(0).preset_ok(32768));
+        assert!(!Unit::Timer(0).preset_ok(-1));
     }
 }

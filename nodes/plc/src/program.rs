@@ -23,8 +23,8 @@
 use std::collections::{BTreeMap, HashMap, HashSet};
 
 use crate::address::{
-    self, Address, BitAddr, ByteAddr, Space, COUNTERS, EDGES, FIXED_COUNTERS, FIXED_TIMERS, LABELS,
-    TIMERS,
+    self, Address, BitAddr, ByteAddr, Space, Unit, COUNTERS, EDGES, FIXED_COUNTERS, FIXED_TIMERS,
+    LABELS, TIMERS,
 };
 
 /// The manual's program capacity.
@@ -433,20 +433,14 @@ impl Program {
             return Err("PRESET needs Tn or Cn and a value".into());
         };
         let v = number(value)?;
-        let (kind, n) = unit.split_at(1.min(unit.len()));
-        let n: u16 = n
-            .parse()
-            .map_err(|_| format!("{unit:?} is not a timer or counter"))?;
-        match kind.to_ascii_uppercase().as_str() {
-            "T" if n < TIMERS && (0..=i64::from(u32::MAX)).contains(&v) => {
-                self.timer_presets.insert(n, v as u32);
-            }
-            "C" if n < COUNTERS && (0..=32767).contains(&v) => {
-                self.counter_presets.insert(n, v);
-            }
-            "T" | "C" => return Err(format!("PRESET {unit} {value}: out of range")),
-            _ => return Err(format!("{unit:?} is not a timer or counter")),
+        let u = Unit::parse(unit)?;
+        if !u.preset_ok(v) {
+            return Err(format!("PRESET {unit} {value}: out of range"));
         }
+        match u {
+            Unit::Timer(n) => self.timer_presets.insert(n, v as u32).map(|_| ()),
+            Unit::Counter(n) => self.counter_presets.insert(n, v).map(|_| ()),
+        };
         Ok(())
     }
 

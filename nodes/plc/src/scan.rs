@@ -7,7 +7,7 @@
 
 use cnc_msgs::signals::{self, FImage, GImage, SignalTable, XImage, YImage};
 
-use crate::address::{self, Address, BitAddr, ByteAddr, Space};
+use crate::address::{self, Address, BitAddr, ByteAddr, Space, Unit};
 use crate::engine::{Engine, Fault};
 use crate::memory::{Memory, Retained};
 use crate::program::{LoadError, Program};
@@ -153,49 +153,41 @@ impl Plc {
 
     /// The value at an address or symbol: `Y2.5`, `D100`, `T1`, `C0`, `PART_COUNT`.
     pub fn read(&self, name: &str) -> Result<Value, String> {
-        let upper = name.trim().to_ascii_uppercase();
-        if let Some(n) = upper
-            .strip_prefix('T')
-            .and_then(|n| n.parse::<usize>().ok())
-        {
-            let t = self.mem.timers.get(n).ok_or(format!("no timer {upper}"))?;
-            return Ok(Value::Timer {
-                preset_ms: t.preset_ms,
-                elapsed_ms: t.elapsed(self.now_ms()),
-            });
+        match Unit::parse(name) {
+            Ok(Unit::Timer(n)) => {
+                let t = &self.mem.timers[n as usize];
+                return Ok(Value::Timer {
+                    preset_ms: t.preset_ms,
+                    elapsed_ms: t.elapsed(self.last_now),
+                });
+            }
+            Ok(Unit::Counter(n)) => {
+                let c = &self.mem.counters[n as usize];
+                return Ok(Value::Counter {
+                    preset: c.preset,
+                    current: c.current,
+                });
+            }
+            Err(_) => {}
         }
-        if let Some(n) = upper
-            .strip_prefix('C')
-            .and_then(|n| n.parse::<usize>().ok())
-        {
-            let c = self
-                .mem
-                .counters
-                .get(n)
-                .ok_or(format!("no counter {upper}"))?;
-            return Ok(Value::Counter {
-                preset: c.preset,
-                current: c.current,
-            });
-        }
-        let a = match self.program.symbols.get(&upper) {
-            Some(a) => *a,
-            None => address::parse(&upper)?,
-        };
-        Ok(match a {
+        Ok(match self.address(name)? {
             Address::Bit(b) => Value::Bit(self.mem.bit(b)),
             Address::Byte(b) => Value::Byte(self.mem.byte(b)),
         })
     }
 
+    /// An address as written or by its symbol.
+    fn address(&self, name: &str) -> Result<Address, String> {
+        let upper = name.trim().to_ascii_uppercase();
+        match self.program.symbols.get(&upper) {
+            Some(a) => Ok(*a),
+            None => address::parse(&upper),
+        }
+    }
+
     /// A binary value of `format` bytes at an address or symbol (e.g. the part count).
     pub fn read_value(&self, name: &str, format: u8) -> Result<i64, String> {
-        let upper = name.trim().to_ascii_uppercase();
-        let a = match self.program.symbols.get(&upper) {
-            Some(a) => *a,
-            None => address::parse(&upper)?,
-        };
-        match a {
+        match self.address(name)? {
             Address::Byte(b) => {
                 b.span(format.into())?;
                 Ok(self.mem.read(b, format))
@@ -206,23 +198,15 @@ impl Plc {
 
     /// The parameter page: sets a timer's preset (ms) or a counter's.
     pub fn set_preset(&mut self, unit: &str, value: i64) -> Result<(), String> {
-        let upper = unit.trim().to_ascii_uppercase();
-        let (kind, n) = upper.split_at(1.min(upper.len()));
-        let n: usize = n.parse().map_err(|_| format!("{unit:?}: Tn or Cn"))?;
-        match kind {
-            "T" if n < self.mem.timers.len() && (0..=i64::from(u32::MAX)).contains(&value) => {
-                self.mem.timers[n].preset_ms = value as u32;
-            }
-            "C" if n < self.mem.counters.len() && (0..=32767).contains(&value) => {
-                self.mem.counters[n].preset = value;
-            }
-            _ => return Err(format!("{unit} = {value}: no such unit or out of range")),
+        let u = Unit::parse(unit)?;
+        if !u.preset_ok(value) {
+            return Err(format!("{unit} = {value}: out of range"));
+        }
+        match u {
+            Unit::Timer(n) => self.mem.timers[n as usize].preset_ms = value as u32,
+            Unit::Counter(n) => self.mem.counters[n as usize].preset = value,
         }
         Ok(())
-    }
-
-    fn now_ms(&self) -> u64 {
-        self.last_now
     }
 
     /// One scan at `now_ms` (ms on any monotonic clock).

@@ -124,6 +124,7 @@ fn timers_count_across_scans() {
     );
     p.set_preset("T1", 50).unwrap();
     assert!(p.set_preset("T40", 50).is_err());
+    assert!(p.set_preset("中", 50).is_err() && p.read("中").is_err());
 }
 
 #[test]
@@ -556,6 +557,8 @@ fn malformed_programs_are_refused_with_line_and_reason() {
         ("RD X0.0\nNUMEB 1, 300, D0\nEND1\nEND2", 2, "does not fit"),
         ("SYM X1 Y0.0\nEND1\nEND2", 1, "cannot be a symbol"),
         ("MSG Y0.0 ALARM \"x\"\nEND1\nEND2", 1, "messages are A bits"),
+        ("PRESET 中1 5\nEND1\nEND2", 1, "is not a timer"),
+        ("PRESET C1 40000\nEND1\nEND2", 1, "out of range"),
         (
             "RD X0.0\nRD.STK X0.0\nRD.STK X0.0\nRD.STK X0.0\nRD.STK X0.0\nRD.STK X0.0\nRD.STK X0.0\nRD.STK X0.0\nRD.STK X0.0\nEND1\nEND2",
             9,
