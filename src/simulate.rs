@@ -171,12 +171,7 @@ pub fn simulate(
         }
         out
     };
-    let start: Vec<f64> = cfg
-        .home()
-        .iter()
-        .zip(&mcfg.axes)
-        .map(|(p, a)| p * a.scale())
-        .collect();
+    let start = cfg.home_slide();
     let period = mcfg.period;
     let capacity = mcfg.queue_capacity.max(2) as u64;
     let mut motion = Motion::new(mcfg, &start);

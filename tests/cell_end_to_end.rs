@@ -23,6 +23,11 @@ fn config(domain: u16) -> LaunchConfig {
     cfg
 }
 
+/// A supervisor node of the cell's machine `lathe1`, calling services with `mapping`.
+fn supervisor(cfg: &LaunchConfig, mapping: ServiceMapping) -> CellClient {
+    CellClient::new(&cfg.network, "lathe1", "test_supervisor", mapping).unwrap()
+}
+
 /// Polls until `done` holds or the timeout passes; returns every machine state seen.
 fn wait_for(
     client: &mut CellClient,
@@ -47,13 +52,7 @@ const PROGRAM: &str = "O0001\nG00 X60 Z5\nS600 M03\nG01 X40 Z0 F600\nZ-20\nG02 X
 fn program_runs_through_ros2_services_and_the_part_is_counted() {
     let cfg = config(41);
     let cell = Cell::start(&cfg).unwrap();
-    let mut client = CellClient::new(
-        &cfg.network,
-        "lathe1",
-        "test_supervisor",
-        ServiceMapping::Enhanced,
-    )
-    .unwrap();
+    let mut client = supervisor(&cfg, ServiceMapping::Enhanced);
     let (ok, _) = wait_for(&mut client, Duration::from_secs(20), |c| {
         c.part_count.is_some() && c.state.is_some() && c.axes.is_some()
     });
@@ -120,13 +119,7 @@ fn program_runs_through_ros2_services_and_the_part_is_counted() {
 fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
     let cfg = config(42);
     let cell = Cell::start(&cfg).unwrap();
-    let mut client = CellClient::new(
-        &cfg.network,
-        "lathe1",
-        "test_supervisor",
-        ServiceMapping::Cyclone,
-    )
-    .unwrap();
+    let mut client = supervisor(&cfg, ServiceMapping::Cyclone);
     let (ok, _) = wait_for(&mut client, Duration::from_secs(20), |c| {
         c.axes.is_some() && c.alarms.is_some()
     });
@@ -222,13 +215,7 @@ fn a_malformed_plc_program_is_refused_and_the_running_one_keeps_the_machine() {
     let mut cfg = config(48);
     cfg.plc.program = Some(file.clone());
     let cell = Cell::start(&cfg).unwrap();
-    let mut client = CellClient::new(
-        &cfg.network,
-        "lathe1",
-        "test_supervisor",
-        ServiceMapping::Enhanced,
-    )
-    .unwrap();
+    let mut client = supervisor(&cfg, ServiceMapping::Enhanced);
     client.wait_ready(Duration::from_secs(20)).unwrap();
     // The machine builder saves a program with a write to an input on line 4.
     std::fs::write(&file, "RD X1.0\nWRT G8.4\nRD X0.0\nWRT X0.1\nEND1\nEND2\n").unwrap();

@@ -52,12 +52,7 @@ impl Rig {
         let interp = Interpreter::with_library(dialect, program, setup, Library::new());
         let mcfg = MotionConfig::from_launch(&cfg);
         let n = mcfg.axes.len();
-        let start: Vec<f64> = cfg
-            .home()
-            .iter()
-            .zip(&mcfg.axes)
-            .map(|(p, a)| p * a.scale())
-            .collect();
+        let start = cfg.home_slide();
         let mut sim = SimLathe::new(sim_config(&cfg), &start);
         let fb = sim.step(&ServoSetpoint::default(), &YImage::default(), 0.0);
         let plc = Plc::new(

@@ -50,12 +50,7 @@ fn run(program: &str, factors: &[f64]) -> Vec<Pass> {
     let mcfg = MotionConfig::from_launch(&cfg);
     let n = mcfg.axes.len();
     let dt = mcfg.period;
-    let start: Vec<f64> = cfg
-        .home()
-        .iter()
-        .zip(&mcfg.axes)
-        .map(|(p, a)| p * a.scale())
-        .collect();
+    let start = cfg.home_slide();
     let mut motion = Motion::new(mcfg, &start);
     // Feed override does not apply to threads (`000` §5.23): set it far from 100 %.
     motion.set_panel(Panel {

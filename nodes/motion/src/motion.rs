@@ -1197,43 +1197,40 @@ impl Motion {
             }
             // The M/S/T handshake (`000` §4.2.1): code and strobe up, wait for FIN, strobe
             // down; the next strobe waits until the PLC has dropped FIN again.
-            Active::Aux { code, raised } => match raised {
-                false => {
-                    if !in_pos || hold || plc.get(g::FIN) {
+            Active::Aux { code, raised } => {
+                if *raised {
+                    if !plc.get(g::FIN) {
                         return false;
                     }
-                    *raised = true;
-                    let fi = &mut self.f;
-                    match *code {
-                        Aux::M(m) => {
-                            fi.write_i32(f::M_CODE, m);
-                            fi.set(f::DM00, m == 0);
-                            fi.set(f::DM01, m == 1);
-                            fi.set(f::DM02, m == 2);
-                            fi.set(f::DM30, m == 30);
-                            fi.set(f::MF, true);
-                        }
-                        Aux::S(s) => {
-                            self.spindle_rpm = s;
-                            fi.write_i32(f::S_CODE, s.round().clamp(0.0, i32::MAX as f64) as i32);
-                            fi.set(f::SF, true);
-                        }
-                        Aux::T(t) => {
-                            fi.write_i32(f::T_CODE, t);
-                            fi.set(f::TF, true);
-                        }
-                    }
-                    false
+                    self.clear_strobe();
+                    return true;
                 }
-                true => {
-                    if plc.get(g::FIN) {
-                        self.clear_strobe();
-                        true
-                    } else {
-                        false
+                if !in_pos || hold || plc.get(g::FIN) {
+                    return false;
+                }
+                *raised = true;
+                let fi = &mut self.f;
+                match *code {
+                    Aux::M(m) => {
+                        fi.write_i32(f::M_CODE, m);
+                        fi.set(f::DM00, m == 0);
+                        fi.set(f::DM01, m == 1);
+                        fi.set(f::DM02, m == 2);
+                        fi.set(f::DM30, m == 30);
+                        fi.set(f::MF, true);
+                    }
+                    Aux::S(s) => {
+                        self.spindle_rpm = s;
+                        fi.write_i32(f::S_CODE, s.round().clamp(0.0, i32::MAX as f64) as i32);
+                        fi.set(f::SF, true);
+                    }
+                    Aux::T(t) => {
+                        fi.write_i32(f::T_CODE, t);
+                        fi.set(f::TF, true);
                     }
                 }
-            },
+                false
+            }
             Active::End => in_pos,
         }
     }

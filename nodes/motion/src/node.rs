@@ -340,3 +340,22 @@ fn servo_loop(
         stats.interval_histogram(period_us).trim_end()
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plc_that_stops_answering_is_silent_after_the_timeout() {
+        let mut link = PlcLink::default();
+        assert!(
+            !link.silent(10_000_000_000),
+            "never heard: starting, not silent"
+        );
+        link.heard(1_000_000_000);
+        assert!(!link.silent(1_000_000_000 + PLC_TIMEOUT_NS));
+        assert!(link.silent(1_000_000_001 + PLC_TIMEOUT_NS));
+        link.heard(2_000_000_000);
+        assert!(!link.silent(2_100_000_000));
+    }
+}

@@ -665,3 +665,42 @@ fn a_thread_too_fine_to_finish_is_refused_with_an_alarm() {
     );
     assert_eq!(m.commanded_display(), vec![50.0, 0.0]);
 }
+
+#[test]
+fn plc_signals_drive_hold_start_overrides_and_reset_shows_as_rst() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(
+        1,
+        1,
+        Command::Linear {
+            end: vec![50.0, -50.0],
+            feed: 600.0,
+        },
+    ));
+    let mut g = GImage::released();
+    g.bytes[g::FEED_OVERRIDE as usize] = 50;
+    m.plc_signals(&g);
+    ticks(&mut m, &g, 400);
+    // 600 mm/min at 50 %: 5 mm/s of travel along the path.
+    let before = m.commanded_display();
+    ticks(&mut m, &g, 25);
+    let after = m.commanded_display();
+    let d = (((after[0] - before[0]) / 2.0).powi(2) + (after[1] - before[1]).powi(2)).sqrt();
+    assert!((d - 0.5).abs() < 1e-6, "{d} mm in 0.1 s");
+    // *SP low: feed hold; ST's rising edge resumes once *SP is high again.
+    g.set(g::SP_N, false);
+    m.plc_signals(&g);
+    ticks(&mut m, &g, 200);
+    assert_eq!(m.state(), RunState::Hold);
+    g.set(g::SP_N, true);
+    g.set(g::ST, true);
+    m.plc_signals(&g);
+    ticks(&mut m, &g, 1);
+    assert_eq!(m.state(), RunState::Running);
+    // Reset: RST (F1.1) stays on for 100 ms of ticks so the PLC's 10 ms scan sees it.
+    m.reset();
+    ticks(&mut m, &g, 24);
+    assert!(m.f_image().get(f::RST));
+    ticks(&mut m, &g, 2);
+    assert!(!m.f_image().get(f::RST));
+}

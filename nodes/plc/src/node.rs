@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 use cnc_msgs::msg::{Alarm, PartCount, PlcStatus, SpindleState};
-use cnc_msgs::signals::{f, x, y, FImage, SignalTable, XImage};
+use cnc_msgs::signals::{f, g, x, y, FImage, SignalTable, XImage};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -148,7 +148,14 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         if let Some(msg) = parts.update(&plc, &fi, now_s, scans.is_multiple_of(500)) {
             let _ = parts_pub.publish(msg);
         }
-        publish_spindle(&spindle_pub, plc.outputs(), &xi, &mut last_spindle, scans);
+        publish_spindle(
+            &spindle_pub,
+            plc.outputs(),
+            &xi,
+            &mut last_spindle,
+            scans,
+            f32::from(plc.to_nc().bytes[g::SPINDLE_OVERRIDE as usize]),
+        );
         if scans.is_multiple_of(100) {
             // Once a second at 10 ms: status, program file, parameters.
             let _ = status_pub.publish(scan_times.message(
@@ -248,11 +255,12 @@ impl ScanTimes {
     }
 }
 
-/// The part count the program keeps at `PART_COUNT`, and the time of each cycle (from the
-/// NC's OP signal coming on to the count going up).
+/// The part count the program keeps at `PART_COUNT`, and the time of each cycle: from the
+/// NC's OP signal coming on to the count going up.
 #[derive(Default)]
 struct PartCounter {
     last: Option<i64>,
+    op: bool,
     cycle_started: Option<f64>,
     last_cycle_time: f64,
 }
@@ -260,16 +268,14 @@ struct PartCounter {
 impl PartCounter {
     fn update(&mut self, plc: &Plc, fi: &FImage, now: f64, every: bool) -> Option<PartCount> {
         let count = plc.read_value(PART_COUNT_SYMBOL, 4).unwrap_or(0);
-        if fi.get(f::OP) && self.cycle_started.is_none() {
+        let op = fi.get(f::OP);
+        if op && !self.op {
             self.cycle_started = Some(now);
         }
+        self.op = op;
         let changed = self.last != Some(count);
         if changed && self.last.is_some() {
-            self.last_cycle_time = self.cycle_started.map_or(0.0, |t| now - t);
-            self.cycle_started = None;
-        }
-        if !fi.get(f::OP) && changed {
-            self.cycle_started = None;
+            self.last_cycle_time = self.cycle_started.take().map_or(0.0, |t| now - t);
         }
         self.last = Some(count);
         (changed || every).then(|| PartCount {
@@ -288,6 +294,7 @@ fn publish_spindle(
     xi: &XImage,
     last: &mut Option<(i64, u8, bool, i64)>,
     scans: u64,
+    override_percent: f32,
 ) {
     let direction = match (yi.get(y::SPINDLE_CW), yi.get(y::SPINDLE_CCW)) {
         (true, false) => SpindleState::DIRECTION_CW,
@@ -315,7 +322,7 @@ fn publish_spindle(
             direction,
             // The simulated spindle models no cutting load yet.
             load: 0.0,
-            override_percent: 100.0,
+            override_percent,
             at_speed,
         });
     }

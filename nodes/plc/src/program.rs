@@ -239,28 +239,6 @@ impl Instr {
     fn is_stack(&self) -> bool {
         matches!(self, Instr::RdStk(_) | Instr::RdNotStk(_))
     }
-
-    /// Whether the instruction is a basic logic instruction (works on bits and the stack).
-    pub fn is_basic(&self) -> bool {
-        use Instr::*;
-        matches!(
-            self,
-            Rd(_)
-                | RdNot(_)
-                | RdStk(_)
-                | RdNotStk(_)
-                | And(_)
-                | AndNot(_)
-                | Or(_)
-                | OrNot(_)
-                | AndStk
-                | OrStk
-                | Wrt(_)
-                | WrtNot(_)
-                | Set(_)
-                | Rst(_)
-        )
-    }
 }
 
 /// One instruction with the line it came from.
@@ -923,8 +901,11 @@ impl Program {
                         "after END2 only subroutines (SP … SPE) may follow".into(),
                     ))
                 }
-                Instr::Lbl(n) if self.labels.insert((scope, n), i).is_some() => {
+                Instr::Lbl(n) if self.labels.contains_key(&(scope, n)) => {
                     return Err(err(line, format!("label L{n} twice in one level")));
+                }
+                Instr::Lbl(n) => {
+                    self.labels.insert((scope, n), i);
                 }
                 _ => {}
             }

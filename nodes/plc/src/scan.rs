@@ -14,6 +14,8 @@ use crate::program::{LoadError, Program};
 
 /// Alarm numbers of PLC messages: A0.0 is 1000, A0.1 1001, … A9.7 1079.
 pub const MESSAGE_ALARM_BASE: u32 = 1000;
+/// Bytes of the A table (A0–A9), kept without allocating every scan.
+const MESSAGE_BYTES: usize = 10;
 /// The PLC stopped itself (watchdog): emergency stop until a program is loaded.
 pub const PLC_FAULT_ALARM: u32 = 1090;
 
@@ -61,12 +63,10 @@ pub struct Plc {
     y: YImage,
     g: GImage,
     /// A table at the end of the last scan, for message events.
-    messages: Vec<u8>,
+    messages: [u8; MESSAGE_BYTES],
     fault: Option<String>,
     events: Vec<PlcEvent>,
     scans: u64,
-    /// Steps executed by the last scan.
-    pub last_steps: usize,
     last_now: u64,
     /// `*ESP` low at the end of the last scan.
     emergency_stop: bool,
@@ -97,11 +97,10 @@ impl Plc {
             spindle_command: 0.0,
             y: YImage::default(),
             g: GImage::default(),
-            messages: vec![0; Space::A.size()],
+            messages: [0; MESSAGE_BYTES],
             fault: None,
             events: Vec::new(),
             scans: 0,
-            last_steps: 0,
             last_now: 0,
             emergency_stop: false,
         }
@@ -230,7 +229,6 @@ impl Plc {
                 let pc = engine.run(self.level2_pc, l2.end, budget)?;
                 Ok(if pc >= l2.end { l2.start } else { pc })
             });
-            self.last_steps = engine.executed;
             match result {
                 Ok(pc) => self.level2_pc = pc,
                 Err(Fault::Watchdog) => {
@@ -275,7 +273,8 @@ impl Plc {
     }
 
     fn message_events(&mut self) {
-        let now = self.mem.table(Space::A).to_vec();
+        let mut now = [0; MESSAGE_BYTES];
+        now.copy_from_slice(self.mem.table(Space::A));
         for (byte, (old, new)) in self.messages.iter().zip(&now).enumerate() {
             if old == new {
                 continue;
