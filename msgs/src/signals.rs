@@ -4,7 +4,8 @@
 //! Each image is the byte table of the Huaxing manual (`000` §18.1, inventory §9.1): F0–F255,
 //! G0–G255, X0–X19, Y0–Y19, bit 0 the lowest. Multi-byte values (M code at F10, S at F22, T at
 //! F26) are binary, least significant byte first, as in a FANUC PMC. The bit assignments the NC
-//! uses are named in [`f`] and [`g`]; the wiring of the standard lathe in [`x`] and [`y`].
+//! uses are named in [`f`] and [`g`]; [`x`] and [`y`] name the standard lathe's bits that the
+//! simulated machine drives (the full wiring table is `docs/plc.md`).
 
 use iceoryx2::prelude::ZeroCopySend;
 
@@ -199,8 +200,6 @@ pub mod g {
     pub const FIN: Bit = bit(4, 3);
     /// Cycle start (the NC acts on its rising edge).
     pub const ST: Bit = bit(7, 2);
-    /// External reset.
-    pub const ERS: Bit = bit(8, 7);
     /// Feed hold, active low.
     pub const SP_N: Bit = bit(8, 5);
     /// Emergency stop, active low.
@@ -214,7 +213,6 @@ pub mod g {
     /// Optional stop switch: not in the manual's G table (the key lamp is PLC-only there), so
     /// it takes the free bit G44.2 next to block skip BDT1 (G44.0).
     pub const MOPS: Bit = bit(44, 2);
-    pub const BDT1: Bit = bit(44, 0);
     pub const DRN: Bit = bit(46, 7);
     pub const SBK: Bit = bit(46, 1);
     /// Current tool number of turret 1, binary.
@@ -230,12 +228,8 @@ pub mod x {
     pub const SPINDLE_AT_SPEED: Bit = bit(0, 1);
     pub const CHUCK_CLAMPED: Bit = bit(0, 3);
     pub const CHUCK_UNCLAMPED: Bit = bit(0, 5);
-    /// Spindle drive alarm (1 = alarm).
-    pub const SPINDLE_ALARM: Bit = bit(0, 6);
     /// Emergency stop, normally closed: 1 = released.
     pub const ESP_N: Bit = bit(1, 0);
-    pub const EXTERNAL_FEED_HOLD: Bit = bit(1, 1);
-    pub const EXTERNAL_CYCLE_START: Bit = bit(1, 3);
     /// Turret position sensors, tool 1 … 8.
     pub const TOOL: [Bit; 8] = [
         bit(2, 7),
@@ -266,10 +260,7 @@ pub mod x {
     pub const ROBOT_CYCLE_START: Bit = bit(8, 5);
     /// Panel keys (X10–X15 of the manual).
     pub const KEY_CYCLE_START: Bit = bit(13, 1);
-    pub const KEY_FEED_HOLD: Bit = bit(15, 3);
     pub const KEY_RESET: Bit = bit(15, 6);
-    pub const KEY_COOLANT: Bit = bit(10, 4);
-    pub const KEY_OPTIONAL_STOP: Bit = bit(10, 5);
     pub const KEY_SINGLE_BLOCK: Bit = bit(10, 3);
     /// Feed override switch, percent in binary (a coded rotary switch on the panel).
     pub const FEED_OVERRIDE_SWITCH: u16 = 16;
@@ -279,8 +270,6 @@ pub mod x {
 pub mod y {
     use super::{bit, Bit};
     pub const COOLANT: Bit = bit(1, 3);
-    pub const LAMP_GREEN: Bit = bit(1, 4);
-    pub const LAMP_YELLOW: Bit = bit(1, 6);
     pub const CHUCK_CLAMP: Bit = bit(1, 7);
     pub const TAILSTOCK_BACK: Bit = bit(2, 0);
     pub const LAMP_RED: Bit = bit(2, 1);
@@ -291,20 +280,14 @@ pub mod y {
     pub const TURRET_CCW: Bit = bit(2, 6);
     pub const SPINDLE_CW: Bit = bit(3, 0);
     pub const SPINDLE_CCW: Bit = bit(3, 1);
-    pub const SPINDLE_ENABLE: Bit = bit(3, 5);
-    pub const LUBRICATION: Bit = bit(3, 6);
     /// Releases the turret lock (0 = locked: a turret without power stays locked).
     pub const TURRET_UNLOCK: Bit = bit(4, 0);
-    pub const CHIP_CONVEYOR: Bit = bit(4, 1);
     pub const DOOR_OPEN: Bit = bit(4, 2);
     pub const DOOR_CLOSE: Bit = bit(4, 3);
     /// Cell: the machine waits for the robot to load a part.
     pub const READY_FOR_LOAD: Bit = bit(5, 0);
     /// Cell: the last cycle ended with M30/M02.
     pub const CYCLE_COMPLETE: Bit = bit(5, 1);
-    /// Gear range outputs S1/S2/S3 (shared with the tailstock pins on the manual's map, so
-    /// the cell lathe drives them from expansion bits).
-    pub const GEAR: [Bit; 3] = [bit(5, 4), bit(5, 5), bit(5, 6)];
 }
 
 #[cfg(test)]
