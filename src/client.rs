@@ -6,6 +6,7 @@ use cnc_msgs::msg::{ActiveAlarms, AxisState, MachineState, PartCount, ServoStats
 use cnc_msgs::srv::*;
 use cnc_runtime::config::NetworkConfig;
 use cnc_runtime::dds::{qos, RosNode};
+use cnc_runtime::topics;
 use ros2_client::dds::{Client, Subscription};
 use ros2_client::qos::History;
 use ros2_client::{Name, ServiceMapping, ServiceTypeName};
@@ -65,16 +66,15 @@ impl CellClient {
             reset: client::<Reset>(&mut ros, mapping, ns, "reset")?,
             // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
             // within a millisecond, and a depth-1 reader would see only STOPPED.
-            machine: ros.subscription(
-                "machine_state",
-                "cnc_msgs/msg/MachineState",
+            machine: ros.subscription_with_qos(
+                &topics::MACHINE_STATE,
                 qos::state().history(History::KeepLast { depth: 64 }),
             )?,
-            spindle_sub: ros.subscription("spindle", "cnc_msgs/msg/SpindleState", qos::state())?,
-            parts: ros.subscription("part_count", "cnc_msgs/msg/PartCount", qos::state())?,
-            alarms_sub: ros.subscription("alarms", "cnc_msgs/msg/ActiveAlarms", qos::state())?,
-            axes_sub: ros.subscription("axes", "cnc_msgs/msg/AxisState", qos::state())?,
-            stats_sub: ros.subscription("servo_stats", "cnc_msgs/msg/ServoStats", qos::state())?,
+            spindle_sub: ros.subscription(&topics::SPINDLE)?,
+            parts: ros.subscription(&topics::PART_COUNT)?,
+            alarms_sub: ros.subscription(&topics::ALARMS)?,
+            axes_sub: ros.subscription(&topics::AXES)?,
+            stats_sub: ros.subscription(&topics::SERVO_STATS)?,
             ros,
             state: None,
             spindle: None,

@@ -17,6 +17,26 @@ pub mod srv;
 /// The ROS 2 package name of these interfaces.
 pub const PACKAGE: &str = "cnc_msgs";
 
+/// Every `msg/*.msg` file of the package: (type name, text). Recordings carry these texts as
+/// their `ros2msg` schemas, so a reader needs nothing but the recording.
+pub const MSG_FILES: &[(&str, &str)] = &[
+    ("ActiveAlarms", include_str!("../msg/ActiveAlarms.msg")),
+    ("Alarm", include_str!("../msg/Alarm.msg")),
+    ("AlarmEvent", include_str!("../msg/AlarmEvent.msg")),
+    ("Axis", include_str!("../msg/Axis.msg")),
+    ("AxisState", include_str!("../msg/AxisState.msg")),
+    ("CommandResult", include_str!("../msg/CommandResult.msg")),
+    ("MachineState", include_str!("../msg/MachineState.msg")),
+    ("MotionBlock", include_str!("../msg/MotionBlock.msg")),
+    ("MotionStatus", include_str!("../msg/MotionStatus.msg")),
+    ("PartCount", include_str!("../msg/PartCount.msg")),
+    ("PlcStatus", include_str!("../msg/PlcStatus.msg")),
+    ("ProgramCommand", include_str!("../msg/ProgramCommand.msg")),
+    ("ServoStats", include_str!("../msg/ServoStats.msg")),
+    ("SimInput", include_str!("../msg/SimInput.msg")),
+    ("SpindleState", include_str!("../msg/SpindleState.msg")),
+];
+
 /// A Rust type with a ROS 2 interface type name, e.g. `float64`, `string`, `cnc_msgs/Alarm`.
 pub trait RosType {
     fn ros_type() -> String;

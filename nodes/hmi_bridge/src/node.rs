@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 use cnc_msgs::msg::{ActiveAlarms, AlarmEvent, CommandResult, ProgramCommand};
 use cnc_msgs::srv::*;
 use cnc_runtime::dds::{qos, stamp, RosNode};
+use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 use ros2_client::dds::rustdds::QosPolicies;
 
@@ -20,7 +21,7 @@ const COMMAND_TIMEOUT: Duration = Duration::from_secs(10);
 const COMMAND_REPEAT: Duration = Duration::from_millis(250);
 
 struct Commands {
-    publisher: ros2_client::dds::Publisher<ProgramCommand>,
+    publisher: cnc_runtime::dds::Publisher<ProgramCommand>,
     results: ros2_client::dds::Subscription<CommandResult>,
     next_id: u64,
 }
@@ -60,25 +61,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let ns = cfg.machine.namespace.clone();
     let mut ros = RosNode::new(&cfg.network, &ns, "hmi_bridge")?;
     let mut commands = Commands {
-        publisher: ros.publisher(
-            "_internal/program_command",
-            "cnc_msgs/msg/ProgramCommand",
-            qos::commands(),
-        )?,
-        results: ros.subscription(
-            "_internal/command_result",
-            "cnc_msgs/msg/CommandResult",
-            qos::commands(),
-        )?,
+        publisher: ros.publisher(&topics::PROGRAM_COMMAND)?,
+        results: ros.subscription(&topics::COMMAND_RESULT)?,
         next_id: cnc_runtime::clock::monotonic_ns(),
     };
-    let alarm_events = ros.subscription::<AlarmEvent>(
-        "alarm_events",
-        "cnc_msgs/msg/AlarmEvent",
-        qos::events(100),
-    )?;
-    let alarms_pub =
-        ros.publisher::<ActiveAlarms>("alarms", "cnc_msgs/msg/ActiveAlarms", qos::state())?;
+    let alarm_events = ros.subscription::<AlarmEvent>(&topics::ALARM_EVENTS)?;
+    let alarms_pub = ros.publisher::<ActiveAlarms>(&topics::ALARMS)?;
     let participant = ros.participant();
     let sq: QosPolicies = (&qos::services()).into();
     let load = DualServer::<LoadProgram>::new(&participant, &ns, "load_program", sq.clone())?;

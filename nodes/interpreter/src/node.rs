@@ -17,7 +17,8 @@ use cnc_msgs::msg::{
 };
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
-use cnc_runtime::dds::{qos, stamp, RosNode};
+use cnc_runtime::dds::{stamp, RosNode};
+use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use cnc_msgs::canon::to_motion_block;
@@ -132,39 +133,14 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
     let axes = cfg.axis_letters();
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
-    let commands = ros.subscription::<ProgramCommand>(
-        "_internal/program_command",
-        "cnc_msgs/msg/ProgramCommand",
-        qos::commands(),
-    )?;
-    let results = ros.publisher::<CommandResult>(
-        "_internal/command_result",
-        "cnc_msgs/msg/CommandResult",
-        qos::commands(),
-    )?;
-    let to_motion_cmd = ros.publisher::<ProgramCommand>(
-        "_internal/program_command",
-        "cnc_msgs/msg/ProgramCommand",
-        qos::commands(),
-    )?;
-    let blocks = ros.publisher::<MotionBlock>(
-        "_internal/motion_blocks",
-        "cnc_msgs/msg/MotionBlock",
-        qos::commands(),
-    )?;
-    let status_sub = ros.subscription::<MotionStatus>(
-        "_internal/motion_status",
-        "cnc_msgs/msg/MotionStatus",
-        qos::state(),
-    )?;
-    let axes_sub = ros.subscription::<AxisState>("axes", "cnc_msgs/msg/AxisState", qos::state())?;
-    let alarm_sub = ros.subscription::<AlarmEvent>(
-        "alarm_events",
-        "cnc_msgs/msg/AlarmEvent",
-        qos::events(100),
-    )?;
-    let state_pub =
-        ros.publisher::<MachineState>("machine_state", "cnc_msgs/msg/MachineState", qos::state())?;
+    let commands = ros.subscription::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
+    let results = ros.publisher::<CommandResult>(&topics::COMMAND_RESULT)?;
+    let to_motion_cmd = ros.publisher::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
+    let blocks = ros.publisher::<MotionBlock>(&topics::MOTION_BLOCKS)?;
+    let status_sub = ros.subscription::<MotionStatus>(&topics::MOTION_STATUS)?;
+    let axes_sub = ros.subscription::<AxisState>(&topics::AXES)?;
+    let alarm_sub = ros.subscription::<AlarmEvent>(&topics::ALARM_EVENTS)?;
+    let state_pub = ros.publisher::<MachineState>(&topics::MACHINE_STATE)?;
     let alarms = AlarmReporter::new(&mut ros, "interpreter")?;
 
     let (mut memory, memory_error) = load_memory(&cfg);
@@ -475,7 +451,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
 /// Publishes `/machine_state` on every change, so readers see each transition in order, and
 /// twice a second otherwise.
 struct StateReporter {
-    publisher: ros2_client::dds::Publisher<MachineState>,
+    publisher: cnc_runtime::dds::Publisher<MachineState>,
     last: Option<(u8, u32, bool, bool, String)>,
     last_ns: u64,
 }

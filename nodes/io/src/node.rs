@@ -9,8 +9,9 @@ use std::time::Duration;
 use cnc_msgs::msg::SimInput;
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint};
 use cnc_msgs::signals::{x, Bit, SignalTable, XImage, YImage};
-use cnc_runtime::dds::{qos, RosNode};
+use cnc_runtime::dds::RosNode;
 use cnc_runtime::shm::{channel, ShmNode};
+use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::sim::{DeviceConfig, SimConfig, SimLathe};
@@ -62,8 +63,7 @@ pub fn apply_input(sim: &mut SimLathe, input: &SimInput) -> bool {
 /// Runs the io node until shutdown (blocking).
 pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "io")?;
-    let inputs =
-        ros.subscription::<SimInput>("sim/input", "cnc_msgs/msg/SimInput", qos::events(10))?;
+    let inputs = ros.subscription::<SimInput>(&topics::SIM_INPUT)?;
     let shm = ShmNode::new(&instance, "io")?;
     let setpoints = shm.receiver::<ServoSetpoint>(channel::SETPOINT, true)?;
     let feedback = shm.sender::<ServoFeedback>(channel::FEEDBACK, true)?;

@@ -15,8 +15,9 @@ use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{FImage, GImage};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
-use cnc_runtime::dds::{qos, stamp, RosNode};
+use cnc_runtime::dds::{stamp, RosNode};
 use cnc_runtime::shm::{channel, ShmNode};
+use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::motion::alarm;
@@ -65,24 +66,11 @@ fn dds_loop(
     shutdown: &Shutdown,
 ) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "motion")?;
-    let blocks = ros.subscription::<MotionBlock>(
-        "_internal/motion_blocks",
-        "cnc_msgs/msg/MotionBlock",
-        qos::commands(),
-    )?;
-    let commands = ros.subscription::<ProgramCommand>(
-        "_internal/program_command",
-        "cnc_msgs/msg/ProgramCommand",
-        qos::commands(),
-    )?;
-    let status_pub = ros.publisher::<MotionStatus>(
-        "_internal/motion_status",
-        "cnc_msgs/msg/MotionStatus",
-        qos::state(),
-    )?;
-    let axes_pub = ros.publisher::<AxisState>("axes", "cnc_msgs/msg/AxisState", qos::state())?;
-    let stats_pub =
-        ros.publisher::<ServoStats>("servo_stats", "cnc_msgs/msg/ServoStats", qos::state())?;
+    let blocks = ros.subscription::<MotionBlock>(&topics::MOTION_BLOCKS)?;
+    let commands = ros.subscription::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
+    let status_pub = ros.publisher::<MotionStatus>(&topics::MOTION_STATUS)?;
+    let axes_pub = ros.publisher::<AxisState>(&topics::AXES)?;
+    let stats_pub = ros.publisher::<ServoStats>(&topics::SERVO_STATS)?;
     let alarms = AlarmReporter::new(&mut ros, "motion")?;
     let axes = &cfg.machine.axes;
     while !shutdown.requested() {
@@ -176,7 +164,7 @@ impl PlcLink {
     }
 }
 
-fn publish<M: ros2_client::Message + std::fmt::Debug>(p: &ros2_client::dds::Publisher<M>, m: M) {
+fn publish<M: ros2_client::Message + std::fmt::Debug>(p: &cnc_runtime::dds::Publisher<M>, m: M) {
     if let Err(e) = p.publish(m) {
         log::warn!("motion: publish failed: {e:?}");
     }

@@ -13,8 +13,9 @@ use cnc_msgs::msg::{Alarm, PartCount, PlcStatus, SpindleState};
 use cnc_msgs::signals::{f, g, x, y, FImage, SignalTable, XImage};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
-use cnc_runtime::dds::{qos, stamp, RosNode};
+use cnc_runtime::dds::{stamp, RosNode};
 use cnc_runtime::shm::{channel, ShmNode};
+use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::memory::Retained;
@@ -67,12 +68,9 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut program_mtime = program_path.as_deref().and_then(modified);
 
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "plc")?;
-    let spindle_pub =
-        ros.publisher::<SpindleState>("spindle", "cnc_msgs/msg/SpindleState", qos::state())?;
-    let parts_pub =
-        ros.publisher::<PartCount>("part_count", "cnc_msgs/msg/PartCount", qos::state())?;
-    let status_pub =
-        ros.publisher::<PlcStatus>("plc/status", "cnc_msgs/msg/PlcStatus", qos::state())?;
+    let spindle_pub = ros.publisher::<SpindleState>(&topics::SPINDLE)?;
+    let parts_pub = ros.publisher::<PartCount>(&topics::PART_COUNT)?;
+    let status_pub = ros.publisher::<PlcStatus>(&topics::PLC_STATUS)?;
     let alarms = AlarmReporter::new(&mut ros, "plc")?;
     let shm = ShmNode::new(&instance, "plc")?;
     let f_in = shm.receiver::<FImage>(channel::F_IMAGE, false)?;
@@ -289,7 +287,7 @@ impl PartCounter {
 
 /// Spindle state on change (to the rpm) and at least every 100 scans.
 fn publish_spindle(
-    publisher: &ros2_client::dds::Publisher<SpindleState>,
+    publisher: &cnc_runtime::dds::Publisher<SpindleState>,
     yi: &cnc_msgs::signals::YImage,
     xi: &XImage,
     last: &mut Option<(i64, u8, bool, i64)>,

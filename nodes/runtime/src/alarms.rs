@@ -1,12 +1,9 @@
 //! Publishing alarms: every node reports on `/<ns>/alarm_events`; hmi_bridge keeps the list.
 
 use cnc_msgs::msg::{Alarm, AlarmEvent};
-use ros2_client::dds::Publisher;
 
-use crate::dds::{qos, stamp, RosNode};
-
-pub const EVENTS_TOPIC: &str = "alarm_events";
-pub const EVENTS_TYPE: &str = "cnc_msgs/msg/AlarmEvent";
+use crate::dds::{stamp, Publisher, RosNode};
+use crate::topics;
 
 /// A node's alarm reporter.
 pub struct AlarmReporter {
@@ -18,7 +15,7 @@ impl AlarmReporter {
     pub fn new(node: &mut RosNode, source: &str) -> Result<Self, String> {
         Ok(AlarmReporter {
             source: source.into(),
-            publisher: node.publisher(EVENTS_TOPIC, EVENTS_TYPE, qos::events(100))?,
+            publisher: node.publisher(&topics::ALARM_EVENTS)?,
         })
     }
 

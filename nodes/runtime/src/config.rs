@@ -17,6 +17,8 @@ pub struct LaunchConfig {
     pub sim: SimConfig,
     #[serde(default)]
     pub plc: PlcConfig,
+    #[serde(default)]
+    pub recorder: RecorderConfig,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -355,6 +357,89 @@ impl Default for PlcConfig {
     }
 }
 
+/// The recorder: which topics go into the audit recording, where, and how files are cut.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecorderConfig {
+    /// Record at all (the launch configs do; a test cell may not).
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    /// Folder of the bags: one bag (a folder with `metadata.yaml` and `.mcap` files) per start
+    /// of the cell.
+    #[serde(default = "default_records")]
+    pub directory: std::path::PathBuf,
+    /// Topic paths under the namespace to record (`*` matches anything); default all.
+    #[serde(default = "default_include")]
+    pub include: Vec<String>,
+    /// Topic paths not to record, applied after `include`.
+    #[serde(default)]
+    pub exclude: Vec<String>,
+    /// Chunk compression: `zstd`, `lz4` or `none`.
+    #[serde(default = "default_compression")]
+    pub compression: String,
+    /// Everything received more than this long ago is on disk, ms.
+    #[serde(default = "default_flush_ms")]
+    pub flush_ms: u64,
+    /// A new file when the current one reaches this size, MiB…
+    #[serde(default = "default_split_mib")]
+    pub split_mib: u64,
+    /// …or this age, s.
+    #[serde(default = "default_split_s")]
+    pub split_seconds: u64,
+    /// The oldest bags are deleted while the folder holds more than this, MiB.
+    #[serde(default = "default_cap_mib")]
+    pub max_total_mib: u64,
+}
+
+fn yes() -> bool {
+    true
+}
+fn default_records() -> std::path::PathBuf {
+    "records".into()
+}
+fn default_include() -> Vec<String> {
+    vec!["*".into()]
+}
+fn default_compression() -> String {
+    "zstd".into()
+}
+fn default_flush_ms() -> u64 {
+    1000
+}
+fn default_split_mib() -> u64 {
+    64
+}
+fn default_split_s() -> u64 {
+    3600
+}
+fn default_cap_mib() -> u64 {
+    2048
+}
+
+impl Default for RecorderConfig {
+    fn default() -> Self {
+        RecorderConfig {
+            enabled: true,
+            directory: default_records(),
+            include: default_include(),
+            exclude: Vec::new(),
+            compression: default_compression(),
+            flush_ms: default_flush_ms(),
+            split_mib: default_split_mib(),
+            split_seconds: default_split_s(),
+            max_total_mib: default_cap_mib(),
+        }
+    }
+}
+
+impl RecorderConfig {
+    /// Whether the topic at `path` (under the namespace) is recorded.
+    pub fn records(&self, path: &str) -> bool {
+        self.include.iter().any(|p| crate::topics::matches(p, path))
+            && !self.exclude.iter().any(|p| crate::topics::matches(p, path))
+    }
+}
+
 impl LaunchConfig {
     pub fn from_yaml(text: &str) -> Result<Self, String> {
         let cfg: LaunchConfig =
@@ -390,6 +475,18 @@ impl LaunchConfig {
             return Err(format!(
                 "machine.namespace {ns:?}: letters, digits and _ only, not starting with a digit"
             ));
+        }
+        let r = &self.recorder;
+        if !["zstd", "lz4", "none"].contains(&r.compression.as_str()) {
+            return Err(format!(
+                "recorder.compression {:?}: zstd, lz4 or none",
+                r.compression
+            ));
+        }
+        if r.flush_ms == 0 || r.split_mib == 0 || r.split_seconds == 0 || r.max_total_mib == 0 {
+            return Err(
+                "recorder: flush_ms, split_mib, split_seconds and max_total_mib must be > 0".into(),
+            );
         }
         let n = self.machine.axes.len();
         if n == 0 || n > cnc_msgs::servo::MAX_AXES {

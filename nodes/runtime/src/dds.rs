@@ -1,7 +1,12 @@
 //! DDS: participants on the configured interfaces and domain, the QoS profiles of DESIGN.md,
 //! and small helpers for publishers and subscriptions under the machine's namespace.
 
+use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Duration;
+
+use cnc_msgs::RosMessage;
 
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::dds::{Context, Node};
@@ -9,12 +14,14 @@ use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{Message, MessageTypeName, Name, NodeName, NodeOptions, QosProfile};
 
 use crate::config::NetworkConfig;
+use crate::topics::Topic;
 
 /// A ROS 2 node of the controller with its own DDS participant.
 pub struct RosNode {
     pub node: Node,
     pub namespace: String,
     context: Context,
+    domain: u16,
 }
 
 /// Creates a participant in the configured domain that uses only the configured interfaces.
@@ -51,6 +58,7 @@ impl RosNode {
             node,
             namespace: namespace.to_string(),
             context,
+            domain: net.effective_domain_id()?,
         })
     }
 
@@ -72,30 +80,105 @@ impl RosNode {
             .map_err(|e| format!("topic {topic}: {e:?}"))
     }
 
-    /// Publisher on `/<namespace>/<topic>`; `type_name` like `cnc_msgs/msg/SpindleState`.
-    pub fn publisher<M: Message>(
+    /// Publisher on `/<namespace>/<topic>`; every sample it sends is counted
+    /// ([`published_count`]).
+    pub fn publisher<M: Message + RosMessage>(
         &mut self,
-        topic: &str,
-        type_name: &str,
-        qos: QosProfile,
-    ) -> Result<ros2_client::dds::Publisher<M>, String> {
-        let t = self.topic(topic, type_name, &qos)?;
-        self.node
+        topic: &Topic,
+    ) -> Result<Publisher<M>, String> {
+        check_type::<M>(topic)?;
+        let qos = topic.qos();
+        let t = self.topic(topic.path, topic.type_name, &qos)?;
+        let inner = self
+            .node
             .create_publisher::<M>(&t, Some(qos))
-            .map_err(|e| format!("publisher {topic}: {e:?}"))
+            .map_err(|e| format!("publisher {}: {e:?}", topic.path))?;
+        Ok(Publisher {
+            inner,
+            count: counter(self.domain, &self.namespace, topic.path),
+        })
     }
 
-    pub fn subscription<M: Message + 'static>(
+    pub fn subscription<M: Message + RosMessage + 'static>(
         &mut self,
-        topic: &str,
-        type_name: &str,
+        topic: &Topic,
+    ) -> Result<ros2_client::dds::Subscription<M>, String> {
+        self.subscription_with_qos(topic, topic.qos())
+    }
+
+    /// A subscription with its own QoS, e.g. a deeper history than the topic's writers keep.
+    pub fn subscription_with_qos<M: Message + RosMessage + 'static>(
+        &mut self,
+        topic: &Topic,
         qos: QosProfile,
     ) -> Result<ros2_client::dds::Subscription<M>, String> {
-        let t = self.topic(topic, type_name, &qos)?;
+        check_type::<M>(topic)?;
+        let t = self.topic(topic.path, topic.type_name, &qos)?;
         self.node
             .create_subscription::<M>(&t, Some(qos))
-            .map_err(|e| format!("subscription {topic}: {e:?}"))
+            .map_err(|e| format!("subscription {}: {e:?}", topic.path))
     }
+
+    /// The DDS topic for `topic`, for readers and writers ros2-client does not offer (the
+    /// recorder's raw readers, replay's raw writers).
+    pub fn dds_topic(&mut self, topic: &Topic) -> Result<ros2_client::dds::rustdds::Topic, String> {
+        self.topic(topic.path, topic.type_name, &topic.qos())
+    }
+
+    pub fn domain(&self) -> u16 {
+        self.domain
+    }
+}
+
+fn check_type<M: RosMessage>(topic: &Topic) -> Result<(), String> {
+    if M::TYPE_NAME == topic.type_name {
+        Ok(())
+    } else {
+        Err(format!(
+            "topic {} carries {}, not {}",
+            topic.path,
+            topic.type_name,
+            M::TYPE_NAME
+        ))
+    }
+}
+
+/// A publisher that counts what it sends, so a test can compare a recording with what the
+/// nodes published.
+pub struct Publisher<M: Message> {
+    inner: ros2_client::dds::Publisher<M>,
+    count: Arc<AtomicU64>,
+}
+
+impl<M: Message> Publisher<M> {
+    pub fn publish(&self, message: M) -> Result<(), String> {
+        match self.inner.publish(message) {
+            Ok(()) => {
+                self.count.fetch_add(1, Ordering::Relaxed);
+                Ok(())
+            }
+            Err(e) => Err(e.to_string()),
+        }
+    }
+}
+
+type Counters = Mutex<BTreeMap<(u16, String), Arc<AtomicU64>>>;
+
+fn counters() -> &'static Counters {
+    static COUNTERS: OnceLock<Counters> = OnceLock::new();
+    COUNTERS.get_or_init(Default::default)
+}
+
+fn counter(domain: u16, namespace: &str, path: &str) -> Arc<AtomicU64> {
+    let key = (domain, format!("/{namespace}/{path}"));
+    let mut map = counters().lock().unwrap_or_else(|e| e.into_inner());
+    map.entry(key).or_default().clone()
+}
+
+/// Samples published so far in this process on `/<namespace>/<path>` in `domain`, by every
+/// publisher of that topic together.
+pub fn published_count(domain: u16, namespace: &str, path: &str) -> u64 {
+    counter(domain, namespace, path).load(Ordering::Relaxed)
 }
 
 /// `/<namespace>/<path>` as a ROS name; `path` may have segments (`sim/input`).

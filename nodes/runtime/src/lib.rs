@@ -8,6 +8,7 @@ pub mod dds;
 pub mod lifecycle;
 pub mod persist;
 pub mod shm;
+pub mod topics;
 
 pub use config::LaunchConfig;
 pub use lifecycle::Shutdown;

@@ -1,0 +1,145 @@
+//! Every DDS topic of one machine, in one table: its name under the machine's namespace, its
+//! message type and what kind of delivery it needs. Nodes create their publishers and
+//! subscriptions from these entries (so a name or type cannot drift between writer and reader),
+//! and the recorder records exactly this table.
+
+use ros2_client::QosProfile;
+
+use crate::dds::qos;
+
+/// How a topic is delivered (DESIGN.md "QoS says what a topic means").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Delivery {
+    /// Reliable, transient-local, depth 1: the current value.
+    State,
+    /// Reliable, volatile, keep the last `n`.
+    Events(usize),
+    /// Reliable, deep: command and block streams between nodes.
+    Commands,
+}
+
+/// One topic: `/<namespace>/<path>` of type `type_name`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Topic {
+    pub path: &'static str,
+    /// `cnc_msgs/msg/SpindleState` style.
+    pub type_name: &'static str,
+    pub delivery: Delivery,
+}
+
+impl Topic {
+    pub fn qos(&self) -> QosProfile {
+        match self.delivery {
+            Delivery::State => qos::state(),
+            Delivery::Events(n) => qos::events(n),
+            Delivery::Commands => qos::commands(),
+        }
+    }
+
+    /// Internal topics (`_internal/…`) are the nodes' own plumbing; ROS 2 tools hide them.
+    pub fn internal(&self) -> bool {
+        self.path.starts_with("_internal/")
+    }
+}
+
+const fn topic(path: &'static str, type_name: &'static str, delivery: Delivery) -> Topic {
+    Topic {
+        path,
+        type_name,
+        delivery,
+    }
+}
+
+pub const MACHINE_STATE: Topic = topic(
+    "machine_state",
+    "cnc_msgs/msg/MachineState",
+    Delivery::State,
+);
+pub const SPINDLE: Topic = topic("spindle", "cnc_msgs/msg/SpindleState", Delivery::State);
+pub const AXES: Topic = topic("axes", "cnc_msgs/msg/AxisState", Delivery::State);
+pub const PART_COUNT: Topic = topic("part_count", "cnc_msgs/msg/PartCount", Delivery::State);
+pub const ALARMS: Topic = topic("alarms", "cnc_msgs/msg/ActiveAlarms", Delivery::State);
+pub const ALARM_EVENTS: Topic = topic(
+    "alarm_events",
+    "cnc_msgs/msg/AlarmEvent",
+    Delivery::Events(100),
+);
+pub const PLC_STATUS: Topic = topic("plc/status", "cnc_msgs/msg/PlcStatus", Delivery::State);
+pub const SERVO_STATS: Topic = topic("servo_stats", "cnc_msgs/msg/ServoStats", Delivery::State);
+pub const SIM_INPUT: Topic = topic("sim/input", "cnc_msgs/msg/SimInput", Delivery::Events(10));
+pub const PROGRAM_COMMAND: Topic = topic(
+    "_internal/program_command",
+    "cnc_msgs/msg/ProgramCommand",
+    Delivery::Commands,
+);
+pub const COMMAND_RESULT: Topic = topic(
+    "_internal/command_result",
+    "cnc_msgs/msg/CommandResult",
+    Delivery::Commands,
+);
+pub const MOTION_BLOCKS: Topic = topic(
+    "_internal/motion_blocks",
+    "cnc_msgs/msg/MotionBlock",
+    Delivery::Commands,
+);
+pub const MOTION_STATUS: Topic = topic(
+    "_internal/motion_status",
+    "cnc_msgs/msg/MotionStatus",
+    Delivery::State,
+);
+
+/// Every topic of a machine.
+pub const ALL: &[Topic] = &[
+    MACHINE_STATE,
+    SPINDLE,
+    AXES,
+    PART_COUNT,
+    ALARMS,
+    ALARM_EVENTS,
+    PLC_STATUS,
+    SERVO_STATS,
+    SIM_INPUT,
+    PROGRAM_COMMAND,
+    COMMAND_RESULT,
+    MOTION_BLOCKS,
+    MOTION_STATUS,
+];
+
+/// Whether `path` matches `pattern`: `*` stands for any run of characters (also `/`).
+pub fn matches(pattern: &str, path: &str) -> bool {
+    match pattern.split_once('*') {
+        None => pattern == path,
+        Some((head, rest)) => {
+            let Some(tail) = path.strip_prefix(head) else {
+                return false;
+            };
+            (0..=tail.len())
+                .filter(|&i| tail.is_char_boundary(i))
+                .any(|i| matches(rest, &tail[i..]))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patterns() {
+        assert!(matches("*", "plc/status"));
+        assert!(matches("_internal/*", "_internal/motion_blocks"));
+        assert!(!matches("_internal/*", "axes"));
+        assert!(matches("*status", "plc/status"));
+        assert!(matches("a*b*c", "axxbyyc"));
+        assert!(!matches("a*b*c", "axxbyy"));
+        assert!(matches("axes", "axes"));
+        assert!(!matches("axes", "axes2"));
+    }
+
+    #[test]
+    fn names_are_unique() {
+        for (i, a) in ALL.iter().enumerate() {
+            assert!(ALL[i + 1..].iter().all(|b| b.path != a.path), "{}", a.path);
+        }
+    }
+}
