@@ -2,12 +2,14 @@
 # The project's test command (README): sets up what the tests need, then runs
 # `cargo test --workspace` inside a network namespace that has only loopback, so no DDS
 # discovery traffic leaves the machine. Needs root (ip netns); CI runs as root.
-#   - target/venv: Python with cyclonedds (the interop peer of tests/cyclonedds_interop.rs)
+#   - target/venv: Python with cyclonedds (the interop peer of tests/cyclonedds_interop.rs) and
+#     rosbags, mcap, mcap-ros2-support (the readers of tests/recording.rs)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-if ! target/venv/bin/python -c "import cyclonedds" 2>/dev/null; then
+if ! target/venv/bin/python -c "import cyclonedds, rosbags, mcap, mcap_ros2, lz4, zstandard" 2>/dev/null; then
     python3 -m venv target/venv
-    target/venv/bin/pip install --quiet --disable-pip-version-check cyclonedds==11.0.1
+    target/venv/bin/pip install --quiet --disable-pip-version-check cyclonedds==11.0.1 \
+        rosbags==0.11.9 mcap==1.6.0 mcap-ros2-support==0.6.0 lz4==4.4.5 zstandard==0.25.0
 fi
 NS="cnc_test_$$"
 cleanup() { ip netns del "$NS" 2>/dev/null || true; }

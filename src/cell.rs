@@ -1,6 +1,7 @@
 //! Starts every node of one machine in this process, each with its own DDS participant and its
 //! own threads, exactly as they would run as separate processes.
 
+use std::path::PathBuf;
 use std::thread::JoinHandle;
 
 use cnc_runtime::shm::instance;
@@ -9,7 +10,12 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 pub struct Cell {
     shutdown: Shutdown,
     threads: Vec<(&'static str, JoinHandle<Result<String, String>>)>,
+    /// The recorder stops after the other nodes, so it keeps what they sent last.
+    recorder: Option<(Shutdown, JoinHandle<Result<PathBuf, String>>)>,
 }
+
+/// How long the recorder goes on taking samples after the other nodes stopped.
+const RECORDER_GRACE: std::time::Duration = std::time::Duration::from_millis(300);
 
 impl Cell {
     pub fn start(cfg: &LaunchConfig) -> Result<Cell, String> {
@@ -19,7 +25,18 @@ impl Cell {
         let mut cell = Cell {
             shutdown: shutdown.clone(),
             threads: Vec::new(),
+            recorder: None,
         };
+        // The recorder first, so it hears the other nodes from their first message.
+        if cfg.recorder.enabled {
+            let (c, s) = (cfg.clone(), Shutdown::default());
+            let stop = s.clone();
+            let h = std::thread::Builder::new()
+                .name("recorder".into())
+                .spawn(move || cnc_recorder::node::run(c, s))
+                .map_err(|e| format!("recorder: {e}"))?;
+            cell.recorder = Some((stop, h));
+        }
         let spawn = |name: &'static str, f: Box<dyn FnOnce() -> Result<String, String> + Send>| {
             std::thread::Builder::new()
                 .name(name.into())
@@ -69,6 +86,9 @@ impl Cell {
 
     /// A node that has stopped on its own, with its error.
     pub fn failed_node(&self) -> Option<&'static str> {
+        if self.recorder.as_ref().is_some_and(|(_, h)| h.is_finished()) {
+            return Some("recorder");
+        }
         self.threads
             .iter()
             .find(|(_, h)| h.is_finished())
@@ -86,6 +106,15 @@ impl Cell {
                 Ok(Ok(_)) => {}
                 Ok(Err(e)) => errors.push(format!("{name}: {e}")),
                 Err(_) => errors.push(format!("{name}: panicked")),
+            }
+        }
+        if let Some((stop, h)) = self.recorder {
+            std::thread::sleep(RECORDER_GRACE);
+            stop.request();
+            match h.join() {
+                Ok(Ok(dir)) => log::info!("recording in {}", dir.display()),
+                Ok(Err(e)) => errors.push(format!("recorder: {e}")),
+                Err(_) => errors.push("recorder: panicked".into()),
             }
         }
         (summary, errors)

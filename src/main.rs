@@ -71,6 +71,42 @@ enum Verb {
         #[arg(long)]
         rungs: bool,
     },
+    /// Recordings (bags) of the machine's topics.
+    Record {
+        #[command(subcommand)]
+        action: RecordVerb,
+    },
+    /// Tamper evidence of recordings.
+    Audit {
+        #[command(subcommand)]
+        action: AuditVerb,
+    },
+    /// Publish a recording on DDS again with its original timing, under
+    /// `/<namespace>_replay/...` unless `--namespace` names another.
+    Replay {
+        bag: PathBuf,
+        /// The launch config whose network section (domain, interfaces) is used.
+        #[arg(long, default_value = DEFAULT_CONFIG)]
+        config: PathBuf,
+        #[arg(long)]
+        namespace: Option<String>,
+        /// 2 = twice as fast.
+        #[arg(long, default_value_t = 1.0)]
+        speed: f64,
+    },
+}
+
+#[derive(Subcommand)]
+enum RecordVerb {
+    /// Repair a bag (or one .mcap file) cut off by a crash: keeps everything up to the last
+    /// flushed chunk, adds the index and rewrites metadata.yaml.
+    Recover { bag: PathBuf },
+}
+
+#[derive(Subcommand)]
+enum AuditVerb {
+    /// Check a bag's audit chain; exits 1 and names the first altered or missing chunk.
+    Verify { bag: PathBuf },
 }
 
 /// A part program and what it is read with.
@@ -164,6 +200,22 @@ fn main() -> ExitCode {
             },
         ),
         Some(Verb::PlcCheck { file, rungs }) => plc_check(&file, rungs),
+        Some(Verb::Record {
+            action: RecordVerb::Recover { bag },
+        }) => cnc_recorder::recover::recover(&bag).map(|lines| {
+            for l in lines {
+                println!("{l}");
+            }
+        }),
+        Some(Verb::Audit {
+            action: AuditVerb::Verify { bag },
+        }) => audit_verify(&bag),
+        Some(Verb::Replay {
+            bag,
+            config,
+            namespace,
+            speed,
+        }) => replay(&bag, &config, namespace.as_deref(), speed),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
     match result {
@@ -172,6 +224,41 @@ fn main() -> ExitCode {
             eprintln!("cnc: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+fn audit_verify(bag: &Path) -> Result<(), String> {
+    use cnc_recorder::audit::{verify, Verdict};
+    match verify(bag)? {
+        Verdict::Intact { files, chunks } => {
+            println!(
+                "{}: intact ({chunks} chunks in {files} files)",
+                bag.display()
+            );
+            Ok(())
+        }
+        Verdict::Altered(why) => Err(format!("ALTERED: {why}")),
+    }
+}
+
+fn replay(bag: &Path, config: &Path, namespace: Option<&str>, speed: f64) -> Result<(), String> {
+    let cfg = LaunchConfig::load(config)?;
+    install_signal_handlers();
+    let r = cnc_recorder::replay::replay(bag, &cfg.network, namespace, speed, &|| {
+        STOP.load(Ordering::SeqCst)
+    })?;
+    println!(
+        "replayed {} messages under /{} in {:.1} s ({} skipped)",
+        r.sent, r.namespace, r.seconds, r.skipped
+    );
+    Ok(())
+}
+
+fn install_signal_handlers() {
+    // SAFETY: installing a handler that only stores to an atomic.
+    unsafe {
+        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
+        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
     }
 }
 
@@ -292,15 +379,12 @@ enum NodeName {
     Motion,
     Interpreter,
     HmiBridge,
+    Recorder,
 }
 
 fn run_node(node: NodeName, config: &Path) -> Result<(), String> {
     let cfg = LaunchConfig::load(config)?;
-    // SAFETY: installing a handler that only stores to an atomic.
-    unsafe {
-        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
-        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
-    }
+    install_signal_handlers();
     let inst =
         cnc_runtime::shm::instance(&cfg.machine.namespace, cfg.network.effective_domain_id()?);
     let shutdown = cnc_runtime::Shutdown::default();
@@ -311,6 +395,9 @@ fn run_node(node: NodeName, config: &Path) -> Result<(), String> {
         NodeName::Motion => cnc_motion::node::run(cfg, inst, s),
         NodeName::Interpreter => cnc_interpreter::node::run(cfg, s).map(|_| String::new()),
         NodeName::HmiBridge => cnc_hmi_bridge::node::run(cfg, s).map(|_| String::new()),
+        NodeName::Recorder => {
+            cnc_recorder::node::run(cfg, s).map(|dir| format!("recorded into {}", dir.display()))
+        }
     });
     while !STOP.load(Ordering::SeqCst) && !worker.is_finished() {
         std::thread::sleep(Duration::from_millis(50));
@@ -326,11 +413,7 @@ fn run_node(node: NodeName, config: &Path) -> Result<(), String> {
 fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String> {
     let cfg = LaunchConfig::load(config)?;
     let text = program.map(read_program).transpose()?;
-    // SAFETY: installing a handler that only stores to an atomic.
-    unsafe {
-        libc::signal(libc::SIGINT, on_signal as *const () as libc::sighandler_t);
-        libc::signal(libc::SIGTERM, on_signal as *const () as libc::sighandler_t);
-    }
+    install_signal_handlers();
     let domain = cfg.network.effective_domain_id()?;
     let ns = cfg.machine.namespace.clone();
     let cell = Cell::start(&cfg)?;

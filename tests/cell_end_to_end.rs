@@ -20,6 +20,7 @@ fn config(domain: u16) -> LaunchConfig {
     cfg.network.domain_id = Some(domain);
     // Each test starts from a PLC with no kept memory (part count 0).
     cfg.plc.memory_file = None;
+    cfg.recorder.enabled = false; // tests/recording.rs tests the recorder
     cfg
 }
 

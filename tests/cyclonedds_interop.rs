@@ -25,6 +25,7 @@ fn cyclone_dds_peer_reads_topics_and_calls_services() {
     cfg.network.domain_id = Some(43);
     // A PLC with no kept memory: the part count starts at 0.
     cfg.plc.memory_file = None;
+    cfg.recorder.enabled = false; // tests/recording.rs tests the recorder
     let cell = Cell::start(&cfg).unwrap();
     let out = Command::new(&python)
         .arg(root.join("tests/interop/cyclone_peer.py"))

@@ -207,3 +207,27 @@ fn cdr_of_spindle_state_has_the_ros_layout() {
     expected.push(1);
     assert_eq!(bytes, expected);
 }
+
+/// Recordings carry `MSG_FILES` as their schemas: it must hold every `.msg` file as it is.
+#[test]
+fn msg_files_embeds_every_msg_file() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("msg");
+    let mut on_disk: Vec<(String, String)> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "msg"))
+        .map(|p| {
+            (
+                p.file_stem().unwrap().to_string_lossy().to_string(),
+                std::fs::read_to_string(&p).unwrap(),
+            )
+        })
+        .collect();
+    on_disk.sort();
+    let embedded: Vec<(String, String)> = cnc_msgs::MSG_FILES
+        .iter()
+        .map(|(n, t)| (n.to_string(), t.to_string()))
+        .collect();
+    assert_eq!(embedded, on_disk);
+}

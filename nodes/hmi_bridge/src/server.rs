@@ -4,73 +4,17 @@
 use std::marker::PhantomData;
 
 use byteorder::LittleEndian;
+use cnc_runtime::raw::{Raw, RawAdapter};
 use ros2_client::dds::rustdds::{
     self,
-    bytes::Bytes,
-    no_key::{self, DataWriter, SimpleDataReader},
+    no_key::{DataWriter, SimpleDataReader},
     rpc::SampleIdentity,
-    QosPolicies, RepresentationIdentifier, SequenceNumber, Timestamp, TopicKind,
-    WriteOptionsBuilder,
+    QosPolicies, SequenceNumber, Timestamp, TopicKind, WriteOptionsBuilder,
 };
 use serde::{de::DeserializeOwned, Serialize};
 
 use crate::mapping::{classify, Mapping};
 use cnc_msgs::srv::RosService;
-
-/// Payload bytes as they travel, without the encapsulation header.
-#[derive(Debug)]
-pub struct Raw {
-    bytes: Vec<u8>,
-    little_endian: bool,
-}
-
-pub struct RawAdapter;
-
-impl no_key::DeserializerAdapter<Raw> for RawAdapter {
-    type Error = std::io::Error;
-    type Decoded = Raw;
-    fn supported_encodings() -> &'static [RepresentationIdentifier] {
-        &[
-            RepresentationIdentifier::CDR_LE,
-            RepresentationIdentifier::CDR_BE,
-        ]
-    }
-    fn transform_decoded(decoded: Raw) -> Raw {
-        decoded
-    }
-}
-
-impl no_key::DefaultDecoder<Raw> for RawAdapter {
-    type Decoder = RawDecoder;
-    const DECODER: RawDecoder = RawDecoder;
-}
-
-#[derive(Clone)]
-pub struct RawDecoder;
-
-impl<'de> no_key::Decode<'de, Raw> for RawDecoder {
-    type Error = std::io::Error;
-    fn decode_bytes(
-        self,
-        input: &'de [u8],
-        encoding: RepresentationIdentifier,
-    ) -> Result<Raw, Self::Error> {
-        Ok(Raw {
-            bytes: input.to_vec(),
-            little_endian: encoding != RepresentationIdentifier::CDR_BE,
-        })
-    }
-}
-
-impl no_key::SerializerAdapter<Raw> for RawAdapter {
-    type Error = std::io::Error;
-    fn output_encoding() -> RepresentationIdentifier {
-        RepresentationIdentifier::CDR_LE
-    }
-    fn to_bytes(value: &Raw) -> Result<Bytes, Self::Error> {
-        Ok(Bytes::from(value.bytes.clone()))
-    }
-}
 
 /// One received request, ready to be answered.
 pub struct Request<Req> {

@@ -69,7 +69,13 @@ impl BagInfo {
         if start == u64::MAX {
             start = 0;
         }
-        let q = |s: &str| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""));
+        let q = |s: &str| {
+            let escaped = s
+                .replace('\\', "\\\\")
+                .replace('"', "\\\"")
+                .replace('\n', "\\n");
+            format!("\"{escaped}\"")
+        };
         let mut y = String::from("rosbag2_bagfile_information:\n  version: 8\n");
         y += "  storage_identifier: mcap\n  relative_file_paths:\n";
         for f in &self.files {
@@ -170,6 +176,11 @@ impl Bag {
 
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// Files begun so far.
+    pub fn file_count(&self) -> usize {
+        self.info.files.len()
     }
 
     fn open_file(&mut self, now_ns: u64) -> Result<(), String> {

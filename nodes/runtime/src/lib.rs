@@ -7,6 +7,7 @@ pub mod config;
 pub mod dds;
 pub mod lifecycle;
 pub mod persist;
+pub mod raw;
 pub mod shm;
 pub mod topics;
 

@@ -1,0 +1,174 @@
+//! recorder node shell: one undecoded DDS reader per recorded topic, each sample written as it
+//! came off the wire (encapsulation header and CDR) into the bag under
+//! `recorder.directory/<namespace>_<UTC start time>/`.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use cnc_runtime::clock::wall_ns;
+use cnc_runtime::dds::RosNode;
+use cnc_runtime::raw::{Raw, RawAdapter};
+use cnc_runtime::topics::{self, Topic};
+use cnc_runtime::{LaunchConfig, Shutdown};
+use ros2_client::dds::rustdds::{no_key::SimpleDataReader, QosPolicies};
+use ros2_client::qos::History;
+
+use crate::bag::{offered_qos, rotate, Bag, BagOptions, BagTopic};
+use crate::mcap::Compression;
+
+/// Samples a reader keeps for the recorder between two takes; the loop takes every few ms, so
+/// this only matters when the disk stalls.
+const READER_DEPTH: usize = 10_000;
+
+/// The topics of `cfg` the recorder records.
+pub fn recorded_topics(cfg: &LaunchConfig) -> Vec<Topic> {
+    topics::ALL
+        .iter()
+        .copied()
+        .filter(|t| cfg.recorder.records(t.path))
+        .collect()
+}
+
+pub fn compression(name: &str) -> Result<Compression, String> {
+    match name {
+        "zstd" => Ok(Compression::Zstd),
+        "lz4" => Ok(Compression::Lz4),
+        "none" => Ok(Compression::None),
+        other => Err(format!("unknown compression {other:?}: zstd, lz4 or none")),
+    }
+}
+
+/// `2026-11-21 10:15:00 UTC` → `20261121T101500Z`, from nanoseconds since the epoch.
+pub fn utc_stamp(ns: u64) -> String {
+    let secs = ns / 1_000_000_000;
+    let (days, rest) = (secs / 86_400, secs % 86_400);
+    // Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}{m:02}{d:02}T{:02}{:02}{:02}Z",
+        rest / 3600,
+        rest % 3600 / 60,
+        rest % 60
+    )
+}
+
+/// Runs the recorder until shutdown; returns the bag folder it wrote.
+pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<PathBuf, String> {
+    let rc = &cfg.recorder;
+    let ns = cfg.machine.namespace.clone();
+    let mut ros = RosNode::new(&cfg.network, &ns, "recorder")?;
+    let participant = ros.participant();
+    let recorded = recorded_topics(&cfg);
+    let mut readers: Vec<SimpleDataReader<Raw, RawAdapter>> = Vec::new();
+    let mut bag_topics = Vec::new();
+    for t in &recorded {
+        let dds_topic = ros.dds_topic(t)?;
+        let qos: QosPolicies = (&t.qos().history(History::KeepLast {
+            depth: READER_DEPTH,
+        }))
+            .into();
+        let subscriber = participant
+            .create_subscriber(&qos)
+            .map_err(|e| format!("recorder {}: {e:?}", t.path))?;
+        let reader = subscriber
+            .create_simple_datareader_no_key::<Raw, RawAdapter>(&dds_topic, Some(qos))
+            .map_err(|e| format!("recorder {}: {e:?}", t.path))?;
+        readers.push(reader);
+        bag_topics.push(BagTopic {
+            name: format!("/{ns}/{}", t.path),
+            type_name: t.type_name.into(),
+            qos: offered_qos(t.delivery),
+        });
+    }
+    let options = BagOptions {
+        compression: compression(&rc.compression)?,
+        flush_ns: rc.flush_ms * 1_000_000,
+        split_bytes: rc.split_mib << 20,
+        split_ns: rc.split_seconds * 1_000_000_000,
+    };
+    let start = wall_ns();
+    let name = format!("{ns}_{}", utc_stamp(start));
+    let mut bag = Bag::create(&rc.directory, &name, bag_topics, options, start)?;
+    let bag_dir = bag.dir().to_path_buf();
+    log::info!(
+        "recorder: {} topics into {}",
+        recorded.len(),
+        bag_dir.display()
+    );
+    let cap = rc.max_total_mib << 20;
+    let rotate_now = |dir: &PathBuf| match rotate(&rc.directory, cap, dir) {
+        Ok(deleted) => {
+            for d in deleted {
+                log::info!("recorder: deleted old bag {}", d.display());
+            }
+        }
+        Err(e) => log::warn!("recorder: rotation: {e}"),
+    };
+    rotate_now(&bag_dir);
+    let mut files = 1;
+    let mut last_error = String::new();
+    loop {
+        // Stop only after a last drain, so what arrived before shutdown is kept.
+        let stopping = shutdown.requested();
+        let mut took = 0;
+        for (i, reader) in readers.iter().enumerate() {
+            reader.drain_read_notifications();
+            while let Ok(Some(sample)) = reader.try_take_one() {
+                took += 1;
+                let now = wall_ns();
+                let published = sample
+                    .write_options
+                    .source_timestamp()
+                    .map(|t| ((u128::from(t.to_ticks()) * 1_000_000_000) >> 32) as u64)
+                    .unwrap_or(now);
+                let data = sample.into_value().serialized();
+                if let Err(e) = bag.record(i, now, published, &data) {
+                    if e != last_error {
+                        log::error!("recorder: {e}");
+                        last_error = e;
+                    }
+                }
+            }
+        }
+        if let Err(e) = bag.tick(wall_ns()) {
+            if e != last_error {
+                log::error!("recorder: {e}");
+                last_error = e;
+            }
+        }
+        if bag.file_count() != files {
+            files = bag.file_count();
+            rotate_now(&bag_dir);
+        }
+        if stopping {
+            break;
+        }
+        if took == 0 {
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+    bag.close()?;
+    Ok(bag_dir)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utc_stamps() {
+        assert_eq!(utc_stamp(0), "19700101T000000Z");
+        // 2026-11-21 10:15:30 UTC.
+        assert_eq!(utc_stamp(1_795_256_130 * 1_000_000_000), "20261121T101530Z");
+        // 2000-02-29 23:59:59 UTC (leap day).
+        assert_eq!(utc_stamp(951_868_799 * 1_000_000_000), "20000229T235959Z");
+    }
+}
