@@ -230,10 +230,15 @@ fn main() -> ExitCode {
 fn audit_verify(bag: &Path) -> Result<(), String> {
     use cnc_recorder::audit::{verify, Verdict};
     match verify(bag)? {
-        Verdict::Intact { files, chunks } => {
+        Verdict::Intact {
+            files,
+            chunks,
+            last,
+        } => {
             println!(
-                "{}: intact ({chunks} chunks in {files} files)",
-                bag.display()
+                "{}: intact ({chunks} chunks in {files} files), last hash {}",
+                bag.display(),
+                cnc_recorder::chain::hex(&last)
             );
             Ok(())
         }

@@ -11,8 +11,12 @@ use crate::reader::walk;
 /// The result of a verification.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Verdict {
-    /// Every segment matches; `chunks` segments in `files` files.
-    Intact { files: usize, chunks: u64 },
+    /// Every segment matches; `chunks` segments in `files` files, ending in hash `last`.
+    Intact {
+        files: usize,
+        chunks: u64,
+        last: Hash,
+    },
     /// The first problem found.
     Altered(String),
 }
@@ -126,5 +130,6 @@ pub fn verify(path: &Path) -> Result<Verdict, String> {
     Ok(Verdict::Intact {
         files: files.len(),
         chunks,
+        last: prev,
     })
 }
