@@ -8,6 +8,7 @@
 //! `servo` and `signals` hold the fixed-size `#[repr(C)]` payloads exchanged over iceoryx2 shared
 //! memory; they never go over DDS.
 
+pub mod action;
 pub mod canon;
 pub mod msg;
 pub mod servo;

@@ -1,6 +1,8 @@
 //! hmi_bridge: the machine's face to the cell. ROS 2 services for supervisors (both service
 //! mappings, see [`mapping`]), the active-alarm list, and the state topics robots read.
 
+pub mod action_server;
 pub mod mapping;
 pub mod node;
+pub mod run_program;
 pub mod server;

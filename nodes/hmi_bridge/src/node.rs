@@ -4,13 +4,17 @@
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
-use cnc_msgs::msg::{ActiveAlarms, AlarmEvent, CommandResult, ProgramCommand};
+use cnc_msgs::msg::{
+    ActiveAlarms, AlarmEvent, CommandResult, MachineState, MotionStatus, PartCount, ProgramCommand,
+};
 use cnc_msgs::srv::*;
 use cnc_runtime::dds::{qos, stamp, RosNode};
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 use ros2_client::dds::rustdds::QosPolicies;
+use ros2_client::qos::History;
 
+use crate::action_server::{CommandPath, RunProgramServer};
 use crate::server::{DualServer, Request};
 
 /// How long a service waits for the interpreter's answer.
@@ -26,7 +30,7 @@ struct Commands {
     next_id: u64,
 }
 
-impl Commands {
+impl CommandPath for Commands {
     /// Sends a command and waits for its result.
     fn call(&mut self, command: u8, program: &str, text: &str) -> (bool, String) {
         self.next_id += 1;
@@ -72,7 +76,21 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let load = DualServer::<LoadProgram>::new(&participant, &ns, "load_program", sq.clone())?;
     let start = DualServer::<StartProgram>::new(&participant, &ns, "start_program", sq.clone())?;
     let stop = DualServer::<Stop>::new(&participant, &ns, "stop", sq.clone())?;
-    let reset = DualServer::<Reset>::new(&participant, &ns, "reset", sq)?;
+    let reset = DualServer::<Reset>::new(&participant, &ns, "reset", sq.clone())?;
+    let mut run_program = RunProgramServer::new(&participant, &ns, sq)?;
+    // Every state change, in order: the action follows the machine through them.
+    let state_sub = ros.subscription_with_qos::<MachineState>(
+        &topics::MACHINE_STATE,
+        topics::MACHINE_STATE
+            .qos()
+            .history(History::KeepLast { depth: 64 }),
+    )?;
+    let motion_sub = ros.subscription::<MotionStatus>(&topics::MOTION_STATUS)?;
+    let parts_sub = ros.subscription::<PartCount>(&topics::PART_COUNT)?;
+    let mut machine: Option<MachineState> = None;
+    let mut motion_run = (0u64, 0u64);
+    let mut part_count = 0u32;
+    let t0 = std::time::Instant::now();
 
     let mut active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm> = BTreeMap::new();
     let publish_alarms = |active: &BTreeMap<(String, u32), cnc_msgs::msg::Alarm>| {
@@ -97,10 +115,55 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         if changed {
             publish_alarms(&active);
         }
+        while let Ok(Some((m, _))) = motion_sub.take() {
+            motion_run = (m.run_id, m.done_seq);
+        }
+        while let Ok(Some((p, _))) = parts_sub.take() {
+            part_count = p.count;
+        }
+        let alarm_list: Vec<cnc_msgs::msg::Alarm> = active.values().cloned().collect();
+        // Each state in turn, so the action sees every transition (a short cycle's end too).
+        let mut states = Vec::new();
+        while let Ok(Some((m, _))) = state_sub.take() {
+            states.push(m);
+        }
+        if states.is_empty() {
+            states.extend(machine.clone());
+        }
+        for m in states {
+            for e in run_program.poll(
+                &mut commands,
+                Some(&m),
+                motion_run,
+                part_count,
+                &alarm_list,
+                t0.elapsed().as_secs_f64(),
+            ) {
+                busy = true;
+                log::info!("{} (from {}, accepted: {})", e.what, e.client, e.accepted);
+            }
+            machine = Some(m);
+        }
+        if machine.is_none() {
+            run_program.poll(
+                &mut commands,
+                None,
+                motion_run,
+                part_count,
+                &alarm_list,
+                t0.elapsed().as_secs_f64(),
+            );
+        }
         if let Some(r) = load.receive() {
             busy = true;
             let (accepted, message) =
                 commands.call(ProgramCommand::LOAD, &r.request.name, &r.request.text);
+            if accepted {
+                let lines = r.request.text.lines().count().min(u32::MAX as usize) as u32;
+                run_program
+                    .program_lines
+                    .insert(r.request.name.clone(), lines);
+            }
             answer(&load, &r, &LoadProgramResponse { accepted, message });
         }
         if let Some(r) = start.receive() {

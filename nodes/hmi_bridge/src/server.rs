@@ -44,11 +44,16 @@ where
         service: &str,
         qos: QosPolicies,
     ) -> Result<Self, String> {
-        let (pkg, ty) = (cnc_msgs::PACKAGE, S::NAME);
+        // `cnc_msgs/srv/Stop` → `cnc_msgs::srv::dds_::Stop_Request_`; actions' services are
+        // `cnc_msgs/action/RunProgram_SendGoal`, `action_msgs/srv/CancelGoal`.
+        let (prefix, ty) = S::TYPE_NAME
+            .rsplit_once('/')
+            .ok_or_else(|| format!("{service}: bad type name {}", S::TYPE_NAME))?;
+        let dds_type = |part: &str| format!("{}::dds_::{ty}_{part}_", prefix.replace('/', "::"));
         let rq = participant
             .create_topic(
                 format!("rq/{namespace}/{service}Request"),
-                format!("{pkg}::srv::dds_::{ty}_Request_"),
+                dds_type("Request"),
                 &qos,
                 TopicKind::NoKey,
             )
@@ -56,7 +61,7 @@ where
         let rr = participant
             .create_topic(
                 format!("rr/{namespace}/{service}Reply"),
-                format!("{pkg}::srv::dds_::{ty}_Response_"),
+                dds_type("Response"),
                 &qos,
                 TopicKind::NoKey,
             )

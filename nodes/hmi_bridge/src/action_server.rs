@@ -1,0 +1,325 @@
+//! The `RunProgram` action server: `/<ns>/run_program/_action/{send_goal,cancel_goal,
+//! get_result}` served to both service mappings ([`DualServer`]), `feedback` and `status`
+//! published as ROS 2 action clients expect. One goal runs at a time; its course is
+//! [`GoalRun`], its commands go through the same path as the services'.
+
+use std::collections::VecDeque;
+
+use byteorder::LittleEndian;
+use cnc_msgs::action::*;
+use cnc_msgs::msg::{Alarm, MachineState, ProgramCommand, Time};
+use cnc_runtime::dds::stamp;
+use cnc_runtime::raw::{Raw, RawAdapter};
+use ros2_client::dds::rustdds::{
+    self, no_key::DataWriter, policy, QosPolicies, QosPolicyBuilder, TopicKind,
+};
+use serde::Serialize;
+
+use crate::run_program::{check, GoalRun, Step, View};
+use crate::server::{DualServer, Request};
+
+/// Finished goals whose results can still be asked for.
+const RESULTS_KEPT: usize = 16;
+
+/// Where commands go: the bridge's command path to the interpreter and motion.
+pub trait CommandPath {
+    fn call(&mut self, command: u8, program: &str, text: &str) -> (bool, String);
+}
+
+struct Topic {
+    writer: DataWriter<Raw, RawAdapter>,
+}
+
+impl Topic {
+    fn new(
+        participant: &rustdds::DomainParticipant,
+        name: String,
+        dds_type: &str,
+        depth: i32,
+    ) -> Result<Self, String> {
+        // Reliable and transient-local: matches every reader a ROS 2 action client creates.
+        let qos = QosPolicyBuilder::new()
+            .reliability(policy::Reliability::Reliable {
+                max_blocking_time: rustdds::Duration::from_millis(100),
+            })
+            .durability(policy::Durability::TransientLocal)
+            .history(policy::History::KeepLast { depth })
+            .build();
+        let topic = participant
+            .create_topic(name.clone(), dds_type.into(), &qos, TopicKind::NoKey)
+            .map_err(|e| format!("{name}: {e:?}"))?;
+        let writer = participant
+            .create_publisher(&qos)
+            .map_err(|e| format!("{name}: {e:?}"))?
+            .create_datawriter_no_key::<Raw, RawAdapter>(&topic, None)
+            .map_err(|e| format!("{name}: {e:?}"))?;
+        Ok(Topic { writer })
+    }
+
+    fn publish<M: Serialize>(&self, m: &M) {
+        match cdr_encoding::to_vec::<_, LittleEndian>(m) {
+            Ok(bytes) => {
+                if let Err(e) = self.writer.write(
+                    Raw {
+                        bytes,
+                        little_endian: true,
+                    },
+                    None,
+                ) {
+                    log::warn!("run_program: {e:?}");
+                }
+            }
+            Err(e) => log::error!("run_program: {e}"),
+        }
+    }
+}
+
+/// A finished goal: id, acceptance time, final status and result.
+struct Done {
+    id: Uuid,
+    accepted: Time,
+    status: i8,
+    result: RunProgramResult,
+}
+
+pub struct RunProgramServer {
+    send_goal: DualServer<RunProgramSendGoal>,
+    cancel_goal: DualServer<CancelGoal>,
+    get_result: DualServer<RunProgramGetResult>,
+    feedback: Topic,
+    status: Topic,
+    goal: Option<(GoalRun, Time)>,
+    done: VecDeque<Done>,
+    waiting: Vec<Request<RunProgramGetResultRequest>>,
+    /// Lines of each program loaded through this bridge, for the feedback's percentage.
+    pub program_lines: std::collections::BTreeMap<String, u32>,
+}
+
+/// What the action server saw the machine do this pass, for its caller's logs and events.
+pub struct Event {
+    pub what: String,
+    pub client: String,
+    pub accepted: bool,
+}
+
+impl RunProgramServer {
+    pub fn new(
+        participant: &rustdds::DomainParticipant,
+        ns: &str,
+        qos: QosPolicies,
+    ) -> Result<Self, String> {
+        let base = "run_program/_action";
+        Ok(RunProgramServer {
+            send_goal: DualServer::new(participant, ns, &format!("{base}/send_goal"), qos.clone())?,
+            cancel_goal: DualServer::new(
+                participant,
+                ns,
+                &format!("{base}/cancel_goal"),
+                qos.clone(),
+            )?,
+            get_result: DualServer::new(participant, ns, &format!("{base}/get_result"), qos)?,
+            feedback: Topic::new(
+                participant,
+                format!("rt/{ns}/{base}/feedback"),
+                "cnc_msgs::action::dds_::RunProgram_FeedbackMessage_",
+                100,
+            )?,
+            status: Topic::new(
+                participant,
+                format!("rt/{ns}/{base}/status"),
+                "action_msgs::msg::dds_::GoalStatusArray_",
+                1,
+            )?,
+            goal: None,
+            done: VecDeque::new(),
+            waiting: Vec::new(),
+            program_lines: Default::default(),
+        })
+    }
+
+    fn publish_status(&self) {
+        let mut list: Vec<GoalStatus> = self
+            .done
+            .iter()
+            .map(|d| GoalStatus {
+                goal_info: GoalInfo {
+                    goal_id: d.id,
+                    stamp: d.accepted.clone(),
+                },
+                status: d.status,
+            })
+            .collect();
+        if let Some((g, accepted)) = &self.goal {
+            list.push(GoalStatus {
+                goal_info: GoalInfo {
+                    goal_id: g.id,
+                    stamp: accepted.clone(),
+                },
+                status: g.status(),
+            });
+        }
+        self.status.publish(&GoalStatusArray { status_list: list });
+    }
+
+    /// Moves a finished goal to the results and answers whoever waits for it.
+    fn retire(&mut self) {
+        let Some((g, accepted)) = self.goal.take_if(|(g, _)| g.finished()) else {
+            return;
+        };
+        if self.done.len() == RESULTS_KEPT {
+            self.done.pop_front();
+        }
+        self.done.push_back(Done {
+            id: g.id,
+            accepted,
+            status: g.status(),
+            result: g.result().clone(),
+        });
+        self.answer_waiting();
+        self.publish_status();
+    }
+
+    fn answer_waiting(&mut self) {
+        let waiting = std::mem::take(&mut self.waiting);
+        for r in waiting {
+            match self.done.iter().find(|d| d.id == r.request.goal_id) {
+                Some(d) => {
+                    let response = RunProgramGetResultResponse {
+                        status: d.status,
+                        result: d.result.clone(),
+                    };
+                    if let Err(e) = self.get_result.reply(&r, &response) {
+                        log::error!("{e}");
+                    }
+                }
+                None => self.waiting.push(r),
+            }
+        }
+    }
+
+    /// Serves requests and follows the running goal; returns what happened, for events.
+    pub fn poll(
+        &mut self,
+        commands: &mut dyn CommandPath,
+        state: Option<&MachineState>,
+        (run_id, done_blocks): (u64, u64),
+        part_count: u32,
+        alarms: &[Alarm],
+        now: f64,
+    ) -> Vec<Event> {
+        let mut events = Vec::new();
+        if let Some(r) = self.send_goal.receive() {
+            let goal = r.request.goal.clone();
+            let outcome = if self.goal.is_some() {
+                Err("a RunProgram goal is running: cancel it first".to_string())
+            } else {
+                check(&goal, true).and_then(|()| {
+                    let (ok, msg) = commands.call(ProgramCommand::START, &goal.program, "");
+                    if ok {
+                        Ok(msg)
+                    } else {
+                        Err(msg)
+                    }
+                })
+            };
+            let accepted = outcome.is_ok();
+            let response = RunProgramSendGoalResponse {
+                accepted,
+                stamp: stamp(),
+            };
+            if accepted {
+                let lines = self.program_lines.get(&goal.program).copied().unwrap_or(0);
+                let run = GoalRun::new(r.request.goal_id, goal.clone(), lines, run_id, now);
+                self.goal = Some((run, response.stamp.clone()));
+            }
+            if let Err(e) = self.send_goal.reply(&r, &response) {
+                log::error!("{e}");
+            }
+            events.push(Event {
+                what: match &outcome {
+                    Ok(m) => format!("RunProgram {} x{}: {m}", goal.program, goal.cycles),
+                    Err(m) => format!("RunProgram {} x{} refused: {m}", goal.program, goal.cycles),
+                },
+                client: r.client.clone(),
+                accepted,
+            });
+            self.publish_status();
+        }
+        if let Some(r) = self.cancel_goal.receive() {
+            let wanted = r.request.goal_info.goal_id;
+            let all = wanted == [0; 16];
+            let mut response = CancelGoalResponse::default();
+            match self.goal.as_mut() {
+                Some((g, accepted)) if (all || g.id == wanted) && !g.finished() => {
+                    g.cancel();
+                    response.return_code = CancelGoalResponse::ERROR_NONE;
+                    response.goals_canceling.push(GoalInfo {
+                        goal_id: g.id,
+                        stamp: accepted.clone(),
+                    });
+                }
+                _ if self.done.iter().any(|d| d.id == wanted) => {
+                    response.return_code = CancelGoalResponse::ERROR_GOAL_TERMINATED
+                }
+                _ => response.return_code = CancelGoalResponse::ERROR_UNKNOWN_GOAL_ID,
+            }
+            if let Err(e) = self.cancel_goal.reply(&r, &response) {
+                log::error!("{e}");
+            }
+            events.push(Event {
+                what: format!("RunProgram cancel: code {}", response.return_code),
+                client: r.client.clone(),
+                accepted: response.return_code == CancelGoalResponse::ERROR_NONE,
+            });
+            let canceling = self
+                .goal
+                .as_ref()
+                .is_some_and(|(g, _)| g.status() == GoalStatus::STATUS_CANCELING);
+            if canceling {
+                self.publish_status();
+                // Stop on the path, then reset: the machine is ready for the next goal.
+                let (_, stop) = commands.call(ProgramCommand::CYCLE_STOP, "", "");
+                let (_, reset) = commands.call(ProgramCommand::RESET, "", "");
+                if let Some((g, _)) = self.goal.as_mut() {
+                    g.canceled(&format!("{stop}, {reset}"));
+                }
+            }
+        }
+        if let Some(r) = self.get_result.receive() {
+            self.waiting.push(r);
+            self.answer_waiting();
+        }
+        if let (Some((g, _)), Some(state)) = (self.goal.as_mut(), state) {
+            let view = View {
+                state,
+                run_id,
+                done_blocks,
+                part_count,
+                alarms,
+                now,
+            };
+            let before = g.status();
+            for step in g.update(&view) {
+                match step {
+                    Step::Feedback(feedback) => self.feedback.publish(&RunProgramFeedbackMessage {
+                        goal_id: g.id,
+                        feedback,
+                    }),
+                    Step::StartCycle => {
+                        let (ok, msg) = commands.call(ProgramCommand::START, &g.goal.program, "");
+                        if ok {
+                            g.cycle_started(now, run_id);
+                        } else {
+                            g.abort(&format!("next cycle refused: {msg}"), alarms);
+                        }
+                    }
+                }
+            }
+            if g.status() != before {
+                self.publish_status();
+            }
+        }
+        self.retire();
+        events
+    }
+}
