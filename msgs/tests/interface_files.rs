@@ -133,6 +133,30 @@ fn every_srv_file_matches_its_rust_types() {
     check_srv::<Reset>();
 }
 
+/// `action/RunProgram.action`: goal, result and feedback sections against their Rust types.
+#[test]
+fn the_action_file_matches_its_rust_types() {
+    use cnc_msgs::action::*;
+    let text = std::fs::read_to_string(root().join("action/RunProgram.action")).expect("action");
+    let sections: Vec<&str> = text.split("\n---").collect();
+    assert_eq!(sections.len(), 3, "goal, result, feedback");
+    assert_eq!(parse_section(sections[0]), rust_section::<RunProgramGoal>());
+    assert_eq!(
+        parse_section(sections[1]),
+        rust_section::<RunProgramResult>()
+    );
+    assert_eq!(
+        parse_section(sections[2]),
+        rust_section::<RunProgramFeedback>()
+    );
+    let cmake = std::fs::read_to_string(root().join("CMakeLists.txt")).expect("CMakeLists.txt");
+    assert!(cmake.contains("\"action/RunProgram.action\""));
+    let dir: Vec<_> = std::fs::read_dir(root().join("action"))
+        .expect("dir")
+        .collect();
+    assert_eq!(dir.len(), 1, "every .action file is checked here");
+}
+
 #[test]
 fn every_interface_file_is_checked_and_listed_in_cmake() {
     let cmake = std::fs::read_to_string(root().join("CMakeLists.txt")).expect("CMakeLists.txt");
