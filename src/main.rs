@@ -93,6 +93,9 @@ enum Verb {
         /// 2 = twice as fast.
         #[arg(long, default_value_t = 1.0)]
         speed: f64,
+        /// Start once this topic (e.g. `axes`) has a reader (up to 10 s).
+        #[arg(long)]
+        wait_for: Option<String>,
     },
 }
 
@@ -215,7 +218,16 @@ fn main() -> ExitCode {
             config,
             namespace,
             speed,
-        }) => replay(&bag, &config, namespace.as_deref(), speed),
+            wait_for,
+        }) => replay(
+            &bag,
+            &config,
+            cnc_recorder::replay::ReplayOptions {
+                namespace,
+                speed,
+                wait_for,
+            },
+        ),
         None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
     };
     match result {
@@ -246,12 +258,15 @@ fn audit_verify(bag: &Path) -> Result<(), String> {
     }
 }
 
-fn replay(bag: &Path, config: &Path, namespace: Option<&str>, speed: f64) -> Result<(), String> {
+fn replay(
+    bag: &Path,
+    config: &Path,
+    options: cnc_recorder::replay::ReplayOptions,
+) -> Result<(), String> {
     let cfg = LaunchConfig::load(config)?;
     install_signal_handlers();
-    let r = cnc_recorder::replay::replay(bag, &cfg.network, namespace, speed, &|| {
-        STOP.load(Ordering::SeqCst)
-    })?;
+    let r =
+        cnc_recorder::replay::replay(bag, &cfg.network, &options, &|| STOP.load(Ordering::SeqCst))?;
     println!(
         "replayed {} messages under /{} in {:.1} s ({} skipped)",
         r.sent, r.namespace, r.seconds, r.skipped

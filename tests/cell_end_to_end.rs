@@ -4,6 +4,8 @@
 
 use std::time::{Duration, Instant};
 
+mod common;
+
 use cnc::cell::Cell;
 use cnc::client::CellClient;
 use cnc_msgs::msg::MachineState;
@@ -11,17 +13,7 @@ use cnc_runtime::LaunchConfig;
 use ros2_client::ServiceMapping;
 
 fn config(domain: u16) -> LaunchConfig {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/launch_configs/sim_lathe.yaml"
-    ))
-    .unwrap();
-    let mut cfg = LaunchConfig::from_yaml(&text).unwrap();
-    cfg.network.domain_id = Some(domain);
-    // Each test starts from a PLC with no kept memory (part count 0).
-    cfg.plc.memory_file = None;
-    cfg.recorder.enabled = false; // tests/recording.rs tests the recorder
-    cfg
+    common::sim_lathe(domain)
 }
 
 /// A supervisor node of the cell's machine `lathe1`, calling services with `mapping`.

@@ -6,8 +6,9 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+mod common;
+
 use cnc::cell::Cell;
-use cnc_runtime::LaunchConfig;
 
 #[test]
 fn cyclone_dds_peer_reads_topics_and_calls_services() {
@@ -20,12 +21,7 @@ fn cyclone_dds_peer_reads_topics_and_calls_services() {
         "{} missing: run scripts/test.sh, which creates the venv with cyclonedds",
         python.display()
     );
-    let text = std::fs::read_to_string(root.join("launch_configs/sim_lathe.yaml")).unwrap();
-    let mut cfg = LaunchConfig::from_yaml(&text).unwrap();
-    cfg.network.domain_id = Some(43);
-    // A PLC with no kept memory: the part count starts at 0.
-    cfg.plc.memory_file = None;
-    cfg.recorder.enabled = false; // tests/recording.rs tests the recorder
+    let cfg = common::sim_lathe(43);
     let cell = Cell::start(&cfg).unwrap();
     let out = Command::new(&python)
         .arg(root.join("tests/interop/cyclone_peer.py"))

@@ -6,12 +6,13 @@
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
 
+mod common;
+
 use cnc::cell::Cell;
 use cnc::client::CellClient;
 use cnc_msgs::action::{RunProgramFeedback, RunProgramGoal, RunProgramResult};
 use cnc_msgs::msg::MachineState;
 use cnc_runtime::dds::{qos, RosNode};
-use cnc_runtime::LaunchConfig;
 use ros2_client::action::ActionClientQosPolicies;
 use ros2_client::action_msgs::{CancelGoalResponseEnum, GoalStatusEnum};
 use ros2_client::{ActionTypeName, Name, ServiceMapping};
@@ -22,20 +23,6 @@ const SHORT: &str =
     "O0001\nG00 X60 Z5\nS600 M03\nG01 X40 Z0 F900\nZ-20\nG02 X50 Z-25 R5\nG01 X56 Z-30\nM05\nM30\n";
 /// One slow cut: a minute at F300.
 const LONG: &str = "O0002\nG00 X60 Z5\nS500 M03\nG01 X50 F300\nZ-300\nM05\nM30\n";
-
-fn config(domain: u16) -> LaunchConfig {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/launch_configs/sim_lathe.yaml"
-    ))
-    .unwrap();
-    let mut cfg = LaunchConfig::from_yaml(&text).unwrap();
-    cfg.network.domain_id = Some(domain);
-    cfg.plc.memory_file = None;
-    cfg.machine.memory_file = None;
-    cfg.recorder.enabled = false;
-    cfg
-}
 
 fn action_client(ros: &mut RosNode) -> Client {
     let q = qos::services();
@@ -108,7 +95,7 @@ fn goal(program: &str, cycles: u32) -> RunProgramGoal {
 
 #[test]
 fn run_program_reports_every_block_and_a_cancel_stops_the_machine_ready_for_the_next_goal() {
-    let cfg = config(51);
+    let cfg = common::sim_lathe(51);
     let cell = Cell::start(&cfg).unwrap();
     let mut cell_client =
         CellClient::new(&cfg.network, "lathe1", "loader", ServiceMapping::Enhanced).unwrap();

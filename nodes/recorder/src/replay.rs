@@ -13,7 +13,8 @@ use cnc_runtime::config::NetworkConfig;
 use cnc_runtime::dds::RosNode;
 use cnc_runtime::raw::{Raw, RawAdapter};
 use cnc_runtime::topics;
-use ros2_client::dds::rustdds::{no_key::DataWriter, QosPolicies};
+use ros2_client::dds::rustdds::{no_key::DataWriter, DataWriterStatus, QosPolicies, StatusEvented};
+use ros2_client::qos::History;
 
 use crate::reader::scan_file;
 use crate::recover::bag_files;
@@ -43,14 +44,32 @@ fn place(full: &str) -> Option<(String, usize)> {
     Some((ns.to_string(), i))
 }
 
+/// How to replay.
+#[derive(Debug, Clone, Default)]
+pub struct ReplayOptions {
+    /// Namespace to publish under; default `<recorded>_replay`.
+    pub namespace: Option<String>,
+    /// 1 = recorded timing; 2 = twice as fast.
+    pub speed: f64,
+    /// Start only once this topic (path under the namespace, e.g. `axes`) has a reader, up to
+    /// [`WAIT_LIMIT`]: without it, messages sent before discovery are lost to a late viewer.
+    pub wait_for: Option<String>,
+}
+
+/// History of each replay writer.
+const REPLAY_DEPTH: usize = 64;
+
+/// Longest wait for `wait_for`'s reader.
+pub const WAIT_LIMIT: Duration = Duration::from_secs(10);
+
 /// Replays `bag` (a bag folder or one file) on `network`.
 pub fn replay(
     bag: &Path,
     network: &NetworkConfig,
-    namespace: Option<&str>,
-    speed: f64,
+    options: &ReplayOptions,
     stop: &dyn Fn() -> bool,
 ) -> Result<ReplayReport, String> {
+    let (namespace, speed) = (options.namespace.as_deref(), options.speed);
     if !(speed.is_finite() && speed > 0.0) {
         return Err(format!("speed {speed}: must be a positive number"));
     }
@@ -96,7 +115,13 @@ pub fn replay(
             continue;
         }
         let t = &topics::ALL[m.topic];
-        let qos: QosPolicies = (&t.qos()).into();
+        // Deeper than the machine's own writers: a replay burst must survive a lost packet
+        // (a depth-1 writer would have replaced it before the resend) and a reader that
+        // matches a moment after the writer.
+        let qos: QosPolicies = (&t.qos().history(History::KeepLast {
+            depth: REPLAY_DEPTH,
+        }))
+            .into();
         let dds_topic = ros.dds_topic(t)?;
         let publisher = participant
             .create_publisher(&qos)
@@ -108,6 +133,31 @@ pub fn replay(
     }
     // Give discovery a moment, as `ros2 bag play` does, so the first messages find readers.
     std::thread::sleep(Duration::from_millis(500));
+    if let Some(path) = &options.wait_for {
+        let i = topics::ALL
+            .iter()
+            .position(|t| t.path == path)
+            .ok_or_else(|| format!("--wait-for {path}: not a topic of the machine"))?;
+        let w = writers
+            .get(&i)
+            .ok_or_else(|| format!("--wait-for {path}: the recording has no such messages"))?;
+        let t0 = Instant::now();
+        let mut readers = 0;
+        while readers == 0 {
+            while let Some(status) = w.try_recv_status() {
+                if let DataWriterStatus::PublicationMatched { current, .. } = status {
+                    readers = current.count();
+                }
+            }
+            if readers == 0 && (t0.elapsed() > WAIT_LIMIT || stop()) {
+                return Err(format!("no reader of {path} within {WAIT_LIMIT:?}"));
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        // The writer has seen the reader; give the reader as long to see the writer, or it
+        // drops the first samples as coming from nobody it knows.
+        std::thread::sleep(Duration::from_millis(500));
+    }
     let first = schedule.first().map_or(0, |m| m.log_time);
     let start = Instant::now();
     for m in schedule {
@@ -117,7 +167,10 @@ pub fn replay(
                 report.seconds = start.elapsed().as_secs_f64();
                 return Ok(report);
             }
-            std::thread::sleep((due - start.elapsed()).min(Duration::from_millis(20)));
+            std::thread::sleep(
+                due.saturating_sub(start.elapsed())
+                    .min(Duration::from_millis(20)),
+            );
         }
         let (Some(raw), Some(w)) = (Raw::from_serialized(&m.data), writers.get(&m.topic)) else {
             report.skipped += 1;
@@ -130,6 +183,11 @@ pub fn replay(
                 report.skipped += 1;
             }
         }
+    }
+    // The last messages may still be on their way: leaving now would drop the participant
+    // under them.
+    for w in writers.values() {
+        let _ = w.wait_for_acknowledgments(Duration::from_secs(2));
     }
     report.seconds = start.elapsed().as_secs_f64();
     Ok(report)
