@@ -26,6 +26,7 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("AlarmEvent", include_str!("../msg/AlarmEvent.msg")),
     ("Axis", include_str!("../msg/Axis.msg")),
     ("AxisState", include_str!("../msg/AxisState.msg")),
+    ("CommandEvent", include_str!("../msg/CommandEvent.msg")),
     ("CommandResult", include_str!("../msg/CommandResult.msg")),
     ("MachineState", include_str!("../msg/MachineState.msg")),
     ("MotionBlock", include_str!("../msg/MotionBlock.msg")),

@@ -277,3 +277,16 @@ ros_message! {
         value: bool,
     }
 }
+
+ros_message! {
+    /// A command from outside the machine, accepted or refused, with who sent it.
+    pub struct CommandEvent("cnc_msgs/msg/CommandEvent") {
+        consts {}
+        stamp: Time,
+        command: String,
+        detail: String,
+        client: String,
+        accepted: bool,
+        message: String,
+    }
+}

@@ -123,6 +123,7 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<CommandResult>("CommandResult.msg");
     check_msg::<SimInput>("SimInput.msg");
     check_msg::<PlcStatus>("PlcStatus.msg");
+    check_msg::<CommandEvent>("CommandEvent.msg");
 }
 
 #[test]
@@ -176,6 +177,7 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "CommandResult",
         "SimInput",
         "PlcStatus",
+        "CommandEvent",
         "LoadProgram",
         "StartProgram",
         "Stop",

@@ -95,11 +95,15 @@ pub struct RunProgramServer {
     pub program_lines: std::collections::BTreeMap<String, u32>,
 }
 
-/// What the action server saw the machine do this pass, for its caller's logs and events.
+/// A request the action server decided on, for the caller's command events.
 pub struct Event {
-    pub what: String,
-    pub client: String,
+    /// `run_program` or `run_program/cancel`.
+    pub command: &'static str,
+    pub detail: String,
+    /// The client's writer GUID.
+    pub writer: [u8; 16],
     pub accepted: bool,
+    pub message: String,
 }
 
 impl RunProgramServer {
@@ -197,10 +201,13 @@ impl RunProgramServer {
         }
     }
 
-    /// Serves requests and follows the running goal; returns what happened, for events.
+    /// Serves requests and follows the running goal; returns the requests decided, for
+    /// events. `may_move` says whether a client (writer GUID) may start the machine.
+    #[allow(clippy::too_many_arguments)]
     pub fn poll(
         &mut self,
         commands: &mut dyn CommandPath,
+        may_move: &dyn Fn(&[u8; 16]) -> Result<(), String>,
         state: Option<&MachineState>,
         (run_id, done_blocks): (u64, u64),
         part_count: u32,
@@ -210,7 +217,9 @@ impl RunProgramServer {
         let mut events = Vec::new();
         if let Some(r) = self.send_goal.receive() {
             let goal = r.request.goal.clone();
-            let outcome = if self.goal.is_some() {
+            let outcome = if let Err(why) = may_move(&r.writer) {
+                Err(why)
+            } else if self.goal.is_some() {
                 Err("a RunProgram goal is running: cancel it first".to_string())
             } else {
                 check(&goal, true).and_then(|()| {
@@ -236,12 +245,13 @@ impl RunProgramServer {
                 log::error!("{e}");
             }
             events.push(Event {
-                what: match &outcome {
-                    Ok(m) => format!("RunProgram {} x{}: {m}", goal.program, goal.cycles),
-                    Err(m) => format!("RunProgram {} x{} refused: {m}", goal.program, goal.cycles),
-                },
-                client: r.client.clone(),
+                command: "run_program",
+                detail: format!("{} x{}", goal.program, goal.cycles),
+                writer: r.writer,
                 accepted,
+                message: match outcome {
+                    Ok(m) | Err(m) => m,
+                },
             });
             self.publish_status();
         }
@@ -267,9 +277,11 @@ impl RunProgramServer {
                 log::error!("{e}");
             }
             events.push(Event {
-                what: format!("RunProgram cancel: code {}", response.return_code),
-                client: r.client.clone(),
+                command: "run_program/cancel",
+                detail: String::new(),
+                writer: r.writer,
                 accepted: response.return_code == CancelGoalResponse::ERROR_NONE,
+                message: format!("return code {}", response.return_code),
             });
             let canceling = self
                 .goal

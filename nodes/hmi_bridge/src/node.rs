@@ -5,15 +5,20 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use cnc_msgs::msg::{
-    ActiveAlarms, AlarmEvent, CommandResult, MachineState, MotionStatus, PartCount, ProgramCommand,
+    ActiveAlarms, AlarmEvent, CommandEvent, CommandResult, MachineState, MotionStatus, PartCount,
+    ProgramCommand,
 };
 use cnc_msgs::srv::*;
 use cnc_runtime::dds::{qos, stamp, RosNode};
 use cnc_runtime::topics;
+use cnc_runtime::MAX_PROGRAM_BYTES;
 use cnc_runtime::{LaunchConfig, Shutdown};
+use ros2_client::dds::rustdds;
 use ros2_client::dds::rustdds::QosPolicies;
+use ros2_client::entities_info::ParticipantEntitiesInfo;
 use ros2_client::qos::History;
 
+use crate::access::{may_move, Clients};
 use crate::action_server::{CommandPath, RunProgramServer};
 use crate::server::{DualServer, Request};
 
@@ -78,6 +83,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let stop = DualServer::<Stop>::new(&participant, &ns, "stop", sq.clone())?;
     let reset = DualServer::<Reset>::new(&participant, &ns, "reset", sq.clone())?;
     let mut run_program = RunProgramServer::new(&participant, &ns, sq)?;
+    let events = ros.publisher::<CommandEvent>(&topics::COMMAND_EVENTS)?;
+    // Which nodes each participant hosts, as they announce it on `ros_discovery_info`: a
+    // reader of our own, transient-local, so every participant's last announcement is there
+    // whenever the bridge looks (ros2-client's node events drop what a full queue cannot take).
+    let discovery = discovery_reader(&participant)?;
+    let mut clients = Clients::default();
+    let allowed = cfg.hmi.allowed_clients.clone();
     // Every state change, in order: the action follows the machine through them.
     let state_sub = ros.subscription_with_qos::<MachineState>(
         &topics::MACHINE_STATE,
@@ -103,6 +115,40 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     while !shutdown.requested() {
         let mut busy = false;
         let mut changed = false;
+        discovery.drain_read_notifications();
+        while let Ok(Some(sample)) = discovery.try_take_one() {
+            let info = sample.into_value();
+            let mut prefix = [0u8; 12];
+            prefix.copy_from_slice(&info.gid().as_bytes()[..12]);
+            let nodes = info
+                .nodes()
+                .iter()
+                .map(|n| n.fully_qualified_name())
+                .collect();
+            clients.learn(prefix, nodes);
+        }
+        let may_move = |writer: &[u8; 16]| {
+            may_move(
+                &allowed,
+                clients.nodes_of(writer),
+                &clients.describe(writer),
+            )
+        };
+        let record =
+            |command: &str, detail: &str, writer: &[u8; 16], accepted: bool, message: &str| {
+                let client = clients.describe(writer);
+                log::info!("{command} {detail} from {client}: accepted {accepted}: {message}");
+                if let Err(e) = events.publish(CommandEvent {
+                    stamp: stamp(),
+                    command: command.into(),
+                    detail: detail.into(),
+                    client,
+                    accepted,
+                    message: message.into(),
+                }) {
+                    log::warn!("hmi_bridge: command event not published: {e}");
+                }
+            };
         while let Ok(Some((e, _))) = alarm_events.take() {
             let key = (e.alarm.source.clone(), e.alarm.number);
             if e.kind == AlarmEvent::RAISED {
@@ -133,6 +179,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         for m in states {
             for e in run_program.poll(
                 &mut commands,
+                &may_move,
                 Some(&m),
                 motion_run,
                 part_count,
@@ -140,13 +187,14 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 t0.elapsed().as_secs_f64(),
             ) {
                 busy = true;
-                log::info!("{} (from {}, accepted: {})", e.what, e.client, e.accepted);
+                record(e.command, &e.detail, &e.writer, e.accepted, &e.message);
             }
             machine = Some(m);
         }
         if machine.is_none() {
             run_program.poll(
                 &mut commands,
+                &may_move,
                 None,
                 motion_run,
                 part_count,
@@ -156,19 +204,33 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         if let Some(r) = load.receive() {
             busy = true;
-            let (accepted, message) =
-                commands.call(ProgramCommand::LOAD, &r.request.name, &r.request.text);
+            let (name, text) = (&r.request.name, &r.request.text);
+            let (accepted, message) = if text.len() > MAX_PROGRAM_BYTES {
+                (
+                    false,
+                    format!(
+                        "program too large: {} bytes, limit {MAX_PROGRAM_BYTES}",
+                        text.len()
+                    ),
+                )
+            } else {
+                commands.call(ProgramCommand::LOAD, name, text)
+            };
             if accepted {
-                let lines = r.request.text.lines().count().min(u32::MAX as usize) as u32;
-                run_program
-                    .program_lines
-                    .insert(r.request.name.clone(), lines);
+                let lines = text.lines().count().min(u32::MAX as usize) as u32;
+                run_program.program_lines.insert(name.clone(), lines);
             }
+            record("load_program", name, &r.writer, accepted, &message);
             answer(&load, &r, &LoadProgramResponse { accepted, message });
         }
         if let Some(r) = start.receive() {
             busy = true;
-            let (accepted, message) = commands.call(ProgramCommand::START, &r.request.name, "");
+            let name = &r.request.name;
+            let (accepted, message) = match may_move(&r.writer) {
+                Ok(()) => commands.call(ProgramCommand::START, name, ""),
+                Err(why) => (false, why),
+            };
+            record("start_program", name, &r.writer, accepted, &message);
             answer(&start, &r, &StartProgramResponse { accepted, message });
         }
         if let Some(r) = stop.receive() {
@@ -181,11 +243,14 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     format!("unknown stop mode {other}: use 1 (FEED_HOLD) or 2 (CYCLE_STOP)"),
                 ),
             };
+            let mode = format!("mode {}", r.request.mode);
+            record("stop", &mode, &r.writer, accepted, &message);
             answer(&stop, &r, &StopResponse { accepted, message });
         }
         if let Some(r) = reset.receive() {
             busy = true;
             let (accepted, message) = commands.call(ProgramCommand::RESET, "", "");
+            record("reset", "", &r.writer, accepted, &message);
             answer(&reset, &r, &ResetResponse { accepted, message });
         }
         if !busy {
@@ -193,6 +258,36 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+type DiscoveryReader = rustdds::no_key::SimpleDataReader<
+    ParticipantEntitiesInfo,
+    rustdds::CDRDeserializerAdapter<ParticipantEntitiesInfo>,
+>;
+
+/// A reader of `ros_discovery_info`, where ROS 2 participants say which nodes they host.
+fn discovery_reader(participant: &rustdds::DomainParticipant) -> Result<DiscoveryReader, String> {
+    use rustdds::policy::{Durability, History, Reliability};
+    let qos = rustdds::QosPolicyBuilder::new()
+        .durability(Durability::TransientLocal)
+        .reliability(Reliability::Reliable {
+            max_blocking_time: rustdds::Duration::ZERO,
+        })
+        .history(History::KeepLast { depth: 256 })
+        .build();
+    let topic = participant
+        .create_topic(
+            "ros_discovery_info".into(),
+            "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_".into(),
+            &qos,
+            rustdds::TopicKind::NoKey,
+        )
+        .map_err(|e| format!("ros_discovery_info: {e:?}"))?;
+    participant
+        .create_subscriber(&qos)
+        .map_err(|e| format!("ros_discovery_info: {e:?}"))?
+        .create_simple_datareader_no_key(&topic, Some(qos))
+        .map_err(|e| format!("ros_discovery_info: {e:?}"))
 }
 
 fn answer<S: RosService>(

@@ -23,6 +23,8 @@ pub struct Request<Req> {
     identity: SampleIdentity,
     /// GUID of the client's writer, for logs and events.
     pub client: String,
+    /// The same GUID as bytes: its first 12 name the client's participant.
+    pub writer: [u8; 16],
 }
 
 pub struct DualServer<S: RosService> {
@@ -123,6 +125,7 @@ where
                         mapping,
                         identity,
                         client,
+                        writer: own.writer_guid.to_bytes(),
                     });
                 }
                 None => log::warn!(

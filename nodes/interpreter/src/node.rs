@@ -26,8 +26,7 @@ use cnc_msgs::canon::to_motion_block;
 use crate::setup::Memory;
 use crate::{Command, Dialect, Interpreter, Library, Setup};
 
-/// Largest program text accepted, bytes.
-pub const MAX_PROGRAM_BYTES: usize = 4 * 1024 * 1024;
+pub use cnc_runtime::MAX_PROGRAM_BYTES;
 /// Programs kept in memory.
 pub const MAX_PROGRAMS: usize = 1000;
 

@@ -19,6 +19,31 @@ pub struct LaunchConfig {
     pub plc: PlcConfig,
     #[serde(default)]
     pub recorder: RecorderConfig,
+    #[serde(default)]
+    pub hmi: HmiConfig,
+}
+
+/// Who may command the machine from outside.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HmiConfig {
+    /// ROS 2 node names (`/cell/supervisor`; `*` matches anything) whose commands that move
+    /// the machine (program start, RunProgram goals) are accepted. Stop, feed hold and reset
+    /// are taken from anyone: stopping a machine is never refused. Default `["*"]`.
+    #[serde(default = "default_allowed")]
+    pub allowed_clients: Vec<String>,
+}
+
+fn default_allowed() -> Vec<String> {
+    vec!["*".into()]
+}
+
+impl Default for HmiConfig {
+    fn default() -> Self {
+        HmiConfig {
+            allowed_clients: default_allowed(),
+        }
+    }
 }
 
 #[derive(Debug, Clone, Deserialize)]

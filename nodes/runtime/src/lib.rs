@@ -13,3 +13,6 @@ pub mod topics;
 
 pub use config::LaunchConfig;
 pub use lifecycle::Shutdown;
+
+/// Largest program text accepted into program memory, bytes.
+pub const MAX_PROGRAM_BYTES: usize = 4 * 1024 * 1024;

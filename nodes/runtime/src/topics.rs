@@ -66,6 +66,11 @@ pub const ALARM_EVENTS: Topic = topic(
 );
 pub const PLC_STATUS: Topic = topic("plc/status", "cnc_msgs/msg/PlcStatus", Delivery::State);
 pub const SERVO_STATS: Topic = topic("servo_stats", "cnc_msgs/msg/ServoStats", Delivery::State);
+pub const COMMAND_EVENTS: Topic = topic(
+    "command_events",
+    "cnc_msgs/msg/CommandEvent",
+    Delivery::Events(100),
+);
 pub const SIM_INPUT: Topic = topic("sim/input", "cnc_msgs/msg/SimInput", Delivery::Events(10));
 pub const PROGRAM_COMMAND: Topic = topic(
     "_internal/program_command",
@@ -98,6 +103,7 @@ pub const ALL: &[Topic] = &[
     ALARM_EVENTS,
     PLC_STATUS,
     SERVO_STATS,
+    COMMAND_EVENTS,
     SIM_INPUT,
     PROGRAM_COMMAND,
     COMMAND_RESULT,

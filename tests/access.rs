@@ -1,0 +1,134 @@
+//! Who may command the machine: a client the launch config does not allow is refused a program
+//! start, one it allows is not; malformed requests get clear refusals; every decision is
+//! published on `/lathe1/command_events` with who sent it. Runs in scripts/test.sh's netns.
+
+mod common;
+
+use std::time::{Duration, Instant};
+
+use cnc::cell::Cell;
+use cnc::client::CellClient;
+use cnc_msgs::msg::{CommandEvent, MachineState};
+use cnc_runtime::dds::RosNode;
+use cnc_runtime::topics;
+use ros2_client::qos::History;
+use ros2_client::ServiceMapping;
+
+const PROGRAM: &str = "O0001\nG00 X60 Z5\nG01 X50 Z0 F900\nM30\n";
+
+#[test]
+fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
+    let mut cfg = common::sim_lathe(52);
+    cfg.hmi.allowed_clients = vec!["/lathe1/supervisor_ok".into()];
+    let cell = Cell::start(&cfg).unwrap();
+    let mut auditor = RosNode::new(&cfg.network, "lathe1", "auditor").unwrap();
+    let events = auditor
+        .subscription_with_qos::<CommandEvent>(
+            &topics::COMMAND_EVENTS,
+            topics::COMMAND_EVENTS
+                .qos()
+                .history(History::KeepLast { depth: 100 }),
+        )
+        .unwrap();
+    let mut good = CellClient::new(
+        &cfg.network,
+        "lathe1",
+        "supervisor_ok",
+        ServiceMapping::Enhanced,
+    )
+    .unwrap();
+    let mut bad =
+        CellClient::new(&cfg.network, "lathe1", "intruder", ServiceMapping::Enhanced).unwrap();
+    good.wait_ready(Duration::from_secs(20)).unwrap();
+    // Both clients' participants announce their nodes on ros_discovery_info.
+    std::thread::sleep(Duration::from_secs(2));
+
+    let r = good.load_program("p.nc", PROGRAM).unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let r = bad.start_program("p.nc").unwrap();
+    assert!(!r.accepted);
+    assert!(
+        r.message.contains("/lathe1/intruder") && r.message.contains("may not move"),
+        "{}",
+        r.message
+    );
+    // Refused means nothing moved.
+    std::thread::sleep(Duration::from_millis(300));
+    good.poll();
+    assert_eq!(good.state.as_ref().unwrap().execution, MachineState::READY);
+
+    // Malformed requests: clear errors, nothing changed.
+    let huge = "G01 X1\n".repeat(cnc_runtime::MAX_PROGRAM_BYTES / 7 + 1);
+    let r = bad.load_program("huge.nc", &huge).unwrap();
+    assert!(
+        !r.accepted && r.message.contains("too large"),
+        "{}",
+        r.message
+    );
+    let r = good.start_program("missing.nc").unwrap();
+    assert!(
+        !r.accepted && r.message.contains("not found"),
+        "{}",
+        r.message
+    );
+    let r = good.stop(9).unwrap();
+    assert!(
+        !r.accepted && r.message.contains("unknown stop mode"),
+        "{}",
+        r.message
+    );
+    let r = good.load_program("../etc/passwd", "M30\n").unwrap();
+    assert!(
+        !r.accepted && r.message.contains("invalid program name"),
+        "{}",
+        r.message
+    );
+    good.poll();
+    assert_eq!(good.state.as_ref().unwrap().execution, MachineState::READY);
+
+    // The allowed client runs the program; anyone may stop.
+    let r = good.start_program("p.nc").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let t0 = Instant::now();
+    loop {
+        good.poll();
+        if good
+            .state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+        {
+            break;
+        }
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "program did not finish"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let r = bad.reset().unwrap();
+    assert!(r.accepted, "{}", r.message);
+
+    std::thread::sleep(Duration::from_millis(300));
+    let mut seen: Vec<CommandEvent> = Vec::new();
+    while let Ok(Some((e, _))) = events.take() {
+        seen.push(e);
+    }
+    let find = |command: &str, client: &str, accepted: bool| {
+        seen.iter()
+            .any(|e| e.command == command && e.client == client && e.accepted == accepted)
+    };
+    assert!(
+        find("start_program", "/lathe1/intruder", false),
+        "{seen:#?}"
+    );
+    assert!(
+        find("start_program", "/lathe1/supervisor_ok", true),
+        "{seen:#?}"
+    );
+    assert!(find("load_program", "/lathe1/intruder", false));
+    assert!(find("stop", "/lathe1/supervisor_ok", false));
+    assert!(find("reset", "/lathe1/intruder", true));
+    assert_eq!(seen.len(), 8, "one event per request: {seen:#?}");
+    let (_, errors) = cell.stop();
+    assert!(errors.is_empty(), "{errors:?}");
+}
