@@ -9,7 +9,9 @@ use std::time::{Duration, Instant};
 use cnc::cell::Cell;
 use cnc::client::CellClient;
 use cnc_msgs::msg::{CommandEvent, MachineState};
+use cnc_msgs::srv::StartProgramResponse;
 use cnc_runtime::dds::RosNode;
+use cnc_runtime::raw::{Raw, RawAdapter};
 use cnc_runtime::topics;
 use ros2_client::qos::History;
 use ros2_client::ServiceMapping;
@@ -83,6 +85,12 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
         "{}",
         r.message
     );
+    let r = start_with_raw_bytes(&mut auditor, &[4, 0, 0, 0, 0xff, 0xfe, b'A', 0]);
+    assert!(
+        !r.accepted && r.message.contains("malformed"),
+        "{}",
+        r.message
+    );
     good.poll();
     assert_eq!(good.state.as_ref().unwrap().execution, MachineState::READY);
 
@@ -128,7 +136,67 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     assert!(find("load_program", "/lathe1/intruder", false));
     assert!(find("stop", "/lathe1/supervisor_ok", false));
     assert!(find("reset", "/lathe1/intruder", true));
-    assert_eq!(seen.len(), 8, "one event per request: {seen:#?}");
+    assert!(seen
+        .iter()
+        .any(|e| e.command == "start_program" && e.detail == "malformed" && !e.accepted));
+    assert_eq!(seen.len(), 9, "one event per request: {seen:#?}");
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
+}
+
+/// A start_program request whose payload is `payload` (CDR, no header: the enhanced mapping),
+/// written with plain DDS as a broken client would; returns the decoded reply.
+fn start_with_raw_bytes(node: &mut RosNode, payload: &[u8]) -> StartProgramResponse {
+    use ros2_client::dds::rustdds::{QosPolicies, TopicKind};
+    let participant = node.participant();
+    let qos: QosPolicies = (&cnc_runtime::dds::qos::services()).into();
+    let rq = participant
+        .create_topic(
+            "rq/lathe1/start_programRequest".into(),
+            "cnc_msgs::srv::dds_::StartProgram_Request_".into(),
+            &qos,
+            TopicKind::NoKey,
+        )
+        .unwrap();
+    let rr = participant
+        .create_topic(
+            "rr/lathe1/start_programReply".into(),
+            "cnc_msgs::srv::dds_::StartProgram_Response_".into(),
+            &qos,
+            TopicKind::NoKey,
+        )
+        .unwrap();
+    let writer = participant
+        .create_publisher(&qos)
+        .unwrap()
+        .create_datawriter_no_key::<Raw, RawAdapter>(&rq, None)
+        .unwrap();
+    let reader = participant
+        .create_subscriber(&qos)
+        .unwrap()
+        .create_simple_datareader_no_key::<Raw, RawAdapter>(&rr, None)
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500)); // discovery both ways
+    writer
+        .write(
+            Raw {
+                bytes: payload.to_vec(),
+                little_endian: true,
+            },
+            None,
+        )
+        .unwrap();
+    let t0 = Instant::now();
+    while t0.elapsed() < Duration::from_secs(10) {
+        if let Ok(Some(sample)) = reader.try_take_one() {
+            let raw = sample.into_value();
+            let (r, _) = cdr_encoding::from_bytes::<StartProgramResponse, byteorder::LittleEndian>(
+                &raw.bytes,
+            )
+            .unwrap();
+            return r;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    panic!("no reply to the malformed request");
 }

@@ -83,6 +83,20 @@ pub fn classify<T: DeserializeOwned>(
     with_header()
 }
 
+/// The mapping of a request that does not decode, so that its refusal reaches the client: a
+/// Cyclone header whose sequence number matches the sample's `related_sample_identity` says
+/// Cyclone; anything else is answered as enhanced.
+pub fn guess_mapping(bytes: &[u8], little_endian: bool, related_seq: Option<i64>) -> Mapping {
+    match related_seq {
+        Some(seq) if bytes.len() >= 16 && header_seq(&bytes[..16], little_endian) == seq => {
+            let mut header = [0u8; 16];
+            header.copy_from_slice(&bytes[..16]);
+            Mapping::Cyclone(header)
+        }
+        _ => Mapping::Enhanced,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,6 +147,18 @@ mod tests {
             classify::<StopRequest>(&cyclone(9, &stop), true, Some(9)),
             Some((Mapping::Cyclone(_), StopRequest { mode: 2 }))
         ));
+    }
+
+    #[test]
+    fn an_undecodable_request_is_answered_in_the_mapping_its_identity_names() {
+        let bad = cyclone(5, &[3, 0, 0, 0, 0xc3, 0x28, 0, 0]);
+        assert!(matches!(
+            guess_mapping(&bad, true, Some(5)),
+            Mapping::Cyclone(h) if h[..8] == [1, 2, 3, 4, 5, 6, 7, 8]
+        ));
+        assert_eq!(guess_mapping(&bad, true, Some(6)), Mapping::Enhanced);
+        assert_eq!(guess_mapping(&bad, true, None), Mapping::Enhanced);
+        assert_eq!(guess_mapping(&[1, 2], true, Some(0)), Mapping::Enhanced);
     }
 
     #[test]

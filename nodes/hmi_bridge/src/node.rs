@@ -78,10 +78,30 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let alarms_pub = ros.publisher::<ActiveAlarms>(&topics::ALARMS)?;
     let participant = ros.participant();
     let sq: QosPolicies = (&qos::services()).into();
-    let load = DualServer::<LoadProgram>::new(&participant, &ns, "load_program", sq.clone())?;
-    let start = DualServer::<StartProgram>::new(&participant, &ns, "start_program", sq.clone())?;
-    let stop = DualServer::<Stop>::new(&participant, &ns, "stop", sq.clone())?;
-    let reset = DualServer::<Reset>::new(&participant, &ns, "reset", sq.clone())?;
+    let load = DualServer::<LoadProgram>::new(&participant, &ns, "load_program", sq.clone())?
+        .refusing(|message| LoadProgramResponse {
+            accepted: false,
+            message,
+        });
+    let start = DualServer::<StartProgram>::new(&participant, &ns, "start_program", sq.clone())?
+        .refusing(|message| StartProgramResponse {
+            accepted: false,
+            message,
+        });
+    let stop =
+        DualServer::<Stop>::new(&participant, &ns, "stop", sq.clone())?.refusing(|message| {
+            StopResponse {
+                accepted: false,
+                message,
+            }
+        });
+    let reset =
+        DualServer::<Reset>::new(&participant, &ns, "reset", sq.clone())?.refusing(|message| {
+            ResetResponse {
+                accepted: false,
+                message,
+            }
+        });
     let mut run_program = RunProgramServer::new(&participant, &ns, sq)?;
     let events = ros.publisher::<CommandEvent>(&topics::COMMAND_EVENTS)?;
     // Which nodes each participant hosts, as they announce it on `ros_discovery_info`: a
@@ -252,6 +272,17 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             let (accepted, message) = commands.call(ProgramCommand::RESET, "", "");
             record("reset", "", &r.writer, accepted, &message);
             answer(&reset, &r, &ResetResponse { accepted, message });
+        }
+        let malformed = [
+            ("load_program", load.take_malformed()),
+            ("start_program", start.take_malformed()),
+            ("stop", stop.take_malformed()),
+            ("reset", reset.take_malformed()),
+        ];
+        for (command, list) in malformed {
+            for (writer, why) in list {
+                record(command, "malformed", &writer, false, &why);
+            }
         }
         if !busy {
             std::thread::sleep(Duration::from_millis(2));

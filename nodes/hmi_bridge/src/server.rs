@@ -1,6 +1,7 @@
 //! A service server that answers rmw_cyclonedds-style and rmw_fastrtps-style clients on the same
 //! topics, built on rustdds directly because ros2-client's `Server` speaks one mapping only.
 
+use std::cell::RefCell;
 use std::marker::PhantomData;
 
 use byteorder::LittleEndian;
@@ -13,7 +14,7 @@ use ros2_client::dds::rustdds::{
 };
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::mapping::{classify, Mapping};
+use crate::mapping::{classify, guess_mapping, Mapping};
 use cnc_msgs::srv::RosService;
 
 /// One received request, ready to be answered.
@@ -31,6 +32,11 @@ pub struct DualServer<S: RosService> {
     reader: SimpleDataReader<Raw, RawAdapter>,
     writer: DataWriter<Raw, RawAdapter>,
     name: String,
+    /// How to say no to a request that cannot be decoded, if the response type can say it.
+    refuse: Option<fn(String) -> S::Response>,
+    /// Undecodable requests seen since the last [`DualServer::take_malformed`]: writer GUID and
+    /// what was wrong.
+    malformed: RefCell<Vec<([u8; 16], String)>>,
     _service: PhantomData<S>,
 }
 
@@ -84,8 +90,22 @@ where
             reader,
             writer,
             name: service.into(),
+            refuse: None,
+            malformed: RefCell::new(Vec::new()),
             _service: PhantomData,
         })
+    }
+
+    /// Answers undecodable requests (a string that is not UTF-8, a payload of the wrong type)
+    /// with `refuse(reason)` instead of only logging them.
+    pub fn refusing(mut self, refuse: fn(String) -> S::Response) -> Self {
+        self.refuse = Some(refuse);
+        self
+    }
+
+    /// The undecodable requests seen since the last call, for command events.
+    pub fn take_malformed(&self) -> Vec<([u8; 16], String)> {
+        std::mem::take(&mut *self.malformed.borrow_mut())
     }
 
     /// The next request, if any. Undecodable requests are logged and dropped: without a valid
@@ -107,6 +127,7 @@ where
                 sequence_number: dcc.sequence_number,
             };
             let client = format!("{:?}", dcc.writer_guid);
+            let dcc_writer = dcc.writer_guid;
             let raw = dcc.into_value();
             let related_seq = related.map(|r| i64::from(r.sequence_number));
             match classify::<S::Request>(&raw.bytes, raw.little_endian, related_seq) {
@@ -128,19 +149,45 @@ where
                         writer: own.writer_guid.to_bytes(),
                     });
                 }
-                None => log::warn!(
-                    "{}: malformed request ({} bytes) from {client} dropped",
-                    self.name,
-                    raw.bytes.len()
-                ),
+                None => {
+                    let why = format!(
+                        "malformed {} request ({} bytes): not a valid {} (strings must be UTF-8)",
+                        self.name,
+                        raw.bytes.len(),
+                        S::TYPE_NAME
+                    );
+                    log::warn!("{why} from {client}");
+                    self.malformed
+                        .borrow_mut()
+                        .push((dcc_writer.to_bytes(), why.clone()));
+                    if let Some(refuse) = self.refuse {
+                        let mapping = guess_mapping(&raw.bytes, raw.little_endian, related_seq);
+                        let identity = match related {
+                            Some(r) if r.sequence_number != SequenceNumber::UNKNOWN => r,
+                            _ => own,
+                        };
+                        if let Err(e) = self.send(mapping, identity, &refuse(why)) {
+                            log::warn!("{e}");
+                        }
+                    }
+                }
             }
         }
     }
 
     pub fn reply(&self, to: &Request<S::Request>, response: &S::Response) -> Result<(), String> {
+        self.send(to.mapping, to.identity, response)
+    }
+
+    fn send(
+        &self,
+        mapping: Mapping,
+        identity: SampleIdentity,
+        response: &S::Response,
+    ) -> Result<(), String> {
         let body = cdr_encoding::to_vec::<_, LittleEndian>(response)
             .map_err(|e| format!("{}: {e}", self.name))?;
-        let bytes = match to.mapping {
+        let bytes = match mapping {
             Mapping::Enhanced => body,
             Mapping::Cyclone(header) => {
                 let mut b = header.to_vec();
@@ -150,7 +197,7 @@ where
         };
         let options = WriteOptionsBuilder::new()
             .source_timestamp(Timestamp::now())
-            .related_sample_identity(to.identity)
+            .related_sample_identity(identity)
             .build();
         self.writer
             .write_with_options(
