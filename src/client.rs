@@ -17,6 +17,7 @@ pub struct CellClient {
     start: Client<StartProgramRequest, StartProgramResponse>,
     stop: Client<StopRequest, StopResponse>,
     reset: Client<ResetRequest, ResetResponse>,
+    robot: Client<RobotRequestRequest, RobotRequestResponse>,
     machine: Subscription<MachineState>,
     spindle_sub: Subscription<SpindleState>,
     parts: Subscription<PartCount>,
@@ -64,6 +65,7 @@ impl CellClient {
             start: client::<StartProgram>(&mut ros, mapping, ns, "start_program")?,
             stop: client::<Stop>(&mut ros, mapping, ns, "stop")?,
             reset: client::<Reset>(&mut ros, mapping, ns, "reset")?,
+            robot: client::<RobotRequest>(&mut ros, mapping, ns, "robot_request")?,
             // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
             // within a millisecond, and a depth-1 reader would see only STOPPED.
             machine: ros.subscription_with_qos(
@@ -148,6 +150,11 @@ impl CellClient {
     }
     pub fn reset(&mut self) -> Result<ResetResponse, String> {
         call(&self.reset, ResetRequest::default())
+    }
+
+    /// A robot handshake request (`RobotRequestRequest::DOOR_OPEN` …).
+    pub fn robot_request(&mut self, request: u8) -> Result<RobotRequestResponse, String> {
+        call(&self.robot, RobotRequestRequest { request })
     }
 
     pub fn node(&self) -> &RosNode {

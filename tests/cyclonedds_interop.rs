@@ -10,8 +10,9 @@ mod common;
 
 use cnc::cell::Cell;
 
-#[test]
-fn cyclone_dds_peer_reads_topics_and_calls_services() {
+/// Runs `tests/interop/<script>` with the venv's Python against a cell in `domain`; returns
+/// its output after checking it passed.
+fn run_peer(script: &str, domain: u16) -> String {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let python = std::env::var("CNC_PYTHON")
         .map(PathBuf::from)
@@ -21,23 +22,46 @@ fn cyclone_dds_peer_reads_topics_and_calls_services() {
         "{} missing: run scripts/test.sh, which creates the venv with cyclonedds",
         python.display()
     );
-    let cfg = common::sim_lathe(43);
+    let cfg = common::sim_lathe(domain);
     let cell = Cell::start(&cfg).unwrap();
     let out = Command::new(&python)
-        .arg(root.join("tests/interop/cyclone_peer.py"))
-        .args(["--domain", "43"])
+        .arg(root.join("tests/interop").join(script))
+        .args(["--domain", &domain.to_string()])
         // Cyclone on loopback only, like the cell.
         .env("CYCLONEDDS_URI", "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>")
         .output()
         .unwrap();
     let (_, errors) = cell.stop();
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
     println!("{stdout}");
     assert!(
         out.status.success(),
-        "Cyclone DDS peer failed:\n{stdout}\n{}",
+        "{script} failed:\n{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(stdout.contains("part_count 0 -> 1"), "{stdout}");
     assert!(errors.is_empty(), "{errors:?}");
+    stdout
+}
+
+#[test]
+fn cyclone_dds_peer_reads_topics_and_calls_services() {
+    let stdout = run_peer("cyclone_peer.py", 43);
+    assert!(stdout.contains("part_count 0 -> 1"), "{stdout}");
+}
+
+/// The robot handshake from outside: cycle complete, door, chuck, clear, next cycle, and
+/// refusals with their reasons.
+#[test]
+fn cyclone_dds_robot_does_the_load_handshake() {
+    let stdout = run_peer("robot_peer.py", 53);
+    assert!(
+        stdout.contains("ok   next cycle started by the robot"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains(
+            "ok   door close with the robot inside refused: door close refused: robot not clear"
+        ),
+        "{stdout}"
+    );
 }

@@ -143,8 +143,12 @@ fn a_recorded_cycle_reads_back_in_rosbags_and_mcap_with_every_message_published(
             .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
             && c.part_count.as_ref().is_some_and(|p| p.count == 1)
     });
-    // An emergency stop and its release, so the alarm topics and the input topic carry
-    // messages too.
+    // A robot report (the robot signal topic), then an emergency stop and its release, so the
+    // alarm topics and the input topic carry messages too.
+    let r = client
+        .robot_request(cnc_msgs::srv::RobotRequestRequest::CLEAR)
+        .unwrap();
+    assert!(r.accepted, "{}", r.message);
     let mut panel = RosNode::new(&cfg.network, "lathe1", "panel_test").unwrap();
     let input = panel.publisher::<SimInput>(&topics::SIM_INPUT).unwrap();
     std::thread::sleep(Duration::from_millis(500)); // discovery of the new writer

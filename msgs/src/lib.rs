@@ -34,6 +34,7 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("PartCount", include_str!("../msg/PartCount.msg")),
     ("PlcStatus", include_str!("../msg/PlcStatus.msg")),
     ("ProgramCommand", include_str!("../msg/ProgramCommand.msg")),
+    ("RobotHandshake", include_str!("../msg/RobotHandshake.msg")),
     ("ServoStats", include_str!("../msg/ServoStats.msg")),
     ("SimInput", include_str!("../msg/SimInput.msg")),
     ("SpindleState", include_str!("../msg/SpindleState.msg")),

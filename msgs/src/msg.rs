@@ -290,3 +290,21 @@ ros_message! {
         message: String,
     }
 }
+
+ros_message! {
+    /// The machine's side of the robot handshake.
+    pub struct RobotHandshake("cnc_msgs/msg/RobotHandshake") {
+        consts {}
+        stamp: Time,
+        ready_for_load: bool,
+        cycle_complete: bool,
+        door_open: bool,
+        door_closed: bool,
+        chuck_clamped: bool,
+        chuck_unclamped: bool,
+        robot_clear: bool,
+        spindle_turning: bool,
+        cycle_active: bool,
+        emergency_stop: bool,
+    }
+}

@@ -67,6 +67,28 @@ ros_message! {
     }
 }
 
+ros_message! {
+    pub struct RobotRequestRequest("cnc_msgs/srv/RobotRequest_Request") {
+        consts {
+            DOOR_OPEN: u8 = 1,
+            DOOR_CLOSE: u8 = 2,
+            CHUCK_UNCLAMP: u8 = 3,
+            CHUCK_CLAMP: u8 = 4,
+            CLEAR: u8 = 5,
+            NOT_CLEAR: u8 = 6,
+            CYCLE_START: u8 = 7,
+        }
+        request: u8,
+    }
+}
+ros_message! {
+    pub struct RobotRequestResponse("cnc_msgs/srv/RobotRequest_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+
 macro_rules! service {
     ($marker:ident, $name:literal, $req:ident, $resp:ident) => {
         /// Marker type naming the service.
@@ -93,3 +115,18 @@ service!(
 );
 service!(Stop, "Stop", StopRequest, StopResponse);
 service!(Reset, "Reset", ResetRequest, ResetResponse);
+service!(
+    RobotRequest,
+    "RobotRequest",
+    RobotRequestRequest,
+    RobotRequestResponse
+);
+
+impl RobotRequestResponse {
+    pub fn refused(message: String) -> Self {
+        RobotRequestResponse {
+            accepted: false,
+            message,
+        }
+    }
+}

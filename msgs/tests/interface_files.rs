@@ -124,6 +124,7 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<SimInput>("SimInput.msg");
     check_msg::<PlcStatus>("PlcStatus.msg");
     check_msg::<CommandEvent>("CommandEvent.msg");
+    check_msg::<RobotHandshake>("RobotHandshake.msg");
 }
 
 #[test]
@@ -132,6 +133,7 @@ fn every_srv_file_matches_its_rust_types() {
     check_srv::<StartProgram>();
     check_srv::<Stop>();
     check_srv::<Reset>();
+    check_srv::<RobotRequest>();
 }
 
 /// `action/RunProgram.action`: goal, result and feedback sections against their Rust types.
@@ -178,6 +180,8 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "SimInput",
         "PlcStatus",
         "CommandEvent",
+        "RobotHandshake",
+        "RobotRequest",
         "LoadProgram",
         "StartProgram",
         "Stop",

@@ -5,5 +5,6 @@ pub mod access;
 pub mod action_server;
 pub mod mapping;
 pub mod node;
+pub mod robot;
 pub mod run_program;
 pub mod server;

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use cnc_msgs::msg::{
     ActiveAlarms, AlarmEvent, CommandEvent, CommandResult, MachineState, MotionStatus, PartCount,
-    ProgramCommand,
+    ProgramCommand, RobotHandshake, SimInput,
 };
 use cnc_msgs::srv::*;
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -20,6 +20,7 @@ use ros2_client::qos::History;
 
 use crate::access::{may_move, Clients};
 use crate::action_server::{CommandPath, RunProgramServer};
+use crate::robot;
 use crate::server::{DualServer, Request};
 
 /// How long a service waits for the interpreter's answer.
@@ -102,7 +103,20 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 message,
             }
         });
+    let robot_srv =
+        DualServer::<RobotRequest>::new(&participant, &ns, "robot_request", sq.clone())?.refusing(
+            |message| RobotRequestResponse {
+                accepted: false,
+                message,
+            },
+        );
     let mut run_program = RunProgramServer::new(&participant, &ns, sq)?;
+    let robot_signals = ros.publisher::<SimInput>(&topics::ROBOT_SIGNALS)?;
+    let handshake_sub = ros.subscription::<RobotHandshake>(&topics::ROBOT_HANDSHAKE)?;
+    let mut handshake: Option<RobotHandshake> = None;
+    let mut pending: Option<PendingRobot> = None;
+    // The program a robot's cycle start runs again: the last one started from outside.
+    let mut last_program: Option<String> = None;
     let events = ros.publisher::<CommandEvent>(&topics::COMMAND_EVENTS)?;
     // Which nodes each participant hosts, as they announce it on `ros_discovery_info`: a
     // reader of our own, transient-local, so every participant's last announcement is there
@@ -250,6 +264,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 Ok(()) => commands.call(ProgramCommand::START, name, ""),
                 Err(why) => (false, why),
             };
+            if accepted {
+                last_program = Some(name.clone());
+            }
             record("start_program", name, &r.writer, accepted, &message);
             answer(&start, &r, &StartProgramResponse { accepted, message });
         }
@@ -273,11 +290,96 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             record("reset", "", &r.writer, accepted, &message);
             answer(&reset, &r, &ResetResponse { accepted, message });
         }
+        if let Some(p) = run_program.last_program.take() {
+            last_program = Some(p);
+        }
+        while let Ok(Some((h, _))) = handshake_sub.take() {
+            handshake = Some(h);
+        }
+        if let Some(r) = robot_srv.receive() {
+            busy = true;
+            let decided = decide_robot(&r, handshake.as_ref(), &may_move, pending.as_mut());
+            match decided {
+                RobotDecision::Joined => {}
+                RobotDecision::Refused(why) => {
+                    record("robot_request", "", &r.writer, false, &why);
+                    answer(&robot_srv, &r, &RobotRequestResponse::refused(why));
+                }
+                RobotDecision::Go(op) => match op.signal() {
+                    None => {
+                        let (accepted, message) = match &last_program {
+                            Some(p) if may_move(&r.writer).is_ok() => {
+                                commands.call(ProgramCommand::START, p, "")
+                            }
+                            Some(_) => (false, "cycle start refused: client not allowed".into()),
+                            None => (
+                                false,
+                                "cycle start refused: no program started yet (start_program or RunProgram first)"
+                                    .into(),
+                            ),
+                        };
+                        record("robot_request", op.name(), &r.writer, accepted, &message);
+                        answer(&robot_srv, &r, &RobotRequestResponse { accepted, message });
+                    }
+                    Some((input, _)) => {
+                        let value = !matches!(op, robot::Op::Clear(false));
+                        if let Err(e) = robot_signals.publish(SimInput { input, value }) {
+                            log::error!("robot signal not sent: {e}");
+                        }
+                        pending = Some(PendingRobot {
+                            op,
+                            requests: vec![r],
+                            since: std::time::Instant::now(),
+                        });
+                    }
+                },
+            }
+        }
+        if let Some(p) = pending.take() {
+            let done = handshake.as_ref().is_some_and(|h| p.op.done(h));
+            let late = p.since.elapsed().as_secs_f64() > robot::ACTUATION_TIMEOUT;
+            if done || late {
+                if let Some((input, hold)) = p.op.signal() {
+                    if !hold {
+                        let _ = robot_signals.publish(SimInput {
+                            input,
+                            value: false,
+                        });
+                    }
+                }
+                let (accepted, message) = if done {
+                    (true, format!("{} done", p.op.name()))
+                } else {
+                    (
+                        false,
+                        format!(
+                            "{} not done within {} s (see the PLC's alarms)",
+                            p.op.name(),
+                            robot::ACTUATION_TIMEOUT
+                        ),
+                    )
+                };
+                for r in &p.requests {
+                    record("robot_request", p.op.name(), &r.writer, accepted, &message);
+                    answer(
+                        &robot_srv,
+                        r,
+                        &RobotRequestResponse {
+                            accepted,
+                            message: message.clone(),
+                        },
+                    );
+                }
+            } else {
+                pending = Some(p);
+            }
+        }
         let malformed = [
             ("load_program", load.take_malformed()),
             ("start_program", start.take_malformed()),
             ("stop", stop.take_malformed()),
             ("reset", reset.take_malformed()),
+            ("robot_request", robot_srv.take_malformed()),
         ];
         for (command, list) in malformed {
             for (writer, why) in list {
@@ -289,6 +391,52 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A robot request waiting for the machine to carry it out; copies of it (a client repeats a
+/// request it has no answer to yet) are answered together.
+struct PendingRobot {
+    op: robot::Op,
+    requests: Vec<Request<RobotRequestRequest>>,
+    since: std::time::Instant,
+}
+
+enum RobotDecision {
+    Refused(String),
+    /// A copy of the pending request: answered with it.
+    Joined,
+    Go(robot::Op),
+}
+
+fn decide_robot(
+    r: &Request<RobotRequestRequest>,
+    handshake: Option<&RobotHandshake>,
+    may_move: &dyn Fn(&[u8; 16]) -> Result<(), String>,
+    pending: Option<&mut PendingRobot>,
+) -> RobotDecision {
+    let op = match robot::Op::from_request(r.request.request) {
+        Ok(op) => op,
+        Err(why) => return RobotDecision::Refused(why),
+    };
+    if let Some(p) = pending {
+        if p.op == op && p.requests.iter().any(|q| q.writer == r.writer) {
+            p.requests.push(r.clone());
+            return RobotDecision::Joined;
+        }
+        return RobotDecision::Refused(format!("{} refused: busy with {}", op.name(), p.op.name()));
+    }
+    if op.moves() {
+        if let Err(why) = may_move(&r.writer) {
+            return RobotDecision::Refused(why);
+        }
+    }
+    let Some(h) = handshake else {
+        return RobotDecision::Refused("no handshake state from the PLC yet".into());
+    };
+    match robot::refusal(op, h) {
+        Some(why) => RobotDecision::Refused(why),
+        None => RobotDecision::Go(op),
+    }
 }
 
 type DiscoveryReader = rustdds::no_key::SimpleDataReader<

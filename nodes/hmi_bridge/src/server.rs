@@ -18,6 +18,7 @@ use crate::mapping::{classify, guess_mapping, Mapping};
 use cnc_msgs::srv::RosService;
 
 /// One received request, ready to be answered.
+#[derive(Clone)]
 pub struct Request<Req> {
     pub request: Req,
     pub mapping: Mapping,

@@ -60,10 +60,24 @@ pub fn apply_input(sim: &mut SimLathe, input: &SimInput) -> bool {
     true
 }
 
+/// The inputs a robot drives (X8.0–X8.5).
+pub fn is_robot_signal(input: u8) -> bool {
+    matches!(
+        input,
+        SimInput::ROBOT_CLEAR
+            | SimInput::ROBOT_CHUCK_OPEN
+            | SimInput::ROBOT_CHUCK_CLOSE
+            | SimInput::ROBOT_DOOR_OPEN
+            | SimInput::ROBOT_DOOR_CLOSE
+            | SimInput::ROBOT_CYCLE_START
+    )
+}
+
 /// Runs the io node until shutdown (blocking).
 pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "io")?;
     let inputs = ros.subscription::<SimInput>(&topics::SIM_INPUT)?;
+    let robot = ros.subscription::<SimInput>(&topics::ROBOT_SIGNALS)?;
     let shm = ShmNode::new(&instance, "io")?;
     let setpoints = shm.receiver::<ServoSetpoint>(channel::SETPOINT, true)?;
     let feedback = shm.sender::<ServoFeedback>(channel::FEEDBACK, true)?;
@@ -81,6 +95,17 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 log::info!("simulated input {} = {}", input.input, input.value);
             } else {
                 log::warn!("unknown simulated input {} ignored", input.input);
+            }
+        }
+        // The robot interface block (X8) set over the network: robot signals only.
+        while let Ok(Some((input, _))) = robot.take() {
+            if is_robot_signal(input.input) {
+                apply_input(&mut sim, &input);
+            } else {
+                log::warn!(
+                    "robot signal {} is not a robot signal: ignored",
+                    input.input
+                );
             }
         }
         if let Some(latest) = outputs.latest()? {

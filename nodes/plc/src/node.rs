@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-use cnc_msgs::msg::{Alarm, PartCount, PlcStatus, SpindleState};
+use cnc_msgs::msg::{Alarm, PartCount, PlcStatus, RobotHandshake, SpindleState};
 use cnc_msgs::signals::{f, g, x, y, FImage, SignalTable, XImage};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
@@ -71,6 +71,8 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let spindle_pub = ros.publisher::<SpindleState>(&topics::SPINDLE)?;
     let parts_pub = ros.publisher::<PartCount>(&topics::PART_COUNT)?;
     let status_pub = ros.publisher::<PlcStatus>(&topics::PLC_STATUS)?;
+    let robot_pub = ros.publisher::<RobotHandshake>(&topics::ROBOT_HANDSHAKE)?;
+    let mut last_robot: Option<RobotHandshake> = None;
     let alarms = AlarmReporter::new(&mut ros, "plc")?;
     let shm = ShmNode::new(&instance, "plc")?;
     let f_in = shm.receiver::<FImage>(channel::F_IMAGE, false)?;
@@ -154,6 +156,14 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             scans,
             f32::from(plc.to_nc().bytes[g::SPINDLE_OVERRIDE as usize]),
         );
+        let robot = handshake(plc.outputs(), &xi, &fi);
+        if last_robot.as_ref() != Some(&robot) || scans.is_multiple_of(100) {
+            let _ = robot_pub.publish(RobotHandshake {
+                stamp: stamp(),
+                ..robot.clone()
+            });
+            last_robot = Some(robot);
+        }
         if scans.is_multiple_of(100) {
             // Once a second at 10 ms: status, program file, parameters.
             let _ = status_pub.publish(scan_times.message(
@@ -282,6 +292,26 @@ impl PartCounter {
             target: 0,
             last_cycle_time: self.last_cycle_time,
         })
+    }
+}
+
+/// The robot's view of the machine from the I/O images (stamp left at zero, so two views
+/// compare equal when the signals do).
+fn handshake(yi: &cnc_msgs::signals::YImage, xi: &XImage, fi: &FImage) -> RobotHandshake {
+    RobotHandshake {
+        stamp: Default::default(),
+        ready_for_load: yi.get(y::READY_FOR_LOAD),
+        cycle_complete: yi.get(y::CYCLE_COMPLETE),
+        door_open: xi.get(x::DOOR_OPEN),
+        door_closed: xi.get(x::DOOR_CLOSED),
+        chuck_clamped: xi.get(x::CHUCK_CLAMPED),
+        chuck_unclamped: xi.get(x::CHUCK_UNCLAMPED),
+        robot_clear: xi.get(x::ROBOT_CLEAR),
+        spindle_turning: yi.get(y::SPINDLE_CW)
+            || yi.get(y::SPINDLE_CCW)
+            || xi.spindle_actual_rpm.abs() > 1.0,
+        cycle_active: fi.get(f::OP),
+        emergency_stop: !xi.get(x::ESP_N),
     }
 }
 

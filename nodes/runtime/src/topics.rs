@@ -66,6 +66,18 @@ pub const ALARM_EVENTS: Topic = topic(
 );
 pub const PLC_STATUS: Topic = topic("plc/status", "cnc_msgs/msg/PlcStatus", Delivery::State);
 pub const SERVO_STATS: Topic = topic("servo_stats", "cnc_msgs/msg/ServoStats", Delivery::State);
+pub const ROBOT_HANDSHAKE: Topic = topic(
+    "robot_handshake",
+    "cnc_msgs/msg/RobotHandshake",
+    Delivery::State,
+);
+/// Robot signals set by hmi_bridge's robot service, for the io node's robot interface block
+/// (X8): what a fieldbus robot interface would carry.
+pub const ROBOT_SIGNALS: Topic = topic(
+    "_internal/robot_signals",
+    "cnc_msgs/msg/SimInput",
+    Delivery::Events(32),
+);
 pub const COMMAND_EVENTS: Topic = topic(
     "command_events",
     "cnc_msgs/msg/CommandEvent",
@@ -104,7 +116,9 @@ pub const ALL: &[Topic] = &[
     PLC_STATUS,
     SERVO_STATS,
     COMMAND_EVENTS,
+    ROBOT_HANDSHAKE,
     SIM_INPUT,
+    ROBOT_SIGNALS,
     PROGRAM_COMMAND,
     COMMAND_RESULT,
     MOTION_BLOCKS,
