@@ -18,6 +18,8 @@ pub struct CellClient {
     stop: Client<StopRequest, StopResponse>,
     reset: Client<ResetRequest, ResetResponse>,
     robot: Client<RobotRequestRequest, RobotRequestResponse>,
+    list: Client<ListProgramsRequest, ListProgramsResponse>,
+    delete: Client<DeleteProgramRequest, DeleteProgramResponse>,
     machine: Subscription<MachineState>,
     spindle_sub: Subscription<SpindleState>,
     parts: Subscription<PartCount>,
@@ -66,6 +68,8 @@ impl CellClient {
             stop: client::<Stop>(&mut ros, mapping, ns, "stop")?,
             reset: client::<Reset>(&mut ros, mapping, ns, "reset")?,
             robot: client::<RobotRequest>(&mut ros, mapping, ns, "robot_request")?,
+            list: client::<ListPrograms>(&mut ros, mapping, ns, "list_programs")?,
+            delete: client::<DeleteProgram>(&mut ros, mapping, ns, "delete_program")?,
             // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
             // within a millisecond, and a depth-1 reader would see only STOPPED.
             machine: ros.subscription_with_qos(
@@ -155,6 +159,13 @@ impl CellClient {
     /// A robot handshake request (`RobotRequestRequest::DOOR_OPEN` …).
     pub fn robot_request(&mut self, request: u8) -> Result<RobotRequestResponse, String> {
         call(&self.robot, RobotRequestRequest { request })
+    }
+
+    pub fn list_programs(&mut self) -> Result<ListProgramsResponse, String> {
+        call(&self.list, ListProgramsRequest::default())
+    }
+    pub fn delete_program(&mut self, name: &str) -> Result<DeleteProgramResponse, String> {
+        call(&self.delete, DeleteProgramRequest { name: name.into() })
     }
 
     pub fn node(&self) -> &RosNode {

@@ -116,6 +116,25 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     let r = bad.reset().unwrap();
     assert!(r.accepted, "{}", r.message);
 
+    // Program memory: list and delete.
+    let r = good.load_program("second.nc", "M30\n").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let l = good.list_programs().unwrap();
+    assert_eq!(l.names, vec!["p.nc".to_string(), "second.nc".to_string()]);
+    assert_eq!(l.sizes, vec![PROGRAM.len() as u64, 4]);
+    let r = good.delete_program("second.nc").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let r = good.delete_program("second.nc").unwrap();
+    assert!(
+        !r.accepted && r.message.contains("not found"),
+        "{}",
+        r.message
+    );
+    assert_eq!(
+        good.list_programs().unwrap().names,
+        vec!["p.nc".to_string()]
+    );
+
     std::thread::sleep(Duration::from_millis(300));
     let mut seen: Vec<CommandEvent> = Vec::new();
     while let Ok(Some((e, _))) = events.take() {
@@ -139,7 +158,8 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     assert!(seen
         .iter()
         .any(|e| e.command == "start_program" && e.detail == "malformed" && !e.accepted));
-    assert_eq!(seen.len(), 9, "one event per request: {seen:#?}");
+    assert!(find("delete_program", "/lathe1/supervisor_ok", false));
+    assert_eq!(seen.len(), 14, "one event per request: {seen:#?}");
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
 }

@@ -239,7 +239,15 @@ ros_message! {
 ros_message! {
     /// Internal command from hmi_bridge to the nodes.
     pub struct ProgramCommand("cnc_msgs/msg/ProgramCommand") {
-        consts { LOAD: u8 = 1, START: u8 = 2, FEED_HOLD: u8 = 3, CYCLE_STOP: u8 = 4, RESET: u8 = 5 }
+        consts {
+            LOAD: u8 = 1,
+            START: u8 = 2,
+            FEED_HOLD: u8 = 3,
+            CYCLE_STOP: u8 = 4,
+            RESET: u8 = 5,
+            LIST: u8 = 6,
+            DELETE: u8 = 7,
+        }
         id: u64,
         command: u8,
         program: String,

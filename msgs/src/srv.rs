@@ -89,6 +89,33 @@ ros_message! {
     }
 }
 
+ros_message! {
+    pub struct ListProgramsRequest("cnc_msgs/srv/ListPrograms_Request") {
+        consts {}
+        structure_needs_at_least_one_member: u8,
+    }
+}
+ros_message! {
+    pub struct ListProgramsResponse("cnc_msgs/srv/ListPrograms_Response") {
+        consts {}
+        names: Vec<String>,
+        sizes: Vec<u64>,
+    }
+}
+ros_message! {
+    pub struct DeleteProgramRequest("cnc_msgs/srv/DeleteProgram_Request") {
+        consts {}
+        name: String,
+    }
+}
+ros_message! {
+    pub struct DeleteProgramResponse("cnc_msgs/srv/DeleteProgram_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+
 macro_rules! service {
     ($marker:ident, $name:literal, $req:ident, $resp:ident) => {
         /// Marker type naming the service.
@@ -130,3 +157,15 @@ impl RobotRequestResponse {
         }
     }
 }
+service!(
+    ListPrograms,
+    "ListPrograms",
+    ListProgramsRequest,
+    ListProgramsResponse
+);
+service!(
+    DeleteProgram,
+    "DeleteProgram",
+    DeleteProgramRequest,
+    DeleteProgramResponse
+);

@@ -134,6 +134,8 @@ fn every_srv_file_matches_its_rust_types() {
     check_srv::<Stop>();
     check_srv::<Reset>();
     check_srv::<RobotRequest>();
+    check_srv::<ListPrograms>();
+    check_srv::<DeleteProgram>();
 }
 
 /// `action/RunProgram.action`: goal, result and feedback sections against their Rust types.
@@ -182,6 +184,8 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "CommandEvent",
         "RobotHandshake",
         "RobotRequest",
+        "ListPrograms",
+        "DeleteProgram",
         "LoadProgram",
         "StartProgram",
         "Stop",

@@ -103,6 +103,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 message,
             }
         });
+    let list = DualServer::<ListPrograms>::new(&participant, &ns, "list_programs", sq.clone())?;
+    let delete = DualServer::<DeleteProgram>::new(&participant, &ns, "delete_program", sq.clone())?
+        .refusing(|message| DeleteProgramResponse {
+            accepted: false,
+            message,
+        });
     let robot_srv =
         DualServer::<RobotRequest>::new(&participant, &ns, "robot_request", sq.clone())?.refusing(
             |message| RobotRequestResponse {
@@ -284,6 +290,36 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             record("stop", &mode, &r.writer, accepted, &message);
             answer(&stop, &r, &StopResponse { accepted, message });
         }
+        if let Some(r) = list.receive() {
+            busy = true;
+            let (accepted, text) = commands.call(ProgramCommand::LIST, "", "");
+            let mut response = ListProgramsResponse::default();
+            if accepted {
+                for line in text.lines() {
+                    if let Some((name, size)) = line.rsplit_once('\t') {
+                        response.names.push(name.to_string());
+                        response.sizes.push(size.parse().unwrap_or(0));
+                    }
+                }
+            }
+            let message = if accepted {
+                format!("{} programs", response.names.len())
+            } else {
+                text
+            };
+            record("list_programs", "", &r.writer, accepted, &message);
+            answer(&list, &r, &response);
+        }
+        if let Some(r) = delete.receive() {
+            busy = true;
+            let name = &r.request.name;
+            let (accepted, message) = commands.call(ProgramCommand::DELETE, name, "");
+            if accepted {
+                run_program.program_lines.remove(name);
+            }
+            record("delete_program", name, &r.writer, accepted, &message);
+            answer(&delete, &r, &DeleteProgramResponse { accepted, message });
+        }
         if let Some(r) = reset.receive() {
             busy = true;
             let (accepted, message) = commands.call(ProgramCommand::RESET, "", "");
@@ -379,6 +415,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             ("start_program", start.take_malformed()),
             ("stop", stop.take_malformed()),
             ("reset", reset.take_malformed()),
+            ("delete_program", delete.take_malformed()),
             ("robot_request", robot_srv.take_malformed()),
         ];
         for (command, list) in malformed {

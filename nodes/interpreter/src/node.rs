@@ -331,6 +331,27 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     };
                     (true, "reset".into())
                 }
+                ProgramCommand::LIST => {
+                    let lines: Vec<String> = programs
+                        .iter()
+                        .map(|(name, text)| format!("{name}\t{}", text.len()))
+                        .collect();
+                    (true, lines.join("\n"))
+                }
+                ProgramCommand::DELETE => {
+                    let running = run.as_ref().is_some_and(|r| r.program == c.program)
+                        && matches!(execution, MachineState::ACTIVE | MachineState::FEED_HOLD);
+                    if running {
+                        (false, format!("{} is running: stop it first", c.program))
+                    } else if programs.remove(&c.program).is_some() {
+                        (true, format!("{} deleted", c.program))
+                    } else {
+                        (
+                            false,
+                            format!("program {:?} not found (alarm 22)", c.program),
+                        )
+                    }
+                }
                 other => (false, format!("unknown command {other}")),
             };
             let result = CommandResult {
