@@ -20,6 +20,7 @@ pub struct CellClient {
     robot: Client<RobotRequestRequest, RobotRequestResponse>,
     list: Client<ListProgramsRequest, ListProgramsResponse>,
     delete: Client<DeleteProgramRequest, DeleteProgramResponse>,
+    overrides: Client<SetOverridesRequest, SetOverridesResponse>,
     machine: Subscription<MachineState>,
     spindle_sub: Subscription<SpindleState>,
     parts: Subscription<PartCount>,
@@ -70,6 +71,7 @@ impl CellClient {
             robot: client::<RobotRequest>(&mut ros, mapping, ns, "robot_request")?,
             list: client::<ListPrograms>(&mut ros, mapping, ns, "list_programs")?,
             delete: client::<DeleteProgram>(&mut ros, mapping, ns, "delete_program")?,
+            overrides: client::<SetOverrides>(&mut ros, mapping, ns, "set_overrides")?,
             // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
             // within a millisecond, and a depth-1 reader would see only STOPPED.
             machine: ros.subscription_with_qos(
@@ -166,6 +168,22 @@ impl CellClient {
     }
     pub fn delete_program(&mut self, name: &str) -> Result<DeleteProgramResponse, String> {
         call(&self.delete, DeleteProgramRequest { name: name.into() })
+    }
+
+    pub fn set_overrides(
+        &mut self,
+        feed_percent: u8,
+        spindle_percent: u8,
+        rapid_percent: u8,
+    ) -> Result<SetOverridesResponse, String> {
+        call(
+            &self.overrides,
+            SetOverridesRequest {
+                feed_percent,
+                spindle_percent,
+                rapid_percent,
+            },
+        )
     }
 
     pub fn node(&self) -> &RosNode {

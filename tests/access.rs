@@ -116,6 +116,35 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     let r = bad.reset().unwrap();
     assert!(r.accepted, "{}", r.message);
 
+    // Overrides: only the switch steps, only from an allowed client, and they reach the PLC.
+    let r = good.set_overrides(200, 100, 100).unwrap();
+    assert!(
+        !r.accepted && r.message.contains("feed override 200 %"),
+        "{}",
+        r.message
+    );
+    let r = bad.set_overrides(100, 80, 100).unwrap();
+    assert!(
+        !r.accepted && r.message.contains("may not move"),
+        "{}",
+        r.message
+    );
+    let r = good.set_overrides(100, 80, 50).unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let t0 = Instant::now();
+    while good
+        .spindle
+        .as_ref()
+        .is_none_or(|s| s.override_percent != 80.0)
+    {
+        assert!(
+            t0.elapsed() < Duration::from_secs(5),
+            "spindle override never 80 %"
+        );
+        good.poll();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+
     // Program memory: list and delete.
     let r = good.load_program("second.nc", "M30\n").unwrap();
     assert!(r.accepted, "{}", r.message);
@@ -159,7 +188,8 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
         .iter()
         .any(|e| e.command == "start_program" && e.detail == "malformed" && !e.accepted));
     assert!(find("delete_program", "/lathe1/supervisor_ok", false));
-    assert_eq!(seen.len(), 14, "one event per request: {seen:#?}");
+    assert!(find("set_overrides", "/lathe1/intruder", false));
+    assert_eq!(seen.len(), 17, "one event per request: {seen:#?}");
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
 }

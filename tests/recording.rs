@@ -149,6 +149,8 @@ fn a_recorded_cycle_reads_back_in_rosbags_and_mcap_with_every_message_published(
         .robot_request(cnc_msgs::srv::RobotRequestRequest::CLEAR)
         .unwrap();
     assert!(r.accepted, "{}", r.message);
+    let r = client.set_overrides(100, 100, 100).unwrap();
+    assert!(r.accepted, "{}", r.message);
     let mut panel = RosNode::new(&cfg.network, "lathe1", "panel_test").unwrap();
     let input = panel.publisher::<SimInput>(&topics::SIM_INPUT).unwrap();
     std::thread::sleep(Duration::from_millis(500)); // discovery of the new writer

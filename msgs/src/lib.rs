@@ -31,6 +31,7 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("MachineState", include_str!("../msg/MachineState.msg")),
     ("MotionBlock", include_str!("../msg/MotionBlock.msg")),
     ("MotionStatus", include_str!("../msg/MotionStatus.msg")),
+    ("Overrides", include_str!("../msg/Overrides.msg")),
     ("PartCount", include_str!("../msg/PartCount.msg")),
     ("PlcStatus", include_str!("../msg/PlcStatus.msg")),
     ("ProgramCommand", include_str!("../msg/ProgramCommand.msg")),

@@ -316,3 +316,13 @@ ros_message! {
         emergency_stop: bool,
     }
 }
+
+ros_message! {
+    /// The panel's override switches.
+    pub struct Overrides("cnc_msgs/msg/Overrides") {
+        consts {}
+        feed_percent: u8,
+        spindle_percent: u8,
+        rapid_percent: u8,
+    }
+}

@@ -264,6 +264,10 @@ pub mod x {
     pub const KEY_SINGLE_BLOCK: Bit = bit(10, 3);
     /// Feed override switch, percent in binary (a coded rotary switch on the panel).
     pub const FEED_OVERRIDE_SWITCH: u16 = 16;
+    /// Spindle override switch, percent in binary.
+    pub const SPINDLE_OVERRIDE_SWITCH: u16 = 17;
+    /// Rapid override switch, as G14's ROV2/ROV1 code: 0 = 100 %, 1 = 50 %, 2 = 25 %, 3 = F0.
+    pub const RAPID_OVERRIDE_SWITCH: u16 = 18;
 }
 
 /// Outputs of the standard lathe (`000` §19.1.6, inventory §9.3).

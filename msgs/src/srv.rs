@@ -116,6 +116,22 @@ ros_message! {
     }
 }
 
+ros_message! {
+    pub struct SetOverridesRequest("cnc_msgs/srv/SetOverrides_Request") {
+        consts {}
+        feed_percent: u8,
+        spindle_percent: u8,
+        rapid_percent: u8,
+    }
+}
+ros_message! {
+    pub struct SetOverridesResponse("cnc_msgs/srv/SetOverrides_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+
 macro_rules! service {
     ($marker:ident, $name:literal, $req:ident, $resp:ident) => {
         /// Marker type naming the service.
@@ -168,4 +184,10 @@ service!(
     "DeleteProgram",
     DeleteProgramRequest,
     DeleteProgramResponse
+);
+service!(
+    SetOverrides,
+    "SetOverrides",
+    SetOverridesRequest,
+    SetOverridesResponse
 );

@@ -125,6 +125,7 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<PlcStatus>("PlcStatus.msg");
     check_msg::<CommandEvent>("CommandEvent.msg");
     check_msg::<RobotHandshake>("RobotHandshake.msg");
+    check_msg::<Overrides>("Overrides.msg");
 }
 
 #[test]
@@ -136,6 +137,7 @@ fn every_srv_file_matches_its_rust_types() {
     check_srv::<RobotRequest>();
     check_srv::<ListPrograms>();
     check_srv::<DeleteProgram>();
+    check_srv::<SetOverrides>();
 }
 
 /// `action/RunProgram.action`: goal, result and feedback sections against their Rust types.
@@ -186,6 +188,8 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "RobotRequest",
         "ListPrograms",
         "DeleteProgram",
+        "Overrides",
+        "SetOverrides",
         "LoadProgram",
         "StartProgram",
         "Stop",

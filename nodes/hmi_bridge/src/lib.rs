@@ -5,6 +5,7 @@ pub mod access;
 pub mod action_server;
 pub mod mapping;
 pub mod node;
+pub mod overrides;
 pub mod robot;
 pub mod run_program;
 pub mod server;

@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use cnc_msgs::msg::{
-    ActiveAlarms, AlarmEvent, CommandEvent, CommandResult, MachineState, MotionStatus, PartCount,
-    ProgramCommand, RobotHandshake, SimInput,
+    ActiveAlarms, AlarmEvent, CommandEvent, CommandResult, MachineState, MotionStatus, Overrides,
+    PartCount, ProgramCommand, RobotHandshake, SimInput,
 };
 use cnc_msgs::srv::*;
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -109,6 +109,14 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             accepted: false,
             message,
         });
+    let overrides_srv =
+        DualServer::<SetOverrides>::new(&participant, &ns, "set_overrides", sq.clone())?.refusing(
+            |message| SetOverridesResponse {
+                accepted: false,
+                message,
+            },
+        );
+    let panel = ros.publisher::<Overrides>(&topics::PANEL_OVERRIDES)?;
     let robot_srv =
         DualServer::<RobotRequest>::new(&participant, &ns, "robot_request", sq.clone())?.refusing(
             |message| RobotRequestResponse {
@@ -290,6 +298,27 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             record("stop", &mode, &r.writer, accepted, &message);
             answer(&stop, &r, &StopResponse { accepted, message });
         }
+        if let Some(r) = overrides_srv.receive() {
+            busy = true;
+            let q = &r.request;
+            let detail = format!(
+                "feed {} %, spindle {} %, rapid {} %",
+                q.feed_percent, q.spindle_percent, q.rapid_percent
+            );
+            let outcome = may_move(&r.writer)
+                .and_then(|()| crate::overrides::check(q))
+                .and_then(|o| panel.publish(o).map_err(|e| format!("not sent: {e}")));
+            let (accepted, message) = match outcome {
+                Ok(()) => (true, format!("overrides set: {detail}")),
+                Err(why) => (false, why),
+            };
+            record("set_overrides", &detail, &r.writer, accepted, &message);
+            answer(
+                &overrides_srv,
+                &r,
+                &SetOverridesResponse { accepted, message },
+            );
+        }
         if let Some(r) = list.receive() {
             busy = true;
             let (accepted, text) = commands.call(ProgramCommand::LIST, "", "");
@@ -416,6 +445,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             ("stop", stop.take_malformed()),
             ("reset", reset.take_malformed()),
             ("delete_program", delete.take_malformed()),
+            ("set_overrides", overrides_srv.take_malformed()),
             ("robot_request", robot_srv.take_malformed()),
         ];
         for (command, list) in malformed {

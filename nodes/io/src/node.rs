@@ -6,7 +6,7 @@
 
 use std::time::Duration;
 
-use cnc_msgs::msg::SimInput;
+use cnc_msgs::msg::{Overrides, SimInput};
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint};
 use cnc_msgs::signals::{x, Bit, SignalTable, XImage, YImage};
 use cnc_runtime::dds::RosNode;
@@ -60,6 +60,18 @@ pub fn apply_input(sim: &mut SimLathe, input: &SimInput) -> bool {
     true
 }
 
+/// Sets the override switch bytes X16–X18 (rapid as its ROV code).
+pub fn set_override_switches(inputs: &mut XImage, o: &Overrides) {
+    inputs.bytes[x::FEED_OVERRIDE_SWITCH as usize] = o.feed_percent;
+    inputs.bytes[x::SPINDLE_OVERRIDE_SWITCH as usize] = o.spindle_percent;
+    inputs.bytes[x::RAPID_OVERRIDE_SWITCH as usize] = match o.rapid_percent {
+        100.. => 0,
+        50..=99 => 1,
+        1..=49 => 2,
+        0 => 3,
+    };
+}
+
 /// The inputs a robot drives (X8.0–X8.5).
 pub fn is_robot_signal(input: u8) -> bool {
     matches!(
@@ -78,6 +90,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "io")?;
     let inputs = ros.subscription::<SimInput>(&topics::SIM_INPUT)?;
     let robot = ros.subscription::<SimInput>(&topics::ROBOT_SIGNALS)?;
+    let panel = ros.subscription::<Overrides>(&topics::PANEL_OVERRIDES)?;
     let shm = ShmNode::new(&instance, "io")?;
     let setpoints = shm.receiver::<ServoSetpoint>(channel::SETPOINT, true)?;
     let feedback = shm.sender::<ServoFeedback>(channel::FEEDBACK, true)?;
@@ -96,6 +109,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             } else {
                 log::warn!("unknown simulated input {} ignored", input.input);
             }
+        }
+        // The panel's override switches set over the network (hmi_bridge checks the values).
+        while let Ok(Some((o, _))) = panel.take() {
+            set_override_switches(&mut sim.devices.inputs, &o);
         }
         // The robot interface block (X8) set over the network: robot signals only.
         while let Ok(Some((input, _))) = robot.take() {

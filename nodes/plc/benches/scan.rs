@@ -28,6 +28,7 @@ fn inputs(k: usize) -> (FImage, XImage) {
     xi.set(x::SPINDLE_AT_SPEED, k % 40 > 20);
     xi.set(x::KEY_SINGLE_BLOCK, k.is_multiple_of(300));
     xi.bytes[x::FEED_OVERRIDE_SWITCH as usize] = 100;
+    xi.bytes[x::SPINDLE_OVERRIDE_SWITCH as usize] = 100;
     let phase = k % 200;
     fi.set(f::OP, true);
     match phase {

@@ -78,6 +78,13 @@ pub const ROBOT_SIGNALS: Topic = topic(
     "cnc_msgs/msg/SimInput",
     Delivery::Events(32),
 );
+/// Override switch positions set by hmi_bridge's override service, for the io node's panel
+/// block (X16–X18).
+pub const PANEL_OVERRIDES: Topic = topic(
+    "_internal/panel_overrides",
+    "cnc_msgs/msg/Overrides",
+    Delivery::Events(8),
+);
 pub const COMMAND_EVENTS: Topic = topic(
     "command_events",
     "cnc_msgs/msg/CommandEvent",

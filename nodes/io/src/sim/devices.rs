@@ -85,8 +85,9 @@ impl Devices {
     pub fn new(cfg: DeviceConfig) -> Self {
         let mut inputs = XImage::default();
         inputs.set(x::ROBOT_CLEAR, true);
-        // The panel's feed override switch stands at 100 %.
+        // The panel's override switches stand at 100 % (rapid code 0 is 100 %).
         inputs.bytes[x::FEED_OVERRIDE_SWITCH as usize] = 100;
+        inputs.bytes[x::SPINDLE_OVERRIDE_SWITCH as usize] = 100;
         Devices {
             cfg,
             turret: 0.0,
