@@ -130,6 +130,7 @@ pub const ALL: &[Topic] = &[
     COMMAND_RESULT,
     MOTION_BLOCKS,
     MOTION_STATUS,
+    PANEL_OVERRIDES,
 ];
 
 /// Whether `path` matches `pattern`: `*` stands for any run of characters (also `/`).
@@ -161,6 +162,18 @@ mod tests {
         assert!(!matches("a*b*c", "axxbyy"));
         assert!(matches("axes", "axes"));
         assert!(!matches("axes", "axes2"));
+    }
+
+    /// A topic left out of [`ALL`] would not be recorded: every `Topic` constant is in it.
+    #[test]
+    fn every_topic_constant_is_in_the_table() {
+        let source = include_str!("topics.rs");
+        let declared: Vec<&str> = source
+            .lines()
+            .filter_map(|l| l.strip_prefix("pub const "))
+            .filter_map(|l| l.split_once(": Topic =").map(|(name, _)| name))
+            .collect();
+        assert_eq!(declared.len(), ALL.len(), "{declared:?}");
     }
 
     #[test]
