@@ -131,42 +131,58 @@ GOOD = "O0042\nG00 X60 Z5\nS700 M03\nG01 X40 Z0 F600\nZ-15\nG02 X50 Z-20 R5\nM05
 BAD = "G00 X100 Z20\nG77 X5\nM30\n"
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--domain", type=int, required=True)
-    ap.add_argument("--namespace", default="lathe1")
-    ap.add_argument("--msgs", default=str(pathlib.Path(__file__).resolve().parents[2] / "msgs"))
-    args = ap.parse_args()
-    peer = Peer(args.domain, args.namespace, Interfaces(pathlib.Path(args.msgs)))
-    readers = {"spindle": peer.subscribe("spindle", "SpindleState"),
-               "part_count": peer.subscribe("part_count", "PartCount"),
-               "alarms": peer.subscribe("alarms", "ActiveAlarms"),
-               "machine_state": peer.subscribe("machine_state", "MachineState")}
-    failures = []
+class Session:
+    """A peer with its state readers and its checks: `check` prints ok/FAIL lines, `wait` polls
+    the readers until a condition holds."""
 
-    def check(ok, what):
+    def __init__(self, topics):
+        ap = argparse.ArgumentParser()
+        ap.add_argument("--domain", type=int, required=True)
+        ap.add_argument("--namespace", default="lathe1")
+        ap.add_argument("--msgs", default=str(pathlib.Path(__file__).resolve().parents[2] / "msgs"))
+        args = ap.parse_args()
+        self.peer = Peer(args.domain, args.namespace, Interfaces(pathlib.Path(args.msgs)))
+        self.readers = {topic: self.peer.subscribe(topic, msg) for topic, msg in topics.items()}
+        self.failures = []
+        self.on_sample = lambda topic, sample: None
+
+    def check(self, ok, what):
         print(("ok   " if ok else "FAIL ") + what, flush=True)
         if not ok:
-            failures.append(what)
+            self.failures.append(what)
 
-    max_rpm = 0.0
-
-    def poll():
-        nonlocal max_rpm
-        for topic, r in readers.items():
+    def poll(self):
+        for topic, r in self.readers.items():
             for sample in r.take(N=64):
-                peer.latest[topic] = sample
-                if topic == "spindle" and abs(sample.commanded_rpm - 700.0) < 1e-9:
-                    max_rpm = max(max_rpm, sample.actual_rpm)
+                self.peer.latest[topic] = sample
+                self.on_sample(topic, sample)
 
-    def wait(cond, timeout):
+    def wait(self, cond, timeout):
         end = time.time() + timeout
         while time.time() < end:
-            poll()
+            self.poll()
             if cond():
                 return True
             time.sleep(0.01)
         return False
+
+    def exit_code(self):
+        print(f"{len(self.failures)} failed", flush=True)
+        return 1 if self.failures else 0
+
+
+def main():
+    session = Session({"spindle": "SpindleState", "part_count": "PartCount",
+                       "alarms": "ActiveAlarms", "machine_state": "MachineState"})
+    peer, check, wait = session.peer, session.check, session.wait
+    max_rpm = 0.0
+
+    def track_rpm(topic, sample):
+        nonlocal max_rpm
+        if topic == "spindle" and abs(sample.commanded_rpm - 700.0) < 1e-9:
+            max_rpm = max(max_rpm, sample.actual_rpm)
+
+    session.on_sample = track_rpm
 
     check(wait(lambda: all(v is not None for v in peer.latest.values()), 30),
           "transient-local spindle, part_count, alarms and machine_state arrive on joining")
@@ -201,8 +217,7 @@ def main():
     r = peer.call("reset", "Reset", structure_needs_at_least_one_member=0)
     check(r.accepted, f"Reset (Cyclone mapping) accepted: {r.message}")
     check(wait(lambda: len(peer.latest["alarms"].alarms) == 0, 20), "alarms empty after reset")
-    print(f"{len(failures)} failed", flush=True)
-    return 1 if failures else 0
+    return session.exit_code()
 
 
 if __name__ == "__main__":

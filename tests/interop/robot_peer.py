@@ -11,12 +11,9 @@ completes too.
 Exit 0 when every check holds; otherwise print what failed and exit 1.
 """
 
-import argparse
-import pathlib
 import sys
-import time
 
-from cyclone_peer import Interfaces, Peer
+from cyclone_peer import Session
 
 DOOR_OPEN, DOOR_CLOSE, CHUCK_UNCLAMP, CHUCK_CLAMP, CLEAR, NOT_CLEAR, CYCLE_START = range(1, 8)
 
@@ -25,35 +22,9 @@ PART = "O0050\nG00 X60 Z5\nS600 M03\nG01 X50 F600\nZ-40\nX60\nG00 Z5\nM05\nM30\n
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--domain", type=int, required=True)
-    ap.add_argument("--namespace", default="lathe1")
-    ap.add_argument("--msgs", default=str(pathlib.Path(__file__).resolve().parents[2] / "msgs"))
-    args = ap.parse_args()
-    peer = Peer(args.domain, args.namespace, Interfaces(pathlib.Path(args.msgs)))
-    readers = {"robot_handshake": peer.subscribe("robot_handshake", "RobotHandshake"),
-               "machine_state": peer.subscribe("machine_state", "MachineState"),
-               "part_count": peer.subscribe("part_count", "PartCount")}
-    failures = []
-
-    def check(ok, what):
-        print(("ok   " if ok else "FAIL ") + what, flush=True)
-        if not ok:
-            failures.append(what)
-
-    def poll():
-        for topic, r in readers.items():
-            for sample in r.take(N=64):
-                peer.latest[topic] = sample
-
-    def wait(cond, timeout):
-        end = time.time() + timeout
-        while time.time() < end:
-            poll()
-            if cond():
-                return True
-            time.sleep(0.01)
-        return False
+    session = Session({"robot_handshake": "RobotHandshake", "machine_state": "MachineState",
+                       "part_count": "PartCount"})
+    peer, check, wait, poll = session.peer, session.check, session.wait, session.poll
 
     def hs():
         return peer.latest["robot_handshake"]
@@ -113,8 +84,7 @@ def main():
     check(wait(lambda: hs().cycle_complete, 20), "cycle complete again")
     r = robot(99)
     check(not r.accepted and "unknown robot request" in r.message, f"unknown request refused: {r.message}")
-    print(f"{len(failures)} failed", flush=True)
-    return 1 if failures else 0
+    return session.exit_code()
 
 
 if __name__ == "__main__":
