@@ -33,6 +33,8 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("MotionStatus", include_str!("../msg/MotionStatus.msg")),
     ("Overrides", include_str!("../msg/Overrides.msg")),
     ("PartCount", include_str!("../msg/PartCount.msg")),
+    ("PlcProgram", include_str!("../msg/PlcProgram.msg")),
+    ("PlcSignals", include_str!("../msg/PlcSignals.msg")),
     ("PlcStatus", include_str!("../msg/PlcStatus.msg")),
     ("ProgramCommand", include_str!("../msg/ProgramCommand.msg")),
     ("RobotHandshake", include_str!("../msg/RobotHandshake.msg")),

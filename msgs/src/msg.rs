@@ -112,6 +112,19 @@ ros_message! {
 }
 
 impl MachineState {
+    /// The mode's name as the panel's mode switch says it.
+    pub fn mode_name_of(mode: u8) -> &'static str {
+        match mode {
+            Self::MODE_AUTO => "AUTO",
+            Self::MODE_MDI => "MDI",
+            Self::MODE_JOG => "JOG",
+            Self::MODE_HOME => "HOME",
+            Self::MODE_EDIT => "EDIT",
+            Self::MODE_HANDWHEEL => "HANDWHEEL",
+            _ => "UNKNOWN",
+        }
+    }
+
     /// MTConnect name of an execution state.
     pub fn execution_name_of(execution: u8) -> &'static str {
         match execution {
@@ -220,6 +233,7 @@ ros_message! {
         aux_kind: u8,
         aux_code: i32,
         aux_value: f64,
+        origin: Vec<f64>,
     }
 }
 
@@ -247,6 +261,12 @@ ros_message! {
             RESET: u8 = 5,
             LIST: u8 = 6,
             DELETE: u8 = 7,
+            READ: u8 = 8,
+            MDI: u8 = 9,
+            MODE: u8 = 10,
+            OFFSETS: u8 = 11,
+            SET_TOOL_OFFSET: u8 = 12,
+            SET_WORK_OFFSET: u8 = 13,
         }
         id: u64,
         command: u8,
@@ -324,5 +344,32 @@ ros_message! {
         feed_percent: u8,
         spindle_percent: u8,
         rapid_percent: u8,
+    }
+}
+
+ros_message! {
+    /// A low-rate snapshot of the PLC's signal tables (ladder monitor, audits).
+    pub struct PlcSignals("cnc_msgs/msg/PlcSignals") {
+        consts {}
+        stamp: Time,
+        scan: u64,
+        x: Vec<u8>,
+        y: Vec<u8>,
+        f: Vec<u8>,
+        g: Vec<u8>,
+        r: Vec<u8>,
+        a: Vec<u8>,
+        k: Vec<u8>,
+    }
+}
+
+ros_message! {
+    /// The running PLC program as rungs, sent when it is loaded.
+    pub struct PlcProgram("cnc_msgs/msg/PlcProgram") {
+        consts {}
+        stamp: Time,
+        source: String,
+        rungs: Vec<String>,
+        lines: Vec<u32>,
     }
 }

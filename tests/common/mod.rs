@@ -13,5 +13,6 @@ pub fn sim_lathe(domain: u16) -> LaunchConfig {
     cfg.plc.memory_file = None;
     cfg.machine.memory_file = None;
     cfg.recorder.enabled = false;
+    cfg.hmi.web_address = String::new();
     cfg
 }

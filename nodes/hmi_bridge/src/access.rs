@@ -11,6 +11,14 @@ use std::collections::BTreeMap;
 
 use cnc_runtime::topics::matches;
 
+/// Who sent a command: a DDS writer (a ROS 2 service client, action client or robot) or a
+/// page of the web HMI, named `web@<address>`.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Who {
+    Dds([u8; 16]),
+    Web(String),
+}
+
 /// Participant (GUID prefix) → the nodes it hosts, `/namespace/name`.
 #[derive(Debug, Default)]
 pub struct Clients {

@@ -5,8 +5,9 @@ use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
 
 use cnc_msgs::msg::{
-    ActiveAlarms, AlarmEvent, CommandEvent, CommandResult, MachineState, MotionStatus, Overrides,
-    PartCount, ProgramCommand, RobotHandshake, SimInput,
+    ActiveAlarms, AlarmEvent, AxisState, CommandEvent, CommandResult, MachineState, MotionBlock,
+    MotionStatus, Overrides, PartCount, PlcProgram, PlcSignals, ProgramCommand, RobotHandshake,
+    SimInput, SpindleState,
 };
 use cnc_msgs::srv::*;
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -18,10 +19,12 @@ use ros2_client::dds::rustdds::QosPolicies;
 use ros2_client::entities_info::ParticipantEntitiesInfo;
 use ros2_client::qos::History;
 
-use crate::access::{may_move, Clients};
+use crate::access::{self, may_move, Clients, Who};
 use crate::action_server::{CommandPath, RunProgramServer};
+use crate::operation::Operation;
 use crate::robot;
 use crate::server::{DualServer, Request};
+use crate::web::WebHmi;
 
 /// How long a service waits for the interpreter's answer.
 const COMMAND_TIMEOUT: Duration = Duration::from_secs(10);
@@ -151,6 +154,28 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let mut motion_run = (0u64, 0u64);
     let mut part_count = 0u32;
     let t0 = std::time::Instant::now();
+    // The web HMI and what only it shows. A port already taken is reported and the bridge
+    // serves the cell without it.
+    let mut web = if cfg.hmi.web_address.is_empty() {
+        None
+    } else {
+        let parameters = serde_json::to_value(&cfg.machine).unwrap_or_default();
+        let axes = cfg.machine.axes.iter().map(|a| a.name.clone()).collect();
+        match WebHmi::start(&cfg.hmi.web_address, axes, parameters) {
+            Ok(w) => Some(w),
+            Err(e) => {
+                log::error!("hmi_bridge: {e}; the web HMI is not served");
+                None
+            }
+        }
+    };
+    let axes_sub = ros.subscription::<AxisState>(&topics::AXES)?;
+    let spindle_sub = ros.subscription::<SpindleState>(&topics::SPINDLE)?;
+    let blocks_sub = ros.subscription::<MotionBlock>(&topics::MOTION_BLOCKS)?;
+    let signals_sub = ros.subscription::<PlcSignals>(&topics::PLC_SIGNALS)?;
+    let ladder_sub = ros.subscription::<PlcProgram>(&topics::PLC_PROGRAM)?;
+    let command_sub = ros.subscription::<CommandEvent>(&topics::COMMAND_EVENTS)?;
+    let overrides_sub = ros.subscription::<Overrides>(&topics::PANEL_OVERRIDES)?;
 
     let mut active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm> = BTreeMap::new();
     let publish_alarms = |active: &BTreeMap<(String, u32), cnc_msgs::msg::Alarm>| {
@@ -182,22 +207,33 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 &clients.describe(writer),
             )
         };
-        let record =
-            |command: &str, detail: &str, writer: &[u8; 16], accepted: bool, message: &str| {
-                let client = clients.describe(writer);
-                log::info!("{command} {detail} from {client}: accepted {accepted}: {message}");
-                if let Err(e) = events.publish(CommandEvent {
-                    stamp: stamp(),
-                    command: command.into(),
-                    detail: detail.into(),
-                    client,
-                    accepted,
-                    message: message.into(),
-                }) {
-                    log::warn!("hmi_bridge: command event not published: {e}");
-                }
+        // A web page is known by its address (`web@127.0.0.1`), and `hmi.allowed_clients`
+        // names it as it names ROS 2 nodes.
+        let may_move_who = |who: &Who| match who {
+            Who::Dds(writer) => may_move(writer),
+            Who::Web(name) => access::may_move(&allowed, std::slice::from_ref(name), name),
+        };
+        let record = |command: &str, detail: &str, who: &Who, accepted: bool, message: &str| {
+            let client = match who {
+                Who::Dds(writer) => clients.describe(writer),
+                Who::Web(name) => name.clone(),
             };
+            log::info!("{command} {detail} from {client}: accepted {accepted}: {message}");
+            if let Err(e) = events.publish(CommandEvent {
+                stamp: stamp(),
+                command: command.into(),
+                detail: detail.into(),
+                client,
+                accepted,
+                message: message.into(),
+            }) {
+                log::warn!("hmi_bridge: command event not published: {e}");
+            }
+        };
         while let Ok(Some((e, _))) = alarm_events.take() {
+            if let Some(w) = web.as_mut() {
+                w.view.on_alarm_event(e.clone());
+            }
             let key = (e.alarm.source.clone(), e.alarm.number);
             if e.kind == AlarmEvent::RAISED {
                 active.insert(key, e.alarm);
@@ -211,14 +247,23 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         while let Ok(Some((m, _))) = motion_sub.take() {
             motion_run = (m.run_id, m.done_seq);
+            if let Some(w) = web.as_mut() {
+                w.view.on_motion_status(m);
+            }
         }
         while let Ok(Some((p, _))) = parts_sub.take() {
+            if let Some(w) = web.as_mut() {
+                w.view.on_parts(p.clone());
+            }
             part_count = p.count;
         }
         let alarm_list: Vec<cnc_msgs::msg::Alarm> = active.values().cloned().collect();
         // Each state in turn, so the action sees every transition (a short cycle's end too).
         let mut states = Vec::new();
         while let Ok(Some((m, _))) = state_sub.take() {
+            if let Some(w) = web.as_mut() {
+                w.view.on_machine_state(m.clone());
+            }
             states.push(m);
         }
         if states.is_empty() {
@@ -235,7 +280,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 t0.elapsed().as_secs_f64(),
             ) {
                 busy = true;
-                record(e.command, &e.detail, &e.writer, e.accepted, &e.message);
+                record(
+                    e.command,
+                    &e.detail,
+                    &Who::Dds(e.writer),
+                    e.accepted,
+                    &e.message,
+                );
             }
             machine = Some(m);
         }
@@ -250,69 +301,54 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 t0.elapsed().as_secs_f64(),
             );
         }
-        if let Some(r) = load.receive() {
-            busy = true;
-            let (name, text) = (&r.request.name, &r.request.text);
-            let (accepted, message) = if text.len() > MAX_PROGRAM_BYTES {
-                (
-                    false,
-                    format!(
-                        "program too large: {} bytes, limit {MAX_PROGRAM_BYTES}",
-                        text.len()
-                    ),
-                )
+        // The services: each request becomes an operation, carried out as the web HMI's are.
+        let mut perform = |op: Operation, who: &Who| -> (bool, String) {
+            let checked = if op.moves() {
+                may_move_who(who)
             } else {
-                commands.call(ProgramCommand::LOAD, name, text)
+                Ok(())
+            };
+            let (accepted, message) = match checked {
+                Ok(()) => execute(&op, &mut commands, &panel, &mut run_program.program_lines),
+                Err(why) => (false, why),
             };
             if accepted {
-                let lines = text.lines().count().min(u32::MAX as usize) as u32;
-                run_program.program_lines.insert(name.clone(), lines);
+                if let Operation::Start { name } = &op {
+                    if !name.is_empty() {
+                        last_program = Some(name.clone());
+                    }
+                }
             }
-            record("load_program", name, &r.writer, accepted, &message);
+            // Reading is not a command: only what changes something, or is refused, is an event.
+            if !matches!(op, Operation::Read { .. } | Operation::Offsets) || !accepted {
+                record(op.command(), &op.detail(), who, accepted, &message);
+            }
+            busy = true;
+            (accepted, message)
+        };
+        if let Some(r) = load.receive() {
+            let (name, text) = (r.request.name.clone(), r.request.text.clone());
+            let (accepted, message) = perform(Operation::Load { name, text }, &Who::Dds(r.writer));
             answer(&load, &r, &LoadProgramResponse { accepted, message });
         }
         if let Some(r) = start.receive() {
-            busy = true;
-            let name = &r.request.name;
-            let (accepted, message) = match may_move(&r.writer) {
-                Ok(()) => commands.call(ProgramCommand::START, name, ""),
-                Err(why) => (false, why),
-            };
-            if accepted {
-                last_program = Some(name.clone());
-            }
-            record("start_program", name, &r.writer, accepted, &message);
+            let name = r.request.name.clone();
+            let (accepted, message) = perform(Operation::Start { name }, &Who::Dds(r.writer));
             answer(&start, &r, &StartProgramResponse { accepted, message });
         }
         if let Some(r) = stop.receive() {
-            busy = true;
-            let (accepted, message) = match r.request.mode {
-                StopRequest::FEED_HOLD => commands.call(ProgramCommand::FEED_HOLD, "", ""),
-                StopRequest::CYCLE_STOP => commands.call(ProgramCommand::CYCLE_STOP, "", ""),
-                other => (
-                    false,
-                    format!("unknown stop mode {other}: use 1 (FEED_HOLD) or 2 (CYCLE_STOP)"),
-                ),
-            };
-            let mode = format!("mode {}", r.request.mode);
-            record("stop", &mode, &r.writer, accepted, &message);
+            let mode = r.request.mode;
+            let (accepted, message) = perform(Operation::Stop { mode }, &Who::Dds(r.writer));
             answer(&stop, &r, &StopResponse { accepted, message });
         }
         if let Some(r) = overrides_srv.receive() {
-            busy = true;
             let q = &r.request;
-            let detail = format!(
-                "feed {} %, spindle {} %, rapid {} %",
-                q.feed_percent, q.spindle_percent, q.rapid_percent
-            );
-            let outcome = may_move(&r.writer)
-                .and_then(|()| crate::overrides::check(q))
-                .and_then(|o| panel.publish(o).map_err(|e| format!("not sent: {e}")));
-            let (accepted, message) = match outcome {
-                Ok(()) => (true, format!("overrides set: {detail}")),
-                Err(why) => (false, why),
+            let o = Overrides {
+                feed_percent: q.feed_percent,
+                spindle_percent: q.spindle_percent,
+                rapid_percent: q.rapid_percent,
             };
-            record("set_overrides", &detail, &r.writer, accepted, &message);
+            let (accepted, message) = perform(Operation::Overrides(o), &Who::Dds(r.writer));
             answer(
                 &overrides_srv,
                 &r,
@@ -320,40 +356,30 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             );
         }
         if let Some(r) = list.receive() {
-            busy = true;
-            let (accepted, text) = commands.call(ProgramCommand::LIST, "", "");
+            let (accepted, text) = perform(Operation::List, &Who::Dds(r.writer));
             let mut response = ListProgramsResponse::default();
             if accepted {
-                for line in text.lines() {
-                    if let Some((name, size)) = line.rsplit_once('\t') {
-                        response.names.push(name.to_string());
-                        response.sizes.push(size.parse().unwrap_or(0));
-                    }
+                for (name, size) in program_list(&text) {
+                    response.names.push(name);
+                    response.sizes.push(size);
                 }
             }
-            let message = if accepted {
-                format!("{} programs", response.names.len())
-            } else {
-                text
-            };
-            record("list_programs", "", &r.writer, accepted, &message);
             answer(&list, &r, &response);
         }
         if let Some(r) = delete.receive() {
-            busy = true;
-            let name = &r.request.name;
-            let (accepted, message) = commands.call(ProgramCommand::DELETE, name, "");
-            if accepted {
-                run_program.program_lines.remove(name);
-            }
-            record("delete_program", name, &r.writer, accepted, &message);
+            let name = r.request.name.clone();
+            let (accepted, message) = perform(Operation::Delete { name }, &Who::Dds(r.writer));
             answer(&delete, &r, &DeleteProgramResponse { accepted, message });
         }
         if let Some(r) = reset.receive() {
-            busy = true;
-            let (accepted, message) = commands.call(ProgramCommand::RESET, "", "");
-            record("reset", "", &r.writer, accepted, &message);
+            let (accepted, message) = perform(Operation::Reset, &Who::Dds(r.writer));
             answer(&reset, &r, &ResetResponse { accepted, message });
+        }
+        if let Some(web) = web.as_mut() {
+            for (who, op, pending) in web.take_operations() {
+                let (accepted, message) = perform(op, &who);
+                web.answer(pending, accepted, message);
+            }
         }
         if let Some(p) = run_program.last_program.take() {
             last_program = Some(p);
@@ -367,7 +393,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             match decided {
                 RobotDecision::Joined => {}
                 RobotDecision::Refused(why) => {
-                    record("robot_request", "", &r.writer, false, &why);
+                    record("robot_request", "", &Who::Dds(r.writer), false, &why);
                     answer(&robot_srv, &r, &RobotRequestResponse::refused(why));
                 }
                 RobotDecision::Go(op) => match op.signal() {
@@ -383,7 +409,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                                     .into(),
                             ),
                         };
-                        record("robot_request", op.name(), &r.writer, accepted, &message);
+                        record(
+                            "robot_request",
+                            op.name(),
+                            &Who::Dds(r.writer),
+                            accepted,
+                            &message,
+                        );
                         answer(&robot_srv, &r, &RobotRequestResponse { accepted, message });
                     }
                     Some((input, _)) => {
@@ -425,7 +457,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     )
                 };
                 for r in &p.requests {
-                    record("robot_request", p.op.name(), &r.writer, accepted, &message);
+                    record(
+                        "robot_request",
+                        p.op.name(),
+                        &Who::Dds(r.writer),
+                        accepted,
+                        &message,
+                    );
                     answer(
                         &robot_srv,
                         r,
@@ -450,8 +488,32 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         ];
         for (command, list) in malformed {
             for (writer, why) in list {
-                record(command, "malformed", &writer, false, &why);
+                record(command, "malformed", &Who::Dds(writer), false, &why);
             }
+        }
+        if let Some(w) = web.as_mut() {
+            while let Ok(Some((a, _))) = axes_sub.take() {
+                w.view.on_axes(a);
+            }
+            while let Ok(Some((s, _))) = spindle_sub.take() {
+                w.view.on_spindle(s);
+            }
+            while let Ok(Some((b, _))) = blocks_sub.take() {
+                w.view.on_block(b);
+            }
+            while let Ok(Some((s, _))) = signals_sub.take() {
+                w.view.on_plc_signals(s);
+            }
+            while let Ok(Some((p, _))) = ladder_sub.take() {
+                w.set_ladder(&p);
+            }
+            while let Ok(Some((e, _))) = command_sub.take() {
+                w.view.on_command_event(&e);
+            }
+            while let Ok(Some((o, _))) = overrides_sub.take() {
+                w.view.on_overrides(o);
+            }
+            w.tick();
         }
         if !busy {
             std::thread::sleep(Duration::from_millis(2));
@@ -534,6 +596,84 @@ fn discovery_reader(participant: &rustdds::DomainParticipant) -> Result<Discover
         .map_err(|e| format!("ros_discovery_info: {e:?}"))?
         .create_simple_datareader_no_key(&topic, Some(qos))
         .map_err(|e| format!("ros_discovery_info: {e:?}"))
+}
+
+/// Carries out one operation through the interpreter's command path (access was checked by
+/// the caller): the one place every door's commands go through.
+fn execute(
+    op: &Operation,
+    commands: &mut Commands,
+    panel: &cnc_runtime::dds::Publisher<Overrides>,
+    program_lines: &mut BTreeMap<String, u32>,
+) -> (bool, String) {
+    match op {
+        Operation::Load { name, text } => {
+            if text.len() > MAX_PROGRAM_BYTES {
+                return (
+                    false,
+                    format!(
+                        "program too large: {} bytes, limit {MAX_PROGRAM_BYTES}",
+                        text.len()
+                    ),
+                );
+            }
+            let (accepted, message) = commands.call(ProgramCommand::LOAD, name, text);
+            if accepted {
+                let lines = text.lines().count().min(u32::MAX as usize) as u32;
+                program_lines.insert(name.clone(), lines);
+            }
+            (accepted, message)
+        }
+        Operation::Start { name } => commands.call(ProgramCommand::START, name, ""),
+        Operation::Stop { mode } => match *mode {
+            StopRequest::FEED_HOLD => commands.call(ProgramCommand::FEED_HOLD, "", ""),
+            StopRequest::CYCLE_STOP => commands.call(ProgramCommand::CYCLE_STOP, "", ""),
+            other => (
+                false,
+                format!("unknown stop mode {other}: use 1 (FEED_HOLD) or 2 (CYCLE_STOP)"),
+            ),
+        },
+        Operation::Reset => commands.call(ProgramCommand::RESET, "", ""),
+        Operation::List => commands.call(ProgramCommand::LIST, "", ""),
+        Operation::Delete { name } => {
+            let (accepted, message) = commands.call(ProgramCommand::DELETE, name, "");
+            if accepted {
+                program_lines.remove(name);
+            }
+            (accepted, message)
+        }
+        Operation::Overrides(o) => {
+            let request = SetOverridesRequest {
+                feed_percent: o.feed_percent,
+                spindle_percent: o.spindle_percent,
+                rapid_percent: o.rapid_percent,
+            };
+            match crate::overrides::check(&request)
+                .and_then(|o| panel.publish(o).map_err(|e| format!("not sent: {e}")))
+            {
+                Ok(()) => (true, format!("overrides set: {}", op.detail())),
+                Err(why) => (false, why),
+            }
+        }
+        Operation::Mode { mode } => commands.call(ProgramCommand::MODE, "", &mode.to_string()),
+        Operation::Mdi { text } => commands.call(ProgramCommand::MDI, "", text),
+        Operation::Read { name } => commands.call(ProgramCommand::READ, name, ""),
+        Operation::Offsets => commands.call(ProgramCommand::OFFSETS, "", ""),
+        Operation::SetToolOffset { number, values } => {
+            commands.call(ProgramCommand::SET_TOOL_OFFSET, number, values)
+        }
+        Operation::SetWorkOffset { code, values } => {
+            commands.call(ProgramCommand::SET_WORK_OFFSET, code, values)
+        }
+    }
+}
+
+/// The interpreter's program list (`name<TAB>size` lines) as names and sizes.
+pub fn program_list(text: &str) -> Vec<(String, u64)> {
+    text.lines()
+        .filter_map(|line| line.rsplit_once('\t'))
+        .map(|(name, size)| (name.to_string(), size.parse().unwrap_or(0)))
+        .collect()
 }
 
 fn answer<S: RosService>(

@@ -721,6 +721,12 @@ impl Interpreter {
         work + self.shift[i] + self.tool_offset[i]
     }
 
+    /// Program zero per axis in machine coordinates (work offset, shifts, tool offset) as it
+    /// stands after the blocks read so far: the HMI's work position is measured from it.
+    pub fn program_origin(&self) -> Vec<f64> {
+        (0..self.pos.len()).map(|i| self.origin(i)).collect()
+    }
+
     /// Current position in work coordinates (X as diameter).
     fn work_position(&self) -> Vec<f64> {
         (0..self.pos.len())

@@ -13,6 +13,7 @@ pub mod expr;
 pub mod geometry;
 pub mod interpreter;
 pub mod node;
+pub mod offset_page;
 pub mod program;
 pub mod rough;
 pub mod setup;

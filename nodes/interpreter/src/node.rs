@@ -23,6 +23,7 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 
 use cnc_msgs::canon::to_motion_block;
 
+use crate::offset_page;
 use crate::setup::Memory;
 use crate::{Command, Dialect, Interpreter, Library, Setup};
 
@@ -38,6 +39,32 @@ pub fn valid_program_name(name: &str) -> bool {
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c))
         && !name.starts_with('.')
+}
+
+/// The name an MDI entry is stored under in program memory.
+pub const MDI_PROGRAM: &str = "MDI";
+/// The longest MDI entry: a few blocks typed at the panel.
+pub const MAX_MDI_BYTES: usize = 4096;
+
+/// Why an MDI entry is not run, if it is not.
+fn mdi_refusal(mode: u8, running: bool, text: &str) -> Option<String> {
+    if mode != MachineState::MODE_MDI {
+        Some(format!(
+            "MDI refused: mode {}, not MDI",
+            MachineState::mode_name_of(mode)
+        ))
+    } else if running {
+        Some("MDI refused: a program is running".into())
+    } else if text.trim().is_empty() {
+        Some("MDI refused: no block entered".into())
+    } else if text.len() > MAX_MDI_BYTES {
+        Some(format!(
+            "MDI refused: {} bytes, limit {MAX_MDI_BYTES}",
+            text.len()
+        ))
+    } else {
+        None
+    }
 }
 
 struct Run {
@@ -163,6 +190,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         last_ns: 0,
     };
     let mut stop_command_id = 0u64;
+    // The mode switch: the cell's machine powers up in AUTO (DESIGN: a robot cell runs
+    // programs without an operator turning the switch).
+    let mut mode = MachineState::MODE_AUTO;
 
     while !shutdown.requested() {
         let mut busy = false;
@@ -219,7 +249,84 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 let _ = results.publish(done.clone());
                 continue;
             }
-            let (accepted, message) = match c.command {
+            let running = matches!(execution, MachineState::ACTIVE | MachineState::FEED_HOLD);
+            // An MDI entry is stored as the program `MDI` and started as a program is
+            // (decisions D43); cycle start runs programs in AUTO only.
+            let mut refusal = None;
+            let c = match c.command {
+                ProgramCommand::MDI => match mdi_refusal(mode, running, &c.text) {
+                    Some(why) => {
+                        refusal = Some(why);
+                        c
+                    }
+                    None => {
+                        programs.insert(MDI_PROGRAM.into(), c.text.clone());
+                        ProgramCommand {
+                            command: ProgramCommand::START,
+                            program: MDI_PROGRAM.into(),
+                            ..c
+                        }
+                    }
+                },
+                ProgramCommand::START
+                    if mode != MachineState::MODE_AUTO && execution != MachineState::FEED_HOLD =>
+                {
+                    refusal = Some(format!(
+                        "cycle start refused: mode {}, not AUTO",
+                        MachineState::mode_name_of(mode)
+                    ));
+                    c
+                }
+                _ => c,
+            };
+            let (accepted, message) = if let Some(why) = refusal {
+                (false, why)
+            } else {
+                match c.command {
+                ProgramCommand::MODE => match c.text.trim().parse::<u8>() {
+                    Ok(m) if m <= MachineState::MODE_HANDWHEEL => {
+                        if running && m != mode {
+                            (false, "mode change refused: a program is running (stop it first)".into())
+                        } else {
+                            mode = m;
+                            (true, format!("mode {}", MachineState::mode_name_of(m)))
+                        }
+                    }
+                    _ => (false, format!("unknown mode {:?}: 0 AUTO, 1 MDI, 2 JOG, 3 HOME, 4 EDIT, 5 HANDWHEEL", c.text)),
+                },
+                ProgramCommand::READ => match programs.get(&c.program) {
+                    Some(text) => (true, text.clone()),
+                    None => (false, format!("program {:?} not found (alarm 22)", c.program)),
+                },
+                ProgramCommand::OFFSETS => (true, offset_page::format(&memory, &axes)),
+                ProgramCommand::SET_TOOL_OFFSET | ProgramCommand::SET_WORK_OFFSET => {
+                    if running {
+                        (false, "offsets cannot change while a program runs (stop it first)".into())
+                    } else {
+                        // A stopped run's offsets are taken first, so the edit is not
+                        // overwritten by them later.
+                        remember(run.as_ref(), &mut memory, memory_path.as_deref());
+                        run = None;
+                        let mut edited = memory.clone();
+                        let outcome = if c.command == ProgramCommand::SET_TOOL_OFFSET {
+                            offset_page::set_tool(&mut edited, &c.program, &c.text)
+                        } else {
+                            offset_page::set_work(&mut edited, &c.program, &c.text, &axes)
+                        };
+                        match outcome {
+                            Ok(message) => {
+                                memory = edited;
+                                if let Some(p) = memory_path.as_deref() {
+                                    if let Err(e) = save_memory(p, &memory) {
+                                        log::error!("interpreter: machine memory not stored: {e}");
+                                    }
+                                }
+                                (true, message)
+                            }
+                            Err(why) => (false, why),
+                        }
+                    }
+                }
                 ProgramCommand::LOAD => {
                     if !valid_program_name(&c.program) {
                         (false, format!("invalid program name {:?}: letters, digits, '.', '_', '-', at most 64", c.program))
@@ -353,6 +460,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     }
                 }
                 other => (false, format!("unknown command {other}")),
+                }
             };
             let result = CommandResult {
                 id: c.id,
@@ -369,6 +477,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         // blocks still shows ACTIVE, then STOPPED, in that order.
         report_state(
             &mut state,
+            mode,
             execution,
             run.as_ref(),
             &status,
@@ -391,13 +500,14 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     Ok(Some(canon)) => {
                         busy = true;
                         r.sent_seq += 1;
-                        let msg = to_motion_block(
+                        let mut msg = to_motion_block(
                             r.id,
                             r.sent_seq,
                             &r.program,
                             canon.line,
                             &canon.command,
                         );
+                        msg.origin = r.interp.program_origin();
                         if canon.command == Command::ProgramEnd {
                             r.end_seq = Some(r.sent_seq);
                         }
@@ -453,6 +563,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         report_state(
             &mut state,
+            mode,
             execution,
             run.as_ref(),
             &status,
@@ -472,12 +583,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
 /// twice a second otherwise.
 struct StateReporter {
     publisher: cnc_runtime::dds::Publisher<MachineState>,
-    last: Option<(u8, u32, bool, bool, String)>,
+    last: Option<(u8, u8, u32, bool, bool, String)>,
     last_ns: u64,
 }
 
 fn report_state(
     state: &mut StateReporter,
+    mode: u8,
     execution: u8,
     run: Option<&Run>,
     status: &MotionStatus,
@@ -493,6 +605,7 @@ fn report_state(
     };
     let estop = active_alarms.iter().any(|(s, n)| s == "plc" && *n == 65);
     let key = (
+        mode,
         execution,
         line,
         estop,
@@ -505,7 +618,7 @@ fn report_state(
         state.last = Some(key);
         let _ = state.publisher.publish(MachineState {
             stamp: stamp(),
-            mode: MachineState::MODE_AUTO,
+            mode,
             execution,
             execution_name: MachineState::execution_name_of(execution).into(),
             program: program_name.into(),

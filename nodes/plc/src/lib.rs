@@ -8,6 +8,7 @@
 pub mod address;
 pub mod engine;
 pub mod memory;
+pub mod monitor;
 pub mod node;
 pub mod program;
 pub mod scan;

@@ -9,7 +9,9 @@
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-use cnc_msgs::msg::{Alarm, PartCount, PlcStatus, RobotHandshake, SpindleState};
+use cnc_msgs::msg::{
+    Alarm, PartCount, PlcProgram, PlcSignals, PlcStatus, RobotHandshake, SpindleState,
+};
 use cnc_msgs::signals::{f, g, x, y, FImage, SignalTable, XImage};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
@@ -18,6 +20,7 @@ use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
+use crate::address::Space;
 use crate::memory::Retained;
 use crate::scan::{PlcEvent, EMERGENCY_STOP_ALARM, PLC_FAULT_ALARM};
 use crate::{Plc, Program, LATHE_STANDARD};
@@ -72,6 +75,12 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let parts_pub = ros.publisher::<PartCount>(&topics::PART_COUNT)?;
     let status_pub = ros.publisher::<PlcStatus>(&topics::PLC_STATUS)?;
     let robot_pub = ros.publisher::<RobotHandshake>(&topics::ROBOT_HANDSHAKE)?;
+    let signals_pub = ros.publisher::<PlcSignals>(&topics::PLC_SIGNALS)?;
+    let program_pub = ros.publisher::<PlcProgram>(&topics::PLC_PROGRAM)?;
+    let source = program_path
+        .as_ref()
+        .map_or("(built in)".into(), |p| p.display().to_string());
+    publish_program(&program_pub, &plc, &source);
     let mut last_robot: Option<RobotHandshake> = None;
     let alarms = AlarmReporter::new(&mut ros, "plc")?;
     let shm = ShmNode::new(&instance, "plc")?;
@@ -164,6 +173,20 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             });
             last_robot = Some(robot);
         }
+        if scans.is_multiple_of(SIGNALS_EVERY) {
+            let table = |s| plc.table(s).to_vec();
+            let _ = signals_pub.publish(PlcSignals {
+                stamp: stamp(),
+                scan: scans,
+                x: table(Space::X),
+                y: table(Space::Y),
+                f: table(Space::F),
+                g: table(Space::G),
+                r: table(Space::R),
+                a: table(Space::A),
+                k: table(Space::K),
+            });
+        }
         if scans.is_multiple_of(100) {
             // Once a second at 10 ms: status, program file, parameters.
             let _ = status_pub.publish(scan_times.message(
@@ -175,7 +198,9 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 let m = modified(p);
                 if m != program_mtime {
                     program_mtime = m;
-                    reload(&mut plc, p, &alarms);
+                    if reload(&mut plc, p, &alarms) {
+                        publish_program(&program_pub, &plc, &source);
+                    }
                 }
             }
             if let Some(path) = memory_file.as_deref() {
@@ -195,12 +220,27 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     Ok(())
 }
 
-fn reload(plc: &mut Plc, path: &Path, alarms: &AlarmReporter) {
+/// The signal snapshot goes out every this many scans (5 a second at the 10 ms default).
+const SIGNALS_EVERY: u64 = 20;
+
+fn publish_program(publisher: &cnc_runtime::dds::Publisher<PlcProgram>, plc: &Plc, source: &str) {
+    let (rungs, lines) = crate::monitor::rungs(plc.program());
+    let _ = publisher.publish(PlcProgram {
+        stamp: stamp(),
+        source: source.into(),
+        rungs,
+        lines,
+    });
+}
+
+/// Loads the changed program file; false if it was refused and the old program runs on.
+fn reload(plc: &mut Plc, path: &Path, alarms: &AlarmReporter) -> bool {
     let result = program_text(Some(path)).and_then(|t| plc.load(&t).map_err(|e| e.to_string()));
     match result {
         Ok(()) => {
             log::info!("PLC program {} loaded", path.display());
             alarms.clear(PROGRAM_REFUSED_ALARM);
+            true
         }
         Err(e) => {
             let text = format!(
@@ -215,6 +255,7 @@ fn reload(plc: &mut Plc, path: &Path, alarms: &AlarmReporter) {
                 "",
                 0,
             ));
+            false
         }
     }
 }

@@ -131,6 +131,10 @@ impl Plc {
     pub fn program(&self) -> &Program {
         &self.program
     }
+    /// One signal table as the ladder sees it (the ladder monitor's snapshot).
+    pub fn table(&self, space: Space) -> &[u8] {
+        self.mem.table(space)
+    }
     pub fn outputs(&self) -> &YImage {
         &self.y
     }

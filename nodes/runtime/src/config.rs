@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::net::IpAddr;
 
 /// Top level of `launch_configs/*.yaml`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LaunchConfig {
     pub machine: MachineConfig,
@@ -24,7 +24,7 @@ pub struct LaunchConfig {
 }
 
 /// Who may command the machine from outside.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct HmiConfig {
     /// ROS 2 node names (`/cell/supervisor`; `*` matches anything) whose commands that move
@@ -32,6 +32,14 @@ pub struct HmiConfig {
     /// are taken from anyone: stopping a machine is never refused. Default `["*"]`.
     #[serde(default = "default_allowed")]
     pub allowed_clients: Vec<String>,
+    /// Where the operator's web HMI is served (`host:port`); empty: no web HMI. Default
+    /// `127.0.0.1:8080`: the machine's own panel PC, nothing off the machine.
+    #[serde(default = "default_web_address")]
+    pub web_address: String,
+}
+
+fn default_web_address() -> String {
+    "127.0.0.1:8080".into()
 }
 
 fn default_allowed() -> Vec<String> {
@@ -42,11 +50,12 @@ impl Default for HmiConfig {
     fn default() -> Self {
         HmiConfig {
             allowed_clients: default_allowed(),
+            web_address: default_web_address(),
         }
     }
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MachineConfig {
     /// ROS 2 namespace of every topic and service, e.g. `lathe1` → `/lathe1/spindle`.
@@ -80,7 +89,7 @@ pub struct MachineConfig {
 
 /// One row of the offset page (`000` §5.2, `002` §3.7): geometry and wear (X as diameter),
 /// nose radius and imaginary tip direction 0–9.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ToolEntry {
     #[serde(default)]
@@ -97,7 +106,7 @@ pub struct ToolEntry {
     pub tip: u8,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ToolPost {
     #[default]
@@ -110,7 +119,7 @@ fn default_arc_plane() -> [String; 2] {
 }
 
 /// One axis: limits in display units (X as diameter when `diameter`).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxisEntry {
     pub name: String,
@@ -181,7 +190,7 @@ fn default_drive_lag() -> f64 {
 }
 
 /// Where DDS may send traffic.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct NetworkConfig {
     /// DDS domain; when absent, `ROS_DOMAIN_ID`, else 0.
@@ -233,7 +242,7 @@ fn valid_domain(d: u16) -> Result<u16, String> {
     }
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ServoConfig {
     /// Servo period, ms (1..8).
@@ -268,7 +277,7 @@ fn default_dry_run_feed() -> f64 {
 }
 
 /// How speed changes along the path.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ProfileShape {
     /// Acceleration limited: the acceleration jumps between +a, 0 and −a.
@@ -305,7 +314,7 @@ impl Default for ServoConfig {
     }
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SimConfig {
     #[serde(default = "default_spindle_acc")]
@@ -344,7 +353,7 @@ impl Default for SimConfig {
     }
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlcConfig {
     /// Level-1 scan period, ms.
@@ -383,7 +392,7 @@ impl Default for PlcConfig {
 }
 
 /// The recorder: which topics go into the audit recording, where, and how files are cut.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RecorderConfig {
     /// Record at all (the launch configs do; a test cell may not).

@@ -66,6 +66,10 @@ pub const ALARM_EVENTS: Topic = topic(
 );
 pub const PLC_STATUS: Topic = topic("plc/status", "cnc_msgs/msg/PlcStatus", Delivery::State);
 pub const SERVO_STATS: Topic = topic("servo_stats", "cnc_msgs/msg/ServoStats", Delivery::State);
+/// The PLC's signal tables, five times a second.
+pub const PLC_SIGNALS: Topic = topic("plc/signals", "cnc_msgs/msg/PlcSignals", Delivery::State);
+/// The PLC program as rungs, latched: a late ladder monitor still gets it.
+pub const PLC_PROGRAM: Topic = topic("plc/program", "cnc_msgs/msg/PlcProgram", Delivery::State);
 pub const ROBOT_HANDSHAKE: Topic = topic(
     "robot_handshake",
     "cnc_msgs/msg/RobotHandshake",
@@ -121,6 +125,8 @@ pub const ALL: &[Topic] = &[
     ALARMS,
     ALARM_EVENTS,
     PLC_STATUS,
+    PLC_SIGNALS,
+    PLC_PROGRAM,
     SERVO_STATS,
     COMMAND_EVENTS,
     ROBOT_HANDSHAKE,

@@ -1,0 +1,122 @@
+//! Every command the bridge takes from outside, whichever door it came through (a ROS 2
+//! service, the `RunProgram` action, a robot request or a button of the web HMI), as one
+//! value: so every door gets the same checks, the same refusals and the same event.
+
+use cnc_msgs::msg::{MachineState, Overrides};
+
+/// One command to the machine.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Operation {
+    Load {
+        name: String,
+        text: String,
+    },
+    /// Cycle start of a stored program; an empty name resumes after feed hold.
+    Start {
+        name: String,
+    },
+    /// `StopRequest::FEED_HOLD` or `CYCLE_STOP`.
+    Stop {
+        mode: u8,
+    },
+    Reset,
+    List,
+    Delete {
+        name: String,
+    },
+    Overrides(Overrides),
+    /// `MachineState::MODE_*`.
+    Mode {
+        mode: u8,
+    },
+    /// Blocks typed at the MDI line, run at once (MDI mode only).
+    Mdi {
+        text: String,
+    },
+    Read {
+        name: String,
+    },
+    Offsets,
+    SetToolOffset {
+        number: String,
+        values: String,
+    },
+    SetWorkOffset {
+        code: String,
+        values: String,
+    },
+}
+
+impl Operation {
+    /// The command's name in events (the service's name where there is one).
+    pub fn command(&self) -> &'static str {
+        match self {
+            Operation::Load { .. } => "load_program",
+            Operation::Start { .. } => "start_program",
+            Operation::Stop { .. } => "stop",
+            Operation::Reset => "reset",
+            Operation::List => "list_programs",
+            Operation::Delete { .. } => "delete_program",
+            Operation::Overrides(_) => "set_overrides",
+            Operation::Mode { .. } => "set_mode",
+            Operation::Mdi { .. } => "mdi",
+            Operation::Read { .. } => "read_program",
+            Operation::Offsets => "get_offsets",
+            Operation::SetToolOffset { .. } => "set_tool_offset",
+            Operation::SetWorkOffset { .. } => "set_work_offset",
+        }
+    }
+
+    /// What the event says about it besides the command.
+    pub fn detail(&self) -> String {
+        match self {
+            Operation::Load { name, .. }
+            | Operation::Start { name }
+            | Operation::Delete { name }
+            | Operation::Read { name } => name.clone(),
+            Operation::Stop { mode } => format!("mode {mode}"),
+            Operation::Overrides(o) => format!(
+                "feed {} %, spindle {} %, rapid {} %",
+                o.feed_percent, o.spindle_percent, o.rapid_percent
+            ),
+            Operation::Mode { mode } => MachineState::mode_name_of(*mode).into(),
+            Operation::Mdi { text } => text.chars().take(200).collect(),
+            Operation::SetToolOffset { number, values } => format!("{number}: {values}"),
+            Operation::SetWorkOffset { code, values } => format!("{code}: {values}"),
+            Operation::Reset | Operation::List | Operation::Offsets => String::new(),
+        }
+    }
+
+    /// Whether only allowed clients may give it (`hmi.allowed_clients`): whatever starts
+    /// motion or changes how the next cut comes out. Stopping is never refused; reading and
+    /// program memory are open to the cell.
+    pub fn moves(&self) -> bool {
+        matches!(
+            self,
+            Operation::Start { .. }
+                | Operation::Overrides(_)
+                | Operation::Mode { .. }
+                | Operation::Mdi { .. }
+                | Operation::SetToolOffset { .. }
+                | Operation::SetWorkOffset { .. }
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stopping_and_reading_are_open_to_everyone_moving_is_not() {
+        assert!(!Operation::Stop { mode: 1 }.moves());
+        assert!(!Operation::Reset.moves());
+        assert!(!Operation::Offsets.moves());
+        assert!(Operation::Start { name: "O1".into() }.moves());
+        assert!(Operation::Mdi {
+            text: "G0X1".into()
+        }
+        .moves());
+        assert_eq!(Operation::Mode { mode: 1 }.detail(), "MDI");
+    }
+}

@@ -1,0 +1,188 @@
+//! The operator's web HMI: one page (`web/`), live over a WebSocket. [`server`] is the network
+//! shell, [`protocol`] turns a page's requests into the bridge's [`Operation`]s, [`view`]
+//! keeps what the page shows. [`WebHmi`] joins them for the bridge's loop.
+
+pub mod assets;
+pub mod protocol;
+pub mod server;
+pub mod view;
+
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+use serde_json::{json, Value};
+
+use crate::access::Who;
+use crate::operation::Operation;
+use server::{Outbox, WebEvent, WebServer};
+use view::View;
+
+/// How often pages get a state frame.
+const FRAME_PERIOD: Duration = Duration::from_millis(100);
+
+/// A page's request waiting for its answer.
+pub struct Pending {
+    connection: u64,
+    id: u64,
+    op: Operation,
+}
+
+pub struct WebHmi {
+    server: WebServer,
+    pages: BTreeMap<u64, Outbox>,
+    pub view: View,
+    /// Sent once to every page: the machine's parameters and the ladder.
+    parameters: Value,
+    ladder: Option<Value>,
+    last_frame: Instant,
+    history_sent: Option<Value>,
+    command_sent: Option<Value>,
+}
+
+impl WebHmi {
+    pub fn start(address: &str, axes: Vec<String>, parameters: Value) -> Result<WebHmi, String> {
+        let server = WebServer::start(address)?;
+        log::info!("web HMI on http://{}/", server.address);
+        Ok(WebHmi {
+            server,
+            pages: BTreeMap::new(),
+            view: View::new(axes),
+            parameters,
+            ladder: None,
+            last_frame: Instant::now(),
+            history_sent: None,
+            command_sent: None,
+        })
+    }
+
+    pub fn address(&self) -> std::net::SocketAddr {
+        self.server.address
+    }
+
+    fn send(&mut self, page: u64, frame: &Value) {
+        if let Some(outbox) = self.pages.get(&page) {
+            if outbox.send(frame.to_string()).is_err() {
+                self.pages.remove(&page);
+            }
+        }
+    }
+
+    fn broadcast(&mut self, frame: &Value) {
+        let text = frame.to_string();
+        self.pages
+            .retain(|_, outbox| outbox.send(text.clone()).is_ok());
+    }
+
+    /// The PLC program for the ladder monitor (sent now and to every page that opens later).
+    pub fn set_ladder(&mut self, program: &cnc_msgs::msg::PlcProgram) {
+        let ladder = json!({
+            "type": "ladder",
+            "source": program.source,
+            "rungs": program.rungs,
+            "lines": program.lines,
+        });
+        self.broadcast(&ladder);
+        self.ladder = Some(ladder);
+    }
+
+    /// New pages are greeted; their requests come out as operations (bad ones are answered
+    /// here).
+    pub fn take_operations(&mut self) -> Vec<(Who, Operation, Pending)> {
+        let mut out = Vec::new();
+        while let Ok(event) = self.server.events.try_recv() {
+            match event {
+                WebEvent::Connected { id, client, outbox } => {
+                    log::info!("web HMI: page {id} opened by {client}");
+                    self.pages.insert(id, outbox);
+                    let welcome = self.view.welcome();
+                    self.send(id, &welcome);
+                    let parameters = json!({"type": "parameters", "parameters": self.parameters});
+                    self.send(id, &parameters);
+                    if let Some(l) = self.ladder.clone() {
+                        self.send(id, &l);
+                    }
+                }
+                WebEvent::Closed { id } => {
+                    self.pages.remove(&id);
+                }
+                WebEvent::Request { id, client, text } => match protocol::parse(&text) {
+                    (request, Ok(op)) => out.push((
+                        Who::Web(client),
+                        op.clone(),
+                        Pending {
+                            connection: id,
+                            id: request,
+                            op,
+                        },
+                    )),
+                    (request, Err(why)) => {
+                        let reply = json!({"type": "reply", "id": request, "accepted": false, "message": why});
+                        self.send(id, &reply);
+                    }
+                },
+            }
+        }
+        out
+    }
+
+    /// Answers a page's request; reads bring their data in a frame of their own.
+    pub fn answer(&mut self, pending: Pending, accepted: bool, message: String) {
+        let data = match (&pending.op, accepted) {
+            (Operation::Read { name }, true) => {
+                Some(json!({"type": "program", "name": name, "text": message}))
+            }
+            (Operation::Offsets, true) => Some(json!({"type": "offsets", "text": message})),
+            (Operation::List, true) => {
+                let list: Vec<Value> = crate::node::program_list(&message)
+                    .into_iter()
+                    .map(|(name, size)| json!({"name": name, "size": size}))
+                    .collect();
+                Some(json!({"type": "programs", "programs": list}))
+            }
+            _ => None,
+        };
+        let shown = if data.is_some() {
+            "ok".to_string()
+        } else {
+            message
+        };
+        let reply = json!({
+            "type": "reply",
+            "id": pending.id,
+            "op": pending.op.command(),
+            "accepted": accepted,
+            "message": shown,
+        });
+        if let Some(d) = data {
+            self.send(pending.connection, &d);
+        }
+        self.send(pending.connection, &reply);
+    }
+
+    /// Sends the state frame when it is due, and history entries as they come.
+    pub fn tick(&mut self) {
+        if self.pages.is_empty() {
+            // Nobody watches: a page that opens gets everything in its welcome.
+            self.view.mark_sent();
+            return;
+        }
+        let history = self.view.last_history().cloned();
+        if history.is_some() && history != self.history_sent {
+            self.broadcast(&json!({"type": "history", "entry": history}));
+            self.history_sent = history;
+        }
+        let command = self.view.last_command().cloned();
+        if command.is_some() && command != self.command_sent {
+            self.broadcast(&json!({"type": "command", "entry": command}));
+            self.command_sent = command;
+        }
+        if self.last_frame.elapsed() >= FRAME_PERIOD {
+            self.last_frame = Instant::now();
+            let frame = self.view.frame();
+            self.broadcast(&frame);
+            if let Some(s) = self.view.signals_frame() {
+                self.broadcast(&s);
+            }
+        }
+    }
+}

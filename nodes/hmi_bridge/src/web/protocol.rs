@@ -1,0 +1,137 @@
+//! What a page may ask, as JSON over its WebSocket: `{"id": 7, "op": "start", "name": "O0001"}`.
+//! Each request becomes the same [`Operation`] a ROS 2 service makes; a request that does not
+//! parse is answered with why, and nothing happens.
+
+use cnc_msgs::msg::{MachineState, Overrides};
+use serde_json::Value;
+
+use crate::operation::Operation;
+
+/// A page's request: its id (echoed in the reply) and the operation, or why it is not one.
+pub fn parse(text: &str) -> (u64, Result<Operation, String>) {
+    let value: Value = match serde_json::from_str(text) {
+        Ok(v) => v,
+        Err(e) => return (0, Err(format!("request is not JSON: {e}"))),
+    };
+    let id = value.get("id").and_then(Value::as_u64).unwrap_or(0);
+    (id, operation(&value))
+}
+
+fn string(v: &Value, key: &str) -> Result<String, String> {
+    v.get(key)
+        .and_then(Value::as_str)
+        .map(str::to_string)
+        .ok_or_else(|| format!("{key} missing (a string)"))
+}
+
+fn percent(v: &Value, key: &str) -> Result<u8, String> {
+    let n = v
+        .get(key)
+        .and_then(Value::as_u64)
+        .ok_or_else(|| format!("{key} missing (a whole number of percent)"))?;
+    u8::try_from(n).map_err(|_| format!("{key} {n} % is out of range"))
+}
+
+fn operation(v: &Value) -> Result<Operation, String> {
+    let op = v.get("op").and_then(Value::as_str).ok_or("op missing")?;
+    Ok(match op {
+        "load" => Operation::Load {
+            name: string(v, "name")?,
+            text: string(v, "text")?,
+        },
+        "start" => Operation::Start {
+            name: string(v, "name").unwrap_or_default(),
+        },
+        "feed_hold" => Operation::Stop {
+            mode: cnc_msgs::srv::StopRequest::FEED_HOLD,
+        },
+        "cycle_stop" => Operation::Stop {
+            mode: cnc_msgs::srv::StopRequest::CYCLE_STOP,
+        },
+        "reset" => Operation::Reset,
+        "list" => Operation::List,
+        "delete" => Operation::Delete {
+            name: string(v, "name")?,
+        },
+        "read" => Operation::Read {
+            name: string(v, "name")?,
+        },
+        "overrides" => Operation::Overrides(Overrides {
+            feed_percent: percent(v, "feed")?,
+            spindle_percent: percent(v, "spindle")?,
+            rapid_percent: percent(v, "rapid")?,
+        }),
+        "mode" => {
+            let name = string(v, "mode")?;
+            let mode = (0..=MachineState::MODE_HANDWHEEL)
+                .find(|m| MachineState::mode_name_of(*m).eq_ignore_ascii_case(&name))
+                .ok_or_else(|| {
+                    format!("unknown mode {name:?}: AUTO, MDI, JOG, HOME, EDIT, HANDWHEEL")
+                })?;
+            Operation::Mode { mode }
+        }
+        "mdi" => Operation::Mdi {
+            text: string(v, "text")?,
+        },
+        "offsets" => Operation::Offsets,
+        "set_tool_offset" => Operation::SetToolOffset {
+            number: string(v, "number")?,
+            values: string(v, "values")?,
+        },
+        "set_work_offset" => Operation::SetWorkOffset {
+            code: string(v, "code")?,
+            values: string(v, "values")?,
+        },
+        other => return Err(format!("unknown op {other:?}")),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requests_become_the_services_operations_and_bad_ones_say_why() {
+        assert_eq!(
+            parse(r#"{"id":3,"op":"start","name":"O0001"}"#),
+            (
+                3,
+                Ok(Operation::Start {
+                    name: "O0001".into()
+                })
+            )
+        );
+        assert_eq!(
+            parse(r#"{"id":4,"op":"mode","mode":"mdi"}"#).1,
+            Ok(Operation::Mode {
+                mode: MachineState::MODE_MDI
+            })
+        );
+        assert_eq!(
+            parse(r#"{"op":"overrides","feed":50,"spindle":100,"rapid":25}"#).1,
+            Ok(Operation::Overrides(Overrides {
+                feed_percent: 50,
+                spindle_percent: 100,
+                rapid_percent: 25
+            }))
+        );
+        for (text, why) in [
+            ("not json", "not JSON"),
+            (r#"{"id":1}"#, "op missing"),
+            (r#"{"op":"explode"}"#, "unknown op"),
+            (r#"{"op":"load","name":"A"}"#, "text missing"),
+            (
+                r#"{"op":"overrides","feed":300,"spindle":100,"rapid":25}"#,
+                "out of range",
+            ),
+            (
+                r#"{"op":"overrides","feed":-5,"spindle":100,"rapid":25}"#,
+                "feed missing",
+            ),
+            (r#"{"op":"mode","mode":"TURBO"}"#, "unknown mode"),
+        ] {
+            let err = parse(text).1.unwrap_err();
+            assert!(err.contains(why), "{text}: {err}");
+        }
+    }
+}

@@ -1,0 +1,395 @@
+//! What the operator's page shows, kept from the machine's topics: positions (machine, work,
+//! distance to go), mode and execution, spindle and feed, overrides, alarms and their history,
+//! part count, the tool path so far and the PLC's signals. Pure: the shell feeds it messages
+//! and sends the frames it makes.
+
+use std::collections::{BTreeMap, VecDeque};
+
+use cnc_msgs::msg::{
+    AlarmEvent, AxisState, CommandEvent, MachineState, MotionBlock, MotionStatus, Overrides,
+    PartCount, PlcSignals, SpindleState,
+};
+use serde_json::{json, Value};
+
+/// Alarm history entries kept (oldest dropped).
+pub const HISTORY: usize = 200;
+/// Tool path points kept; a longer path keeps its newest half.
+pub const PATH_POINTS: usize = 50_000;
+/// A new path point is taken when the tool has moved this far (mm).
+const PATH_STEP: f64 = 0.01;
+/// Blocks kept for distance to go: more than motion's queue holds.
+const BLOCKS_KEPT: usize = 512;
+
+#[derive(Debug, Default)]
+pub struct View {
+    names: Vec<String>,
+    /// The two axes the tool path is drawn in: (horizontal, vertical).
+    plot: (usize, usize),
+    machine: Option<MachineState>,
+    axes: Option<AxisState>,
+    status: MotionStatus,
+    blocks: BTreeMap<(u64, u64), MotionBlock>,
+    spindle: Option<SpindleState>,
+    parts: Option<PartCount>,
+    overrides: Option<Overrides>,
+    active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm>,
+    history: VecDeque<Value>,
+    commands: VecDeque<Value>,
+    path: Vec<[f64; 2]>,
+    /// Points already sent to every page.
+    path_sent: usize,
+    path_run: u64,
+    /// The path was cut or restarted since the last frame: pages start over.
+    path_reset: bool,
+    signals: Option<PlcSignals>,
+    signals_sent: u64,
+}
+
+/// Which machine axes a 2-D tool path shows: a lathe's Z across and X (as radius) up; a mill's
+/// X across and Y up.
+pub fn plot_axes(names: &[String]) -> (usize, usize) {
+    let find = |n: &str| names.iter().position(|a| a.eq_ignore_ascii_case(n));
+    match (find("X"), find("Y"), find("Z")) {
+        (Some(x), None, Some(z)) => (z, x),
+        (Some(x), Some(y), _) => (x, y),
+        _ => (0, 1.min(names.len().saturating_sub(1))),
+    }
+}
+
+fn stamp_seconds(t: &cnc_msgs::msg::Time) -> f64 {
+    f64::from(t.sec) + f64::from(t.nanosec) * 1e-9
+}
+
+impl View {
+    pub fn new(names: Vec<String>) -> View {
+        View {
+            plot: plot_axes(&names),
+            names,
+            ..View::default()
+        }
+    }
+
+    pub fn on_machine_state(&mut self, m: MachineState) {
+        self.machine = Some(m);
+    }
+
+    pub fn on_motion_status(&mut self, s: MotionStatus) {
+        if s.run_id != self.path_run && s.run_id != 0 {
+            // A new run draws a new path.
+            self.path_run = s.run_id;
+            self.path.clear();
+            self.path_sent = 0;
+            self.path_reset = true;
+        }
+        self.status = s;
+    }
+
+    pub fn on_block(&mut self, b: MotionBlock) {
+        self.blocks.insert((b.run_id, b.seq), b);
+        while self.blocks.len() > BLOCKS_KEPT {
+            self.blocks.pop_first();
+        }
+    }
+
+    pub fn on_axes(&mut self, a: AxisState) {
+        let (h, v) = self.plot;
+        if let (Some(ah), Some(av)) = (a.axes.get(h), a.axes.get(v)) {
+            // A lathe's X is a diameter: the path is drawn at the radius.
+            let scale = if self.names.get(v).is_some_and(|n| n == "X") && self.plot.0 != 0 {
+                0.5
+            } else {
+                1.0
+            };
+            let p = [ah.actual_position, av.actual_position * scale];
+            let moved = self
+                .path
+                .last()
+                .is_none_or(|q| (q[0] - p[0]).hypot(q[1] - p[1]) >= PATH_STEP);
+            if moved && p.iter().all(|c| c.is_finite()) {
+                self.path.push(p);
+                if self.path.len() > PATH_POINTS {
+                    self.path.drain(..PATH_POINTS / 2);
+                    self.path_sent = 0;
+                    self.path_reset = true;
+                }
+            }
+        }
+        self.axes = Some(a);
+    }
+
+    pub fn on_spindle(&mut self, s: SpindleState) {
+        self.spindle = Some(s);
+    }
+
+    pub fn on_parts(&mut self, p: PartCount) {
+        self.parts = Some(p);
+    }
+
+    pub fn on_overrides(&mut self, o: Overrides) {
+        self.overrides = Some(o);
+    }
+
+    pub fn on_plc_signals(&mut self, s: PlcSignals) {
+        self.signals = Some(s);
+    }
+
+    pub fn on_alarm_event(&mut self, e: AlarmEvent) {
+        let key = (e.alarm.source.clone(), e.alarm.number);
+        let raised = e.kind == AlarmEvent::RAISED;
+        self.history.push_back(json!({
+            "time": stamp_seconds(&e.alarm.stamp),
+            "raised": raised,
+            "number": e.alarm.number,
+            "text": e.alarm.text,
+            "source": e.alarm.source,
+        }));
+        while self.history.len() > HISTORY {
+            self.history.pop_front();
+        }
+        if raised {
+            self.active.insert(key, e.alarm);
+        } else {
+            self.active.remove(&key);
+        }
+    }
+
+    pub fn on_command_event(&mut self, e: &CommandEvent) {
+        self.commands.push_back(json!({
+            "time": stamp_seconds(&e.stamp),
+            "command": e.command,
+            "detail": e.detail,
+            "client": e.client,
+            "accepted": e.accepted,
+            "message": e.message,
+        }));
+        while self.commands.len() > 20 {
+            self.commands.pop_front();
+        }
+    }
+
+    /// The block motion is executing, if its stream is known.
+    fn current_block(&self) -> Option<&MotionBlock> {
+        let s = &self.status;
+        self.blocks.get(&(s.run_id, s.done_seq + 1))
+    }
+
+    /// Per axis: machine position, work position (machine minus the program origin of the
+    /// executing block) and distance to go (end of that block minus the commanded position).
+    fn positions(&self) -> Vec<Value> {
+        let Some(a) = &self.axes else {
+            return Vec::new();
+        };
+        let block = self.current_block();
+        let last = self
+            .blocks
+            .range((self.status.run_id, 0)..=(self.status.run_id, self.status.done_seq))
+            .next_back()
+            .map(|(_, b)| b);
+        a.axes
+            .iter()
+            .enumerate()
+            .map(|(i, axis)| {
+                let origin = block
+                    .or(last)
+                    .and_then(|b| b.origin.get(i))
+                    .copied()
+                    .unwrap_or(0.0);
+                let moving = block.is_some_and(|b| {
+                    b.kind <= MotionBlock::KIND_ARC_CCW || b.kind == MotionBlock::KIND_THREAD
+                });
+                let to_go = match block.and_then(|b| b.end.get(i)) {
+                    Some(end) if moving => end - axis.commanded_position,
+                    _ => 0.0,
+                };
+                json!({
+                    "name": axis.name,
+                    "machine": axis.actual_position,
+                    "work": axis.actual_position - origin,
+                    "to_go": to_go,
+                    "following_error": axis.following_error,
+                    "homed": axis.homed,
+                })
+            })
+            .collect()
+    }
+
+    /// The frame every page gets several times a second; the tool path and PLC signals carry
+    /// only what is new since the previous frame.
+    pub fn frame(&mut self) -> Value {
+        let machine = self.machine.as_ref().map(|m| {
+            json!({
+                "mode": MachineState::mode_name_of(m.mode),
+                "execution": m.execution_name,
+                "program": m.program,
+                "line": m.line,
+                "emergency_stop": m.emergency_stop,
+                "alarm": m.alarm_active,
+            })
+        });
+        let feed = self.current_block().map_or(0.0, |b| b.feed);
+        let path_from = self.path_sent;
+        let frame = json!({
+            "type": "state",
+            "machine": machine,
+            "axes": self.positions(),
+            "plot": [self.names.get(self.plot.0), self.names.get(self.plot.1)],
+            "feed": feed,
+            "spindle": self.spindle.as_ref().map(|s| json!({
+                "commanded_rpm": s.commanded_rpm,
+                "actual_rpm": s.actual_rpm,
+                "direction": s.direction,
+                "override": s.override_percent,
+                "at_speed": s.at_speed,
+            })),
+            "overrides": self.overrides.as_ref().map(|o| json!({
+                "feed": o.feed_percent, "spindle": o.spindle_percent, "rapid": o.rapid_percent,
+            })),
+            "parts": self.parts.as_ref().map(|p| json!({"count": p.count, "target": p.target})),
+            "alarms": self.active.values().map(|a| json!({
+                "number": a.number, "severity": a.severity, "text": a.text,
+                "source": a.source, "program": a.program, "line": a.line,
+            })).collect::<Vec<_>>(),
+            "path_reset": self.path_reset,
+            "path": &self.path[path_from.min(self.path.len())..],
+        });
+        self.path_sent = self.path.len();
+        self.path_reset = false;
+        frame
+    }
+
+    /// Every page has what there is (there are none: the next page gets the welcome).
+    pub fn mark_sent(&mut self) {
+        self.path_sent = self.path.len();
+        self.path_reset = false;
+    }
+
+    /// A new page's first frame: everything, the whole path and the histories.
+    pub fn welcome(&self) -> Value {
+        json!({
+            "type": "welcome",
+            "axes": self.names,
+            "path": self.path,
+            "history": self.history,
+            "commands": self.commands,
+        })
+    }
+
+    /// The PLC signals, when a new snapshot came since the last call.
+    pub fn signals_frame(&mut self) -> Option<Value> {
+        let s = self.signals.as_ref()?;
+        if s.scan == self.signals_sent {
+            return None;
+        }
+        self.signals_sent = s.scan;
+        Some(json!({
+            "type": "signals",
+            "scan": s.scan,
+            "X": s.x, "Y": s.y, "F": s.f, "G": s.g, "R": s.r, "A": s.a, "K": s.k,
+        }))
+    }
+
+    /// The alarm and command histories' newest entries, for pages that are open.
+    pub fn last_history(&self) -> Option<&Value> {
+        self.history.back()
+    }
+    pub fn last_command(&self) -> Option<&Value> {
+        self.commands.back()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cnc_msgs::msg::Axis;
+
+    fn axes(x: f64, z: f64) -> AxisState {
+        let axis = |name: &str, p: f64| Axis {
+            name: name.into(),
+            commanded_position: p,
+            actual_position: p,
+            following_error: 0.0,
+            homed: true,
+        };
+        AxisState {
+            axes: vec![axis("X", x), axis("Z", z)],
+            ..AxisState::default()
+        }
+    }
+
+    #[test]
+    fn work_position_and_distance_to_go_come_from_the_executing_block() {
+        let mut v = View::new(vec!["X".into(), "Z".into()]);
+        v.on_motion_status(MotionStatus {
+            run_id: 7,
+            done_seq: 1,
+            ..MotionStatus::default()
+        });
+        v.on_block(MotionBlock {
+            run_id: 7,
+            seq: 2,
+            kind: MotionBlock::KIND_LINEAR,
+            end: vec![40.0, -30.0],
+            origin: vec![-100.0, -200.0],
+            feed: 120.0,
+            ..MotionBlock::default()
+        });
+        v.on_axes(axes(50.0, -20.0));
+        let f = v.frame();
+        assert_eq!(f["axes"][0]["work"], 150.0);
+        assert_eq!(f["axes"][1]["work"], 180.0);
+        assert_eq!(f["axes"][0]["to_go"], -10.0);
+        assert_eq!(f["axes"][1]["to_go"], -10.0);
+        assert_eq!(f["feed"], 120.0);
+        // A lathe's path: Z across, X as radius up.
+        assert_eq!(f["path"][0], json!([-20.0, 25.0]));
+        assert_eq!(f["plot"], json!(["Z", "X"]));
+    }
+
+    #[test]
+    fn frames_carry_only_new_path_points_and_a_new_run_starts_over() {
+        let mut v = View::new(vec!["X".into(), "Z".into()]);
+        v.on_motion_status(MotionStatus {
+            run_id: 1,
+            ..MotionStatus::default()
+        });
+        v.on_axes(axes(10.0, 0.0));
+        v.on_axes(axes(10.0, 0.001)); // closer than PATH_STEP: not a new point
+        v.on_axes(axes(10.0, -1.0));
+        assert_eq!(v.frame()["path"].as_array().map(Vec::len), Some(2));
+        v.on_axes(axes(10.0, -2.0));
+        let f = v.frame();
+        assert_eq!(f["path"], json!([[-2.0, 5.0]]));
+        assert_eq!(f["path_reset"], false);
+        v.on_motion_status(MotionStatus {
+            run_id: 2,
+            ..MotionStatus::default()
+        });
+        let f = v.frame();
+        assert_eq!(f["path_reset"], true);
+        assert_eq!(f["path"], json!([]));
+        assert_eq!(v.welcome()["path"], json!([]));
+    }
+
+    #[test]
+    fn alarm_history_keeps_raised_and_cleared_in_order() {
+        let mut v = View::new(vec!["X".into(), "Z".into()]);
+        let alarm = cnc_msgs::msg::Alarm {
+            number: 65,
+            text: "emergency stop".into(),
+            source: "plc".into(),
+            ..Default::default()
+        };
+        for kind in [AlarmEvent::RAISED, AlarmEvent::CLEARED] {
+            v.on_alarm_event(AlarmEvent {
+                kind,
+                alarm: alarm.clone(),
+            });
+            let active = v.frame()["alarms"].as_array().map_or(0, Vec::len);
+            assert_eq!(active, usize::from(kind == AlarmEvent::RAISED));
+        }
+        let w = v.welcome();
+        assert_eq!(w["history"][0]["raised"], true);
+        assert_eq!(w["history"][1]["raised"], false);
+        assert_eq!(w["history"][1]["number"], 65);
+    }
+}

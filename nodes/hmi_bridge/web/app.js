@@ -1,0 +1,236 @@
+// The operator panel: everything arrives over one WebSocket, and every button sends a request
+// that the bridge carries out through the same path as the ROS 2 services.
+"use strict";
+const $ = (id) => document.getElementById(id);
+let ws = null;
+let nextId = 1;
+let path = [];
+let listingName = null;
+let ladder = null;
+let signals = null;
+let lastLine = -1;
+
+const STEPS = [0, 10, 15, 20, 25, 30, 35, 40, 50, 60, 70, 80, 90, 100, 125, 150];
+for (const id of ["feed_ov", "spindle_ov"]) {
+  for (const s of STEPS) {
+    const o = document.createElement("option");
+    o.textContent = s;
+    if (s === 100) o.selected = true;
+    $(id).appendChild(o);
+  }
+}
+
+function send(request) {
+  if (!ws || ws.readyState !== WebSocket.OPEN) return;
+  request.id = nextId++;
+  ws.send(JSON.stringify(request));
+}
+
+function connect() {
+  ws = new WebSocket(`ws://${location.host}/ws`);
+  ws.onopen = () => {
+    $("link").textContent = "online";
+    $("link").className = "on";
+    send({ op: "list" });
+  };
+  ws.onclose = () => {
+    $("link").textContent = "offline";
+    $("link").className = "off";
+    setTimeout(connect, 1000);
+  };
+  ws.onmessage = (e) => {
+    let m;
+    try { m = JSON.parse(e.data); } catch (_) { return; }
+    (handlers[m.type] || (() => {}))(m);
+  };
+}
+
+const fmt = (v) => (typeof v === "number" ? v.toFixed(3) : "-");
+
+const handlers = {
+  welcome(m) {
+    path = m.path || [];
+    $("history").innerHTML = "";
+    for (const h of m.history || []) handlers.history({ entry: h });
+    $("commands").innerHTML = "";
+    for (const c of m.commands || []) handlers.command({ entry: c });
+    draw();
+  },
+  state(m) {
+    const s = m.machine;
+    if (s) {
+      $("mode").textContent = s.mode;
+      $("execution").textContent = s.execution;
+      $("program").textContent = s.program || "-";
+      $("line").textContent = s.line;
+      $("estop").hidden = !s.emergency_stop;
+      if (s.program && s.program !== listingName) {
+        listingName = s.program;
+        send({ op: "read", name: s.program });
+      }
+      if (s.line !== lastLine) {
+        lastLine = s.line;
+        markLine(s.line);
+      }
+    }
+    $("axes").innerHTML = (m.axes || [])
+      .map((a) => `<tr><th>${a.name}</th><td>${fmt(a.machine)}</td><td>${fmt(a.work)}</td><td>${fmt(a.to_go)}</td></tr>`)
+      .join("");
+    $("feed").textContent = Math.round(m.feed || 0);
+    if (m.spindle) {
+      $("rpm").textContent = Math.round(m.spindle.actual_rpm);
+      $("rpm_cmd").textContent = Math.round(m.spindle.commanded_rpm);
+    }
+    if (m.overrides) {
+      $("ov_feed").textContent = m.overrides.feed;
+      $("ov_spindle").textContent = m.overrides.spindle;
+      $("ov_rapid").textContent = m.overrides.rapid;
+    }
+    $("parts").textContent = m.parts ? m.parts.count : 0;
+    $("alarms").innerHTML = (m.alarms || [])
+      .map((a) => `<li>${a.number} ${escape(a.text)}${a.line ? ` (line ${a.line})` : ""} [${a.source}]</li>`)
+      .join("");
+    if (m.path_reset) path = [];
+    path.push(...(m.path || []));
+    if (m.plot) $("toolpath").dataset.axes = m.plot.join(",");
+    draw();
+  },
+  history(m) {
+    const h = m.entry;
+    const li = document.createElement("li");
+    li.textContent = `${h.raised ? "raised" : "cleared"} ${h.number} ${h.text} [${h.source}]`;
+    $("history").prepend(li);
+  },
+  command(m) {
+    const c = m.entry;
+    const li = document.createElement("li");
+    li.textContent = `${c.accepted ? "✓" : "✗"} ${c.command} ${c.detail} — ${c.client}: ${c.message}`;
+    $("commands").prepend(li);
+  },
+  reply(m) {
+    // Reads answer with their data; the message line is for commands.
+    if (m.accepted && ["read_program", "list_programs", "get_offsets"].includes(m.op)) return;
+    $("message").textContent = `${m.op || "request"}: ${m.message}`;
+    $("message").className = m.accepted ? "accepted" : "refused";
+    if (m.accepted && ["load_program", "delete_program"].includes(m.op)) send({ op: "list" });
+  },
+  program(m) {
+    listingName = m.name;
+    $("listing_name").textContent = m.name;
+    $("listing").innerHTML = m.text.split("\n").map((l) => `<li>${escape(l) || "&nbsp;"}</li>`).join("");
+    markLine(lastLine);
+  },
+  programs(m) {
+    $("programs").innerHTML = m.programs.map((p) => `<option value="${escape(p.name)}">${escape(p.name)} (${p.size} B)</option>`).join("");
+  },
+  offsets(m) {
+    const tools = [], works = [];
+    for (const line of m.text.split("\n")) {
+      const w = line.trim().split(/\s+/);
+      if (w[0] === "T") tools.push(`<tr>${w.slice(1).map((v) => `<td>${escape(v)}</td>`).join("")}</tr>`);
+      if (w[0] === "W") works.push(`<tr><th>${escape(w[1])}</th>${w.slice(2).map((v) => `<td>${escape(v)}</td>`).join("")}</tr>`);
+    }
+    $("tools").innerHTML = tools.join("");
+    $("works").innerHTML = works.join("");
+  },
+  parameters(m) {
+    $("parameters").textContent = JSON.stringify(m.parameters, null, 1);
+  },
+  ladder(m) {
+    ladder = m;
+    $("ladder_source").textContent = m.source;
+    drawLadder();
+  },
+  signals(m) {
+    signals = m;
+    $("scan").textContent = m.scan;
+    drawLadder();
+  },
+};
+
+function escape(s) {
+  return String(s).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]);
+}
+
+function markLine(line) {
+  const items = $("listing").children;
+  for (const li of items) li.classList.remove("current");
+  const li = items[line - 1];
+  if (li) {
+    li.classList.add("current");
+    li.scrollIntoView({ block: "nearest" });
+  }
+}
+
+function draw() {
+  const c = $("toolpath");
+  const g = c.getContext("2d");
+  g.clearRect(0, 0, c.width, c.height);
+  if (path.length < 2) return;
+  let [x0, y0, x1, y1] = [Infinity, Infinity, -Infinity, -Infinity];
+  for (const [x, y] of path) {
+    x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+  }
+  const k = Math.min((c.width - 20) / Math.max(x1 - x0, 1e-3), (c.height - 20) / Math.max(y1 - y0, 1e-3));
+  const px = (x) => 10 + (x - x0) * k;
+  const py = (y) => c.height - 10 - (y - y0) * k;
+  g.strokeStyle = "#1565c0";
+  g.beginPath();
+  g.moveTo(px(path[0][0]), py(path[0][1]));
+  for (const [x, y] of path) g.lineTo(px(x), py(y));
+  g.stroke();
+  const [tx, ty] = path[path.length - 1];
+  g.fillStyle = "#d84315";
+  g.beginPath();
+  g.arc(px(tx), py(ty), 4, 0, 2 * Math.PI);
+  g.fill();
+  g.fillStyle = "#37474f";
+  g.fillText(c.dataset.axes || "", 4, 12);
+}
+
+// An address's bit in the last snapshot: R9000+ follows R0-R999 in the R table.
+function bit(space, byte, b) {
+  if (!signals || !signals[space]) return null;
+  let i = byte;
+  if (space === "R" && byte >= 9000) i = 1000 + byte - 9000;
+  const v = signals[space][i];
+  return v === undefined ? null : (v >> b) & 1;
+}
+
+function drawLadder() {
+  if (!ladder) return;
+  const filter = $("ladder_filter").value.trim().toUpperCase();
+  const html = [];
+  ladder.rungs.forEach((rung, i) => {
+    if (filter && !rung.toUpperCase().includes(filter)) return;
+    const text = escape(rung).replace(/\b([XYFGRAK])(\d+)\.([0-7])\b/g, (all, s, n, b) => {
+      const v = bit(s, Number(n), Number(b));
+      return v === null ? all : `<span class="sig ${v ? "on" : "off"}">${all}</span>`;
+    });
+    html.push(`<div class="rung" data-line="${ladder.lines[i]}">${text}</div>`);
+  });
+  $("ladder").innerHTML = html.join("");
+}
+
+$("cycle_start").onclick = () => {
+  const stored = $("programs").value;
+  const execution = $("execution").textContent;
+  // In feed hold cycle start resumes; otherwise it starts the program shown or selected.
+  const name = execution === "FEED_HOLD" ? "" : listingName || stored || "";
+  send({ op: "start", name });
+};
+$("feed_hold").onclick = () => send({ op: "feed_hold" });
+$("reset").onclick = () => send({ op: "reset" });
+$("mode_set").onclick = () => send({ op: "mode", mode: $("mode_select").value });
+$("mdi_run").onclick = () => send({ op: "mdi", text: $("mdi").value });
+$("ov_set").onclick = () =>
+  send({ op: "overrides", feed: Number($("feed_ov").value), spindle: Number($("spindle_ov").value), rapid: Number($("rapid_ov").value) });
+$("load").onclick = () => send({ op: "load", name: $("load_name").value, text: $("load_text").value });
+$("select").onclick = () => { if ($("programs").value) send({ op: "read", name: $("programs").value }); };
+$("delete").onclick = () => { if ($("programs").value) send({ op: "delete", name: $("programs").value }); };
+$("refresh").onclick = () => send({ op: "list" });
+$("offsets_read").onclick = () => send({ op: "offsets" });
+$("tool_set").onclick = () => send({ op: "set_tool_offset", number: $("tool_no").value, values: $("tool_values").value });
+$("work_set").onclick = () => send({ op: "set_work_offset", code: $("work_code").value, values: $("work_values").value });
+$("ladder_filter").oninput = drawLadder;
+connect();

@@ -1,0 +1,125 @@
+// Drives the operator's web HMI in headless Debian chromium (playwright-core, no downloaded
+// browser): loads a program, starts it, watches the line and the part count advance, checks
+// refusals, the offset page, the ladder monitor and the tool path, and keeps a screenshot.
+// Usage: node panel.cjs <url> <screenshot.png>; PLAYWRIGHT_CORE names the module. Exits 1 with
+// the reason when something is not as it should be.
+"use strict";
+const { chromium } = require(process.env.PLAYWRIGHT_CORE || "playwright-core");
+const [url, screenshot] = process.argv.slice(2);
+
+const PROGRAM = [
+  "O0005",
+  "G00 X60 Z5",
+  "S800 M03",
+  "G01 X40 Z0 F1200",
+  "Z-15",
+  "G02 X50 Z-20 R5",
+  "G01 X56 Z-25",
+  "G00 X60 Z5",
+  "M05",
+  "M30",
+].join("\n");
+
+function fail(why) {
+  console.error(`FAIL: ${why}`);
+  process.exit(1);
+}
+
+let page = null;
+
+async function waitFor(what, check, seconds) {
+  const t0 = Date.now();
+  for (;;) {
+    const v = await check();
+    if (v) return v;
+    if (Date.now() - t0 > seconds * 1000) {
+      const shown = await page.evaluate(() =>
+        ["mode", "execution", "line", "parts", "message"].map((id) => `${id}=${document.getElementById(id).textContent}`).join(" "));
+      fail(`timed out waiting for ${what} (${shown})`);
+    }
+    await new Promise((r) => setTimeout(r, 50));
+  }
+}
+
+(async () => {
+  const browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
+    args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
+  });
+  page = await browser.newPage({ viewport: { width: 1400, height: 1100 } });
+  page.on("pageerror", (e) => fail(`page error: ${e.message}`));
+  await page.goto(url);
+  const text = (id) => page.textContent(`#${id}`);
+  await waitFor("the WebSocket", async () => (await text("link")) === "online", 20);
+  await waitFor("the machine to be ready", async () => (await text("execution")) === "READY", 30);
+
+  // MDI is refused in AUTO, with the interpreter's reason, and nothing runs.
+  await page.fill("#mdi", "G00 X70 Z10");
+  await page.click("#mdi_run");
+  await waitFor("the MDI refusal", async () => (await text("message")).includes("MDI refused: mode AUTO"), 10);
+
+  // Load, then cycle start.
+  await page.fill("#load_name", "O0005");
+  await page.fill("#load_text", PROGRAM);
+  await page.click("#load");
+  await waitFor("the load answer", async () => (await text("message")).includes("O0005 stored"), 10);
+  await waitFor("the program list", async () => (await page.$$eval("#programs option", (o) => o.map((x) => x.value))).includes("O0005"), 10);
+  await page.selectOption("#programs", "O0005");
+  await page.click("#select");
+  await waitFor("the listing", async () => (await page.$$eval("#listing li", (l) => l.length)) === 10, 10);
+
+  const cycle = async (expectParts) => {
+    await page.click("#cycle_start");
+    const lines = new Set();
+    let shot = false;
+    await waitFor(`part ${expectParts}`, async () => {
+      const line = Number(await text("line"));
+      const state = await text("execution");
+      if (state === "ACTIVE" && line > 0) lines.add(line);
+      // The screenshot is taken while the program runs, its line marked in the listing.
+      if (!shot && state === "ACTIVE" && line >= 6 && screenshot) {
+        shot = true;
+        await page.screenshot({ path: screenshot, fullPage: true });
+      }
+      return Number(await text("parts")) >= expectParts && state === "PROGRAM_COMPLETED";
+    }, 60);
+    if (lines.size < 3) fail(`only lines ${[...lines]} seen running`);
+    const marked = await page.$$eval("#listing li.current", (l) => l.length);
+    if (marked !== 1) fail(`${marked} listing lines marked`);
+    return [...lines];
+  };
+  const first = await cycle(1);
+  const second = await cycle(2);
+
+  // Positions, the tool path, the offset page, the ladder monitor.
+  const axes = await page.$$eval("#axes tr", (rows) => rows.map((r) => r.textContent));
+  if (axes.length !== 2) fail(`axes shown: ${axes}`);
+  const points = await page.evaluate(() => path.length);
+  if (points < 20) fail(`tool path has ${points} points`);
+  await page.click("#offsets_read");
+  await waitFor("the work offsets", async () => (await page.$$eval("#works tr", (r) => r.length)) === 6, 10);
+  const rungs = await page.$$eval("#ladder .rung", (r) => r.length);
+  if (rungs < 20) fail(`ladder shows ${rungs} rungs`);
+  await waitFor("live ladder signals", async () => (await page.$$eval("#ladder .sig.on", (s) => s.length)) > 0, 10);
+
+  // MDI in MDI mode runs; back to AUTO.
+  await page.selectOption("#mode_select", "MDI");
+  await page.click("#mode_set");
+  await waitFor("MDI mode", async () => (await text("mode")) === "MDI", 10);
+  await page.fill("#mdi", "G00 X70 Z10");
+  await page.click("#mdi_run");
+  await waitFor("the MDI block to start", async () => (await text("message")).includes("MDI started"), 10);
+  await waitFor("the MDI block to finish", async () => (await text("program")) === "MDI" && (await text("execution")) === "PROGRAM_COMPLETED", 20);
+  const x = await page.$eval("#axes tr", (r) => Number(r.children[2].textContent));
+  if (Math.abs(x - 70) > 0.01) fail(`work X at ${x} after MDI G00 X70`);
+  // An out-of-range override is refused at the bridge.
+  await page.evaluate(() => send({ op: "overrides", feed: 7, spindle: 100, rapid: 100 }));
+  await waitFor("the override refusal", async () => (await text("message")).includes("feed override 7 %"), 10);
+  await page.selectOption("#mode_select", "AUTO");
+  await page.click("#mode_set");
+  await waitFor("AUTO mode", async () => (await text("mode")) === "AUTO", 10);
+
+  console.log(JSON.stringify({ first, second, points, rungs, parts: Number(await text("parts")) }));
+  await browser.close();
+})().catch((e) => fail(e.stack || String(e)));
