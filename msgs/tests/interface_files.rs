@@ -123,6 +123,8 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<CommandResult>("CommandResult.msg");
     check_msg::<SimInput>("SimInput.msg");
     check_msg::<PlcStatus>("PlcStatus.msg");
+    check_msg::<PlcSignals>("PlcSignals.msg");
+    check_msg::<PlcProgram>("PlcProgram.msg");
     check_msg::<CommandEvent>("CommandEvent.msg");
     check_msg::<RobotHandshake>("RobotHandshake.msg");
     check_msg::<Overrides>("Overrides.msg");
@@ -183,6 +185,8 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "CommandResult",
         "SimInput",
         "PlcStatus",
+        "PlcSignals",
+        "PlcProgram",
         "CommandEvent",
         "RobotHandshake",
         "RobotRequest",
