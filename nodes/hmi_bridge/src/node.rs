@@ -1,5 +1,7 @@
-//! hmi_bridge node shell: serves `/<ns>/load_program`, `start_program`, `stop`, `reset`, turns
-//! each request into an internal command, and keeps `/<ns>/alarms` (ActiveAlarms).
+//! hmi_bridge node shell: serves the cell's services and the `RunProgram` action, the robot
+//! requests and the operator's web HMI, turns each request into an [`Operation`] carried out
+//! through one command path (with one access check and one command event), and keeps
+//! `/<ns>/alarms` (ActiveAlarms).
 
 use std::collections::BTreeMap;
 use std::time::{Duration, Instant};
