@@ -163,7 +163,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     } else {
         let parameters = serde_json::to_value(&cfg.machine).unwrap_or_default();
         let axes = cfg.machine.axes.iter().map(|a| a.name.clone()).collect();
-        match WebHmi::start(&cfg.hmi.web_address, axes, parameters) {
+        match WebHmi::start(&cfg.hmi.web_address, axes, cfg.diameter_axes(), parameters) {
             Ok(w) => Some(w),
             Err(e) => {
                 log::error!("hmi_bridge: {e}; the web HMI is not served");
@@ -361,7 +361,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             let (accepted, text) = perform(Operation::List, &Who::Dds(r.writer));
             let mut response = ListProgramsResponse::default();
             if accepted {
-                for (name, size) in program_list(&text) {
+                for (name, size) in crate::operation::program_list(&text) {
                     response.names.push(name);
                     response.sizes.push(size);
                 }
@@ -668,14 +668,6 @@ fn execute(
             commands.call(ProgramCommand::SET_WORK_OFFSET, code, values)
         }
     }
-}
-
-/// The interpreter's program list (`name<TAB>size` lines) as names and sizes.
-pub fn program_list(text: &str) -> Vec<(String, u64)> {
-    text.lines()
-        .filter_map(|line| line.rsplit_once('\t'))
-        .map(|(name, size)| (name.to_string(), size.parse().unwrap_or(0)))
-        .collect()
 }
 
 fn answer<S: RosService>(

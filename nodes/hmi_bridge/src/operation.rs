@@ -103,6 +103,14 @@ impl Operation {
     }
 }
 
+/// The interpreter's program list (`name<TAB>size` lines) as names and sizes.
+pub fn program_list(text: &str) -> Vec<(String, u64)> {
+    text.lines()
+        .filter_map(|line| line.rsplit_once('\t'))
+        .map(|(name, size)| (name.to_string(), size.parse().unwrap_or(0)))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -118,5 +126,9 @@ mod tests {
         }
         .moves());
         assert_eq!(Operation::Mode { mode: 1 }.detail(), "MDI");
+        assert_eq!(
+            program_list("O0001\t95\nMDI\t12\nbroken line\n"),
+            [("O0001".to_string(), 95), ("MDI".to_string(), 12)]
+        );
     }
 }

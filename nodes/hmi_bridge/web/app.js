@@ -90,6 +90,8 @@ const handlers = {
     $("alarms").innerHTML = (m.alarms || [])
       .map((a) => `<li>${a.number} ${escape(a.text)}${a.line ? ` (line ${a.line})` : ""} [${a.source}]</li>`)
       .join("");
+    for (const h of m.history || []) handlers.history({ entry: h });
+    for (const c of m.commands || []) handlers.command({ entry: c });
     if (m.path_reset) path = [];
     path.push(...(m.path || []));
     if (m.plot) $("toolpath").dataset.axes = m.plot.join(",");

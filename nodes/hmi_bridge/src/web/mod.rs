@@ -35,23 +35,24 @@ pub struct WebHmi {
     parameters: Value,
     ladder: Option<Value>,
     last_frame: Instant,
-    history_sent: Option<Value>,
-    command_sent: Option<Value>,
 }
 
 impl WebHmi {
-    pub fn start(address: &str, axes: Vec<String>, parameters: Value) -> Result<WebHmi, String> {
+    pub fn start(
+        address: &str,
+        axes: Vec<String>,
+        diameter: Vec<bool>,
+        parameters: Value,
+    ) -> Result<WebHmi, String> {
         let server = WebServer::start(address)?;
         log::info!("web HMI on http://{}/", server.address);
         Ok(WebHmi {
             server,
             pages: BTreeMap::new(),
-            view: View::new(axes),
+            view: View::new(axes, diameter),
             parameters,
             ladder: None,
             last_frame: Instant::now(),
-            history_sent: None,
-            command_sent: None,
         })
     }
 
@@ -133,7 +134,7 @@ impl WebHmi {
             }
             (Operation::Offsets, true) => Some(json!({"type": "offsets", "text": message})),
             (Operation::List, true) => {
-                let list: Vec<Value> = crate::node::program_list(&message)
+                let list: Vec<Value> = crate::operation::program_list(&message)
                     .into_iter()
                     .map(|(name, size)| json!({"name": name, "size": size}))
                     .collect();
@@ -159,22 +160,12 @@ impl WebHmi {
         self.send(pending.connection, &reply);
     }
 
-    /// Sends the state frame when it is due, and history entries as they come.
+    /// Sends the state frame when it is due.
     pub fn tick(&mut self) {
         if self.pages.is_empty() {
             // Nobody watches: a page that opens gets everything in its welcome.
             self.view.mark_sent();
             return;
-        }
-        let history = self.view.last_history().cloned();
-        if history.is_some() && history != self.history_sent {
-            self.broadcast(&json!({"type": "history", "entry": history}));
-            self.history_sent = history;
-        }
-        let command = self.view.last_command().cloned();
-        if command.is_some() && command != self.command_sent {
-            self.broadcast(&json!({"type": "command", "entry": command}));
-            self.command_sent = command;
         }
         if self.last_frame.elapsed() >= FRAME_PERIOD {
             self.last_frame = Instant::now();

@@ -5,7 +5,7 @@
 
 use std::io::{Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc::{self, Receiver, Sender};
 use std::sync::Arc;
 use std::time::Duration;
@@ -20,6 +20,10 @@ const MAX_HEAD: usize = 16 * 1024;
 /// The longest message a page may send (an MDI entry, an offset row; not programs, which are
 /// loaded through the same 4 MiB limit as the services).
 pub const MAX_MESSAGE: usize = cnc_runtime::MAX_PROGRAM_BYTES + 64 * 1024;
+
+/// Connections served at once; more are answered 503 and closed, so a client that opens
+/// connections without end cannot take the bridge's threads.
+pub const MAX_CONNECTIONS: usize = 32;
 
 /// Frames for one page; a page that is gone makes `send` fail and is forgotten.
 pub type Outbox = Sender<String>;
@@ -82,9 +86,21 @@ impl WebServer {
 
 fn accept_loop(listener: TcpListener, events: Sender<WebEvent>, stop: Arc<AtomicBool>) {
     let mut next_id = 0u64;
+    let open = Arc::new(AtomicUsize::new(0));
     while !stop.load(Ordering::Relaxed) {
         match listener.accept() {
-            Ok((stream, peer)) => {
+            Ok((mut stream, peer)) => {
+                if open.load(Ordering::Relaxed) >= MAX_CONNECTIONS {
+                    let _ = stream.set_nonblocking(false);
+                    let _ = respond(
+                        &mut stream,
+                        "503 Service Unavailable",
+                        "text/plain",
+                        b"too many connections\n",
+                    );
+                    continue;
+                }
+                let slot = Slot::take(&open);
                 next_id += 1;
                 let id = next_id;
                 let events = events.clone();
@@ -92,6 +108,7 @@ fn accept_loop(listener: TcpListener, events: Sender<WebEvent>, stop: Arc<Atomic
                 let spawned = std::thread::Builder::new()
                     .name(format!("web-hmi-{id}"))
                     .spawn(move || {
+                        let _slot = slot;
                         if let Err(e) = serve(stream, peer, id, &events, &stop) {
                             log::debug!("web HMI connection {peer}: {e}");
                         }
@@ -108,6 +125,23 @@ fn accept_loop(listener: TcpListener, events: Sender<WebEvent>, stop: Arc<Atomic
                 std::thread::sleep(Duration::from_millis(100));
             }
         }
+    }
+}
+
+/// One of the [`MAX_CONNECTIONS`], given back when the connection's thread ends (or was never
+/// started).
+struct Slot(Arc<AtomicUsize>);
+
+impl Slot {
+    fn take(open: &Arc<AtomicUsize>) -> Slot {
+        open.fetch_add(1, Ordering::Relaxed);
+        Slot(open.clone())
+    }
+}
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, Ordering::Relaxed);
     }
 }
 
@@ -305,6 +339,34 @@ mod tests {
             path: "/ws".into(),
             headers,
         }
+    }
+
+    fn get(address: SocketAddr, request: &str) -> String {
+        let mut s = TcpStream::connect(address).expect("connect");
+        s.write_all(request.as_bytes()).expect("send");
+        let mut answer = String::new();
+        let _ = s.read_to_string(&mut answer);
+        answer
+    }
+
+    #[test]
+    fn the_page_is_served_other_paths_are_not_and_connections_are_capped() {
+        let server = WebServer::start("127.0.0.1:0").expect("listens");
+        let a = server.address;
+        assert!(get(a, "GET / HTTP/1.1\r\nHost: x\r\n\r\n").contains("<title>CNC operator panel"));
+        assert!(get(a, "GET /app.js HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 200"));
+        assert!(get(a, "GET /../etc/passwd HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 404"));
+        assert!(get(a, "POST / HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 405"));
+        assert!(get(a, "GET /ws HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 400"));
+        // Connections that never send a request hold their slots until their timeout.
+        let idle: Vec<TcpStream> = (0..MAX_CONNECTIONS)
+            .map(|_| TcpStream::connect(a).expect("connect"))
+            .collect();
+        std::thread::sleep(Duration::from_millis(300));
+        assert!(get(a, "GET / HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 503"));
+        drop(idle);
+        std::thread::sleep(Duration::from_millis(300));
+        assert!(get(a, "GET / HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 200"));
     }
 
     #[test]

@@ -19,10 +19,44 @@ pub const PATH_POINTS: usize = 50_000;
 const PATH_STEP: f64 = 0.01;
 /// Blocks kept for distance to go: more than motion's queue holds.
 const BLOCKS_KEPT: usize = 512;
+/// Command events kept.
+const COMMANDS: usize = 20;
+
+/// The newest entries of a history, counting every entry ever added, so frames carry exactly
+/// the entries pages have not had yet.
+#[derive(Debug, Default)]
+struct Log {
+    entries: VecDeque<Value>,
+    added: usize,
+    sent: usize,
+}
+
+impl Log {
+    fn push(&mut self, entry: Value, keep: usize) {
+        self.entries.push_back(entry);
+        self.added += 1;
+        while self.entries.len() > keep {
+            self.entries.pop_front();
+        }
+    }
+
+    /// Entries added since the last call (those still kept).
+    fn take_new(&mut self) -> Vec<Value> {
+        let new = (self.added - self.sent).min(self.entries.len());
+        self.sent = self.added;
+        self.entries
+            .iter()
+            .skip(self.entries.len() - new)
+            .cloned()
+            .collect()
+    }
+}
 
 #[derive(Debug, Default)]
 pub struct View {
     names: Vec<String>,
+    /// Per axis: programmed and shown as a diameter (a lathe's X).
+    diameter: Vec<bool>,
     /// The two axes the tool path is drawn in: (horizontal, vertical).
     plot: (usize, usize),
     machine: Option<MachineState>,
@@ -33,8 +67,8 @@ pub struct View {
     parts: Option<PartCount>,
     overrides: Option<Overrides>,
     active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm>,
-    history: VecDeque<Value>,
-    commands: VecDeque<Value>,
+    history: Log,
+    commands: Log,
     path: Vec<[f64; 2]>,
     /// Points already sent to every page.
     path_sent: usize,
@@ -61,10 +95,11 @@ fn stamp_seconds(t: &cnc_msgs::msg::Time) -> f64 {
 }
 
 impl View {
-    pub fn new(names: Vec<String>) -> View {
+    pub fn new(names: Vec<String>, diameter: Vec<bool>) -> View {
         View {
             plot: plot_axes(&names),
             names,
+            diameter,
             ..View::default()
         }
     }
@@ -94,8 +129,8 @@ impl View {
     pub fn on_axes(&mut self, a: AxisState) {
         let (h, v) = self.plot;
         if let (Some(ah), Some(av)) = (a.axes.get(h), a.axes.get(v)) {
-            // A lathe's X is a diameter: the path is drawn at the radius.
-            let scale = if self.names.get(v).is_some_and(|n| n == "X") && self.plot.0 != 0 {
+            // A diameter axis is drawn at the radius.
+            let scale = if self.diameter.get(v).copied().unwrap_or(false) {
                 0.5
             } else {
                 1.0
@@ -136,16 +171,14 @@ impl View {
     pub fn on_alarm_event(&mut self, e: AlarmEvent) {
         let key = (e.alarm.source.clone(), e.alarm.number);
         let raised = e.kind == AlarmEvent::RAISED;
-        self.history.push_back(json!({
+        let entry = json!({
             "time": stamp_seconds(&e.alarm.stamp),
             "raised": raised,
             "number": e.alarm.number,
             "text": e.alarm.text,
             "source": e.alarm.source,
-        }));
-        while self.history.len() > HISTORY {
-            self.history.pop_front();
-        }
+        });
+        self.history.push(entry, HISTORY);
         if raised {
             self.active.insert(key, e.alarm);
         } else {
@@ -154,17 +187,15 @@ impl View {
     }
 
     pub fn on_command_event(&mut self, e: &CommandEvent) {
-        self.commands.push_back(json!({
+        let entry = json!({
             "time": stamp_seconds(&e.stamp),
             "command": e.command,
             "detail": e.detail,
             "client": e.client,
             "accepted": e.accepted,
             "message": e.message,
-        }));
-        while self.commands.len() > 20 {
-            self.commands.pop_front();
-        }
+        });
+        self.commands.push(entry, COMMANDS);
     }
 
     /// The block motion is executing, if its stream is known.
@@ -251,6 +282,8 @@ impl View {
             })).collect::<Vec<_>>(),
             "path_reset": self.path_reset,
             "path": &self.path[path_from.min(self.path.len())..],
+            "history": self.history.take_new(),
+            "commands": self.commands.take_new(),
         });
         self.path_sent = self.path.len();
         self.path_reset = false;
@@ -261,6 +294,8 @@ impl View {
     pub fn mark_sent(&mut self) {
         self.path_sent = self.path.len();
         self.path_reset = false;
+        self.history.take_new();
+        self.commands.take_new();
     }
 
     /// A new page's first frame: everything, the whole path and the histories.
@@ -269,8 +304,8 @@ impl View {
             "type": "welcome",
             "axes": self.names,
             "path": self.path,
-            "history": self.history,
-            "commands": self.commands,
+            "history": self.history.entries,
+            "commands": self.commands.entries,
         })
     }
 
@@ -286,14 +321,6 @@ impl View {
             "scan": s.scan,
             "X": s.x, "Y": s.y, "F": s.f, "G": s.g, "R": s.r, "A": s.a, "K": s.k,
         }))
-    }
-
-    /// The alarm and command histories' newest entries, for pages that are open.
-    pub fn last_history(&self) -> Option<&Value> {
-        self.history.back()
-    }
-    pub fn last_command(&self) -> Option<&Value> {
-        self.commands.back()
     }
 }
 
@@ -318,7 +345,7 @@ mod tests {
 
     #[test]
     fn work_position_and_distance_to_go_come_from_the_executing_block() {
-        let mut v = View::new(vec!["X".into(), "Z".into()]);
+        let mut v = View::new(vec!["X".into(), "Z".into()], vec![true, false]);
         v.on_motion_status(MotionStatus {
             run_id: 7,
             done_seq: 1,
@@ -347,7 +374,7 @@ mod tests {
 
     #[test]
     fn frames_carry_only_new_path_points_and_a_new_run_starts_over() {
-        let mut v = View::new(vec!["X".into(), "Z".into()]);
+        let mut v = View::new(vec!["X".into(), "Z".into()], vec![true, false]);
         v.on_motion_status(MotionStatus {
             run_id: 1,
             ..MotionStatus::default()
@@ -372,7 +399,7 @@ mod tests {
 
     #[test]
     fn alarm_history_keeps_raised_and_cleared_in_order() {
-        let mut v = View::new(vec!["X".into(), "Z".into()]);
+        let mut v = View::new(vec!["X".into(), "Z".into()], vec![true, false]);
         let alarm = cnc_msgs::msg::Alarm {
             number: 65,
             text: "emergency stop".into(),
@@ -387,6 +414,20 @@ mod tests {
             let active = v.frame()["alarms"].as_array().map_or(0, Vec::len);
             assert_eq!(active, usize::from(kind == AlarmEvent::RAISED));
         }
+        // Entries that come between two frames all go out with the next one.
+        for number in [1000, 1001] {
+            v.on_alarm_event(AlarmEvent {
+                kind: AlarmEvent::RAISED,
+                alarm: cnc_msgs::msg::Alarm {
+                    number,
+                    ..alarm.clone()
+                },
+            });
+        }
+        let f = v.frame();
+        assert_eq!(f["history"].as_array().map(Vec::len), Some(2));
+        assert_eq!(f["history"][1]["number"], 1001);
+        assert_eq!(v.frame()["history"], json!([]));
         let w = v.welcome();
         assert_eq!(w["history"][0]["raised"], true);
         assert_eq!(w["history"][1]["raised"], false);
