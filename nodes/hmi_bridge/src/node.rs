@@ -171,13 +171,11 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             }
         }
     };
-    let axes_sub = ros.subscription::<AxisState>(&topics::AXES)?;
-    let spindle_sub = ros.subscription::<SpindleState>(&topics::SPINDLE)?;
-    let blocks_sub = ros.subscription::<MotionBlock>(&topics::MOTION_BLOCKS)?;
-    let signals_sub = ros.subscription::<PlcSignals>(&topics::PLC_SIGNALS)?;
-    let ladder_sub = ros.subscription::<PlcProgram>(&topics::PLC_PROGRAM)?;
-    let command_sub = ros.subscription::<CommandEvent>(&topics::COMMAND_EVENTS)?;
-    let overrides_sub = ros.subscription::<Overrides>(&topics::PANEL_OVERRIDES)?;
+    // What only the panel shows is read only when there is a panel.
+    let panel_feeds = match web {
+        Some(_) => Some(PanelFeeds::new(&mut ros)?),
+        None => None,
+    };
 
     let mut active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm> = BTreeMap::new();
     let publish_alarms = |active: &BTreeMap<(String, u32), cnc_msgs::msg::Alarm>| {
@@ -493,28 +491,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 record(command, "malformed", &Who::Dds(writer), false, &why);
             }
         }
-        if let Some(w) = web.as_mut() {
-            while let Ok(Some((a, _))) = axes_sub.take() {
-                w.view.on_axes(a);
-            }
-            while let Ok(Some((s, _))) = spindle_sub.take() {
-                w.view.on_spindle(s);
-            }
-            while let Ok(Some((b, _))) = blocks_sub.take() {
-                w.view.on_block(b);
-            }
-            while let Ok(Some((s, _))) = signals_sub.take() {
-                w.view.on_plc_signals(s);
-            }
-            while let Ok(Some((p, _))) = ladder_sub.take() {
-                w.set_ladder(&p);
-            }
-            while let Ok(Some((e, _))) = command_sub.take() {
-                w.view.on_command_event(&e);
-            }
-            while let Ok(Some((o, _))) = overrides_sub.take() {
-                w.view.on_overrides(o);
-            }
+        if let (Some(w), Some(feeds)) = (web.as_mut(), panel_feeds.as_ref()) {
+            feeds.feed(w);
             w.tick();
         }
         if !busy {
@@ -598,6 +576,56 @@ fn discovery_reader(participant: &rustdds::DomainParticipant) -> Result<Discover
         .map_err(|e| format!("ros_discovery_info: {e:?}"))?
         .create_simple_datareader_no_key(&topic, Some(qos))
         .map_err(|e| format!("ros_discovery_info: {e:?}"))
+}
+
+/// The topics only the web panel shows.
+struct PanelFeeds {
+    axes: ros2_client::dds::Subscription<AxisState>,
+    spindle: ros2_client::dds::Subscription<SpindleState>,
+    blocks: ros2_client::dds::Subscription<MotionBlock>,
+    signals: ros2_client::dds::Subscription<PlcSignals>,
+    ladder: ros2_client::dds::Subscription<PlcProgram>,
+    commands: ros2_client::dds::Subscription<CommandEvent>,
+    overrides: ros2_client::dds::Subscription<Overrides>,
+}
+
+impl PanelFeeds {
+    fn new(ros: &mut RosNode) -> Result<PanelFeeds, String> {
+        Ok(PanelFeeds {
+            axes: ros.subscription(&topics::AXES)?,
+            spindle: ros.subscription(&topics::SPINDLE)?,
+            blocks: ros.subscription(&topics::MOTION_BLOCKS)?,
+            signals: ros.subscription(&topics::PLC_SIGNALS)?,
+            ladder: ros.subscription(&topics::PLC_PROGRAM)?,
+            commands: ros.subscription(&topics::COMMAND_EVENTS)?,
+            overrides: ros.subscription(&topics::PANEL_OVERRIDES)?,
+        })
+    }
+
+    /// Hands everything that arrived to the panel.
+    fn feed(&self, w: &mut WebHmi) {
+        while let Ok(Some((a, _))) = self.axes.take() {
+            w.view.on_axes(a);
+        }
+        while let Ok(Some((s, _))) = self.spindle.take() {
+            w.view.on_spindle(s);
+        }
+        while let Ok(Some((b, _))) = self.blocks.take() {
+            w.view.on_block(b);
+        }
+        while let Ok(Some((s, _))) = self.signals.take() {
+            w.view.on_plc_signals(s);
+        }
+        while let Ok(Some((p, _))) = self.ladder.take() {
+            w.set_ladder(&p);
+        }
+        while let Ok(Some((e, _))) = self.commands.take() {
+            w.view.on_command_event(&e);
+        }
+        while let Ok(Some((o, _))) = self.overrides.take() {
+            w.view.on_overrides(o);
+        }
+    }
 }
 
 /// Carries out one operation through the interpreter's command path (access was checked by
