@@ -11,8 +11,9 @@ mod common;
 use cnc::cell::Cell;
 use cnc::client::CellClient;
 use cnc_msgs::action::{RunProgramFeedback, RunProgramGoal, RunProgramResult};
-use cnc_msgs::msg::MachineState;
+use cnc_msgs::msg::{MachineState, ProgramEvent};
 use cnc_runtime::dds::{qos, RosNode};
+use cnc_runtime::topics;
 use ros2_client::action::ActionClientQosPolicies;
 use ros2_client::action_msgs::{CancelGoalResponseEnum, GoalStatusEnum};
 use ros2_client::{ActionTypeName, Name, ServiceMapping};
@@ -105,6 +106,16 @@ fn run_program_reports_every_block_and_a_cancel_stops_the_machine_ready_for_the_
         assert!(r.accepted, "{}", r.message);
     }
     let mut supervisor = RosNode::new(&cfg.network, "cell", "supervisor").unwrap();
+    // The program events a line-side display would follow.
+    let mut watcher = RosNode::new(&cfg.network, "lathe1", "event_watch").unwrap();
+    let program_events = watcher
+        .subscription_with_qos::<ProgramEvent>(
+            &topics::PROGRAM_EVENTS,
+            topics::PROGRAM_EVENTS
+                .qos()
+                .history(ros2_client::qos::History::KeepLast { depth: 10_000 }),
+        )
+        .unwrap();
     let client = action_client(&mut supervisor);
     std::thread::sleep(Duration::from_secs(2)); // discovery of the action's services
 
@@ -188,6 +199,62 @@ fn run_program_reports_every_block_and_a_cancel_stops_the_machine_ready_for_the_
     let (_, status, result) = follow(&client, id, Duration::from_secs(60), |_| {});
     assert_eq!(status, GoalStatusEnum::Succeeded, "{}", result.message);
     assert_eq!(result.parts_made, 1);
+    std::thread::sleep(Duration::from_millis(300));
+    let mut events = Vec::new();
+    loop {
+        match program_events.take() {
+            Ok(Some((e, _))) => events.push(e),
+            Ok(None) => break,
+            Err(e) => panic!("{e:?}"),
+        }
+    }
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
+
+    // The same story on `program_events`: three runs of short.nc completed with a block event
+    // at each motion line, and the canceled cut started then aborted.
+    let story: Vec<(String, &str)> = events
+        .iter()
+        .filter(|e| e.kind != ProgramEvent::BLOCK)
+        .map(|e| (e.program.clone(), e.kind_name.as_str()))
+        .collect();
+    let expected: Vec<(String, &str)> = [
+        ("short.nc", "STARTED"),
+        ("short.nc", "COMPLETED"),
+        ("short.nc", "STARTED"),
+        ("short.nc", "COMPLETED"),
+        ("long.nc", "STARTED"),
+        ("long.nc", "ABORTED"),
+        ("short.nc", "STARTED"),
+        ("short.nc", "COMPLETED"),
+    ]
+    .iter()
+    .map(|(p, k)| (p.to_string(), *k))
+    .collect();
+    assert_eq!(story, expected, "{events:#?}");
+    let runs: Vec<&[ProgramEvent]> = events
+        .split_inclusive(|e| matches!(e.kind, ProgramEvent::COMPLETED | ProgramEvent::ABORTED))
+        .collect();
+    for run in &runs {
+        let end = &run[run.len() - 1];
+        let blocks: Vec<u32> = run.iter().map(|e| e.blocks).collect();
+        assert!(blocks.windows(2).all(|w| w[0] <= w[1]), "{blocks:?}");
+        if end.program == "short.nc" {
+            let lines: BTreeSet<u32> = run
+                .iter()
+                .filter(|e| e.kind == ProgramEvent::BLOCK)
+                .map(|e| e.line)
+                .collect();
+            for line in [2, 4, 5, 6, 7] {
+                assert!(
+                    lines.contains(&line),
+                    "no block event at line {line}: {lines:?}"
+                );
+            }
+            assert!(end.elapsed > 1.0, "cycle of {} s", end.elapsed);
+        } else {
+            assert_eq!(end.line, 5, "the cut was aborted in line 5");
+            assert!(!end.reason.is_empty());
+        }
+    }
 }

@@ -37,6 +37,7 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("PlcSignals", include_str!("../msg/PlcSignals.msg")),
     ("PlcStatus", include_str!("../msg/PlcStatus.msg")),
     ("ProgramCommand", include_str!("../msg/ProgramCommand.msg")),
+    ("ProgramEvent", include_str!("../msg/ProgramEvent.msg")),
     ("RobotHandshake", include_str!("../msg/RobotHandshake.msg")),
     ("ServoStats", include_str!("../msg/ServoStats.msg")),
     ("SimInput", include_str!("../msg/SimInput.msg")),

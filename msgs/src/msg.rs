@@ -320,6 +320,28 @@ ros_message! {
 }
 
 ros_message! {
+    /// What happened to a program run: started, each block, paused, resumed, completed, aborted.
+    pub struct ProgramEvent("cnc_msgs/msg/ProgramEvent") {
+        consts {
+            STARTED: u8 = 1,
+            BLOCK: u8 = 2,
+            PAUSED: u8 = 3,
+            RESUMED: u8 = 4,
+            COMPLETED: u8 = 5,
+            ABORTED: u8 = 6,
+        }
+        stamp: Time,
+        kind: u8,
+        kind_name: String,
+        program: String,
+        line: u32,
+        blocks: u32,
+        elapsed: f64,
+        reason: String,
+    }
+}
+
+ros_message! {
     /// The machine's side of the robot handshake.
     pub struct RobotHandshake("cnc_msgs/msg/RobotHandshake") {
         consts {}

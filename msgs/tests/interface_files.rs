@@ -126,6 +126,7 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<PlcSignals>("PlcSignals.msg");
     check_msg::<PlcProgram>("PlcProgram.msg");
     check_msg::<CommandEvent>("CommandEvent.msg");
+    check_msg::<ProgramEvent>("ProgramEvent.msg");
     check_msg::<RobotHandshake>("RobotHandshake.msg");
     check_msg::<Overrides>("Overrides.msg");
 }
@@ -188,6 +189,7 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "PlcSignals",
         "PlcProgram",
         "CommandEvent",
+        "ProgramEvent",
         "RobotHandshake",
         "RobotRequest",
         "ListPrograms",

@@ -7,6 +7,7 @@ pub mod mapping;
 pub mod node;
 pub mod operation;
 pub mod overrides;
+pub mod program_events;
 pub mod robot;
 pub mod run_program;
 pub mod server;

@@ -8,8 +8,8 @@ use std::time::{Duration, Instant};
 
 use cnc_msgs::msg::{
     ActiveAlarms, AlarmEvent, AxisState, CommandEvent, CommandResult, MachineState, MotionBlock,
-    MotionStatus, Overrides, PartCount, PlcProgram, PlcSignals, ProgramCommand, RobotHandshake,
-    SimInput, SpindleState,
+    MotionStatus, Overrides, PartCount, PlcProgram, PlcSignals, ProgramCommand, ProgramEvent,
+    RobotHandshake, SimInput, SpindleState,
 };
 use cnc_msgs::srv::*;
 use cnc_runtime::dds::{qos, stamp, RosNode};
@@ -24,6 +24,7 @@ use ros2_client::qos::History;
 use crate::access::{self, may_move, Clients, Who};
 use crate::action_server::{CommandPath, RunProgramServer};
 use crate::operation::Operation;
+use crate::program_events::ProgramEvents;
 use crate::robot;
 use crate::server::{DualServer, Request};
 use crate::web::WebHmi;
@@ -137,6 +138,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     // The program a robot's cycle start runs again: the last one started from outside.
     let mut last_program: Option<String> = None;
     let events = ros.publisher::<CommandEvent>(&topics::COMMAND_EVENTS)?;
+    let program_events_pub = ros.publisher::<ProgramEvent>(&topics::PROGRAM_EVENTS)?;
+    let mut program_events = ProgramEvents::default();
     // Which nodes each participant hosts, as they announce it on `ros_discovery_info`: a
     // reader of our own, transient-local, so every participant's last announcement is there
     // whenever the bridge looks (ros2-client's node events drop what a full queue cannot take).
@@ -270,6 +273,15 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             states.extend(machine.clone());
         }
         for m in states {
+            for e in program_events.update(&m, &alarm_list, t0.elapsed().as_secs_f64()) {
+                let e = ProgramEvent {
+                    stamp: stamp(),
+                    ..e
+                };
+                if let Err(err) = program_events_pub.publish(e) {
+                    log::warn!("hmi_bridge: program event not published: {err}");
+                }
+            }
             for e in run_program.poll(
                 &mut commands,
                 &may_move,

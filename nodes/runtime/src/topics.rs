@@ -94,6 +94,11 @@ pub const COMMAND_EVENTS: Topic = topic(
     "cnc_msgs/msg/CommandEvent",
     Delivery::Events(100),
 );
+pub const PROGRAM_EVENTS: Topic = topic(
+    "program_events",
+    "cnc_msgs/msg/ProgramEvent",
+    Delivery::Events(100),
+);
 pub const SIM_INPUT: Topic = topic("sim/input", "cnc_msgs/msg/SimInput", Delivery::Events(10));
 pub const PROGRAM_COMMAND: Topic = topic(
     "_internal/program_command",
@@ -129,6 +134,7 @@ pub const ALL: &[Topic] = &[
     PLC_PROGRAM,
     SERVO_STATS,
     COMMAND_EVENTS,
+    PROGRAM_EVENTS,
     ROBOT_HANDSHAKE,
     SIM_INPUT,
     ROBOT_SIGNALS,
