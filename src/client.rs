@@ -13,6 +13,8 @@ use ros2_client::{Name, ServiceMapping, ServiceTypeName};
 
 pub struct CellClient {
     ros: RosNode,
+    mapping: ServiceMapping,
+    namespace: String,
     load: Client<LoadProgramRequest, LoadProgramResponse>,
     start: Client<StartProgramRequest, StartProgramResponse>,
     stop: Client<StopRequest, StopResponse>,
@@ -84,6 +86,8 @@ impl CellClient {
             axes_sub: ros.subscription(&topics::AXES)?,
             stats_sub: ros.subscription(&topics::SERVO_STATS)?,
             ros,
+            mapping,
+            namespace: ns.into(),
             state: None,
             spindle: None,
             part_count: None,
@@ -188,6 +192,27 @@ impl CellClient {
 
     pub fn node(&self) -> &RosNode {
         &self.ros
+    }
+
+    /// A client of any other service of the cell (`set_mode`, `mdi`, `get_offsets`,
+    /// `set_tool_offset`, `set_work_offset`, `get_parameters`, `set_parameter`,
+    /// `acknowledge_alarm`), on this client's node and mapping.
+    pub fn service<S: RosService>(&mut self, service: &str) -> Result<ServiceClient<S>, String> {
+        let ns = self.namespace.clone();
+        Ok(ServiceClient {
+            client: client::<S>(&mut self.ros, self.mapping, &ns, service)?,
+        })
+    }
+}
+
+/// One service of the cell; see [`CellClient::service`].
+pub struct ServiceClient<S: RosService> {
+    client: Client<S::Request, S::Response>,
+}
+
+impl<S: RosService> ServiceClient<S> {
+    pub fn call(&self, request: S::Request) -> Result<S::Response, String> {
+        call(&self.client, request)
     }
 }
 

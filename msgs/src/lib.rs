@@ -42,6 +42,8 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("ServoStats", include_str!("../msg/ServoStats.msg")),
     ("SimInput", include_str!("../msg/SimInput.msg")),
     ("SpindleState", include_str!("../msg/SpindleState.msg")),
+    ("ToolOffset", include_str!("../msg/ToolOffset.msg")),
+    ("WorkOffset", include_str!("../msg/WorkOffset.msg")),
 ];
 
 /// A Rust type with a ROS 2 interface type name, e.g. `float64`, `string`, `cnc_msgs/Alarm`.

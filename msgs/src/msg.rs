@@ -40,6 +40,7 @@ ros_message! {
         program: String,
         line: u32,
         stamp: Time,
+        acknowledged: bool,
     }
 }
 
@@ -316,6 +317,30 @@ ros_message! {
         client: String,
         accepted: bool,
         message: String,
+    }
+}
+
+ros_message! {
+    /// One row of the tool offset page.
+    pub struct ToolOffset("cnc_msgs/msg/ToolOffset") {
+        consts {}
+        number: u32,
+        x: f64,
+        z: f64,
+        wear_x: f64,
+        wear_z: f64,
+        radius: f64,
+        tip: u8,
+    }
+}
+
+ros_message! {
+    /// One work offset (G54–G59): the named axes' values.
+    pub struct WorkOffset("cnc_msgs/msg/WorkOffset") {
+        consts {}
+        code: String,
+        axes: Vec<String>,
+        values: Vec<f64>,
     }
 }
 

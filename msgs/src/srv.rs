@@ -1,6 +1,7 @@
 //! Service types of `srv/`. ROS 2 gives an empty request or response one `uint8` member named
 //! `structure_needs_at_least_one_member`; the types here do the same so the CDR matches.
 
+use crate::msg::{ToolOffset, WorkOffset};
 use crate::ros_message;
 
 /// A service: its ROS name and its request and response types.
@@ -132,6 +133,116 @@ ros_message! {
     }
 }
 
+ros_message! {
+    pub struct GetOffsetsRequest("cnc_msgs/srv/GetOffsets_Request") {
+        consts {}
+        structure_needs_at_least_one_member: u8,
+    }
+}
+ros_message! {
+    pub struct GetOffsetsResponse("cnc_msgs/srv/GetOffsets_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+        tools: Vec<ToolOffset>,
+        work: Vec<WorkOffset>,
+    }
+}
+ros_message! {
+    pub struct SetToolOffsetRequest("cnc_msgs/srv/SetToolOffset_Request") {
+        consts {}
+        offset: ToolOffset,
+    }
+}
+ros_message! {
+    pub struct SetToolOffsetResponse("cnc_msgs/srv/SetToolOffset_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct SetWorkOffsetRequest("cnc_msgs/srv/SetWorkOffset_Request") {
+        consts {}
+        offset: WorkOffset,
+    }
+}
+ros_message! {
+    pub struct SetWorkOffsetResponse("cnc_msgs/srv/SetWorkOffset_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct SetModeRequest("cnc_msgs/srv/SetMode_Request") {
+        consts {}
+        mode: u8,
+    }
+}
+ros_message! {
+    pub struct SetModeResponse("cnc_msgs/srv/SetMode_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct MdiRequest("cnc_msgs/srv/Mdi_Request") {
+        consts {}
+        text: String,
+    }
+}
+ros_message! {
+    pub struct MdiResponse("cnc_msgs/srv/Mdi_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct GetParametersRequest("cnc_msgs/srv/GetParameters_Request") {
+        consts {}
+        prefix: String,
+    }
+}
+ros_message! {
+    pub struct GetParametersResponse("cnc_msgs/srv/GetParameters_Response") {
+        consts {}
+        names: Vec<String>,
+        values: Vec<String>,
+        pending: Vec<String>,
+    }
+}
+ros_message! {
+    pub struct SetParameterRequest("cnc_msgs/srv/SetParameter_Request") {
+        consts {}
+        name: String,
+        value: String,
+    }
+}
+ros_message! {
+    pub struct SetParameterResponse("cnc_msgs/srv/SetParameter_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
+    pub struct AcknowledgeAlarmRequest("cnc_msgs/srv/AcknowledgeAlarm_Request") {
+        consts {}
+        source: String,
+        number: u32,
+    }
+}
+ros_message! {
+    pub struct AcknowledgeAlarmResponse("cnc_msgs/srv/AcknowledgeAlarm_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+
 macro_rules! service {
     ($marker:ident, $name:literal, $req:ident, $resp:ident) => {
         /// Marker type naming the service.
@@ -190,4 +301,42 @@ service!(
     "SetOverrides",
     SetOverridesRequest,
     SetOverridesResponse
+);
+service!(
+    GetOffsets,
+    "GetOffsets",
+    GetOffsetsRequest,
+    GetOffsetsResponse
+);
+service!(
+    SetToolOffset,
+    "SetToolOffset",
+    SetToolOffsetRequest,
+    SetToolOffsetResponse
+);
+service!(
+    SetWorkOffset,
+    "SetWorkOffset",
+    SetWorkOffsetRequest,
+    SetWorkOffsetResponse
+);
+service!(SetMode, "SetMode", SetModeRequest, SetModeResponse);
+service!(Mdi, "Mdi", MdiRequest, MdiResponse);
+service!(
+    GetParameters,
+    "GetParameters",
+    GetParametersRequest,
+    GetParametersResponse
+);
+service!(
+    SetParameter,
+    "SetParameter",
+    SetParameterRequest,
+    SetParameterResponse
+);
+service!(
+    AcknowledgeAlarm,
+    "AcknowledgeAlarm",
+    AcknowledgeAlarmRequest,
+    AcknowledgeAlarmResponse
 );

@@ -129,6 +129,8 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<ProgramEvent>("ProgramEvent.msg");
     check_msg::<RobotHandshake>("RobotHandshake.msg");
     check_msg::<Overrides>("Overrides.msg");
+    check_msg::<ToolOffset>("ToolOffset.msg");
+    check_msg::<WorkOffset>("WorkOffset.msg");
 }
 
 #[test]
@@ -141,6 +143,14 @@ fn every_srv_file_matches_its_rust_types() {
     check_srv::<ListPrograms>();
     check_srv::<DeleteProgram>();
     check_srv::<SetOverrides>();
+    check_srv::<GetOffsets>();
+    check_srv::<SetToolOffset>();
+    check_srv::<SetWorkOffset>();
+    check_srv::<SetMode>();
+    check_srv::<Mdi>();
+    check_srv::<GetParameters>();
+    check_srv::<SetParameter>();
+    check_srv::<AcknowledgeAlarm>();
 }
 
 /// `action/RunProgram.action`: goal, result and feedback sections against their Rust types.
@@ -196,6 +206,16 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "DeleteProgram",
         "Overrides",
         "SetOverrides",
+        "ToolOffset",
+        "WorkOffset",
+        "GetOffsets",
+        "SetToolOffset",
+        "SetWorkOffset",
+        "SetMode",
+        "Mdi",
+        "GetParameters",
+        "SetParameter",
+        "AcknowledgeAlarm",
         "LoadProgram",
         "StartProgram",
         "Stop",

@@ -3,10 +3,13 @@
 
 pub mod access;
 pub mod action_server;
+pub mod alarm_list;
 pub mod mapping;
 pub mod node;
+pub mod offsets;
 pub mod operation;
 pub mod overrides;
+pub mod parameters;
 pub mod program_events;
 pub mod robot;
 pub mod run_program;

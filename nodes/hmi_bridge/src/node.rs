@@ -12,6 +12,7 @@ use cnc_msgs::msg::{
     RobotHandshake, SimInput, SpindleState,
 };
 use cnc_msgs::srv::*;
+use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::dds::{qos, stamp, RosNode};
 use cnc_runtime::topics;
 use cnc_runtime::MAX_PROGRAM_BYTES;
@@ -23,7 +24,9 @@ use ros2_client::qos::History;
 
 use crate::access::{self, may_move, Clients, Who};
 use crate::action_server::{CommandPath, RunProgramServer};
+use crate::alarm_list::AlarmList;
 use crate::operation::Operation;
+use crate::parameters::Parameters;
 use crate::program_events::ProgramEvents;
 use crate::robot;
 use crate::server::{DualServer, Request};
@@ -83,6 +86,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     };
     let alarm_events = ros.subscription::<AlarmEvent>(&topics::ALARM_EVENTS)?;
     let alarms_pub = ros.publisher::<ActiveAlarms>(&topics::ALARMS)?;
+    let alarm_reporter = AlarmReporter::new(&mut ros, "hmi_bridge")?;
+    let mut parameters = Parameters::new(&cfg);
     let participant = ros.participant();
     let sq: QosPolicies = (&qos::services()).into();
     let load = DualServer::<LoadProgram>::new(&participant, &ns, "load_program", sq.clone())?
@@ -123,6 +128,52 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             },
         );
     let panel = ros.publisher::<Overrides>(&topics::PANEL_OVERRIDES)?;
+    let mode_srv = DualServer::<SetMode>::new(&participant, &ns, "set_mode", sq.clone())?.refusing(
+        |message| SetModeResponse {
+            accepted: false,
+            message,
+        },
+    );
+    let mdi_srv =
+        DualServer::<Mdi>::new(&participant, &ns, "mdi", sq.clone())?.refusing(|message| {
+            MdiResponse {
+                accepted: false,
+                message,
+            }
+        });
+    let offsets_srv = DualServer::<GetOffsets>::new(&participant, &ns, "get_offsets", sq.clone())?
+        .refusing(|message| GetOffsetsResponse {
+            accepted: false,
+            message,
+            ..GetOffsetsResponse::default()
+        });
+    let tool_offset_srv =
+        DualServer::<SetToolOffset>::new(&participant, &ns, "set_tool_offset", sq.clone())?
+            .refusing(|message| SetToolOffsetResponse {
+                accepted: false,
+                message,
+            });
+    let work_offset_srv =
+        DualServer::<SetWorkOffset>::new(&participant, &ns, "set_work_offset", sq.clone())?
+            .refusing(|message| SetWorkOffsetResponse {
+                accepted: false,
+                message,
+            });
+    let get_parameters_srv =
+        DualServer::<GetParameters>::new(&participant, &ns, "get_parameters", sq.clone())?;
+    let set_parameter_srv =
+        DualServer::<SetParameter>::new(&participant, &ns, "set_parameter", sq.clone())?.refusing(
+            |message| SetParameterResponse {
+                accepted: false,
+                message,
+            },
+        );
+    let acknowledge_srv =
+        DualServer::<AcknowledgeAlarm>::new(&participant, &ns, "acknowledge_alarm", sq.clone())?
+            .refusing(|message| AcknowledgeAlarmResponse {
+                accepted: false,
+                message,
+            });
     let robot_srv =
         DualServer::<RobotRequest>::new(&participant, &ns, "robot_request", sq.clone())?.refusing(
             |message| RobotRequestResponse {
@@ -180,11 +231,11 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         None => None,
     };
 
-    let mut active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm> = BTreeMap::new();
-    let publish_alarms = |active: &BTreeMap<(String, u32), cnc_msgs::msg::Alarm>| {
+    let mut active = AlarmList::default();
+    let publish_alarms = |active: &AlarmList| {
         let _ = alarms_pub.publish(ActiveAlarms {
             stamp: stamp(),
-            alarms: active.values().cloned().collect(),
+            alarms: active.alarms(),
         });
     };
     publish_alarms(&active);
@@ -237,13 +288,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             if let Some(w) = web.as_mut() {
                 w.view.on_alarm_event(e.clone());
             }
-            let key = (e.alarm.source.clone(), e.alarm.number);
-            if e.kind == AlarmEvent::RAISED {
-                active.insert(key, e.alarm);
-            } else {
-                active.remove(&key);
-            }
-            changed = true;
+            changed |= active.on_event(e);
         }
         if changed {
             publish_alarms(&active);
@@ -260,7 +305,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             }
             part_count = p.count;
         }
-        let alarm_list: Vec<cnc_msgs::msg::Alarm> = active.values().cloned().collect();
+        let alarm_list: Vec<cnc_msgs::msg::Alarm> = active.alarms();
         // Each state in turn, so the action sees every transition (a short cycle's end too).
         let mut states = Vec::new();
         while let Ok(Some((m, _))) = state_sub.take() {
@@ -314,6 +359,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             );
         }
         // The services: each request becomes an operation, carried out as the web HMI's are.
+        let mut alarms_changed = false;
         let mut perform = |op: Operation, who: &Who| -> (bool, String) {
             let checked = if op.moves() {
                 may_move_who(who)
@@ -321,7 +367,47 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 Ok(())
             };
             let (accepted, message) = match checked {
-                Ok(()) => execute(&op, &mut commands, &panel, &mut run_program.program_lines),
+                Ok(()) => match &op {
+                    Operation::Parameters { prefix } => (
+                        true,
+                        crate::operation::parameter_text(&parameters.read(prefix)),
+                    ),
+                    Operation::SetParameter { name, value } => {
+                        match parameters.write(name, value, machine.as_ref()) {
+                            Ok(message) => {
+                                // A control asks for a power-off after a parameter change.
+                                let alarm = alarm_reporter.alarm(
+                                    PARAMETER_CHANGED_ALARM,
+                                    cnc_msgs::msg::Alarm::SEVERITY_WARNING,
+                                    &format!(
+                                        "parameter changed ({} pending): restart the cell to apply",
+                                        parameters.pending()
+                                    ),
+                                    "",
+                                    0,
+                                );
+                                active.on_event(AlarmEvent {
+                                    kind: AlarmEvent::RAISED,
+                                    alarm: alarm.clone(),
+                                });
+                                alarm_reporter.raise(alarm);
+                                alarms_changed = true;
+                                (true, message)
+                            }
+                            Err(why) => (false, why),
+                        }
+                    }
+                    Operation::Acknowledge { source, number } => {
+                        match active.acknowledge(source, *number) {
+                            Ok(message) => {
+                                alarms_changed = true;
+                                (true, message)
+                            }
+                            Err(why) => (false, why),
+                        }
+                    }
+                    _ => execute(&op, &mut commands, &panel, &mut run_program.program_lines),
+                },
                 Err(why) => (false, why),
             };
             if accepted {
@@ -332,7 +418,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 }
             }
             // Reading is not a command: only what changes something, or is refused, is an event.
-            if !matches!(op, Operation::Read { .. } | Operation::Offsets) || !accepted {
+            if !op.reads() || !accepted {
                 record(op.command(), &op.detail(), who, accepted, &message);
             }
             busy = true;
@@ -387,11 +473,107 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             let (accepted, message) = perform(Operation::Reset, &Who::Dds(r.writer));
             answer(&reset, &r, &ResetResponse { accepted, message });
         }
+        if let Some(r) = mode_srv.receive() {
+            let mode = r.request.mode;
+            let (accepted, message) = perform(Operation::Mode { mode }, &Who::Dds(r.writer));
+            answer(&mode_srv, &r, &SetModeResponse { accepted, message });
+        }
+        if let Some(r) = mdi_srv.receive() {
+            let text = r.request.text.clone();
+            let (accepted, message) = perform(Operation::Mdi { text }, &Who::Dds(r.writer));
+            answer(&mdi_srv, &r, &MdiResponse { accepted, message });
+        }
+        if let Some(r) = offsets_srv.receive() {
+            let (accepted, text) = perform(Operation::Offsets, &Who::Dds(r.writer));
+            let response = if accepted {
+                let (tools, work) = crate::offsets::parse_page(&text);
+                GetOffsetsResponse {
+                    accepted,
+                    message: format!("{} tool offsets, {} work offsets", tools.len(), work.len()),
+                    tools,
+                    work,
+                }
+            } else {
+                GetOffsetsResponse {
+                    accepted,
+                    message: text,
+                    ..GetOffsetsResponse::default()
+                }
+            };
+            answer(&offsets_srv, &r, &response);
+        }
+        if let Some(r) = tool_offset_srv.receive() {
+            let (number, values) = crate::offsets::tool_command(&r.request.offset);
+            let op = Operation::SetToolOffset { number, values };
+            let (accepted, message) = perform(op, &Who::Dds(r.writer));
+            answer(
+                &tool_offset_srv,
+                &r,
+                &SetToolOffsetResponse { accepted, message },
+            );
+        }
+        if let Some(r) = work_offset_srv.receive() {
+            let (accepted, message) = match crate::offsets::work_command(&r.request.offset) {
+                Ok((code, values)) => perform(
+                    Operation::SetWorkOffset { code, values },
+                    &Who::Dds(r.writer),
+                ),
+                Err(why) => {
+                    record(
+                        "set_work_offset",
+                        "malformed",
+                        &Who::Dds(r.writer),
+                        false,
+                        &why,
+                    );
+                    (false, why)
+                }
+            };
+            answer(
+                &work_offset_srv,
+                &r,
+                &SetWorkOffsetResponse { accepted, message },
+            );
+        }
+        if let Some(r) = get_parameters_srv.receive() {
+            let prefix = r.request.prefix.clone();
+            let (_, text) = perform(Operation::Parameters { prefix }, &Who::Dds(r.writer));
+            let mut response = GetParametersResponse::default();
+            for (name, value, pending) in crate::operation::parameter_rows(&text) {
+                response.names.push(name);
+                response.values.push(value);
+                response.pending.push(pending);
+            }
+            answer(&get_parameters_srv, &r, &response);
+        }
+        if let Some(r) = set_parameter_srv.receive() {
+            let (name, value) = (r.request.name.clone(), r.request.value.clone());
+            let op = Operation::SetParameter { name, value };
+            let (accepted, message) = perform(op, &Who::Dds(r.writer));
+            answer(
+                &set_parameter_srv,
+                &r,
+                &SetParameterResponse { accepted, message },
+            );
+        }
+        if let Some(r) = acknowledge_srv.receive() {
+            let (source, number) = (r.request.source.clone(), r.request.number);
+            let op = Operation::Acknowledge { source, number };
+            let (accepted, message) = perform(op, &Who::Dds(r.writer));
+            answer(
+                &acknowledge_srv,
+                &r,
+                &AcknowledgeAlarmResponse { accepted, message },
+            );
+        }
         if let Some(web) = web.as_mut() {
             for (who, op, pending) in web.take_operations() {
                 let (accepted, message) = perform(op, &who);
                 web.answer(pending, accepted, message);
             }
+        }
+        if alarms_changed {
+            publish_alarms(&active);
         }
         if let Some(p) = run_program.last_program.take() {
             last_program = Some(p);
@@ -497,6 +679,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             ("delete_program", delete.take_malformed()),
             ("set_overrides", overrides_srv.take_malformed()),
             ("robot_request", robot_srv.take_malformed()),
+            ("set_mode", mode_srv.take_malformed()),
+            ("mdi", mdi_srv.take_malformed()),
+            ("set_tool_offset", tool_offset_srv.take_malformed()),
+            ("set_work_offset", work_offset_srv.take_malformed()),
+            ("set_parameter", set_parameter_srv.take_malformed()),
+            ("acknowledge_alarm", acknowledge_srv.take_malformed()),
         ];
         for (command, list) in malformed {
             for (writer, why) in list {
@@ -513,6 +701,10 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     }
     Ok(())
 }
+
+/// hmi_bridge's alarm after a parameter write: the change waits for a restart (FANUC's
+/// alarm 000 "turn off power"; decisions D44).
+pub const PARAMETER_CHANGED_ALARM: u32 = 0;
 
 /// A robot request waiting for the machine to carry it out; copies of it (a client repeats a
 /// request it has no answer to yet) are answered together.
@@ -707,6 +899,10 @@ fn execute(
         Operation::SetWorkOffset { code, values } => {
             commands.call(ProgramCommand::SET_WORK_OFFSET, code, values)
         }
+        // Carried out by the bridge itself (its parameters and alarm list), in the loop.
+        Operation::Parameters { .. }
+        | Operation::SetParameter { .. }
+        | Operation::Acknowledge { .. } => (false, "not an interpreter command".into()),
     }
 }
 

@@ -45,6 +45,19 @@ pub enum Operation {
         code: String,
         values: String,
     },
+    /// Parameters whose names start with `prefix`.
+    Parameters {
+        prefix: String,
+    },
+    SetParameter {
+        name: String,
+        value: String,
+    },
+    /// An empty source and number 0: every active alarm.
+    Acknowledge {
+        source: String,
+        number: u32,
+    },
 }
 
 impl Operation {
@@ -64,6 +77,9 @@ impl Operation {
             Operation::Offsets => "get_offsets",
             Operation::SetToolOffset { .. } => "set_tool_offset",
             Operation::SetWorkOffset { .. } => "set_work_offset",
+            Operation::Parameters { .. } => "get_parameters",
+            Operation::SetParameter { .. } => "set_parameter",
+            Operation::Acknowledge { .. } => "acknowledge_alarm",
         }
     }
 
@@ -83,6 +99,9 @@ impl Operation {
             Operation::Mdi { text } => text.chars().take(200).collect(),
             Operation::SetToolOffset { number, values } => format!("{number}: {values}"),
             Operation::SetWorkOffset { code, values } => format!("{code}: {values}"),
+            Operation::Parameters { prefix } => prefix.clone(),
+            Operation::SetParameter { name, value } => format!("{name} = {value}"),
+            Operation::Acknowledge { source, number } => format!("{source} {number}"),
             Operation::Reset | Operation::List | Operation::Offsets => String::new(),
         }
     }
@@ -99,8 +118,35 @@ impl Operation {
                 | Operation::Mdi { .. }
                 | Operation::SetToolOffset { .. }
                 | Operation::SetWorkOffset { .. }
+                | Operation::SetParameter { .. }
         )
     }
+
+    /// Reading changes nothing: it is an event only when refused.
+    pub fn reads(&self) -> bool {
+        matches!(
+            self,
+            Operation::Read { .. } | Operation::Offsets | Operation::Parameters { .. }
+        )
+    }
+}
+
+/// Parameter rows as one text (`name<TAB>value<TAB>pending` lines), as `List` answers.
+pub fn parameter_text(rows: &[crate::parameters::Row]) -> String {
+    rows.iter()
+        .map(|(n, v, p)| format!("{n}\t{v}\t{p}"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The rows of [`parameter_text`] again.
+pub fn parameter_rows(text: &str) -> Vec<crate::parameters::Row> {
+    text.lines()
+        .filter_map(|line| {
+            let mut f = line.splitn(3, '\t');
+            Some((f.next()?.into(), f.next()?.into(), f.next()?.into()))
+        })
+        .collect()
 }
 
 /// The interpreter's program list (`name<TAB>size` lines) as names and sizes.
@@ -126,6 +172,21 @@ mod tests {
         }
         .moves());
         assert_eq!(Operation::Mode { mode: 1 }.detail(), "MDI");
+        assert!(Operation::SetParameter {
+            name: "servo.lookahead".into(),
+            value: "8".into()
+        }
+        .moves());
+        assert!(!Operation::Acknowledge {
+            source: String::new(),
+            number: 0
+        }
+        .moves());
+        let rows = vec![
+            ("a.b".to_string(), "1.0".to_string(), String::new()),
+            ("c".to_string(), "x y".to_string(), "z".to_string()),
+        ];
+        assert_eq!(parameter_rows(&parameter_text(&rows)), rows);
         assert_eq!(
             program_list("O0001\t95\nMDI\t12\nbroken line\n"),
             [("O0001".to_string(), 95), ("MDI".to_string(), 12)]

@@ -563,3 +563,15 @@ fn gtc2e_m(n: u32) -> Option<M> {
         _ => return None,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The launch config accepts exactly the dialects the interpreter knows.
+    #[test]
+    fn the_configs_dialect_list_is_the_interpreters() {
+        let names: Vec<&str> = Dialect::ALL.iter().map(|d| d.name()).collect();
+        assert_eq!(names, cnc_runtime::config::DIALECTS);
+    }
+}

@@ -73,6 +73,9 @@ fn dds_loop(
     let stats_pub = ros.publisher::<ServoStats>(&topics::SERVO_STATS)?;
     let alarms = AlarmReporter::new(&mut ros, "motion")?;
     let axes = &cfg.machine.axes;
+    // Motion's alarms are latched, as the manuals' are: they stay until reset (`000` §2.4,
+    // §13.1.3; alarms 53/64 "press RESET"). One whose cause persists is raised again after the reset.
+    let mut raised = std::collections::BTreeSet::new();
     while !shutdown.requested() {
         let mut idle = true;
         while let Ok(Some((m, _))) = blocks.take() {
@@ -88,6 +91,7 @@ fn dds_loop(
                 }
                 Err(why) => {
                     let text = format!("block refused: {why}");
+                    raised.insert(alarm::BAD_BLOCK);
                     alarms.raise(alarms.alarm(
                         alarm::BAD_BLOCK,
                         Alarm::SEVERITY_ERROR,
@@ -100,6 +104,11 @@ fn dds_loop(
         }
         while let Ok(Some((c, _))) = commands.take() {
             idle = false;
+            if c.command == ProgramCommand::RESET {
+                for number in std::mem::take(&mut raised) {
+                    alarms.clear(number);
+                }
+            }
             let _ = to_servo.send(Input::Command(c.command));
         }
         loop {
@@ -130,6 +139,7 @@ fn dds_loop(
                 }
                 Ok(Report::Stats(s)) => publish(&stats_pub, s),
                 Ok(Report::Alarm(number, text, line)) => {
+                    raised.insert(number);
                     alarms.raise(alarms.alarm(number, Alarm::SEVERITY_ERROR, &text, "", line))
                 }
                 Err(TryRecvError::Empty) => break,
@@ -229,7 +239,11 @@ fn servo_loop(
                 Input::Block(b) => motion.push(b),
                 Input::Command(ProgramCommand::FEED_HOLD) => motion.feed_hold(),
                 Input::Command(ProgramCommand::CYCLE_STOP) => motion.cycle_stop(),
-                Input::Command(ProgramCommand::RESET) => motion.reset(),
+                Input::Command(ProgramCommand::RESET) => {
+                    motion.reset();
+                    // A PLC still silent is reported again (its alarm was cleared by reset).
+                    plc.reported = false;
+                }
                 Input::Command(ProgramCommand::START) => motion.cycle_start(),
                 Input::Command(_) => {}
             }

@@ -28,6 +28,7 @@ impl AlarmReporter {
             program: program.into(),
             line,
             stamp: stamp(),
+            acknowledged: false,
         }
     }
 

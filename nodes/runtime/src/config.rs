@@ -60,7 +60,7 @@ impl Default for HmiConfig {
 pub struct MachineConfig {
     /// ROS 2 namespace of every topic and service, e.g. `lathe1` → `/lathe1/spindle`.
     pub namespace: String,
-    /// Program dialect: `huaxing-lathe`, `gtc2e-lathe` or `iso-lathe`.
+    /// Program dialect: one of [`DIALECTS`].
     pub dialect: String,
     pub axes: Vec<AxisEntry>,
     /// Arc plane as (horizontal, vertical) axis names; G02 is clockwise seen this way.
@@ -85,7 +85,15 @@ pub struct MachineConfig {
     /// macro; absent: T goes to the PLC.
     #[serde(default)]
     pub tool_change_macro: Option<u32>,
+    /// Where parameters written from the cell (SetParameter) are stored; they are applied over
+    /// this file at start (decisions D44). Absent: parameters cannot be written.
+    #[serde(default)]
+    pub parameter_file: Option<std::path::PathBuf>,
 }
+
+/// The program dialects a launch config may name (the interpreter's `Dialect::from_name`
+/// knows each; its tests check that).
+pub const DIALECTS: [&str; 4] = ["huaxing-lathe", "gtc2e-lathe", "iso-lathe", "fanuc-mill"];
 
 /// One row of the offset page (`000` §5.2, `002` §3.7): geometry and wear (X as diameter),
 /// nose radius and imaginary tip direction 0–9.
@@ -482,9 +490,27 @@ impl LaunchConfig {
         Ok(cfg)
     }
 
+    /// Reads the launch config and applies the parameter file over it. A parameter file that
+    /// does not apply stops the start with its entry named: the machine never runs on
+    /// parameters nobody checked.
     pub fn load(path: &std::path::Path) -> Result<Self, String> {
         let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        Self::from_yaml(&text).map_err(|e| format!("{}: {e}", path.display()))
+        let cfg = Self::from_yaml(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        cfg.with_parameter_file()
+    }
+
+    /// This config with the written parameters of `machine.parameter_file` applied.
+    pub fn with_parameter_file(self) -> Result<Self, String> {
+        let Some(file) = self.machine.parameter_file.clone() else {
+            return Ok(self);
+        };
+        let overlay = crate::parameters::load_file(&file)?;
+        crate::parameters::apply(self, &overlay).map_err(|e| {
+            format!(
+                "parameter file {}: {e} (correct or remove the entry)",
+                file.display()
+            )
+        })
     }
 
     /// `G54` → 0 … `G59` → 5.
@@ -500,8 +526,15 @@ impl LaunchConfig {
         }
     }
 
-    fn validate(&self) -> Result<(), String> {
+    pub(crate) fn validate(&self) -> Result<(), String> {
         let ns = &self.machine.namespace;
+        if !DIALECTS.contains(&self.machine.dialect.as_str()) {
+            return Err(format!(
+                "machine.dialect {:?}: one of {}",
+                self.machine.dialect,
+                DIALECTS.join(", ")
+            ));
+        }
         if ns.is_empty()
             || !ns.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
             || ns.starts_with(|c: char| c.is_ascii_digit())

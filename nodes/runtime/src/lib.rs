@@ -6,6 +6,7 @@ pub mod clock;
 pub mod config;
 pub mod dds;
 pub mod lifecycle;
+pub mod parameters;
 pub mod persist;
 pub mod raw;
 pub mod shm;
