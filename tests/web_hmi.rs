@@ -30,6 +30,10 @@ fn the_operator_runs_a_program_from_the_web_hmi_in_chromium() {
     );
     let mut cfg = common::sim_lathe(DOMAIN);
     cfg.hmi.web_address = ADDRESS.into();
+    let parameter_file =
+        std::env::temp_dir().join(format!("cnc_web_parameters_{}.yaml", std::process::id()));
+    let _ = std::fs::remove_file(&parameter_file);
+    cfg.machine.parameter_file = Some(parameter_file.clone());
     let cell = Cell::start(&cfg).expect("cell starts");
     let mut ros = RosNode::new(&cfg.network, "lathe1", "web_hmi_test").expect("node");
     let events = ros
@@ -89,6 +93,15 @@ fn the_operator_runs_a_program_from_the_web_hmi_in_chromium() {
     assert!(from_page("set_mode", true) >= 1, "{seen:#?}");
     assert!(from_page("set_overrides", false) >= 1, "{seen:#?}");
     assert!(from_page("mdi", true) >= 1, "{seen:#?}");
+    assert!(from_page("set_parameter", true) >= 1, "{seen:#?}");
+    assert!(from_page("acknowledge_alarm", true) >= 1, "{seen:#?}");
+    // The written parameter waits in the file for the next start.
+    let next = cfg
+        .clone()
+        .with_parameter_file()
+        .expect("parameter file applies");
+    assert_eq!(next.servo.lookahead, 12);
+    let _ = std::fs::remove_file(&parameter_file);
     let (_, failed) = cell.stop();
     assert!(failed.is_empty(), "nodes failed: {failed:?}");
 }

@@ -113,6 +113,18 @@ async function waitFor(what, check, seconds) {
   await waitFor("the MDI block to finish", async () => (await text("program")) === "MDI" && (await text("execution")) === "PROGRAM_COMPLETED", 20);
   const x = await page.$eval("#axes tr", (r) => Number(r.children[2].textContent));
   if (Math.abs(x - 70) > 0.01) fail(`work X at ${x} after MDI G00 X70`);
+  // Parameters: the table, a write in MDI mode waiting for the next start, its alarm seen.
+  await waitFor("the parameter table", async () => (await page.$$eval("#parameters tr", (r) => r.length)) > 20, 10);
+  const paramRows = await page.$$eval("#parameters tr", (r) => r.length);
+  await page.fill("#param_name", "servo.lookahead");
+  await page.fill("#param_value", "12");
+  await page.click("#param_set");
+  await waitFor("the parameter write", async () => (await text("message")).includes("stored"), 10);
+  await waitFor("the pending value", async () =>
+    (await page.$$eval("#parameters tr[data-name='servo.lookahead'] td", (c) => c.map((x) => x.textContent))).join("|").endsWith("|12"), 10);
+  await waitFor("the restart alarm", async () => (await text("alarms")).includes("restart the cell"), 10);
+  await page.click("#acknowledge");
+  await waitFor("the alarm marked seen", async () => (await page.$$eval("#alarms li.seen", (l) => l.length)) === 1, 10);
   // An out-of-range override is refused at the bridge.
   await page.evaluate(() => send({ op: "overrides", feed: 7, spindle: 100, rapid: 100 }));
   await waitFor("the override refusal", async () => (await text("message")).includes("feed override 7 %"), 10);
@@ -120,6 +132,6 @@ async function waitFor(what, check, seconds) {
   await page.click("#mode_set");
   await waitFor("AUTO mode", async () => (await text("mode")) === "AUTO", 10);
 
-  console.log(JSON.stringify({ first, second, points, rungs, parts: Number(await text("parts")) }));
+  console.log(JSON.stringify({ first, second, points, rungs, paramRows, parts: Number(await text("parts")) }));
   await browser.close();
 })().catch((e) => fail(e.stack || String(e)));

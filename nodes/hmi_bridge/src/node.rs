@@ -215,9 +215,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let mut web = if cfg.hmi.web_address.is_empty() {
         None
     } else {
-        let parameters = serde_json::to_value(&cfg.machine).unwrap_or_default();
         let axes = cfg.machine.axes.iter().map(|a| a.name.clone()).collect();
-        match WebHmi::start(&cfg.hmi.web_address, axes, cfg.diameter_axes(), parameters) {
+        match WebHmi::start(&cfg.hmi.web_address, axes, cfg.diameter_axes()) {
             Ok(w) => Some(w),
             Err(e) => {
                 log::error!("hmi_bridge: {e}; the web HMI is not served");
@@ -292,6 +291,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         if changed {
             publish_alarms(&active);
+            if let Some(w) = web.as_mut() {
+                w.view.set_active_alarms(active.alarms());
+            }
         }
         while let Ok(Some((m, _))) = motion_sub.take() {
             motion_run = (m.run_id, m.done_seq);
@@ -574,6 +576,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         if alarms_changed {
             publish_alarms(&active);
+            if let Some(w) = web.as_mut() {
+                w.view.set_active_alarms(active.alarms());
+            }
         }
         if let Some(p) = run_program.last_program.take() {
             last_program = Some(p);
@@ -702,8 +707,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     Ok(())
 }
 
-/// hmi_bridge's alarm after a parameter write: the change waits for a restart (FANUC's
-/// alarm 000 "turn off power"; decisions D44).
+/// hmi_bridge's alarm after a parameter write: the change waits for a restart (FANUC P/S
+/// alarm 000 "power off required", `003` Appendix A.4; decisions D44).
 pub const PARAMETER_CHANGED_ALARM: u32 = 0;
 
 /// A robot request waiting for the machine to carry it out; copies of it (a client repeats a

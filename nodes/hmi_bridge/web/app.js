@@ -9,6 +9,7 @@ let listingName = null;
 let ladder = null;
 let signals = null;
 let lastLine = -1;
+let parameters = [];
 
 const STEPS = [0, 10, 15, 20, 25, 30, 35, 40, 50, 60, 70, 80, 90, 100, 125, 150];
 for (const id of ["feed_ov", "spindle_ov"]) {
@@ -32,6 +33,7 @@ function connect() {
     $("link").textContent = "online";
     $("link").className = "on";
     send({ op: "list" });
+    send({ op: "parameters" });
   };
   ws.onclose = () => {
     $("link").textContent = "offline";
@@ -88,7 +90,7 @@ const handlers = {
     }
     $("parts").textContent = m.parts ? m.parts.count : 0;
     $("alarms").innerHTML = (m.alarms || [])
-      .map((a) => `<li>${a.number} ${escape(a.text)}${a.line ? ` (line ${a.line})` : ""} [${a.source}]</li>`)
+      .map((a) => `<li class="${a.acknowledged ? "seen" : "unseen"}">${a.number} ${escape(a.text)}${a.line ? ` (line ${a.line})` : ""} [${a.source}]${a.acknowledged ? " (seen)" : ""}</li>`)
       .join("");
     for (const h of m.history || []) handlers.history({ entry: h });
     for (const c of m.commands || []) handlers.command({ entry: c });
@@ -111,7 +113,8 @@ const handlers = {
   },
   reply(m) {
     // Reads answer with their data; the message line is for commands.
-    if (m.accepted && ["read_program", "list_programs", "get_offsets"].includes(m.op)) return;
+    if (m.accepted && ["read_program", "list_programs", "get_offsets", "get_parameters"].includes(m.op)) return;
+    if (m.accepted && m.op === "set_parameter") send({ op: "parameters" });
     $("message").textContent = `${m.op || "request"}: ${m.message}`;
     $("message").className = m.accepted ? "accepted" : "refused";
     if (m.accepted && ["load_program", "delete_program"].includes(m.op)) send({ op: "list" });
@@ -136,7 +139,8 @@ const handlers = {
     $("works").innerHTML = works.join("");
   },
   parameters(m) {
-    $("parameters").textContent = JSON.stringify(m.parameters, null, 1);
+    parameters = m.rows || [];
+    showParameters();
   },
   ladder(m) {
     ladder = m;
@@ -149,6 +153,18 @@ const handlers = {
     drawLadder();
   },
 };
+
+// The parameter table, filtered; a row's click puts its name in the write line.
+function showParameters() {
+  const filter = $("param_filter").value.trim();
+  $("parameters").innerHTML = parameters
+    .filter(([name]) => !filter || name.includes(filter))
+    .map(([name, value, pending]) => `<tr data-name="${escape(name)}"><td>${escape(name)}</td><td>${escape(value)}</td><td>${escape(pending)}</td></tr>`)
+    .join("");
+  for (const row of $("parameters").children) {
+    row.onclick = () => { $("param_name").value = row.dataset.name; };
+  }
+}
 
 function escape(s) {
   return String(s).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" })[c]);
@@ -235,4 +251,7 @@ $("offsets_read").onclick = () => send({ op: "offsets" });
 $("tool_set").onclick = () => send({ op: "set_tool_offset", number: $("tool_no").value, values: $("tool_values").value });
 $("work_set").onclick = () => send({ op: "set_work_offset", code: $("work_code").value, values: $("work_values").value });
 $("ladder_filter").oninput = drawLadder;
+$("acknowledge").onclick = () => send({ op: "acknowledge" });
+$("param_set").onclick = () => send({ op: "set_parameter", name: $("param_name").value, value: $("param_value").value });
+$("param_filter").oninput = showParameters;
 connect();

@@ -31,26 +31,19 @@ pub struct WebHmi {
     server: WebServer,
     pages: BTreeMap<u64, Outbox>,
     pub view: View,
-    /// Sent once to every page: the machine's parameters and the ladder.
-    parameters: Value,
+    /// Sent once to every page, and again when it changes.
     ladder: Option<Value>,
     last_frame: Instant,
 }
 
 impl WebHmi {
-    pub fn start(
-        address: &str,
-        axes: Vec<String>,
-        diameter: Vec<bool>,
-        parameters: Value,
-    ) -> Result<WebHmi, String> {
+    pub fn start(address: &str, axes: Vec<String>, diameter: Vec<bool>) -> Result<WebHmi, String> {
         let server = WebServer::start(address)?;
         log::info!("web HMI on http://{}/", server.address);
         Ok(WebHmi {
             server,
             pages: BTreeMap::new(),
             view: View::new(axes, diameter),
-            parameters,
             ladder: None,
             last_frame: Instant::now(),
         })
@@ -97,8 +90,6 @@ impl WebHmi {
                     self.pages.insert(id, outbox);
                     let welcome = self.view.welcome();
                     self.send(id, &welcome);
-                    let parameters = json!({"type": "parameters", "parameters": self.parameters});
-                    self.send(id, &parameters);
                     if let Some(l) = self.ladder.clone() {
                         self.send(id, &l);
                     }
@@ -133,6 +124,13 @@ impl WebHmi {
                 Some(json!({"type": "program", "name": name, "text": message}))
             }
             (Operation::Offsets, true) => Some(json!({"type": "offsets", "text": message})),
+            (Operation::Parameters { .. }, true) => {
+                let rows: Vec<Value> = crate::operation::parameter_rows(&message)
+                    .into_iter()
+                    .map(|(name, value, pending)| json!([name, value, pending]))
+                    .collect();
+                Some(json!({"type": "parameters", "rows": rows}))
+            }
             (Operation::List, true) => {
                 let list: Vec<Value> = crate::operation::program_list(&message)
                     .into_iter()

@@ -82,6 +82,24 @@ fn operation(v: &Value) -> Result<Operation, String> {
             code: string(v, "code")?,
             values: string(v, "values")?,
         },
+        "parameters" => Operation::Parameters {
+            prefix: string(v, "prefix").unwrap_or_default(),
+        },
+        "set_parameter" => Operation::SetParameter {
+            name: string(v, "name")?,
+            value: string(v, "value")?,
+        },
+        // Without source and number: every active alarm.
+        "acknowledge" => Operation::Acknowledge {
+            source: string(v, "source").unwrap_or_default(),
+            number: match v.get("number") {
+                None => 0,
+                Some(n) => n
+                    .as_u64()
+                    .and_then(|n| u32::try_from(n).ok())
+                    .ok_or("number: an alarm number")?,
+            },
+        },
         other => return Err(format!("unknown op {other:?}")),
     })
 }
@@ -101,6 +119,21 @@ mod tests {
                 })
             )
         );
+        assert_eq!(
+            parse(r#"{"op":"acknowledge"}"#).1,
+            Ok(Operation::Acknowledge {
+                source: String::new(),
+                number: 0
+            })
+        );
+        assert_eq!(
+            parse(r#"{"op":"set_parameter","name":"servo.lookahead","value":"8"}"#).1,
+            Ok(Operation::SetParameter {
+                name: "servo.lookahead".into(),
+                value: "8".into()
+            })
+        );
+        assert!(parse(r#"{"op":"acknowledge","number":-3}"#).1.is_err());
         assert_eq!(
             parse(r#"{"id":4,"op":"mode","mode":"mdi"}"#).1,
             Ok(Operation::Mode {

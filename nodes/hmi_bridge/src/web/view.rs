@@ -186,6 +186,14 @@ impl View {
         }
     }
 
+    /// The bridge's active list, acknowledgements included, replaces what the events built.
+    pub fn set_active_alarms(&mut self, alarms: Vec<cnc_msgs::msg::Alarm>) {
+        self.active = alarms
+            .into_iter()
+            .map(|a| ((a.source.clone(), a.number), a))
+            .collect();
+    }
+
     pub fn on_command_event(&mut self, e: &CommandEvent) {
         let entry = json!({
             "time": stamp_seconds(&e.stamp),
@@ -279,6 +287,7 @@ impl View {
             "alarms": self.active.values().map(|a| json!({
                 "number": a.number, "severity": a.severity, "text": a.text,
                 "source": a.source, "program": a.program, "line": a.line,
+                "acknowledged": a.acknowledged,
             })).collect::<Vec<_>>(),
             "path_reset": self.path_reset,
             "path": &self.path[path_from.min(self.path.len())..],
