@@ -276,14 +276,6 @@ service!(
     RobotRequestResponse
 );
 
-impl RobotRequestResponse {
-    pub fn refused(message: String) -> Self {
-        RobotRequestResponse {
-            accepted: false,
-            message,
-        }
-    }
-}
 service!(
     ListPrograms,
     "ListPrograms",
@@ -340,3 +332,42 @@ service!(
     AcknowledgeAlarmRequest,
     AcknowledgeAlarmResponse
 );
+
+/// Answers of the services that say yes or no with a reason: `refused(why)` is the no.
+macro_rules! refusable {
+    ($($resp:ident),*) => {$(
+        impl $resp {
+            pub fn refused(message: String) -> Self {
+                $resp {
+                    accepted: false,
+                    message,
+                }
+            }
+        }
+    )*};
+}
+refusable!(
+    LoadProgramResponse,
+    StartProgramResponse,
+    StopResponse,
+    ResetResponse,
+    RobotRequestResponse,
+    DeleteProgramResponse,
+    SetOverridesResponse,
+    SetToolOffsetResponse,
+    SetWorkOffsetResponse,
+    SetModeResponse,
+    MdiResponse,
+    SetParameterResponse,
+    AcknowledgeAlarmResponse
+);
+
+impl GetOffsetsResponse {
+    pub fn refused(message: String) -> Self {
+        GetOffsetsResponse {
+            accepted: false,
+            message,
+            ..Default::default()
+        }
+    }
+}

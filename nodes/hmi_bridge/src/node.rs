@@ -91,96 +91,43 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let participant = ros.participant();
     let sq: QosPolicies = (&qos::services()).into();
     let load = DualServer::<LoadProgram>::new(&participant, &ns, "load_program", sq.clone())?
-        .refusing(|message| LoadProgramResponse {
-            accepted: false,
-            message,
-        });
+        .refusing(LoadProgramResponse::refused);
     let start = DualServer::<StartProgram>::new(&participant, &ns, "start_program", sq.clone())?
-        .refusing(|message| StartProgramResponse {
-            accepted: false,
-            message,
-        });
-    let stop =
-        DualServer::<Stop>::new(&participant, &ns, "stop", sq.clone())?.refusing(|message| {
-            StopResponse {
-                accepted: false,
-                message,
-            }
-        });
-    let reset =
-        DualServer::<Reset>::new(&participant, &ns, "reset", sq.clone())?.refusing(|message| {
-            ResetResponse {
-                accepted: false,
-                message,
-            }
-        });
+        .refusing(StartProgramResponse::refused);
+    let stop = DualServer::<Stop>::new(&participant, &ns, "stop", sq.clone())?
+        .refusing(StopResponse::refused);
+    let reset = DualServer::<Reset>::new(&participant, &ns, "reset", sq.clone())?
+        .refusing(ResetResponse::refused);
     let list = DualServer::<ListPrograms>::new(&participant, &ns, "list_programs", sq.clone())?;
     let delete = DualServer::<DeleteProgram>::new(&participant, &ns, "delete_program", sq.clone())?
-        .refusing(|message| DeleteProgramResponse {
-            accepted: false,
-            message,
-        });
+        .refusing(DeleteProgramResponse::refused);
     let overrides_srv =
-        DualServer::<SetOverrides>::new(&participant, &ns, "set_overrides", sq.clone())?.refusing(
-            |message| SetOverridesResponse {
-                accepted: false,
-                message,
-            },
-        );
+        DualServer::<SetOverrides>::new(&participant, &ns, "set_overrides", sq.clone())?
+            .refusing(SetOverridesResponse::refused);
     let panel = ros.publisher::<Overrides>(&topics::PANEL_OVERRIDES)?;
-    let mode_srv = DualServer::<SetMode>::new(&participant, &ns, "set_mode", sq.clone())?.refusing(
-        |message| SetModeResponse {
-            accepted: false,
-            message,
-        },
-    );
-    let mdi_srv =
-        DualServer::<Mdi>::new(&participant, &ns, "mdi", sq.clone())?.refusing(|message| {
-            MdiResponse {
-                accepted: false,
-                message,
-            }
-        });
+    let mode_srv = DualServer::<SetMode>::new(&participant, &ns, "set_mode", sq.clone())?
+        .refusing(SetModeResponse::refused);
+    let mdi_srv = DualServer::<Mdi>::new(&participant, &ns, "mdi", sq.clone())?
+        .refusing(MdiResponse::refused);
     let offsets_srv = DualServer::<GetOffsets>::new(&participant, &ns, "get_offsets", sq.clone())?
-        .refusing(|message| GetOffsetsResponse {
-            accepted: false,
-            message,
-            ..GetOffsetsResponse::default()
-        });
+        .refusing(GetOffsetsResponse::refused);
     let tool_offset_srv =
         DualServer::<SetToolOffset>::new(&participant, &ns, "set_tool_offset", sq.clone())?
-            .refusing(|message| SetToolOffsetResponse {
-                accepted: false,
-                message,
-            });
+            .refusing(SetToolOffsetResponse::refused);
     let work_offset_srv =
         DualServer::<SetWorkOffset>::new(&participant, &ns, "set_work_offset", sq.clone())?
-            .refusing(|message| SetWorkOffsetResponse {
-                accepted: false,
-                message,
-            });
+            .refusing(SetWorkOffsetResponse::refused);
     let get_parameters_srv =
         DualServer::<GetParameters>::new(&participant, &ns, "get_parameters", sq.clone())?;
     let set_parameter_srv =
-        DualServer::<SetParameter>::new(&participant, &ns, "set_parameter", sq.clone())?.refusing(
-            |message| SetParameterResponse {
-                accepted: false,
-                message,
-            },
-        );
+        DualServer::<SetParameter>::new(&participant, &ns, "set_parameter", sq.clone())?
+            .refusing(SetParameterResponse::refused);
     let acknowledge_srv =
         DualServer::<AcknowledgeAlarm>::new(&participant, &ns, "acknowledge_alarm", sq.clone())?
-            .refusing(|message| AcknowledgeAlarmResponse {
-                accepted: false,
-                message,
-            });
+            .refusing(AcknowledgeAlarmResponse::refused);
     let robot_srv =
-        DualServer::<RobotRequest>::new(&participant, &ns, "robot_request", sq.clone())?.refusing(
-            |message| RobotRequestResponse {
-                accepted: false,
-                message,
-            },
-        );
+        DualServer::<RobotRequest>::new(&participant, &ns, "robot_request", sq.clone())?
+            .refusing(RobotRequestResponse::refused);
     let mut run_program = RunProgramServer::new(&participant, &ns, sq)?;
     let robot_signals = ros.publisher::<SimInput>(&topics::ROBOT_SIGNALS)?;
     let handshake_sub = ros.subscription::<RobotHandshake>(&topics::ROBOT_HANDSHAKE)?;
@@ -496,11 +443,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                     work,
                 }
             } else {
-                GetOffsetsResponse {
-                    accepted,
-                    message: text,
-                    ..GetOffsetsResponse::default()
-                }
+                GetOffsetsResponse::refused(text)
             };
             answer(&offsets_srv, &r, &response);
         }
