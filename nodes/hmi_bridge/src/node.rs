@@ -628,6 +628,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             ("set_overrides", overrides_srv.take_malformed()),
             ("robot_request", robot_srv.take_malformed()),
             ("set_mode", mode_srv.take_malformed()),
+            ("get_offsets", offsets_srv.take_malformed()),
+            ("get_parameters", get_parameters_srv.take_malformed()),
             ("mdi", mdi_srv.take_malformed()),
             ("set_tool_offset", tool_offset_srv.take_malformed()),
             ("set_work_offset", work_offset_srv.take_malformed()),

@@ -74,7 +74,8 @@ fn dds_loop(
     let alarms = AlarmReporter::new(&mut ros, "motion")?;
     let axes = &cfg.machine.axes;
     // Motion's alarms are latched, as the manuals' are: they stay until reset (`000` §2.4,
-    // §13.1.3; alarms 53/64 "press RESET"). One whose cause persists is raised again after the reset.
+    // §13.1.3; alarms 53/64 "press RESET"). One whose cause persists is raised again after
+    // the reset.
     let mut raised = std::collections::BTreeSet::new();
     while !shutdown.requested() {
         let mut idle = true;
