@@ -91,8 +91,6 @@ pub struct RunProgramServer {
     goal: Option<(GoalRun, Time)>,
     done: VecDeque<Done>,
     waiting: Vec<Request<RunProgramGetResultRequest>>,
-    /// The program of the last goal accepted.
-    pub last_program: Option<String>,
     /// Lines of each program loaded through this bridge, for the feedback's percentage.
     pub program_lines: std::collections::BTreeMap<String, u32>,
 }
@@ -140,7 +138,6 @@ impl RunProgramServer {
             done: VecDeque::new(),
             waiting: Vec::new(),
             program_lines: Default::default(),
-            last_program: None,
         })
     }
 
@@ -243,7 +240,6 @@ impl RunProgramServer {
                 let lines = self.program_lines.get(&goal.program).copied().unwrap_or(0);
                 let run = GoalRun::new(r.request.goal_id, goal.clone(), lines, run_id, now);
                 self.goal = Some((run, response.stamp.clone()));
-                self.last_program = Some(goal.program.clone());
             }
             if let Err(e) = self.send_goal.reply(&r, &response) {
                 log::error!("{e}");

@@ -15,8 +15,8 @@ use cnc_msgs::srv::*;
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::dds::{qos, stamp, RosNode};
 use cnc_runtime::topics;
-use cnc_runtime::MAX_PROGRAM_BYTES;
 use cnc_runtime::{LaunchConfig, Shutdown};
+use cnc_runtime::{MAX_PROGRAM_BYTES, MDI_PROGRAM};
 use ros2_client::dds::rustdds;
 use ros2_client::dds::rustdds::QosPolicies;
 use ros2_client::entities_info::ParticipantEntitiesInfo;
@@ -133,8 +133,6 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let handshake_sub = ros.subscription::<RobotHandshake>(&topics::ROBOT_HANDSHAKE)?;
     let mut handshake: Option<RobotHandshake> = None;
     let mut pending: Option<PendingRobot> = None;
-    // The program a robot's cycle start runs again: the last one started from outside.
-    let mut last_program: Option<String> = None;
     let events = ros.publisher::<CommandEvent>(&topics::COMMAND_EVENTS)?;
     let program_events_pub = ros.publisher::<ProgramEvent>(&topics::PROGRAM_EVENTS)?;
     let mut program_events = ProgramEvents::default();
@@ -232,7 +230,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         };
         while let Ok(Some((e, _))) = alarm_events.take() {
             if let Some(w) = web.as_mut() {
-                w.view.on_alarm_event(e.clone());
+                w.view.on_alarm_event(&e);
             }
             changed |= active.on_event(e);
         }
@@ -316,56 +314,23 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 Ok(())
             };
             let (accepted, message) = match checked {
-                Ok(()) => match &op {
-                    Operation::Parameters { prefix } => (
-                        true,
-                        crate::operation::parameter_text(&parameters.read(prefix)),
-                    ),
-                    Operation::SetParameter { name, value } => {
-                        match parameters.write(name, value, machine.as_ref()) {
-                            Ok(message) => {
-                                // A control asks for a power-off after a parameter change.
-                                let alarm = alarm_reporter.alarm(
-                                    PARAMETER_CHANGED_ALARM,
-                                    cnc_msgs::msg::Alarm::SEVERITY_WARNING,
-                                    &format!(
-                                        "parameter changed ({} pending): restart the cell to apply",
-                                        parameters.pending()
-                                    ),
-                                    "",
-                                    0,
-                                );
-                                active.on_event(AlarmEvent {
-                                    kind: AlarmEvent::RAISED,
-                                    alarm: alarm.clone(),
-                                });
-                                alarm_reporter.raise(alarm);
-                                alarms_changed = true;
-                                (true, message)
-                            }
-                            Err(why) => (false, why),
-                        }
-                    }
-                    Operation::Acknowledge { source, number } => {
-                        match active.acknowledge(source, *number) {
-                            Ok(message) => {
-                                alarms_changed = true;
-                                (true, message)
-                            }
-                            Err(why) => (false, why),
-                        }
-                    }
-                    _ => execute(&op, &mut commands, &panel, &mut run_program.program_lines),
-                },
+                Ok(()) => {
+                    let mut desk = Desk {
+                        commands: &mut commands,
+                        panel: &panel,
+                        program_lines: &mut run_program.program_lines,
+                        parameters: &mut parameters,
+                        alarms: &mut active,
+                        reporter: &alarm_reporter,
+                        machine: machine.as_ref(),
+                        alarms_changed: false,
+                    };
+                    let outcome = execute(&op, &mut desk);
+                    alarms_changed |= desk.alarms_changed;
+                    outcome
+                }
                 Err(why) => (false, why),
             };
-            if accepted {
-                if let Operation::Start { name } = &op {
-                    if !name.is_empty() {
-                        last_program = Some(name.clone());
-                    }
-                }
-            }
             // Reading is not a command: only what changes something, or is refused, is an event.
             if !op.reads() || !accepted {
                 record(op.command(), &op.detail(), who, accepted, &message);
@@ -517,20 +482,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 web.answer(pending, accepted, message);
             }
         }
-        if alarms_changed {
-            publish_alarms(&active);
-            if let Some(w) = web.as_mut() {
-                w.view.set_active_alarms(active.alarms());
-            }
-        }
-        if let Some(p) = run_program.last_program.take() {
-            last_program = Some(p);
-        }
         while let Ok(Some((h, _))) = handshake_sub.take() {
             handshake = Some(h);
         }
-        if let Some(r) = robot_srv.receive() {
-            busy = true;
+        let robot_request = robot_srv.receive();
+        let robot_busy = robot_request.is_some();
+        if let Some(r) = robot_request {
             let decided = decide_robot(&r, handshake.as_ref(), &may_move, pending.as_mut());
             match decided {
                 RobotDecision::Joined => {}
@@ -540,24 +497,20 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 }
                 RobotDecision::Go(op) => match op.signal() {
                     None => {
-                        let (accepted, message) = match &last_program {
-                            Some(p) if may_move(&r.writer).is_ok() => {
-                                commands.call(ProgramCommand::START, p, "")
+                        // Cycle start runs the selected program, as the panel's key does: the
+                        // one the machine ran last, never an MDI entry.
+                        let selected = machine
+                            .as_ref()
+                            .map(|m| m.program.clone())
+                            .filter(|p| !p.is_empty() && p != MDI_PROGRAM);
+                        let (accepted, message) = match selected {
+                            Some(name) => perform(Operation::Start { name }, &Who::Dds(r.writer)),
+                            None => {
+                                let why = "cycle start refused: no program started yet (start_program or RunProgram first)";
+                                record("robot_request", op.name(), &Who::Dds(r.writer), false, why);
+                                (false, why.to_string())
                             }
-                            Some(_) => (false, "cycle start refused: client not allowed".into()),
-                            None => (
-                                false,
-                                "cycle start refused: no program started yet (start_program or RunProgram first)"
-                                    .into(),
-                            ),
                         };
-                        record(
-                            "robot_request",
-                            op.name(),
-                            &Who::Dds(r.writer),
-                            accepted,
-                            &message,
-                        );
                         answer(&robot_srv, &r, &RobotRequestResponse { accepted, message });
                     }
                     Some((input, _)) => {
@@ -572,6 +525,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                         });
                     }
                 },
+            }
+        }
+        if alarms_changed {
+            publish_alarms(&active);
+            if let Some(w) = web.as_mut() {
+                w.view.set_active_alarms(active.alarms());
             }
         }
         if let Some(p) = pending.take() {
@@ -645,7 +604,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             feeds.feed(w);
             w.tick();
         }
-        if !busy {
+        if !busy && !robot_busy {
             std::thread::sleep(Duration::from_millis(2));
         }
     }
@@ -782,14 +741,24 @@ impl PanelFeeds {
     }
 }
 
-/// Carries out one operation through the interpreter's command path (access was checked by
-/// the caller): the one place every door's commands go through.
-fn execute(
-    op: &Operation,
-    commands: &mut Commands,
-    panel: &cnc_runtime::dds::Publisher<Overrides>,
-    program_lines: &mut BTreeMap<String, u32>,
-) -> (bool, String) {
+/// What operations act on: the interpreter's command path, the panel switches, and the
+/// bridge's own parameters and alarm list.
+struct Desk<'a> {
+    commands: &'a mut Commands,
+    panel: &'a cnc_runtime::dds::Publisher<Overrides>,
+    program_lines: &'a mut BTreeMap<String, u32>,
+    parameters: &'a mut Parameters,
+    alarms: &'a mut AlarmList,
+    reporter: &'a AlarmReporter,
+    machine: Option<&'a MachineState>,
+    /// Set when the active list changed (to be published).
+    alarms_changed: bool,
+}
+
+/// Carries out one operation (access was checked by the caller): the one place every door's
+/// commands go through.
+fn execute(op: &Operation, desk: &mut Desk) -> (bool, String) {
+    let commands = &mut *desk.commands;
     match op {
         Operation::Load { name, text } => {
             if text.len() > MAX_PROGRAM_BYTES {
@@ -804,7 +773,7 @@ fn execute(
             let (accepted, message) = commands.call(ProgramCommand::LOAD, name, text);
             if accepted {
                 let lines = text.lines().count().min(u32::MAX as usize) as u32;
-                program_lines.insert(name.clone(), lines);
+                desk.program_lines.insert(name.clone(), lines);
             }
             (accepted, message)
         }
@@ -822,7 +791,7 @@ fn execute(
         Operation::Delete { name } => {
             let (accepted, message) = commands.call(ProgramCommand::DELETE, name, "");
             if accepted {
-                program_lines.remove(name);
+                desk.program_lines.remove(name);
             }
             (accepted, message)
         }
@@ -833,7 +802,7 @@ fn execute(
                 rapid_percent: o.rapid_percent,
             };
             match crate::overrides::check(&request)
-                .and_then(|o| panel.publish(o).map_err(|e| format!("not sent: {e}")))
+                .and_then(|o| desk.panel.publish(o).map_err(|e| format!("not sent: {e}")))
             {
                 Ok(()) => (true, format!("overrides set: {}", op.detail())),
                 Err(why) => (false, why),
@@ -849,10 +818,44 @@ fn execute(
         Operation::SetWorkOffset { code, values } => {
             commands.call(ProgramCommand::SET_WORK_OFFSET, code, values)
         }
-        // Carried out by the bridge itself (its parameters and alarm list), in the loop.
-        Operation::Parameters { .. }
-        | Operation::SetParameter { .. }
-        | Operation::Acknowledge { .. } => (false, "not an interpreter command".into()),
+        Operation::Parameters { prefix } => (
+            true,
+            crate::operation::parameter_text(&desk.parameters.read(prefix)),
+        ),
+        Operation::SetParameter { name, value } => {
+            match desk.parameters.write(name, value, desk.machine) {
+                Ok(message) => {
+                    // A control asks for a power-off after a parameter change.
+                    let text = format!(
+                        "parameter changed ({} pending): restart the cell to apply",
+                        desk.parameters.pending()
+                    );
+                    let alarm = desk.reporter.alarm(
+                        PARAMETER_CHANGED_ALARM,
+                        cnc_msgs::msg::Alarm::SEVERITY_WARNING,
+                        &text,
+                        "",
+                        0,
+                    );
+                    desk.alarms.on_event(AlarmEvent {
+                        kind: AlarmEvent::RAISED,
+                        alarm: alarm.clone(),
+                    });
+                    desk.reporter.raise(alarm);
+                    desk.alarms_changed = true;
+                    (true, message)
+                }
+                Err(why) => (false, why),
+            }
+        }
+        Operation::Acknowledge { source, number } => match desk.alarms.acknowledge(source, *number)
+        {
+            Ok(message) => {
+                desk.alarms_changed = true;
+                (true, message)
+            }
+            Err(why) => (false, why),
+        },
     }
 }
 

@@ -19,7 +19,7 @@ use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{stamp, RosNode};
 use cnc_runtime::topics;
-use cnc_runtime::{LaunchConfig, Shutdown};
+use cnc_runtime::{LaunchConfig, Shutdown, MDI_PROGRAM};
 
 use cnc_msgs::canon::to_motion_block;
 
@@ -41,8 +41,6 @@ pub fn valid_program_name(name: &str) -> bool {
         && !name.starts_with('.')
 }
 
-/// The name an MDI entry is stored under in program memory.
-pub const MDI_PROGRAM: &str = "MDI";
 /// The longest MDI entry: a few blocks typed at the panel.
 pub const MAX_MDI_BYTES: usize = 4096;
 

@@ -17,3 +17,6 @@ pub use lifecycle::Shutdown;
 
 /// Largest program text accepted into program memory, bytes.
 pub const MAX_PROGRAM_BYTES: usize = 4 * 1024 * 1024;
+
+/// The name an MDI entry runs under in program memory (decisions D43).
+pub const MDI_PROGRAM: &str = "MDI";

@@ -66,7 +66,8 @@ pub struct View {
     spindle: Option<SpindleState>,
     parts: Option<PartCount>,
     overrides: Option<Overrides>,
-    active: BTreeMap<(String, u32), cnc_msgs::msg::Alarm>,
+    /// The bridge's active list (`AlarmList`), acknowledgements included.
+    active: Vec<cnc_msgs::msg::Alarm>,
     history: Log,
     commands: Log,
     path: Vec<[f64; 2]>,
@@ -168,8 +169,8 @@ impl View {
         self.signals = Some(s);
     }
 
-    pub fn on_alarm_event(&mut self, e: AlarmEvent) {
-        let key = (e.alarm.source.clone(), e.alarm.number);
+    /// An alarm raised or cleared, for the history (the active list comes from the bridge).
+    pub fn on_alarm_event(&mut self, e: &AlarmEvent) {
         let raised = e.kind == AlarmEvent::RAISED;
         let entry = json!({
             "time": stamp_seconds(&e.alarm.stamp),
@@ -179,19 +180,10 @@ impl View {
             "source": e.alarm.source,
         });
         self.history.push(entry, HISTORY);
-        if raised {
-            self.active.insert(key, e.alarm);
-        } else {
-            self.active.remove(&key);
-        }
     }
 
-    /// The bridge's active list, acknowledgements included, replaces what the events built.
     pub fn set_active_alarms(&mut self, alarms: Vec<cnc_msgs::msg::Alarm>) {
-        self.active = alarms
-            .into_iter()
-            .map(|a| ((a.source.clone(), a.number), a))
-            .collect();
+        self.active = alarms;
     }
 
     pub fn on_command_event(&mut self, e: &CommandEvent) {
@@ -284,7 +276,7 @@ impl View {
                 "feed": o.feed_percent, "spindle": o.spindle_percent, "rapid": o.rapid_percent,
             })),
             "parts": self.parts.as_ref().map(|p| json!({"count": p.count, "target": p.target})),
-            "alarms": self.active.values().map(|a| json!({
+            "alarms": self.active.iter().map(|a| json!({
                 "number": a.number, "severity": a.severity, "text": a.text,
                 "source": a.source, "program": a.program, "line": a.line,
                 "acknowledged": a.acknowledged,
@@ -415,17 +407,21 @@ mod tests {
             source: "plc".into(),
             ..Default::default()
         };
+        let mut list = crate::alarm_list::AlarmList::default();
         for kind in [AlarmEvent::RAISED, AlarmEvent::CLEARED] {
-            v.on_alarm_event(AlarmEvent {
+            let e = AlarmEvent {
                 kind,
                 alarm: alarm.clone(),
-            });
+            };
+            v.on_alarm_event(&e);
+            list.on_event(e);
+            v.set_active_alarms(list.alarms());
             let active = v.frame()["alarms"].as_array().map_or(0, Vec::len);
             assert_eq!(active, usize::from(kind == AlarmEvent::RAISED));
         }
         // Entries that come between two frames all go out with the next one.
         for number in [1000, 1001] {
-            v.on_alarm_event(AlarmEvent {
+            v.on_alarm_event(&AlarmEvent {
                 kind: AlarmEvent::RAISED,
                 alarm: cnc_msgs::msg::Alarm {
                     number,
