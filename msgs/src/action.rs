@@ -4,7 +4,6 @@
 
 use crate::msg::{Alarm, Time};
 use crate::ros_message;
-use crate::srv::RosService;
 
 /// `unique_identifier_msgs/UUID`: a goal's id, 16 bytes.
 pub type Uuid = [u8; 16];
@@ -139,29 +138,25 @@ ros_message! {
     }
 }
 
-/// `…/_action/send_goal`.
-pub struct RunProgramSendGoal;
-impl RosService for RunProgramSendGoal {
-    type Request = RunProgramSendGoalRequest;
-    type Response = RunProgramSendGoalResponse;
-    const TYPE_NAME: &'static str = "cnc_msgs/action/RunProgram_SendGoal";
-    const NAME: &'static str = "RunProgram_SendGoal";
-}
-
-/// `…/_action/get_result`.
-pub struct RunProgramGetResult;
-impl RosService for RunProgramGetResult {
-    type Request = RunProgramGetResultRequest;
-    type Response = RunProgramGetResultResponse;
-    const TYPE_NAME: &'static str = "cnc_msgs/action/RunProgram_GetResult";
-    const NAME: &'static str = "RunProgram_GetResult";
-}
-
-/// `…/_action/cancel_goal`.
-pub struct CancelGoal;
-impl RosService for CancelGoal {
-    type Request = CancelGoalRequest;
-    type Response = CancelGoalResponse;
-    const TYPE_NAME: &'static str = "action_msgs/srv/CancelGoal";
-    const NAME: &'static str = "CancelGoal";
-}
+// `…/_action/send_goal`, `…/_action/get_result`, `…/_action/cancel_goal`.
+crate::service!(
+    RunProgramSendGoal,
+    type "cnc_msgs/action/RunProgram_SendGoal",
+    "RunProgram_SendGoal",
+    RunProgramSendGoalRequest,
+    RunProgramSendGoalResponse
+);
+crate::service!(
+    RunProgramGetResult,
+    type "cnc_msgs/action/RunProgram_GetResult",
+    "RunProgram_GetResult",
+    RunProgramGetResultRequest,
+    RunProgramGetResultResponse
+);
+crate::service!(
+    CancelGoal,
+    type "action_msgs/srv/CancelGoal",
+    "CancelGoal",
+    CancelGoalRequest,
+    CancelGoalResponse
+);

@@ -243,14 +243,21 @@ ros_message! {
     }
 }
 
+/// Declares a service's marker type: `service!(Stop, "Stop", StopRequest, StopResponse)` for
+/// `cnc_msgs/srv/Stop`; with `type "pkg/…/Name"` first for a service of another kind (an
+/// action's).
+#[macro_export]
 macro_rules! service {
     ($marker:ident, $name:literal, $req:ident, $resp:ident) => {
+        $crate::service!($marker, type concat!("cnc_msgs/srv/", $name), $name, $req, $resp);
+    };
+    ($marker:ident, type $type_name:expr, $name:literal, $req:ident, $resp:ident) => {
         /// Marker type naming the service.
         pub struct $marker;
-        impl RosService for $marker {
+        impl $crate::srv::RosService for $marker {
             type Request = $req;
             type Response = $resp;
-            const TYPE_NAME: &'static str = concat!("cnc_msgs/srv/", $name);
+            const TYPE_NAME: &'static str = $type_name;
             const NAME: &'static str = $name;
         }
     };
