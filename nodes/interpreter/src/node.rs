@@ -96,7 +96,7 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
         );
     }
     for (code, axes) in &cfg.machine.work_offsets {
-        if let Some(i) = cfg.work_offset_index(code) {
+        if let Some(i) = cnc_runtime::config::work_offset_index(code) {
             let row = setup.offsets.work.entry(i).or_default();
             for (axis, &v) in axes {
                 if let Some(c) = axis.chars().next() {

@@ -88,15 +88,8 @@ pub fn set_work(
     text: &str,
     axes: &[char],
 ) -> Result<String, String> {
-    let index = match code.trim().to_ascii_uppercase().as_str() {
-        "G54" => 0u8,
-        "G55" => 1,
-        "G56" => 2,
-        "G57" => 3,
-        "G58" => 4,
-        "G59" => 5,
-        _ => return Err(format!("work offset {code:?} is not G54-G59 (alarm 62)")),
-    };
+    let index = cnc_runtime::config::work_offset_index(code)
+        .ok_or_else(|| format!("work offset {code:?} is not G54-G59 (alarm 62)"))?;
     let mut changes = Vec::new();
     for word in text.split_whitespace() {
         let (axis, v) = word

@@ -91,6 +91,19 @@ pub struct MachineConfig {
     pub parameter_file: Option<std::path::PathBuf>,
 }
 
+/// `G54` → 0 … `G59` → 5 (case and surrounding blanks ignored).
+pub fn work_offset_index(code: &str) -> Option<u8> {
+    match code.trim().to_ascii_uppercase().as_str() {
+        "G54" => Some(0),
+        "G55" => Some(1),
+        "G56" => Some(2),
+        "G57" => Some(3),
+        "G58" => Some(4),
+        "G59" => Some(5),
+        _ => None,
+    }
+}
+
 /// The program dialects a launch config may name (the interpreter's `Dialect::from_name`
 /// knows each; its tests check that).
 pub const DIALECTS: [&str; 4] = ["huaxing-lathe", "gtc2e-lathe", "iso-lathe", "fanuc-mill"];
@@ -513,19 +526,6 @@ impl LaunchConfig {
         })
     }
 
-    /// `G54` → 0 … `G59` → 5.
-    pub fn work_offset_index(&self, code: &str) -> Option<u8> {
-        match code.to_ascii_uppercase().as_str() {
-            "G54" => Some(0),
-            "G55" => Some(1),
-            "G56" => Some(2),
-            "G57" => Some(3),
-            "G58" => Some(4),
-            "G59" => Some(5),
-            _ => None,
-        }
-    }
-
     pub(crate) fn validate(&self) -> Result<(), String> {
         let ns = &self.machine.namespace;
         if !DIALECTS.contains(&self.machine.dialect.as_str()) {
@@ -629,7 +629,7 @@ impl LaunchConfig {
             }
         }
         for (code, axes) in &self.machine.work_offsets {
-            if self.work_offset_index(code).is_none() {
+            if work_offset_index(code).is_none() {
                 return Err(format!("machine.work_offsets: {code:?} is not G54..G59"));
             }
             for (axis, v) in axes {
