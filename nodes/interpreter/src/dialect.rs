@@ -66,6 +66,12 @@ pub enum G {
     Finishing,
     FaceGrooving,
     RadialGrooving,
+    /// G83 (axial, `radial` false) / G87 (radial) peck drilling (`000` §5.22.7).
+    Drilling {
+        radial: bool,
+    },
+    /// G07 K L: pause K s after every L mm of a G01; plain G07 cancels (`000` §5.6).
+    ChipBreak,
     // Huaxing program flow (`000` §5.12, §5.13).
     /// G21 (`high` false) / G23 (`high` true): input-conditioned range repeat.
     ConditionalRepeat {
@@ -310,13 +316,10 @@ fn huaxing_g(n: u32) -> Option<GCode> {
         40 => (0, Dwell),
         50 => (1, ThreePointArc { absolute: false }),
         51 => (1, ThreePointArc { absolute: true }),
-        70 => (
-            0,
-            Unsupported("G07 chip breaking needs feed interruption in motion"),
-        ),
+        70 => (0, ChipBreak),
         71 => (
             0,
-            Unsupported("G07.1 thread chip breaking needs oscillation in motion"),
+            Unsupported("G07.1 thread chip breaking needs an oscillation superimposed in motion"),
         ),
         80..=86 => (
             1,
@@ -380,10 +383,8 @@ fn huaxing_g(n: u32) -> Option<GCode> {
             1,
             Unsupported("G80 cancels rigid tapping, which needs a position spindle"),
         ),
-        830 | 870 => (
-            1,
-            Unsupported("G83/G87 drilling needs a C axis for hole positions"),
-        ),
+        830 => (1, Drilling { radial: false }),
+        870 => (1, Drilling { radial: true }),
         840 | 880 => (
             1,
             Unsupported("G84/G88 rigid tapping needs a position spindle"),

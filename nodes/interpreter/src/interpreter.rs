@@ -204,6 +204,10 @@ pub struct Interpreter {
     compound: compound::CompoundWords,
     /// G74/G75 retract per peck (`000` GS#43 default 1 mm).
     groove_retract: f64,
+    /// G83/G87 modal words (`000` §5.22.7).
+    drill: drilling::DrillWords,
+    /// G07 K L linear chip breaking while set (`000` §5.6).
+    chip_break: Option<chip_break::ChipBreak>,
     /// G92 number of starts (`000` §5.23.5, modal).
     cycle_starts: u32,
     /// The sign of the approach move before a GTC2E thread cycle (its retract goes the other way).
@@ -278,6 +282,8 @@ impl Interpreter {
             cycle_starts: 1,
             compound: compound::CompoundWords::default(),
             groove_retract: 1.0,
+            drill: drilling::DrillWords::default(),
+            chip_break: None,
             common,
             pending: VecDeque::new(),
             line: 0,
@@ -1302,8 +1308,12 @@ impl Interpreter {
         if let Some(t) = b.get('T') {
             self.tool_word(t)?;
         }
+        // In a G83/G87 block an M word is the spindle clamp code of the cycle (`000` §5.22.7).
+        let drill_block = matches!(b.group(1).unwrap_or(self.motion), G::Drilling { .. })
+            && self.has_axis_words(&b);
         for &(m, code) in &b.m {
             match m {
+                M::AuxBefore | M::AuxAfter if drill_block => {}
                 M::AuxBefore => {
                     self.track_spindle(code);
                     self.aux(Aux::M((code / 10) as i32));
@@ -1316,6 +1326,7 @@ impl Interpreter {
         self.block_body(&b)?;
         for &(m, code) in &b.m {
             match m {
+                M::AuxBefore | M::AuxAfter if drill_block => {}
                 M::AuxAfter | M::Stop | M::CountPart => {
                     self.track_spindle(code);
                     self.aux(Aux::M((code / 10) as i32));
@@ -1824,6 +1835,7 @@ impl Interpreter {
                 G::FaceGrooving | G::RadialGrooving => {
                     return self.grooving(b, g == G::RadialGrooving)
                 }
+                G::ChipBreak => return self.set_chip_break(b),
                 G::MultiThreadCycle => return self.g76(b),
                 G::LoopStart => return self.gtc_loop_start(b),
                 G::LoopEnd => return self.gtc_loop_end(),
@@ -1872,6 +1884,7 @@ impl Interpreter {
                     | G::GtcCylinderCycle
                     | G::GtcDrillCycle
                     | G::GtcGroovingCycle
+                    | G::Drilling { .. }
             ) {
                 if self.motion != m {
                     // A new cycle or motion code drops the retained cycle words.
@@ -1902,6 +1915,10 @@ impl Interpreter {
                 }
             }
         }
+        if let G::Drilling { .. } = self.motion {
+            // The cycle's modal words are kept even from a block without a hole position.
+            self.drill_words(b)?;
+        }
         if !self.has_axis_words(b) {
             // A block of only modal words; arcs may still be full circles by I/K.
             let arc_ik = matches!(self.motion, G::ArcCw | G::ArcCcw) && (b.has('I') || b.has('K'));
@@ -1928,13 +1945,15 @@ impl Interpreter {
                 let end = self.end_point(b)?;
                 self.track_x_direction(&end);
                 let f = self.feed;
-                match chamfer {
-                    Some(c) => self.hold_corner(end, f, c),
-                    None => self.emit(&end, MoveKind::Feed(f)),
+                match (chamfer, self.chip_break) {
+                    (Some(c), _) => self.hold_corner(end, f, c),
+                    (None, Some(cb)) => self.linear_with_chip_break(&end, f, cb),
+                    (None, None) => self.emit(&end, MoveKind::Feed(f)),
                 }
             }
             G::ArcCw | G::ArcCcw => self.arc(b),
             G::ThreePointArc { absolute } => self.three_point_arc(b, absolute),
+            G::Drilling { radial } => self.drilling(b, radial),
             G::Thread => self.g32(b),
             G::VariableLeadThread => self.g34(b),
             G::TappingCycle => self.g33(b),
@@ -2619,8 +2638,10 @@ impl Variables for Interpreter {
 }
 
 // Cycles that need more room live in their own files.
+mod chip_break;
 mod compound;
 mod corner;
+mod drilling;
 mod grooving;
 mod gtc;
 mod nose;

@@ -652,3 +652,499 @@ fn fixtures_005_006_tool_change_macros_called_by_t() {
         cnc_interpreter::check_with_library(Dialect::HuaxingLathe, main, setup, lib).unwrap_err();
     assert_eq!(e.number, 6, "{e}");
 }
+
+/// The listing's lines, trimmed, without blank ones.
+fn lines(text: &str) -> Vec<String> {
+    text.lines()
+        .map(|l| l.trim().to_string())
+        .filter(|l| !l.is_empty())
+        .collect()
+}
+
+fn speeds(cmds: &[Canon]) -> Vec<(u32, f64)> {
+    cmds.iter()
+        .filter_map(|c| match c.command {
+            Command::Aux(Aux::S(v)) => Some((c.line, v)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The radius (in the X-radius/Z plane) of an arc command that starts at `from`.
+fn arc_radius(from: [f64; 2], c: &Command) -> Option<(f64, f64)> {
+    if let Command::Arc { end, center, .. } = c {
+        let r = |p: [f64; 2]| ((p[0] - center[0]) / 2.0).hypot(p[1] - center[1]);
+        Some((r(from), r([end[0], end[1]])))
+    } else {
+        None
+    }
+}
+
+#[test]
+fn fixture_003_g96_surface_speed_is_kept_through_g97() {
+    // Line 3 (G96 X3000) cuts at 50 m/min again: 50 000 / (π · X) r/min.
+    let text = fixture("003_g96_s_value_retention_snippet.nc");
+    let cmds = run(&text, HOME).unwrap();
+    let s = speeds(&cmds);
+    assert!(s.contains(&(line_of(&text, "G97"), 1000.0)), "{s:?}");
+    // Speeds go out in 0.1 r/min steps, and not below 10 r/min (D17).
+    let css = |x: f64| ((50_000.0 / (std::f64::consts::PI * x)).max(10.0) * 10.0).round() / 10.0;
+    let third = line_of(&text, "G96 X3000");
+    let on_third: Vec<f64> = s.iter().filter(|(l, _)| *l == third).map(|p| p.1).collect();
+    // At the start point X200 as the block begins, then at the end point X3000.
+    assert_eq!(on_third, [css(200.0), css(3000.0)], "{s:?}");
+}
+
+#[test]
+fn fixtures_004_014_to_017_need_the_c_axis_or_live_tool_this_lathe_lacks() {
+    // `000` §3.1: an unlicensed optional code is alarm 7. The simulated lathe has X and Z
+    // only: no C axis (M14, G08, G12.1, C words), no live tool (G14.n), and no oscillation
+    // in motion (G07.1). Every line of 004 is an independent example; each is refused.
+    let text = fixture("004_spindle_c_axis_position_m14_g08.nc");
+    for l in lines(&text) {
+        let e = run(&l, HOME).unwrap_err();
+        assert_eq!((e.number, e.line), (7, 1), "{l}: {e}");
+    }
+    for (name, first_bad) in [
+        ("014_g07_1_thread_chip_break.nc", "N0020"),
+        ("015_g08_rotary_axis_examples.nc", "M14.6"),
+        ("016_g12_1_polar_interpolation.nc", "G00 C0"),
+        ("017_g14_4_flying_cutter_tapping.nc", "N0020"),
+    ] {
+        let text = fixture(name);
+        let e = run(&text, HOME).unwrap_err();
+        assert_eq!(
+            (e.number, e.line),
+            (7, line_of(&text, first_bad)),
+            "{name}: {e}"
+        );
+    }
+}
+
+#[test]
+fn fixture_007_008_each_form_reaches_b() {
+    for l in lines(&fixture("007_g00_rapid_forms.nc")) {
+        let cmds = run(&l, [42.0, 43.0]).unwrap();
+        assert!(
+            matches!(&cmds[0].command, Command::Rapid { end } if close([end[0], end[1]], [20.0, 25.0], 1e-9)),
+            "{l}"
+        );
+    }
+    for l in lines(&fixture("008_g01_linear_forms.nc")) {
+        // The F500 of the first form is modal for the other three.
+        let cmds = run(&format!("F500\n{l}"), [40.0, 32.0]).unwrap();
+        assert!(
+            matches!(&cmds[0].command, Command::Linear { end, feed } if close([end[0], end[1]], [60.0, 7.0], 1e-9) && *feed == 500.0),
+            "{l}: {cmds:?}"
+        );
+    }
+}
+
+#[test]
+fn fixture_009_arc_forms_end_at_x63_060_on_radius_19_16() {
+    // From X45.359 Z0. The I/K forms give the stated end point; I is the centre's offset
+    // in radius (the printed text says diameter, the geometry says radius: decision D22's
+    // reading for arcs as in fixture 010). The first form as printed has no X/U word: by
+    // the modal rules it stays at X45.359 and ends at Z-24.071 on R19.16.
+    let start = [45.359, 0.0];
+    let forms = lines(&fixture("009_g02_arc_forms.nc"));
+    for (l, want) in [
+        (format!("G02\n{}", forms[0]), [45.359, -24.071]),
+        (forms[1].clone(), [63.060, -24.071]),
+        (forms[2].clone(), [63.060, -24.071]),
+    ] {
+        let cmds = run(&l, start).unwrap();
+        let c = &cmds
+            .iter()
+            .find(|c| c.command.end().is_some())
+            .unwrap()
+            .command;
+        assert!(close(end_of(c).unwrap(), want, 1e-9), "{l}: {c:?}");
+        let (r0, r1) = arc_radius(start, c).unwrap();
+        assert!(
+            (r0 - 19.16).abs() < 3e-3 && (r1 - 19.16).abs() < 3e-3,
+            "{l}: {r0} {r1}"
+        );
+    }
+}
+
+#[test]
+fn fixtures_011_012_three_point_arcs() {
+    // 012 (G05.1, absolute mid point X20 Z15) and 011 with the G05 its caption names (mid
+    // point I5 radius, K-5 from the start) are the semicircle X10 Z20 → X20 Z15 → X10 Z10:
+    // centre X10 Z15, radius 5.
+    let semicircle = |text: &str| {
+        let cmds = run(text, HOME).unwrap();
+        let arc = cmds
+            .iter()
+            .find(|c| matches!(c.command, Command::Arc { .. }))
+            .unwrap();
+        let Command::Arc { end, center, .. } = &arc.command else {
+            unreachable!()
+        };
+        (
+            [end[0], end[1]],
+            [center[0], center[1]],
+            arc_radius([10.0, 20.0], &arc.command).unwrap(),
+        )
+    };
+    let g05 = fixture("011_g05_three_point_arc_prog1.nc").replace("G5.1", "G05");
+    for text in [g05, fixture("012_g05_1_three_point_arc_prog2.nc")] {
+        let (end, center, (r0, r1)) = semicircle(&text);
+        assert!(close(end, [10.0, 10.0], 1e-9) && close(center, [10.0, 15.0], 1e-9));
+        assert!((r0 - 5.0).abs() < 1e-9 && (r1 - 5.0).abs() < 1e-9);
+    }
+    // As printed, 011's G5.1 takes I5 K-5 as the absolute mid point (D22): another circle,
+    // through X5 Z-5.
+    let (_, center, (r0, _)) = semicircle(&fixture("011_g05_three_point_arc_prog1.nc"));
+    let mid = ((5.0 - center[0]) / 2.0).hypot(-5.0 - center[1]);
+    assert!((mid - r0).abs() < 1e-9, "{center:?} {r0} {mid}");
+}
+
+#[test]
+fn fixture_013_g07_pauses_1_s_every_5_mm() {
+    // The listing's "....." elision is alarm 13 on its line; the blocks before it run.
+    let text = fixture("013_g07_linear_chip_break.nc");
+    let e = run(&text, HOME).unwrap_err();
+    assert_eq!((e.number, e.line), (13, line_of(&text, ".....")));
+    let head: String = text
+        .lines()
+        .take_while(|l| !l.starts_with("....."))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let cmds = run(&(head + "N0100 G07\nG01 Z-40\nM30\n"), HOME).unwrap();
+    let g01: Vec<&Canon> = cmds.iter().filter(|c| c.line == 4).collect();
+    // Z0 → Z-30 at F300: six 5 mm pieces with a 1 s pause between them, none after the last.
+    let mut z = 0.0;
+    for (k, c) in g01.iter().enumerate() {
+        if k % 2 == 0 {
+            z -= 5.0;
+            assert!(
+                matches!(&c.command, Command::Linear { end, feed } if close([end[0], end[1]], [20.0, z], 1e-9) && *feed == 300.0),
+                "{c:?}"
+            );
+        } else {
+            assert_eq!(c.command, Command::Dwell { seconds: 1.0 });
+        }
+    }
+    assert_eq!(g01.len(), 11);
+    // After the cancel, the next G01 is one move.
+    let after: Vec<&Canon> = cmds.iter().filter(|c| c.line == 6).collect();
+    assert_eq!(after.len(), 1, "{after:?}");
+    // Its errors: K without L, and L 0.
+    for bad in ["G07 K1", "G07 K1 L0", "G07 K-1 L5", "G07 P5 Q1 L15"] {
+        let e = run(&format!("G00 X20 Z0\n{bad}\n"), HOME).unwrap_err();
+        assert_eq!(e.line, 2, "{bad}: {e}");
+        assert!([23, 13, 7].contains(&e.number), "{bad}: {e}");
+    }
+}
+
+/// Whether each motion of `cmds` runs in exact stop (`PathMode` before it), by line.
+fn exact_stops(cmds: &[Canon]) -> Vec<(u32, bool)> {
+    let mut exact = false;
+    let mut out = Vec::new();
+    for c in cmds {
+        match c.command {
+            Command::PathMode { exact_stop } => exact = exact_stop,
+            _ if c.command.end().is_some() => out.push((c.line, exact)),
+            _ => {}
+        }
+    }
+    out
+}
+
+#[test]
+fn fixtures_023_to_026_g09_g61_g64_exact_stop() {
+    // 023/025: no G09/G61, every block blends.
+    for name in ["023_g09_prog1_smooth_corner.nc", "025_g61_prog3_smooth.nc"] {
+        let cmds = run(&fixture(name), HOME).unwrap();
+        assert!(exact_stops(&cmds).iter().all(|&(_, e)| !e), "{name}");
+    }
+    // 024: G09 on N2 only.
+    let text = fixture("024_g09_prog2_exact_stop.nc");
+    let n = |k: u32| line_of(&text, &format!("N{k} "));
+    let cmds = run(&text, HOME).unwrap();
+    assert_eq!(
+        exact_stops(&cmds),
+        [(n(1), false), (n(2), true), (n(3), false), (n(4), false)]
+    );
+    // 026: G61 on N2 up to G64 on N7: N3–N6 stop exactly.
+    let text = fixture("026_g61_g64_prog4_exact_stop_mode.nc");
+    let n = |k: u32| line_of(&text, &format!("N{k} "));
+    let cmds = run(&text, HOME).unwrap();
+    assert_eq!(
+        exact_stops(&cmds),
+        [
+            (n(1), false),
+            (n(3), true),
+            (n(4), true),
+            (n(5), true),
+            (n(6), true)
+        ]
+    );
+    assert!(cmds
+        .iter()
+        .any(|c| c.line == n(7) && c.command == Command::PathMode { exact_stop: false }));
+}
+
+#[test]
+fn fixture_028_g94_faces_the_end_and_the_taper_to_dia_60() {
+    let cmds = run(&fixture("028_g94_radial_cycle_O0003.nc"), HOME).unwrap();
+    // Face model: the blank's face at Z2 for every radius up to 62.5 (dia 125).
+    let mut stock = Stock::new(false, 0.0, 62.5, 2.0);
+    stock.apply(&cmds, HOME);
+    assert!(stock.rapid_through.is_empty(), "{:?}", stock.rapid_through);
+    // Faced to Z0 inside dia 60; from dia 60 at Z-30 the cone of the last pass (X60 R-50:
+    // dia 120 at Z-80); outside dia 120 the first cycles' cut to Z-110.
+    let face = |r: f64| {
+        if r < 30.0 {
+            0.0
+        } else if r < 60.0 {
+            -30.0 - (r - 30.0) * 50.0 / 30.0
+        } else {
+            -110.0
+        }
+    };
+    let mut r: f64 = 0.5;
+    while r < 62.4 {
+        if (r - 30.0).abs() > 0.02 && (r - 60.0).abs() > 0.02 {
+            assert!(
+                (stock.at(r) - face(r)).abs() < 1e-6,
+                "at R{r}: {} vs {}",
+                stock.at(r),
+                face(r)
+            );
+        }
+        r += 0.25;
+    }
+    // Each cycle returns to its start point: the last one to X120 Z0.
+    let last = cmds.iter().rev().find_map(|c| end_of(&c.command)).unwrap();
+    assert!(close(last, [120.0, 0.0], 1e-9));
+}
+
+/// Stock after `cmds` cut a fresh blank (radius `blank` along Z from `z0` to `z1`).
+fn swept(cmds: &[Canon], start: [f64; 2], z0: f64, z1: f64, blank: f64) -> Stock {
+    let mut stock = Stock::new(true, z0, z1, blank);
+    stock.apply(cmds, start);
+    stock
+}
+
+/// `cmds` moved by `dx` (diameter) and `dz`.
+fn translated(cmds: &[Canon], dx: f64, dz: f64) -> Vec<Canon> {
+    let mut out = cmds.to_vec();
+    for c in &mut out {
+        match &mut c.command {
+            Command::Rapid { end } | Command::Linear { end, .. } => {
+                end[0] += dx;
+                end[1] += dz;
+            }
+            Command::Arc { end, center, .. } => {
+                end[0] += dx;
+                end[1] += dz;
+                center[0] += dx;
+                center[1] += dz;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+#[test]
+fn fixture_031_g71_type_two_leaves_the_mixed_contour_plus_u3() {
+    let text = fixture("031_g71_mixed_example3.nc");
+    let cmds = run(&text, HOME).unwrap();
+    // Blank: bar dia 60 between the contour's ends (Z90 to Z10).
+    let rough = swept(&cmds, HOME, 10.0, 90.0, 30.0);
+    assert!(rough.rapid_through.is_empty(), "{:?}", rough.rapid_through);
+    // U2 is the depth of cut (radius).
+    assert!(rough.max_cut <= 2.0 + 1e-6, "deepest cut {}", rough.max_cut);
+    // The finishing contour (its own blocks, run as a program from the start point), moved
+    // by the allowance U3 W0, swept through the same blank: the material that must be left.
+    let contour: String = text
+        .lines()
+        .skip_while(|l| !l.starts_with("N0040"))
+        .take_while(|l| !l.starts_with("N0180"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let finish = run(&format!("G00 X60 Z90\n{contour}"), HOME).unwrap();
+    let want = swept(
+        &translated(&finish, 3.0, 0.0),
+        [63.0, 90.0],
+        10.0,
+        90.0,
+        30.0,
+    );
+    let mut z: f64 = 10.5;
+    while z < 89.5 {
+        // Away from the contour's vertical walls (Z85, Z60 and Z70's step).
+        if [85.0, 70.0, 65.0, 60.0]
+            .iter()
+            .all(|w| (z - w).abs() > 0.02)
+        {
+            assert!(
+                (rough.at(z) - want.at(z)).abs() < 1e-6,
+                "at Z{z}: {} vs {}",
+                rough.at(z),
+                want.at(z)
+            );
+        }
+        z += 0.1;
+    }
+    // The pockets are cut: at Z57.5 the material is the X30 floor + 1.5.
+    assert!((rough.at(57.5) - 16.5).abs() < 1e-6, "{}", rough.at(57.5));
+}
+
+#[test]
+fn fixture_038_g33_taps_to_z50_and_reverses_out() {
+    let text = fixture("038_g33_tapping_O0011.nc");
+    let cmds = run(&text, HOME).unwrap();
+    let tap: Vec<&Command> = cmds
+        .iter()
+        .filter(|c| c.line == line_of(&text, "G33"))
+        .map(|c| &c.command)
+        .collect();
+    // In at 1.5 mm/rev, spindle stop, reverse, out to the start at the same lead, stop.
+    assert!(
+        matches!(tap[0], Command::Thread { end, lead, .. } if close([end[0], end[1]], [0.0, 50.0], 1e-9) && *lead == 1.5)
+    );
+    assert_eq!(tap[1], &Command::Aux(Aux::M(5)));
+    assert_eq!(tap[2], &Command::Aux(Aux::M(4)));
+    assert!(
+        matches!(tap[3], Command::Thread { end, lead, .. } if close([end[0], end[1]], [0.0, 90.0], 1e-9) && *lead == 1.5)
+    );
+    assert_eq!(tap[4], &Command::Aux(Aux::M(5)));
+    assert_eq!(tap.len(), 5);
+    // The spindle is started again by the program's own M03 on the next line.
+    assert!(cmds
+        .iter()
+        .any(|c| c.line == line_of(&text, "M03;") && c.command == Command::Aux(Aux::M(3))));
+}
+
+#[test]
+fn macro_fixtures_043_044_046_047() {
+    // 043: the fragment is written for a mill (G90 = absolute); on this lathe G90 is the
+    // turning cycle, which needs Z: alarm 23 on line 1.
+    let text = fixture("043_macro_null_variable_snippets.nc");
+    assert_eq!(run(&text, HOME).unwrap_err().number, 23);
+    // A word with a null value is left out: `G00 X100 Y[#0]` is `G00 X100` (no Y axis here).
+    let a = run("G00 X100 Z[#0]\n", HOME).unwrap();
+    assert_eq!(ends(&a), [[100.0, 100.0]]);
+    // #1 = null, #2 = #0 + 1 = 1, #3 = #0 * 3 = 0.
+    let cmds = run("#1=#0\n#2=#0+1\n#3=#0*3\nG00 X[#2] Z[#3]\n", HOME).unwrap();
+    assert_eq!(ends(&cmds), [[1.0, 0.0]]);
+    for (cond, holds) in [
+        ("#1==#0", true),
+        ("#1==0", false),
+        ("#1!=0", true),
+        ("#1>=0", true),
+    ] {
+        let p = format!("#1=#0\nIF[{cond}]GOTO9\nG00 X1\nN9 G00 Z1\nM30\n");
+        let first = ends(&run(&p, HOME).unwrap())[0];
+        assert_eq!(first == [200.0, 1.0], holds, "{cond}");
+    }
+    // The comparisons as printed are not statements: alarm 20 on their line.
+    let e = run("#1=#0\n#1==#0\n", HOME).unwrap_err();
+    assert_eq!((e.number, e.line), (20, 2));
+
+    // 044: G91 does not exist on this lathe (alarm 7); its incremental words are U and W.
+    // With ROUND the third move returns exactly to the start.
+    let text = fixture("044_macro_round_snippet.nc");
+    let e = run(&text, HOME).unwrap_err();
+    assert_eq!((e.number, e.line), (7, line_of(&text, "G00 G91")));
+    let p = "#1=1.2345\n#2=2.3456\nG00 U[-ROUND[#1]]\nG01 U[-ROUND[#2]] F300\nG00 U[ROUND[#1]+ROUND[#2]]\n";
+    let e = ends(&run(p, HOME).unwrap());
+    assert!(close(e[0], [200.0 - 1.235, 100.0], 1e-9), "{e:?}");
+    assert!(close(e[1], [200.0 - 1.235 - 2.346, 100.0], 1e-9), "{e:?}");
+    assert!(close(e[2], HOME, 1e-9), "{e:?}");
+
+    // 046: #1 = 60, #2 = COS[60] = 0.5, #3 = 87.5, #4 = 87.5.
+    let text = fixture("046_macro_assignment.nc") + "G00 X[#4] Z[#2]\nG00 X[#3] Z[#1]\n";
+    let e = ends(&run(&text, HOME).unwrap());
+    assert!(close(e[0], [87.5, 0.5], 1e-9) && close(e[1], [87.5, 60.0], 1e-9));
+
+    // 047: as printed there is no N200: alarm 24 on line 1. With one, each form gets there
+    // (N200 and N0200 are the same number).
+    let text = fixture("047_macro_goto_forms.nc");
+    let e = run(&text, HOME).unwrap_err();
+    assert_eq!((e.number, e.line), (24, line_of(&text, "N0010GOTO200")));
+    for form in lines(&text) {
+        for target in ["N200", "N0200"] {
+            let p = format!("#1=100\n#2=200\n{form}\nG00 X1\n{target} G00 X2\nM30\n");
+            assert_eq!(ends(&run(&p, HOME).unwrap())[0][0], 2.0, "{form} {target}");
+        }
+    }
+}
+
+/// Thread commands of `cmds` on `line`: (end, lead).
+fn threads(cmds: &[Canon], line: u32) -> Vec<([f64; 2], f64)> {
+    cmds.iter()
+        .filter(|c| c.line == line)
+        .filter_map(|c| match &c.command {
+            Command::Thread { end, lead, .. } => Some(([end[0], end[1]], *lead)),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn fixtures_055_056_chapter_20_parts() {
+    // 055: an internal M-thread of 1.5 mm lead in two passes (X37.5 then X38.5) to Z-16,
+    // run out J3 (radius, toward the axis: inside a bore) over K1.
+    let text = fixture("055_ch20_ex1_brass_bore_groove_thread.nc");
+    let cmds = run(&text, [100.0, 50.0]).unwrap();
+    for (line, x) in [
+        (line_of(&text, "N0230"), 37.5),
+        (line_of(&text, "N0240"), 38.5),
+    ] {
+        let t = threads(&cmds, line);
+        assert_eq!(t.len(), 2, "{t:?}");
+        assert!(close(t[0].0, [x, -15.0], 1e-9) && t[0].1 == 1.5, "{t:?}");
+        assert!(close(t[1].0, [x - 6.0, -16.0], 1e-9), "{t:?}");
+    }
+    // The groove: T2 feeds out to dia 44 at Z-18.
+    assert!(ends(&cmds).iter().any(|e| close(*e, [44.0, -18.0], 1e-9)));
+    assert!(close(*ends(&cmds).last().unwrap(), [100.0, 250.0], 1e-9));
+    assert!(matches!(
+        cmds[cmds.len() - 2].command,
+        Command::Aux(Aux::M(2))
+    ));
+
+    // 056: one pass of an inch taper thread, 14 threads per inch (lead 25.4/14), R-1.1: from
+    // dia 17.8 at Z106 along the taper to Z84 at dia 20, run out J4 (radius) from Z88.
+    let text = fixture("056_ch20_ex2_taper_inch_thread.nc");
+    let cmds = run(&text, [100.0, 160.0]).unwrap();
+    let t = threads(&cmds, line_of(&text, "N0300"));
+    let lead = 25.4 / 14.0;
+    assert_eq!(t.len(), 2, "{t:?}");
+    assert!(close(t[0].0, [19.6, 88.0], 1e-9) && (t[0].1 - lead).abs() < 1e-12);
+    assert!(close(t[1].0, [28.0, 84.0], 1e-9));
+    let start = cmds
+        .iter()
+        .filter(|c| c.line == line_of(&text, "N0300"))
+        .find_map(|c| end_of(&c.command))
+        .unwrap();
+    assert!(close(start, [17.8, 106.0], 1e-9));
+    // Finished to dia 20 between Z84 and Z34 after roughing at 20.4.
+    assert!(ends(&cmds).iter().any(|e| close(*e, [20.0, 34.0], 1e-9)));
+    assert!(close(*ends(&cmds).last().unwrap(), [100.0, 160.0], 1e-9));
+}
+
+#[test]
+fn fixture_060_single_block_examples() {
+    let l = lines(&fixture("060_misc_single_block_examples.nc"));
+    // N0010 G01 X1000 Z-23.7 F100 (its comment after ";").
+    let cmds = run(&l[0], HOME).unwrap();
+    assert!(
+        matches!(&cmds[0].command, Command::Linear { end, feed } if close([end[0], end[1]], [1000.0, -23.7], 1e-9) && *feed == 100.0)
+    );
+    // M50 (bar feeder driving outputs itself) and G77 (absolute encoder zero) are refused with
+    // alarm 7 and their reasons; M51 N0070 (auto-start block) is an MDI operation.
+    for k in [1, 2, 3] {
+        let e = run(&l[k], HOME).unwrap_err();
+        assert_eq!((e.number, e.line), (7, 1), "{}: {e}", l[k]);
+    }
+    // G50 X100 Z150 makes the current point X100 Z150: G00 X0 Z0 then moves by (−100, −150).
+    let cmds = run(&format!("{}\nG00 X0 Z0\n", l[5]), HOME).unwrap();
+    assert_eq!(ends(&cmds), [[HOME[0] - 100.0, HOME[1] - 150.0]]);
+}

@@ -410,3 +410,196 @@ fn fixture_032_g71_roughs_and_g70_finishes_the_compensated_contour() {
         "roughing nose comes within {nose} of the contour"
     );
 }
+
+/// The material of a turned part as its radius along Z (material inside), cut by a round
+/// nose of radius `r` whose centre follows the path: each cut lowers the boundary to the
+/// lower edge of the swept disc.
+struct DiscStock {
+    z0: f64,
+    h: f64,
+    v: Vec<f64>,
+    r: f64,
+}
+
+impl DiscStock {
+    fn new(z0: f64, z1: f64, radius: f64, nose: f64) -> DiscStock {
+        let h = 0.005;
+        DiscStock {
+            z0,
+            h,
+            v: vec![radius; ((z1 - z0) / h).round() as usize + 1],
+            r: nose,
+        }
+    }
+
+    fn z(&self, i: usize) -> f64 {
+        self.z0 + i as f64 * self.h
+    }
+
+    /// The lower edge of the disc centred at `c` (z, r) at each sample: (index, value).
+    fn disc(&self, c: [f64; 2]) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let lo = (((c[0] - self.r - self.z0) / self.h).ceil().max(0.0)) as usize;
+        let hi = ((c[0] + self.r - self.z0) / self.h).floor();
+        let hi = if hi < 0.0 {
+            0
+        } else {
+            (hi as usize + 1).min(self.v.len())
+        };
+        (lo..hi).map(move |i| {
+            let dz = self.z(i) - c[0];
+            (i, c[1] - (self.r * self.r - dz * dz).max(0.0).sqrt())
+        })
+    }
+
+    /// The lower edge of the disc swept along `el`, exactly for lines (end discs and the
+    /// offset line between them), every 1 µm of path for arcs.
+    fn envelope(&self, el: El) -> Vec<(usize, f64)> {
+        let mut out = Vec::new();
+        match el {
+            El::Line(a, b) => {
+                out.extend(self.disc(a));
+                out.extend(self.disc(b));
+                let (dz, dr) = (b[0] - a[0], b[1] - a[1]);
+                let l = dz.hypot(dr);
+                if l > 1e-12 && dz.abs() > 1e-12 {
+                    // The normal pointing toward the axis (its r part negative).
+                    let mut n = [-dr / l, dz / l];
+                    if n[1] > 0.0 {
+                        n = [-n[0], -n[1]];
+                    }
+                    let (p, q) = (
+                        [a[0] + self.r * n[0], a[1] + self.r * n[1]],
+                        [b[0] + self.r * n[0], b[1] + self.r * n[1]],
+                    );
+                    let (lo, hi) = (p[0].min(q[0]), p[0].max(q[0]));
+                    let i0 = ((lo - self.z0) / self.h).ceil().max(0.0) as usize;
+                    let i1 =
+                        (((hi - self.z0) / self.h).floor() as i64).min(self.v.len() as i64 - 1);
+                    for i in i0..=(i1.max(-1) as usize).min(self.v.len().saturating_sub(1)) {
+                        if i1 < i0 as i64 {
+                            break;
+                        }
+                        let z = self.z(i);
+                        out.push((i, p[1] + (q[1] - p[1]) * (z - p[0]) / (q[0] - p[0])));
+                    }
+                }
+            }
+            El::Arc(..) => {
+                for c in samples(el, 0.001) {
+                    out.extend(self.disc(c));
+                }
+            }
+        }
+        out
+    }
+
+    /// Cuts along `el`; returns how deep it cut into the material.
+    fn cut(&mut self, el: El) -> f64 {
+        let mut deepest: f64 = 0.0;
+        for (i, value) in self.envelope(el) {
+            if value < self.v[i] {
+                deepest = deepest.max(self.v[i] - value);
+                self.v[i] = value;
+            }
+        }
+        deepest
+    }
+
+    /// How deep a rapid along `el` would go into the material.
+    fn intrusion(&self, el: El) -> f64 {
+        self.envelope(el)
+            .into_iter()
+            .map(|(i, value)| self.v[i] - value)
+            .fold(0.0, f64::max)
+    }
+
+    fn at(&self, z: f64) -> f64 {
+        self.v[((z - self.z0) / self.h).round() as usize]
+    }
+}
+
+/// The radius of a polyline/arc-free contour given as (Z, X diameter) corners at `z`.
+fn polyline_at(points: &[[f64; 2]], z: f64) -> Option<f64> {
+    points.windows(2).find_map(|w| {
+        let ([z0, x0], [z1, x1]) = (w[0], w[1]);
+        (z >= z0.min(z1) && z <= z0.max(z1) && (z1 - z0).abs() > 1e-9)
+            .then(|| (x0 + (x1 - x0) * (z - z0) / (z1 - z0)) / 2.0)
+    })
+}
+
+#[test]
+fn fixture_032_roughing_leaves_the_contour_plus_allowance_under_the_nose() {
+    let text = fixture("000", "032_g71_g70_tnrc_example4.nc");
+    let nose = 0.8;
+    let comp =
+        cnc_interpreter::check(Dialect::HuaxingLathe, &text, setup_post(nose, 3, true)).unwrap();
+    // Blank: bar dia 85 over the contour's span Z35–Z140. The nose centre is the controlled
+    // point less the tip vector.
+    let d = tip_vector(3, nose);
+    let mut stock = DiscStock::new(30.0, 145.0, 42.5, nose);
+    let mut deepest: f64 = 0.0;
+    for (el, cut, line) in elements(&comp, HOME) {
+        if line != 4 {
+            continue;
+        }
+        let moved = match el {
+            El::Line(a, b) => El::Line([a[0] - d[0], a[1] - d[1]], [b[0] - d[0], b[1] - d[1]]),
+            El::Arc(a, b, c, cw) => El::Arc(
+                [a[0] - d[0], a[1] - d[1]],
+                [b[0] - d[0], b[1] - d[1]],
+                [c[0] - d[0], c[1] - d[1]],
+                cw,
+            ),
+        };
+        if cut {
+            deepest = deepest.max(stock.cut(moved));
+        } else {
+            let into = stock.intrusion(moved);
+            assert!(into < 1e-6, "line {line}: rapid {into} mm into the stock");
+        }
+    }
+    // U2: no pass cuts deeper than 2 mm (radius).
+    assert!(deepest <= 2.0 + 1e-6, "deepest cut {deepest}");
+    // Material left: the contour moved by the allowance (U0.2 diameter = 0.1 radius, W0.2),
+    // wherever the nose can reach it: away from the corners, where it leaves its radius, and
+    // off the first and last elements, where the start-up (N0040) and the cancel (G40 in
+    // N0140) bring the offset on and off as §6 defines.
+    let (du, dw) = (0.2, 0.2);
+    let corners = [
+        [140.0, 80.0],
+        [130.0, 40.0],
+        [120.0, 40.0],
+        [110.0, 60.0],
+        [100.0, 60.0],
+        [90.0, 50.0],
+        [80.0, 50.0],
+    ];
+    let tail = [[60.0, 50.0], [50.0, 50.0], [40.0, 70.0], [35.0, 80.0]];
+    let moved = |pts: &[[f64; 2]]| -> Vec<[f64; 2]> {
+        pts.iter().map(|p| [p[0] + dw, p[1] + du]).collect()
+    };
+    let (head, tail) = (moved(&corners), moved(&tail));
+    let vertices: Vec<f64> = head.iter().chain(&tail).map(|p| p[0]).collect();
+    let mut checked = 0;
+    let mut z = 40.2;
+    while z < 130.2 {
+        if vertices.iter().all(|v| (z - v).abs() > nose + 0.3) {
+            // The arc G02 X50 Z60 R10 (front tool post: a groove dipping to dia 30).
+            let want = if (60.0 + dw..=80.0 + dw).contains(&z) {
+                25.0 + du / 2.0 - (100.0 - (z - 70.0 - dw).powi(2)).max(0.0).sqrt()
+            } else {
+                polyline_at(&head, z)
+                    .or_else(|| polyline_at(&tail, z))
+                    .expect("contour")
+            };
+            assert!(
+                (stock.at(z) - want).abs() < 1e-6,
+                "at Z{z:.3}: {} vs {want}",
+                stock.at(z)
+            );
+            checked += 1;
+        }
+        z += 0.05;
+    }
+    assert!(checked > 1000, "{checked}");
+}

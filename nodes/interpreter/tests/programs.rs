@@ -498,3 +498,82 @@ fn huaxing_modal_codes_reach_the_canonical_stream() {
         && (end[1] - 50.0).abs() < 1e-9)
     ));
 }
+
+/// The moves and dwells of `cmds` as short text: `R x z` rapid, `F x z` feed, `D s` dwell,
+/// `M n` aux M.
+fn moves(cmds: &[Canon]) -> Vec<String> {
+    cmds.iter()
+        .filter_map(|c| match &c.command {
+            Command::Rapid { end } => Some(format!("R{} {}", end[0], end[1])),
+            Command::Linear { end, .. } => Some(format!("F{} {}", end[0], end[1])),
+            Command::Dwell { seconds } => Some(format!("D{seconds}")),
+            Command::Aux(Aux::M(m)) => Some(format!("M{m}")),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn g83_g87_drilling() {
+    let hx = |text: &str| check(Dialect::HuaxingLathe, text, &AXES, &DIAMETER, &[50.0, 5.0]);
+    // G83 J0 at X0 from Z5 to Z-5: pecks of 4 mm, back off 1, dwell 0.5 s, out to Z5.
+    let cmds = hx("G83 X0 Z-5 Q4. R1 P500 F80\nM30\n").unwrap();
+    assert_eq!(
+        moves(&cmds),
+        ["R0 5", "F0 1", "R0 2", "F0 -3", "R0 -2", "F0 -5", "D0.5", "R0 5", "M30"]
+    );
+    // J1 leaves the hole after each peck and comes back to R short of the depth reached.
+    let cmds = hx("G83 X0 Z-5 Q4. R1 J1 F80\nM30\n").unwrap();
+    assert_eq!(
+        moves(&cmds),
+        ["R0 5", "F0 1", "R0 5", "R0 2", "F0 -3", "R0 5", "R0 -2", "F0 -5", "R0 5", "M30"]
+    );
+    // Q is modal: the next block with a position drills again with the same pecks; Q0 drills
+    // straight; without a decimal point Q counts 0.0001 mm increments (D12).
+    let cmds = hx("G83 X0 Z-3 Q20000 F80\nZ-1\nZ-2 Q0\nM30\n").unwrap();
+    assert_eq!(
+        moves(&cmds),
+        [
+            "R0 5", "F0 3", "R0 4", "F0 1", "R0 2", "F0 -1", "R0 0", "F0 -3", "R0 5", "F0 3",
+            "R0 4", "F0 1", "R0 2", "F0 -1", "R0 5", "F0 -2", "R0 5", "M30"
+        ]
+    );
+    // K2 with an incremental hole position: two holes 10 mm apart; M20 clamps after
+    // positioning, M21 unclamps at the end of each hole.
+    let cmds = hx("G00 X60 Z-10\nG87 W-5 X40 K2 M20 F50\nM30\n").unwrap();
+    assert_eq!(
+        moves(&cmds),
+        [
+            "R60 -10", "R60 -15", "M20", "F40 -15", "R60 -15", "M21", "R60 -20", "M20", "F40 -20",
+            "R60 -20", "M21", "M30"
+        ]
+    );
+    // Errors, on the line of the drilling block.
+    for (bad, number) in [
+        ("G83 X0 F80", 23),           // no hole bottom
+        ("G83 X0 Z-5 K0 F80", 13),    // repeat count below 1
+        ("G83 X0 Z-5 J2 F80", 13),    // J is 0 or 1
+        ("G83 X0 C90 Z-5 F80", 7),    // no C axis on this lathe
+        ("G83 X0 Z-5 M20 M8 F80", 7), // one clamp code
+    ] {
+        let e = hx(&format!("G00 X0 Z5\n{bad}\nM30\n")).unwrap_err();
+        assert_eq!((e.number, e.line), (number, 2), "{bad}: {e}");
+    }
+    // With nose compensation on, the cycle is refused (D45).
+    let mut setup = Setup::new(&AXES, &DIAMETER, &[50.0, 5.0]);
+    setup.offsets.tools.insert(
+        1,
+        cnc_interpreter::setup::ToolOffset {
+            radius: 0.4,
+            tip: 3,
+            ..Default::default()
+        },
+    );
+    let e = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "T0101\nG42 G01 X40 Z2 F100\nG83 X0 Z-5 F80\nM30\n",
+        setup,
+    )
+    .unwrap_err();
+    assert_eq!((e.number, e.line), (42, 3), "{e}");
+}

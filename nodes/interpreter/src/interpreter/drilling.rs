@@ -1,0 +1,282 @@
+//! G83 axial and G87 radial peck drilling (`000` §5.22.7).
+//!
+//! The tool goes to the hole position at the level where the block starts, pecks down to the
+//! bottom (high-speed: back off R after each peck, J0; deep-hole: all the way out, J1), dwells
+//! P ms, and returns to the hole position at the start level, K times. The manual's figures
+//! give the pecks in least-input increments (Q, decision D12) and R in mm, both radius values.
+//! Decision D45 records what the manual leaves open.
+
+use super::*;
+
+/// The cycle's modal words; positions, K and M are not modal.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct DrillWords {
+    /// P: dwell at the bottom.
+    dwell_ms: f64,
+    /// Q: depth of one peck (0: straight to the bottom).
+    peck: f64,
+    /// R: back-off after each peck (`000` GS#44, default 1 mm).
+    retract: f64,
+    /// J1: deep-hole pecking, out of the hole after every peck.
+    deep_hole: bool,
+}
+
+impl Default for DrillWords {
+    fn default() -> Self {
+        DrillWords {
+            dwell_ms: 0.0,
+            peck: 0.0,
+            retract: 1.0,
+            deep_hole: false,
+        }
+    }
+}
+
+/// Most repetitions of one drilling block (`000` §3.3.2: K up to 9999).
+const MAX_REPEATS: f64 = 9999.0;
+
+impl Interpreter {
+    /// Takes the modal words P, Q, R and J of a G83/G87 block.
+    pub(super) fn drill_words(&mut self, b: &Block) -> Result<(), ProgramError> {
+        if let Some(p) = b.get('P') {
+            if p.abs() > 99_999_999.0 {
+                return Err(self.fault(Fault::DwellTime, "G83/G87 P dwell out of range"));
+            }
+            self.drill.dwell_ms = p.max(0.0);
+        }
+        if let Some(q) = self.increments(b, 'Q') {
+            self.drill.peck = q.abs();
+        }
+        if let Some(r) = b.get('R') {
+            if r.abs() > 9999.999 {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("G83/G87 R{}: 0–9999.999 mm", show(r)),
+                ));
+            }
+            self.drill.retract = r.abs();
+        }
+        if let Some(j) = b.get('J') {
+            self.drill.deep_hole = match j {
+                0.0 => false,
+                1.0 => true,
+                _ => {
+                    return Err(
+                        self.fault(Fault::OutOfRange, format!("G83/G87 J{}: 0 or 1", show(j)))
+                    )
+                }
+            };
+        }
+        Ok(())
+    }
+
+    pub(super) fn drilling(&mut self, b: &Block, radial: bool) -> Result<(), ProgramError> {
+        let (xi, zi) = self.xz()?;
+        let name = if radial { "G87" } else { "G83" };
+        // G83 drills along Z at hole position X; G87 along X at hole position Z.
+        let (hole_axis, drill_axis) = if radial { (zi, xi) } else { (xi, zi) };
+        let (bottom, bottom_inc, hole_inc) = if radial {
+            ('X', 'U', 'W')
+        } else {
+            ('Z', 'W', 'U')
+        };
+        if !b.has(bottom) && !b.has(bottom_inc) {
+            return Err(self.fault(
+                Fault::MissingWord,
+                format!("{name} needs the hole bottom {bottom}({bottom_inc})"),
+            ));
+        }
+        let repeats = match b.get('K') {
+            None => 1,
+            Some(k) if (1.0..=MAX_REPEATS).contains(&k) && k.fract() == 0.0 => k as u32,
+            Some(k) => {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("{name} K{}: repeat count 1–9999", show(k)),
+                ))
+            }
+        };
+        let clamp = self.clamp_code(b, name)?;
+        let here = self.work_position();
+        let end = self.end_point(b)?;
+        // With an incremental hole position each repetition drills the next hole.
+        let step = if b.has(hole_inc) {
+            end[hole_axis] - here[hole_axis]
+        } else {
+            0.0
+        };
+        let s = if radial { self.x_scale() } else { 1.0 };
+        let (top, depth) = (
+            here[drill_axis] * s,
+            end[drill_axis] * s - here[drill_axis] * s,
+        );
+        let words = self.drill;
+        if words.peck > 0.0
+            && (depth.abs() / words.peck + 1.0) * f64::from(repeats) > MAX_CYCLE_STEPS as f64
+        {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!("{name} gives more than {MAX_CYCLE_STEPS} pecks"),
+            ));
+        }
+        let mut hole = end[hole_axis];
+        for _ in 0..repeats {
+            let at = |p: f64| {
+                let mut v = here.clone();
+                v[hole_axis] = hole;
+                v[drill_axis] = p / s;
+                v
+            };
+            self.rapid_unless_there(&at(top))?;
+            if let Some(m) = clamp {
+                self.aux(Aux::M(m));
+            }
+            for (p, kind) in pecks(top, depth, words) {
+                let kind = if kind {
+                    MoveKind::Feed(self.feed)
+                } else {
+                    MoveKind::Rapid
+                };
+                self.emit(&at(p), kind)?;
+            }
+            if words.dwell_ms > 0.0 {
+                self.push(Command::Dwell {
+                    seconds: words.dwell_ms / 1000.0,
+                });
+            }
+            self.emit(&at(top), MoveKind::Rapid)?;
+            if let Some(m) = clamp {
+                // The unclamp code is the clamp code + 1 (decision D45).
+                self.aux(Aux::M(m + 1));
+            }
+            hole += step;
+        }
+        Ok(())
+    }
+
+    /// The spindle clamp code Mα of a drilling block, if it has one.
+    fn clamp_code(&self, b: &Block, name: &str) -> Result<Option<i32>, ProgramError> {
+        let mut codes =
+            b.m.iter()
+                .filter(|(m, _)| matches!(m, M::AuxBefore | M::AuxAfter))
+                .map(|&(_, code)| code);
+        let first = codes.next();
+        if codes.next().is_some() {
+            return Err(self.fault(
+                Fault::IllegalWord,
+                format!("{name} takes one spindle clamp M code"),
+            ));
+        }
+        match first {
+            Some(code) if code % 10 != 0 => Err(self.fault(
+                Fault::IllegalWord,
+                format!(
+                    "{name}: M{} cannot clamp the spindle",
+                    show(f64::from(code) / 10.0)
+                ),
+            )),
+            Some(code) => Ok(Some((code / 10) as i32)),
+            None => Ok(None),
+        }
+    }
+
+    fn rapid_unless_there(&mut self, target: &[f64]) -> Result<(), ProgramError> {
+        let here = self.work_position();
+        if here.iter().zip(target).any(|(a, b)| (a - b).abs() > 1e-9) {
+            self.emit(target, MoveKind::Rapid)?;
+        }
+        Ok(())
+    }
+}
+
+/// The moves down the hole from level `top` by `depth` (signed), as (level, is-feed): the
+/// manual's steps ②–⑤ for J0 and J1. Q = 0, or J0 with R = 0, drills straight to the bottom.
+fn pecks(top: f64, depth: f64, w: DrillWords) -> Vec<(f64, bool)> {
+    let (total, dir) = (depth.abs(), if depth < 0.0 { -1.0 } else { 1.0 });
+    let level = |d: f64| top + dir * d;
+    if w.peck <= 0.0 || (!w.deep_hole && w.retract <= 0.0) {
+        return vec![(level(total), true)];
+    }
+    let mut moves = Vec::new();
+    let mut done = 0.0;
+    loop {
+        done = (done + w.peck).min(total);
+        moves.push((level(done), true));
+        if done >= total - 1e-9 {
+            return moves;
+        }
+        let back = (done - w.retract).max(0.0);
+        if w.deep_hole {
+            // Out of the hole, then rapid back to R short of the depth reached.
+            moves.push((top, false));
+            if back > 0.0 {
+                moves.push((level(back), false));
+            }
+        } else {
+            moves.push((level(back), false));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn words(peck: f64, retract: f64, deep_hole: bool) -> DrillWords {
+        DrillWords {
+            dwell_ms: 0.0,
+            peck,
+            retract,
+            deep_hole,
+        }
+    }
+
+    #[test]
+    fn high_speed_pecks_back_off_r_and_feed_q_plus_r() {
+        let m = pecks(0.0, -10.0, words(4.0, 1.0, false));
+        assert_eq!(
+            m,
+            [
+                (-4.0, true),
+                (-3.0, false),
+                (-8.0, true),
+                (-7.0, false),
+                (-10.0, true)
+            ]
+        );
+    }
+
+    #[test]
+    fn deep_hole_pecks_leave_the_hole_each_time() {
+        let m = pecks(5.0, -6.0, words(2.5, 0.5, true));
+        assert_eq!(
+            m,
+            [
+                (2.5, true),
+                (5.0, false),
+                (3.0, false),
+                (0.0, true),
+                (5.0, false),
+                (0.5, false),
+                (-1.0, true)
+            ]
+        );
+    }
+
+    #[test]
+    fn no_peck_or_no_back_off_drills_straight() {
+        assert_eq!(pecks(0.0, -10.0, words(0.0, 1.0, false)), [(-10.0, true)]);
+        assert_eq!(pecks(0.0, -10.0, words(3.0, 0.0, false)), [(-10.0, true)]);
+        // A back-off larger than the depth reached stops at the start level.
+        assert_eq!(
+            pecks(0.0, -3.0, words(1.0, 5.0, false)),
+            [
+                (-1.0, true),
+                (0.0, false),
+                (-2.0, true),
+                (0.0, false),
+                (-3.0, true)
+            ]
+        );
+    }
+}
