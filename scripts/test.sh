@@ -6,6 +6,8 @@
 #     rosbags, mcap, mcap-ros2-support (the readers of tests/recording.rs)
 #   - Debian's chromium and Node.js, and target/npm: playwright-core, which drives that chromium
 #     in tests/web_hmi.rs (it never downloads a browser of its own)
+#   - Debian's linuxcnc-uspace (2.9.0~pre1 in bookworm): its standalone interpreter rs274 is
+#     the reference of tests/linuxcnc_oracle.rs (../shared/notes/linuxcnc_oracle.md)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if ! target/venv/bin/python -c "import cyclonedds, rosbags, mcap, mcap_ros2, lz4, zstandard" 2>/dev/null; then
@@ -16,6 +18,10 @@ fi
 if ! command -v chromium >/dev/null || ! command -v node >/dev/null || ! command -v npm >/dev/null; then
     apt-get update
     apt-get install -y chromium nodejs npm
+fi
+if ! command -v rs274 >/dev/null; then
+    apt-get update
+    DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends linuxcnc-uspace
 fi
 if [ ! -f target/npm/node_modules/playwright-core/package.json ]; then
     mkdir -p target/npm

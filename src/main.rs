@@ -48,6 +48,10 @@ enum Verb {
         /// Print the canonical block stream, one command per line.
         #[arg(long)]
         trace: bool,
+        /// The trace's text: `text` (our golden-file format) or `linuxcnc` (the canonical
+        /// calls as LinuxCNC 2.9's `rs274` prints them).
+        #[arg(long, default_value = "text", value_parser = ["text", "linuxcnc"])]
+        format: String,
     },
     /// Run a program through the interpreter and the planner on a simulated clock: prints
     /// `cycle time: <seconds> s` and can draw the tool path over the turned part.
@@ -187,7 +191,11 @@ fn main() -> ExitCode {
             program,
             cycles,
         }) => run(&config, program.as_deref(), cycles),
-        Some(Verb::Check { program, trace }) => check(&program, trace),
+        Some(Verb::Check {
+            program,
+            trace,
+            format,
+        }) => check(&program, trace.then_some(format.as_str())),
         Some(Verb::Node { node, config }) => run_node(node, &config),
         Some(Verb::Simulate {
             program,
@@ -307,7 +315,8 @@ fn plc_check(file: &Path, rungs: bool) -> Result<(), String> {
     Ok(())
 }
 
-fn check(args: &ProgramArgs, trace: bool) -> Result<(), String> {
+/// `trace`: print the canonical stream in that format (`text` or `linuxcnc`).
+fn check(args: &ProgramArgs, trace: Option<&str>) -> Result<(), String> {
     use cnc_interpreter::diagnose;
     let LoadedProgram {
         cfg,
@@ -319,19 +328,31 @@ fn check(args: &ProgramArgs, trace: bool) -> Result<(), String> {
     let letters = cfg.axis_letters();
     let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
     let errors = diagnose(dialect, &text, setup.clone(), lib.clone());
-    if trace {
+    if let Some(format) = trace {
+        use std::io::Write;
         let mut interp = cnc_interpreter::Interpreter::with_library(dialect, &text, setup, lib);
-        let mut out = String::new();
+        let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
+        let plane = cfg
+            .machine
+            .arc_plane
+            .clone()
+            .map(|p| p.chars().next().unwrap_or('X'));
+        let mut linuxcnc = cnc_interpreter::trace::LinuxCnc::new(&letters, &diameter, plane);
+        let mut out = std::io::BufWriter::new(std::io::stdout().lock());
         let mut count = 0;
         while let Ok(Some(c)) = interp.next_command() {
             count += 1;
             if count > cnc_interpreter::interpreter::MAX_CHECK_COMMANDS {
                 break; // the diagnosis above reports the endless program
             }
-            out.push_str(&cnc_interpreter::trace::line(&letters, &c));
-            out.push('\n');
+            let written = if format == "linuxcnc" {
+                out.write_all(linuxcnc.lines(&c).as_bytes())
+            } else {
+                writeln!(out, "{}", cnc_interpreter::trace::line(&letters, &c))
+            };
+            written.map_err(|e| format!("stdout: {e}"))?;
         }
-        print!("{out}");
+        out.flush().map_err(|e| format!("stdout: {e}"))?;
     }
     if errors.is_empty() {
         eprintln!("{}: no alarm ({})", program.display(), dialect.name());

@@ -38,6 +38,10 @@ pub enum G {
     LocalCoordinate,
     /// G54–G59 (index 0–5).
     WorkSystem(u8),
+    /// G10 L2 P: write a work offset from the program (FANUC 0-M, `003` Appendix A).
+    SetOffsetData,
+    /// G53: this block's positions are machine coordinates (`003` §4.3.1).
+    MachineCoordinates,
     FeedPerMinute,
     FeedPerRevolution,
     ConstantSurfaceSpeed,
@@ -243,9 +247,10 @@ impl Dialect {
                 initial_feed: 0.0,
                 needs_end: false,
             },
-            // `003` §7.2.2: least input increment 0.001 mm, ±99999.999; power-on G00.
+            // `003` §7.2.2: least input increment 0.001 mm, ±99999.999; power-on G00. User
+            // macro B (`003` contents, inventory Appendix A).
             Dialect::FanucMill => Rules {
-                macros: false,
+                macros: true,
                 increment: 0.001,
                 max_coordinate: 99999.999,
                 max_feed: 24000.0,
@@ -483,11 +488,15 @@ fn mill_g(n: u32) -> Option<GCode> {
             Unsupported("G20 inch input: this controller works in millimetres"),
         ),
         210 => (6, MetricInput),
+        100 => (0, SetOffsetData),
+        280 => (0, ReferenceReturn),
+        530 => (0, MachineCoordinates),
         540..=590 if n.is_multiple_of(10) => (14, WorkSystem(((n - 540) / 10) as u8)),
         610 => (15, ExactStopMode),
         640 => (15, ContinuousMode),
         900 => (3, Absolute),
         910 => (3, Incremental),
+        920 => (0, SetCoordinate),
         940 => (5, FeedPerMinute),
         950 => (5, FeedPerRevolution),
         _ => return None,

@@ -938,9 +938,9 @@ impl Interpreter {
             MoveKind::Arc { center, ccw, .. } => {
                 let mut c = self.to_machine(&self.with_point(end, center));
                 // Axes outside the plane keep the end's value.
-                if let Ok((xi, zi)) = self.xz() {
+                if let Ok((p, q)) = self.plane_axes() {
                     for (i, v) in c.iter_mut().enumerate() {
-                        if i != xi && i != zi {
+                        if i != p && i != q {
                             *v = m[i];
                         }
                     }
@@ -1806,6 +1806,8 @@ impl Interpreter {
             match g {
                 G::Dwell => return self.dwell(b),
                 G::SetCoordinate => return self.set_coordinate(b, false),
+                G::SetOffsetData => return self.set_offset_data(b),
+                G::MachineCoordinates => return self.machine_coordinates(b),
                 G::AssignCoordinate | G::AssignClearLocal => {
                     return self.set_coordinate(b, g == G::AssignClearLocal)
                 }
@@ -2017,6 +2019,60 @@ impl Interpreter {
             self.shift[i] += here[i] - end[i];
         }
         Ok(())
+    }
+
+    /// G10 L2 Pp: work offset p (1–6 = G54–G59) gets the axis words, added under G91.
+    fn set_offset_data(&mut self, b: &Block) -> Result<(), ProgramError> {
+        match b.get('L') {
+            Some(2.0) => {}
+            Some(l) => {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("G10 L{}: only L2 (work offsets) is built", show(l)),
+                ))
+            }
+            None => return Err(self.fault(Fault::MissingWord, "G10 needs L2")),
+        }
+        let p = match b.get('P') {
+            Some(p) if (1.0..=6.0).contains(&p) && p.fract() == 0.0 => p as u8 - 1,
+            Some(p) => {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("G10 L2 P{}: work offset 1–6 (G54–G59)", show(p)),
+                ))
+            }
+            None => return Err(self.fault(Fault::MissingWord, "G10 L2 needs P (1–6)")),
+        };
+        for &a in &self.setup.axes.clone() {
+            if let Some(v) = b.get(a) {
+                let base = if self.incremental {
+                    self.setup.offsets.work(p, a)
+                } else {
+                    0.0
+                };
+                self.setup
+                    .offsets
+                    .work
+                    .entry(p)
+                    .or_default()
+                    .insert(a, base + v);
+            }
+        }
+        Ok(())
+    }
+
+    /// G53: a rapid to the block's axis words as machine coordinates (absolute only).
+    fn machine_coordinates(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let mut target = self.work_position();
+        for (i, &a) in self.setup.axes.clone().iter().enumerate() {
+            if let Some(v) = b.get(a) {
+                if self.incremental {
+                    return Err(self.fault(Fault::IllegalWord, "G53 takes absolute positions"));
+                }
+                target[i] = v - self.origin(i);
+            }
+        }
+        self.emit(&target, MoveKind::Rapid)
     }
 
     fn reference_return(&mut self, b: &Block) -> Result<(), ProgramError> {

@@ -500,7 +500,13 @@ impl Parser<'_> {
                 };
                 self.i += name.len();
                 let mut args = Vec::new();
-                for _ in 0..f.arity() {
+                for k in 0..f.arity() {
+                    if k == 1 && f == Func::Atan {
+                        // FANUC macro B writes `ATAN[a]/[b]`, Huaxing `ATAN[a][b]`.
+                        self.skip_ws();
+                        self.eat(b'/');
+                        self.skip_ws();
+                    }
                     if !self.eat(b'[') {
                         return err(Fault::Macro, format!("{name} needs [argument]"));
                     }

@@ -92,3 +92,189 @@ pub fn format(letters: &[char], commands: &[Canon]) -> String {
     }
     out
 }
+
+/// The canonical stream in the text of LinuxCNC 2.9's standalone interpreter `rs274`
+/// (`../shared/notes/linuxcnc_oracle.md` §1.3), for `cnc check --trace --format linuxcnc`:
+///
+/// ```text
+///     1 N..... STRAIGHT_TRAVERSE(10.0000, 5.0000, 2.0000, 0.0000, 0.0000, 0.0000)
+///     2 N..... SET_FEED_RATE(200.0000)
+///     3 N..... STRAIGHT_FEED(10.0000, 5.0000, -1.0000, 0.0000, 0.0000, 0.0000)
+///     4 N..... ARC_FEED(20.0000, 5.0000, 15.0000, 5.0000, -1, -1.0000, 0.0000, 0.0000, 0.0000)
+/// ```
+///
+/// Call names, argument order and `%.4f` are rs274's. Positions are machine coordinates:
+/// our canonical commands carry the work offsets, G92 and tool length already applied, so
+/// no `SET_G5X_OFFSET` / `SET_G92_OFFSET` / `USE_TOOL_LENGTH_OFFSET` lines are printed (rs274
+/// prints positions in the program frame and those offsets beside them; the oracle test adds
+/// them back). Diameter axes print as radius, as rs274 does in G7.
+pub struct LinuxCnc {
+    /// For each of x, y, z, a, b, c: the index of our axis with that letter.
+    slots: [Option<usize>; 6],
+    diameter: Vec<bool>,
+    /// The arc plane as (first, second) axis letters of rs274's ARC_FEED (XY: X, Y; XZ: Z, X;
+    /// YZ: Y, Z).
+    plane: (usize, usize),
+    feed: Option<f64>,
+    tool: i32,
+    seq: u64,
+}
+
+impl LinuxCnc {
+    /// `letters`/`diameter`: the machine's axes; `arc_plane`: the two axes arcs turn in.
+    pub fn new(letters: &[char], diameter: &[bool], arc_plane: [char; 2]) -> LinuxCnc {
+        let mut slots = [None; 6];
+        for (k, l) in ['X', 'Y', 'Z', 'A', 'B', 'C'].iter().enumerate() {
+            slots[k] = letters.iter().position(|a| a == l);
+        }
+        let slot = |c: char| "XYZABC".find(c).unwrap_or(0);
+        let (p, q) = (slot(arc_plane[0]), slot(arc_plane[1]));
+        // rs274 orders the plane's axes cyclically: XY, ZX (G18 prints Z first), YZ.
+        let plane = match (p.min(q), p.max(q)) {
+            (0, 2) => (2, 0),
+            (a, b) => (a, b),
+        };
+        LinuxCnc {
+            slots,
+            diameter: diameter.to_vec(),
+            plane,
+            feed: None,
+            tool: 0,
+            seq: 0,
+        }
+    }
+
+    /// The value of rs274 slot `k` (x..c) of a machine position.
+    fn value(&self, p: &[f64], k: usize) -> f64 {
+        match self.slots[k] {
+            Some(i) => {
+                let v = p.get(i).copied().unwrap_or(0.0);
+                if self.diameter.get(i) == Some(&true) {
+                    v / 2.0
+                } else {
+                    v
+                }
+            }
+            None => 0.0,
+        }
+    }
+
+    fn six(&self, p: &[f64]) -> String {
+        (0..6)
+            .map(|k| num(self.value(p, k)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    fn push(&mut self, out: &mut String, call: &str) {
+        self.seq += 1;
+        let _ = writeln!(out, "{:5} N..... {call}", self.seq);
+    }
+
+    fn set_feed(&mut self, out: &mut String, feed: f64) {
+        if self.feed != Some(feed) {
+            self.feed = Some(feed);
+            self.push(out, &format!("SET_FEED_RATE({})", num(feed)));
+        }
+    }
+
+    /// The rs274 lines of one command (none for commands rs274 has no call for).
+    pub fn lines(&mut self, c: &Canon) -> String {
+        let mut out = String::new();
+        match &c.command {
+            Command::Rapid { end } => {
+                let call = format!("STRAIGHT_TRAVERSE({})", self.six(end));
+                self.push(&mut out, &call);
+            }
+            Command::Linear { end, feed } => {
+                self.set_feed(&mut out, *feed);
+                let call = format!("STRAIGHT_FEED({})", self.six(end));
+                self.push(&mut out, &call);
+            }
+            Command::Arc {
+                end,
+                center,
+                clockwise,
+                feed,
+            } => {
+                self.set_feed(&mut out, *feed);
+                let (p, q) = self.plane;
+                let normal = 3 - p - q;
+                let call = format!(
+                    "ARC_FEED({}, {}, {}, {}, {}, {}, {}, {}, {})",
+                    num(self.value(end, p)),
+                    num(self.value(end, q)),
+                    num(self.value(center, p)),
+                    num(self.value(center, q)),
+                    if *clockwise { -1 } else { 1 },
+                    num(self.value(end, normal)),
+                    num(self.value(end, 3)),
+                    num(self.value(end, 4)),
+                    num(self.value(end, 5)),
+                );
+                self.push(&mut out, &call);
+            }
+            Command::Thread { end, lead, .. } => {
+                self.push(
+                    &mut out,
+                    &format!("START_SPEED_FEED_SYNCH(0, {lead:.6}, 0)"),
+                );
+                let call = format!("STRAIGHT_FEED({})", self.six(end));
+                self.push(&mut out, &call);
+                self.push(&mut out, "STOP_SPEED_FEED_SYNCH()");
+            }
+            Command::Dwell { seconds } => {
+                self.push(&mut out, &format!("DWELL({})", num(*seconds)));
+            }
+            Command::FeedMode { per_rev } => {
+                self.push(
+                    &mut out,
+                    &format!("SET_FEED_MODE(0, {})", u8::from(*per_rev)),
+                );
+            }
+            Command::PathMode { exact_stop } => {
+                let mode = if *exact_stop {
+                    "CANON_EXACT_STOP"
+                } else {
+                    "CANON_CONTINUOUS"
+                };
+                self.push(
+                    &mut out,
+                    &format!("SET_MOTION_CONTROL_MODE({mode}, 0.000000)"),
+                );
+            }
+            Command::Aux(Aux::S(v)) => {
+                self.push(&mut out, &format!("SET_SPINDLE_SPEED(0, {})", num(*v)));
+            }
+            Command::Aux(Aux::T(t)) => {
+                self.tool = *t;
+                self.push(&mut out, &format!("SELECT_TOOL({t})"));
+            }
+            Command::Aux(Aux::M(m)) => {
+                let call = match m {
+                    0 => "PROGRAM_STOP()".to_string(),
+                    1 => "OPTIONAL_PROGRAM_STOP()".to_string(),
+                    3 => "START_SPINDLE_CLOCKWISE(0)".to_string(),
+                    4 => "START_SPINDLE_COUNTERCLOCKWISE(0)".to_string(),
+                    5 => "STOP_SPINDLE_TURNING(0)".to_string(),
+                    6 => format!("CHANGE_TOOL({})", self.tool),
+                    7 => "MIST_ON()".to_string(),
+                    8 => "FLOOD_ON()".to_string(),
+                    9 => "FLOOD_OFF()".to_string(),
+                    30 => "PALLET_SHUTTLE()".to_string(),
+                    2 => return out,
+                    other => format!("COMMENT(\"M{other}\")"),
+                };
+                self.push(&mut out, &call);
+            }
+            Command::ProgramEnd => self.push(&mut out, "PROGRAM_END()"),
+        }
+        out
+    }
+}
+
+/// rs274's `%.4f`, without a negative zero.
+fn num(v: f64) -> String {
+    let v = if v.abs() < 5e-5 { 0.0 } else { v };
+    format!("{v:.4}")
+}

@@ -1,0 +1,204 @@
+//! The mill dialect checked line by line against LinuxCNC 2.9's standalone interpreter
+//! `rs274` (Debian `linuxcnc-uspace`, installed by `scripts/test.sh`; notes in
+//! `../shared/notes/linuxcnc_oracle.md`). Every program in `tests/oracle/` is run through
+//! both: `rs274 -g` and our interpreter with `trace::LinuxCnc` (what `cnc check --trace
+//! --format linuxcnc` prints). The motion calls (STRAIGHT_TRAVERSE, STRAIGHT_FEED,
+//! ARC_FEED, DWELL) must agree in order, kind and every number to 1e-4 mm, each feed move
+//! with the same feed rate.
+//!
+//! rs274 prints positions in the program frame and the work offset, G92 offset and tool
+//! length offset beside them (SET_G5X_OFFSET, SET_G92_OFFSET, USE_TOOL_LENGTH_OFFSET); our
+//! canonical stream is in machine coordinates. The comparison adds rs274's offsets back.
+
+use std::path::{Path, PathBuf};
+use std::process::Command as Process;
+
+use cnc_interpreter::{Dialect, Interpreter, Setup};
+
+const TOLERANCE: f64 = 1e-4;
+
+/// One motion call, in machine coordinates: kind, numbers, feed in effect.
+#[derive(Debug, Clone, PartialEq)]
+struct Call {
+    name: String,
+    args: Vec<f64>,
+    feed: f64,
+}
+
+/// Splits `   12 N..... NAME(a, b, c)` into the name and its argument text.
+fn split(line: &str) -> Option<(&str, &str)> {
+    let rest = line.trim_start();
+    let rest = rest.split_once(' ')?.1.trim_start();
+    let rest = rest.split_once(' ')?.1.trim_start();
+    let (name, args) = rest.split_once('(')?;
+    Some((name, args.strip_suffix(')')?))
+}
+
+fn numbers(args: &str) -> Vec<f64> {
+    args.split([',', ' '])
+        .filter(|s| !s.is_empty())
+        .filter_map(|s| s.parse().ok())
+        .collect()
+}
+
+/// The motion calls of a canon listing, with the offsets added to every position.
+fn motion_calls(listing: &str) -> Vec<Call> {
+    let mut g5x = [0.0; 6];
+    let mut g92 = [0.0; 6];
+    let mut tlo = [0.0; 6];
+    // rs274's ARC_FEED plane: (first, second, normal) as indices of x..c.
+    let mut plane = (0, 1, 2);
+    let mut feed = 0.0;
+    let mut out = Vec::new();
+    for line in listing.lines() {
+        let Some((name, args)) = split(line) else {
+            continue;
+        };
+        let n = numbers(args);
+        let offset = |k: usize| g5x[k] + g92[k] + tlo[k];
+        match name {
+            "SET_G5X_OFFSET" if n.len() == 7 => g5x.copy_from_slice(&n[1..7]),
+            "SET_G92_OFFSET" if n.len() == 6 => g92.copy_from_slice(&n),
+            "USE_TOOL_LENGTH_OFFSET" if n.len() >= 6 => tlo.copy_from_slice(&n[..6]),
+            "SELECT_PLANE" => {
+                plane = match args {
+                    "CANON_PLANE_XZ" => (2, 0, 1),
+                    "CANON_PLANE_YZ" => (1, 2, 0),
+                    _ => (0, 1, 2),
+                }
+            }
+            "SET_FEED_RATE" if n.len() == 1 => feed = n[0],
+            "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" if n.len() == 6 => out.push(Call {
+                name: name.to_string(),
+                args: (0..6).map(|k| n[k] + offset(k)).collect(),
+                feed: if name == "STRAIGHT_FEED" { feed } else { 0.0 },
+            }),
+            "ARC_FEED" if n.len() == 9 => {
+                let (p, q, r) = plane;
+                out.push(Call {
+                    name: name.to_string(),
+                    args: vec![
+                        n[0] + offset(p),
+                        n[1] + offset(q),
+                        n[2] + offset(p),
+                        n[3] + offset(q),
+                        n[4],
+                        n[5] + offset(r),
+                        n[6] + offset(3),
+                        n[7] + offset(4),
+                        n[8] + offset(5),
+                    ],
+                    feed,
+                })
+            }
+            "DWELL" if n.len() == 1 => out.push(Call {
+                name: name.to_string(),
+                args: n,
+                feed: 0.0,
+            }),
+            _ => {}
+        }
+    }
+    out
+}
+
+fn oracle_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracle")
+}
+
+fn rs274(program: &Path) -> Result<String, String> {
+    let out = std::env::temp_dir().join(format!(
+        "cnc_oracle_{}_{}.canon",
+        std::process::id(),
+        program.file_stem().and_then(|s| s.to_str()).unwrap_or("p")
+    ));
+    let run = Process::new("rs274")
+        .arg("-g")
+        .arg(program)
+        .arg(&out)
+        .output()
+        .map_err(|e| format!("rs274: {e} (Debian linuxcnc-uspace; scripts/test.sh installs it)"))?;
+    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let _ = std::fs::remove_file(&out);
+    if !run.status.success() {
+        return Err(format!(
+            "rs274 rejected {}: {}",
+            program.display(),
+            String::from_utf8_lossy(&run.stderr)
+        ));
+    }
+    Ok(text)
+}
+
+/// Our interpreter on the simulated mill (X, Y, Z from the machine zero, as rs274 starts).
+fn ours(program: &Path) -> Result<String, String> {
+    let text = std::fs::read_to_string(program).map_err(|e| e.to_string())?;
+    let letters = ['X', 'Y', 'Z'];
+    let setup = Setup::new(&letters, &[false; 3], &[0.0; 3]);
+    let mut interp = Interpreter::new(Dialect::FanucMill, &text, setup);
+    let mut fmt = cnc_interpreter::trace::LinuxCnc::new(&letters, &[false; 3], ['X', 'Y']);
+    let mut out = String::new();
+    while let Some(c) = interp
+        .next_command()
+        .map_err(|e| format!("{}: {e}", program.display()))?
+    {
+        out.push_str(&fmt.lines(&c));
+    }
+    Ok(out)
+}
+
+/// The first difference of two call lists, if any.
+fn compare(theirs: &[Call], ours: &[Call]) -> Option<String> {
+    for (k, (a, b)) in theirs.iter().zip(ours).enumerate() {
+        let same = a.name == b.name
+            && a.args.len() == b.args.len()
+            && a.args
+                .iter()
+                .zip(&b.args)
+                .all(|(x, y)| (x - y).abs() <= TOLERANCE)
+            && (a.feed - b.feed).abs() <= TOLERANCE;
+        if !same {
+            return Some(format!("call {k}: rs274 {a:?}\n            ours  {b:?}"));
+        }
+    }
+    (theirs.len() != ours.len()).then(|| {
+        format!(
+            "rs274 made {} motion calls, ours {}",
+            theirs.len(),
+            ours.len()
+        )
+    })
+}
+
+#[test]
+fn every_oracle_program_agrees_with_rs274() {
+    let mut programs: Vec<PathBuf> = std::fs::read_dir(oracle_dir())
+        .expect("tests/oracle")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "ngc"))
+        .collect();
+    programs.sort();
+    assert!(programs.len() >= 8, "{} programs", programs.len());
+    let mut failures = Vec::new();
+    let mut calls = 0;
+    for p in &programs {
+        let result = rs274(p).and_then(|theirs| Ok((theirs, ours(p)?)));
+        match result {
+            Ok((theirs, ours)) => {
+                let (t, o) = (motion_calls(&theirs), motion_calls(&ours));
+                assert!(!t.is_empty(), "{}: no motion from rs274", p.display());
+                calls += t.len();
+                if let Some(diff) = compare(&t, &o) {
+                    failures.push(format!("{}: {diff}", p.display()));
+                }
+            }
+            Err(e) => failures.push(e),
+        }
+    }
+    println!(
+        "{} programs, {calls} motion calls compared, {} mismatches",
+        programs.len(),
+        failures.len()
+    );
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
