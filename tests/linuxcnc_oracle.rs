@@ -9,6 +9,11 @@
 //! rs274 prints positions in the program frame and the work offset, G92 offset and tool
 //! length offset beside them (SET_G5X_OFFSET, SET_G92_OFFSET, USE_TOOL_LENGTH_OFFSET); our
 //! canonical stream is in machine coordinates. The comparison adds rs274's offsets back.
+//!
+//! Where FANUC and LinuxCNC differ by design the programs keep to the common subset, and the
+//! FANUC behaviour is asserted elsewhere: LinuxCNC has no G09 (`fixtures_000.rs`, 024), its
+//! G04 P is seconds where FANUC's is milliseconds (`programs.rs`), and it rejects U/W words,
+//! G65 and FANUC T-word forms (notes §"What rs274 accepts and rejects").
 
 use std::path::{Path, PathBuf};
 use std::process::Command as Process;
