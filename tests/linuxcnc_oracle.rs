@@ -12,7 +12,7 @@
 //!
 //! Where FANUC and LinuxCNC differ by design the programs keep to the common subset, and the
 //! FANUC behaviour is asserted elsewhere: LinuxCNC has no G09 (`fixtures_000.rs`, 024), its
-//! G04 P is seconds where FANUC's is milliseconds (`programs.rs`), and it rejects U/W words,
+//! G04 P is seconds where FANUC's is milliseconds (`fixtures_003.rs`), and it rejects U/W words,
 //! G65 and FANUC T-word forms (notes §"What rs274 accepts and rejects").
 
 use std::path::{Path, PathBuf};

@@ -156,3 +156,18 @@ fn fixture_005_g92_shifts_every_work_system() {
         ],
     );
 }
+
+#[test]
+fn g04_dwell_p_is_milliseconds_x_is_seconds() {
+    // FANUC 0-M: G04 P in ms (no decimal point), X in seconds; LinuxCNC's P is seconds, so the
+    // oracle programs leave G04 out and this test holds the FANUC reading.
+    let cmds = run("G04 P1500\nG04 X2.5\n", mill(&XYZ, &[0.0; 3])).unwrap();
+    let dwells: Vec<f64> = cmds
+        .iter()
+        .filter_map(|c| match c.command {
+            Command::Dwell { seconds } => Some(seconds),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(dwells, [1.5, 2.5]);
+}
