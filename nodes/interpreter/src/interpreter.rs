@@ -936,15 +936,8 @@ impl Interpreter {
             MoveKind::Rapid => Command::Rapid { end: m },
             MoveKind::Feed(_) => Command::Linear { end: m, feed },
             MoveKind::Arc { center, ccw, .. } => {
-                let mut c = self.to_machine(&self.with_point(end, center));
-                // Axes outside the plane keep the end's value.
-                if let Ok((p, q)) = self.plane_axes() {
-                    for (i, v) in c.iter_mut().enumerate() {
-                        if i != p && i != q {
-                            *v = m[i];
-                        }
-                    }
-                }
+                // Axes outside the plane keep the end's value (a helix's centre is at its end).
+                let c = self.to_machine(&self.with_point(end, center));
                 Command::Arc {
                     end: m,
                     center: c,

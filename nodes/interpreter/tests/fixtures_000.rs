@@ -3,6 +3,9 @@
 
 use cnc_interpreter::{Aux, Canon, Command, Dialect, Library, ProgramError, Setup};
 
+mod support;
+use support::contour_at;
+
 const HOME: [f64; 2] = [200.0, 100.0];
 
 fn fixture(name: &str) -> String {
@@ -165,16 +168,6 @@ impl Stock {
     fn at(&self, t: f64) -> f64 {
         self.v[((t - self.t0) / self.h).round() as usize]
     }
-}
-
-/// Radius of a polyline contour (Z, X-diameter points) at z (first hit).
-fn contour_at(points: &[[f64; 2]], z: f64) -> Option<f64> {
-    points.windows(2).find_map(|w| {
-        let ([z0, x0], [z1, x1]) = (w[0], w[1]);
-        let (lo, hi) = (z0.min(z1), z0.max(z1));
-        (z >= lo && z <= hi && (z1 - z0).abs() > 1e-9)
-            .then(|| (x0 + (x1 - x0) * (z - z0) / (z1 - z0)) / 2.0)
-    })
 }
 
 #[test]
@@ -831,11 +824,15 @@ fn fixture_013_g07_pauses_1_s_every_5_mm() {
     // After the cancel, the next G01 is one move.
     let after: Vec<&Canon> = cmds.iter().filter(|c| c.line == 6).collect();
     assert_eq!(after.len(), 1, "{after:?}");
-    // Its errors: K without L, and L 0.
-    for bad in ["G07 K1", "G07 K1 L0", "G07 K-1 L5", "G07 P5 Q1 L15"] {
+    // Its errors (D45): K without L (23), L 0 or a negative pause (13), the thread form (7).
+    for (bad, number) in [
+        ("G07 K1", 23),
+        ("G07 K1 L0", 13),
+        ("G07 K-1 L5", 13),
+        ("G07 P5 Q1 L15", 7),
+    ] {
         let e = run(&format!("G00 X20 Z0\n{bad}\n"), HOME).unwrap_err();
-        assert_eq!(e.line, 2, "{bad}: {e}");
-        assert!([23, 13, 7].contains(&e.number), "{bad}: {e}");
+        assert_eq!((e.number, e.line), (number, 2), "{bad}: {e}");
     }
 }
 

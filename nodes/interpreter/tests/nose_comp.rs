@@ -6,6 +6,9 @@
 use cnc_interpreter::setup::ToolOffset;
 use cnc_interpreter::{Canon, Command, Dialect, Setup};
 
+mod support;
+use support::contour_at;
+
 const HOME: [f64; 2] = [200.0, 250.0];
 
 fn fixture(dir: &str, name: &str) -> String {
@@ -473,12 +476,11 @@ impl DiscStock {
                     );
                     let (lo, hi) = (p[0].min(q[0]), p[0].max(q[0]));
                     let i0 = ((lo - self.z0) / self.h).ceil().max(0.0) as usize;
-                    let i1 =
-                        (((hi - self.z0) / self.h).floor() as i64).min(self.v.len() as i64 - 1);
-                    for i in i0..=(i1.max(-1) as usize).min(self.v.len().saturating_sub(1)) {
-                        if i1 < i0 as i64 {
-                            break;
-                        }
+                    let i1 = ((hi - self.z0) / self.h)
+                        .floor()
+                        .min(self.v.len() as f64 - 1.0);
+                    let i1 = if i1 < 0.0 { 0 } else { i1 as usize + 1 };
+                    for i in i0..i1 {
                         let z = self.z(i);
                         out.push((i, p[1] + (q[1] - p[1]) * (z - p[0]) / (q[0] - p[0])));
                     }
@@ -516,15 +518,6 @@ impl DiscStock {
     fn at(&self, z: f64) -> f64 {
         self.v[((z - self.z0) / self.h).round() as usize]
     }
-}
-
-/// The radius of a polyline/arc-free contour given as (Z, X diameter) corners at `z`.
-fn polyline_at(points: &[[f64; 2]], z: f64) -> Option<f64> {
-    points.windows(2).find_map(|w| {
-        let ([z0, x0], [z1, x1]) = (w[0], w[1]);
-        (z >= z0.min(z1) && z <= z0.max(z1) && (z1 - z0).abs() > 1e-9)
-            .then(|| (x0 + (x1 - x0) * (z - z0) / (z1 - z0)) / 2.0)
-    })
 }
 
 #[test]
@@ -588,8 +581,8 @@ fn fixture_032_roughing_leaves_the_contour_plus_allowance_under_the_nose() {
             let want = if (60.0 + dw..=80.0 + dw).contains(&z) {
                 25.0 + du / 2.0 - (100.0 - (z - 70.0 - dw).powi(2)).max(0.0).sqrt()
             } else {
-                polyline_at(&head, z)
-                    .or_else(|| polyline_at(&tail, z))
+                contour_at(&head, z)
+                    .or_else(|| contour_at(&tail, z))
                     .expect("contour")
             };
             assert!(
