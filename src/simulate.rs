@@ -105,10 +105,14 @@ impl ProgrammedPath {
                 center,
                 clockwise,
                 feed,
-            } => (
-                path::arc(&self.end, &slide(end), &slide(center), plane, *clockwise),
-                *feed,
-            ),
+                plane: arc_plane,
+            } => {
+                let plane = arc_plane.map_or(plane, |[h, v]| (usize::from(h), usize::from(v)));
+                (
+                    path::arc(&self.end, &slide(end), &slide(center), plane, *clockwise),
+                    *feed,
+                )
+            }
             Command::Rapid { end } => {
                 self.end = slide(end);
                 return;

@@ -16,12 +16,17 @@ pub enum Command {
         end: Vec<f64>,
         feed: f64,
     },
-    /// Circular arc around `center` in the machine's arc plane; `end == start` is a full circle.
+    /// Circular arc around `center`; `end == start` is a full circle. Axes outside the plane
+    /// move linearly with the arc (a helix).
     Arc {
         end: Vec<f64>,
         center: Vec<f64>,
         clockwise: bool,
         feed: f64,
+        /// The plane as (first, second) axis indices, counter-clockwise turning from the first
+        /// towards the second (G17: X, Y; G18: Z, X; G19: Y, Z). `None`: the machine's
+        /// configured arc plane.
+        plane: Option<[u8; 2]>,
     },
     /// Thread cutting: a straight move whose long axis advances `lead` mm per spindle
     /// revolution, starting `start_angle` degrees after the spindle's index pulse. Feed
@@ -98,7 +103,9 @@ pub fn to_motion_block(
             center,
             clockwise,
             feed,
+            plane,
         } => {
+            m.plane = plane.map(|p| p.to_vec()).unwrap_or_default();
             m.kind = if *clockwise {
                 MotionBlock::KIND_ARC_CW
             } else {
@@ -169,6 +176,16 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
             center: m.center.clone(),
             clockwise: m.kind == MotionBlock::KIND_ARC_CW,
             feed: feed()?,
+            plane: match m.plane[..] {
+                [] => None,
+                [a, b] if a != b => Some([a, b]),
+                _ => {
+                    return Err(format!(
+                        "arc plane {:?} does not name two different axes",
+                        m.plane
+                    ))
+                }
+            },
         },
         MotionBlock::KIND_THREAD => {
             if !(m.lead.is_finite() && m.lead > 0.0 && m.start_angle.is_finite()) {
@@ -230,12 +247,14 @@ mod tests {
                 center: vec![5.0, 0.0],
                 clockwise: true,
                 feed: 90.0,
+                plane: None,
             },
             Command::Arc {
                 end: vec![5.0, 6.0],
                 center: vec![5.0, 0.0],
                 clockwise: false,
                 feed: 90.0,
+                plane: Some([2, 0]),
             },
             Command::Dwell { seconds: 1.5 },
             Command::Aux(Aux::M(3)),
@@ -278,5 +297,12 @@ mod tests {
         let mut k = d.clone();
         k.kind = 99;
         assert!(from_motion_block(&k).is_err());
+        let mut arc = m.clone();
+        arc.end = vec![1.0];
+        arc.kind = MotionBlock::KIND_ARC_CW;
+        for bad_plane in [vec![0], vec![1, 1], vec![0, 1, 2]] {
+            arc.plane.clone_from(&bad_plane);
+            assert!(from_motion_block(&arc).is_err(), "plane {bad_plane:?}");
+        }
     }
 }

@@ -226,6 +226,7 @@ ros_message! {
         kind: u8,
         end: Vec<f64>,
         center: Vec<f64>,
+        plane: Vec<u8>,
         feed: f64,
         dwell_seconds: f64,
         lead: f64,

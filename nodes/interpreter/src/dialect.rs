@@ -475,14 +475,8 @@ fn mill_g(n: u32) -> Option<GCode> {
         40 => (0, Dwell),
         90 => (0, ExactStopBlock),
         170 => (2, PlaneXy),
-        180 => (
-            2,
-            Unsupported("G18: arcs in the Z-X plane on the mill come with issue 7"),
-        ),
-        190 => (
-            2,
-            Unsupported("G19: arcs in the Y-Z plane on the mill come with issue 7"),
-        ),
+        180 => (2, PlaneZx),
+        190 => (2, PlaneYz),
         200 => (
             6,
             Unsupported("G20 inch input: this controller works in millimetres"),

@@ -159,6 +159,8 @@ pub struct Interpreter {
     /// GTC2E G25 memory.
     stored: Option<Vec<f64>>,
     motion: G,
+    /// G17/G18/G19 on the mill (the lathe always turns in Z-X).
+    plane: G,
     incremental: bool,
     feed: f64,
     feed_per_rev: bool,
@@ -250,6 +252,7 @@ impl Interpreter {
             previous_start: Vec::new(),
             stored: None,
             motion: rules.initial_motion,
+            plane: G::PlaneXy,
             incremental: false,
             feed: rules.initial_feed,
             feed_per_rev: false,
@@ -789,17 +792,25 @@ impl Interpreter {
         }
     }
 
-    /// The working plane as (horizontal, vertical) axis indices: the lathe's Z-X plane, the
-    /// mill's G17 X-Y plane (G18/G19 come with issue 7).
+    /// The working plane as (horizontal, vertical) axis indices, counter-clockwise turning
+    /// from the first to the second: the lathe's Z-X plane, the mill's G17 X-Y, G18 Z-X and
+    /// G19 Y-Z (`003` §2.3, §4.4).
     fn plane_axes(&self) -> Result<(usize, usize), ProgramError> {
         if self.dialect.is_lathe() {
             let (xi, zi) = self.xz()?;
-            Ok((zi, xi))
-        } else {
-            match (self.axis('X'), self.axis('Y')) {
-                (Some(x), Some(y)) => Ok((x, y)),
-                _ => Err(self.fault(Fault::AxisAddress, "G17 needs the X and Y axes")),
-            }
+            return Ok((zi, xi));
+        }
+        let (h, v, name) = match self.plane {
+            G::PlaneZx => ('Z', 'X', "G18"),
+            G::PlaneYz => ('Y', 'Z', "G19"),
+            _ => ('X', 'Y', "G17"),
+        };
+        match (self.axis(h), self.axis(v)) {
+            (Some(h), Some(v)) => Ok((h, v)),
+            _ => Err(self.fault(
+                Fault::AxisAddress,
+                format!("{name} needs the {h} and {v} axes"),
+            )),
         }
     }
 
@@ -938,11 +949,16 @@ impl Interpreter {
             MoveKind::Arc { center, ccw, .. } => {
                 // Axes outside the plane keep the end's value (a helix's centre is at its end).
                 let c = self.to_machine(&self.with_point(end, center));
+                let plane = self
+                    .plane_axes()
+                    .ok()
+                    .and_then(|(h, v)| Some([u8::try_from(h).ok()?, u8::try_from(v).ok()?]));
                 Command::Arc {
                     end: m,
                     center: c,
                     clockwise: !ccw,
                     feed,
+                    plane,
                 }
             }
             MoveKind::Thread { lead, angle } => Command::Thread {
@@ -1271,7 +1287,7 @@ impl Interpreter {
                     // Keep the machine position; the work coordinates change.
                     self.work_system = n;
                 }
-                G::PlaneXy if !self.dialect.is_lathe() => {}
+                G::PlaneXy | G::PlaneZx | G::PlaneYz if !self.dialect.is_lathe() => self.plane = g,
                 G::MetricInput => {}
                 G::PlaneXy | G::PlaneYz => {
                     return Err(self.fault(

@@ -41,11 +41,16 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             center,
             clockwise,
             feed,
+            plane,
         } => {
             s.push_str(if *clockwise { "ARC_CW" } else { "ARC_CCW" });
             axes(&mut s, letters, end, "");
             axes(&mut s, letters, center, "C");
             let _ = write!(s, " F{feed:.4}");
+            if let Some(p) = plane {
+                let letter = |i: u8| letters.get(usize::from(i)).copied().unwrap_or('?');
+                let _ = write!(s, " PLANE {}{}", letter(p[0]), letter(p[1]));
+            }
         }
         Command::Thread {
             end,
@@ -128,12 +133,7 @@ impl LinuxCnc {
             slots[k] = letters.iter().position(|a| a == l);
         }
         let slot = |c: char| "XYZABC".find(c).unwrap_or(0);
-        let (p, q) = (slot(arc_plane[0]), slot(arc_plane[1]));
-        // rs274 orders the plane's axes cyclically: XY, ZX (G18 prints Z first), YZ.
-        let plane = match (p.min(q), p.max(q)) {
-            (0, 2) => (2, 0),
-            (a, b) => (a, b),
-        };
+        let plane = cyclic(slot(arc_plane[0]), slot(arc_plane[1]));
         LinuxCnc {
             slots,
             diameter: diameter.to_vec(),
@@ -141,6 +141,30 @@ impl LinuxCnc {
             feed: None,
             tool: 0,
             seq: 0,
+        }
+    }
+
+    /// rs274's plane (slots of x..c) of an arc turning in our axes `a`, `b`.
+    fn rs274_plane(&self, a: u8, b: u8) -> (usize, usize) {
+        let slot = |i: u8| {
+            self.slots
+                .iter()
+                .position(|s| *s == Some(usize::from(i)))
+                .unwrap_or(0)
+        };
+        cyclic(slot(a), slot(b))
+    }
+
+    /// `SELECT_PLANE` when an arc turns in another plane than the last one printed.
+    fn select_plane(&mut self, out: &mut String, plane: (usize, usize)) {
+        if plane != self.plane {
+            self.plane = plane;
+            let name = match plane {
+                (2, 0) => "CANON_PLANE_XZ",
+                (1, 2) => "CANON_PLANE_YZ",
+                _ => "CANON_PLANE_XY",
+            };
+            self.push(out, &format!("SELECT_PLANE({name})"));
         }
     }
 
@@ -196,8 +220,12 @@ impl LinuxCnc {
                 center,
                 clockwise,
                 feed,
+                plane,
             } => {
                 self.set_feed(&mut out, *feed);
+                if let Some([a, b]) = plane {
+                    self.select_plane(&mut out, self.rs274_plane(*a, *b));
+                }
                 let (p, q) = self.plane;
                 let normal = 3 - p - q;
                 let call = format!(
@@ -270,6 +298,14 @@ impl LinuxCnc {
             Command::ProgramEnd => self.push(&mut out, "PROGRAM_END()"),
         }
         out
+    }
+}
+
+/// rs274 orders a plane's axes cyclically: XY, ZX (G18 prints Z first), YZ.
+fn cyclic(p: usize, q: usize) -> (usize, usize) {
+    match (p.min(q), p.max(q)) {
+        (0, 2) => (2, 0),
+        (a, b) => (a, b),
     }
 }
 

@@ -113,7 +113,11 @@ fn fixture_004_four_arc_forms_reach_d_around_the_same_centre() {
     assert_eq!(variants.len(), 4);
     for v in variants {
         let cmds = run(&format!("{v}\nM2\n"), [40.0, 60.0]);
-        assert_eq!(lines(&cmds)[0], "ARC_CW X60 Z50 CX60 CZ60 F80", "{v}");
+        assert_eq!(
+            lines(&cmds)[0],
+            "ARC_CW X60 Z50 CX60 CZ60 F80 PLANE ZX",
+            "{v}"
+        );
     }
 }
 

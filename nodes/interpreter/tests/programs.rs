@@ -348,7 +348,7 @@ fn chamfer_and_corner_rounding_in_g01() {
     assert_eq!(
         hx("G01 Z-10 D2 F100\nX40\nM30\n"),
         "L1 LINEAR X20.0000 Z-8.0000 F100.0000\n\
-         L1 ARC_CW X24.0000 Z-10.0000 CX24.0000 CZ-8.0000 F100.0000\n\
+         L1 ARC_CW X24.0000 Z-10.0000 CX24.0000 CZ-8.0000 F100.0000 PLANE ZX\n\
          L2 LINEAR X40.0000 Z-10.0000 F100.0000\n\
          L3 M30\nL3 END\n"
     );

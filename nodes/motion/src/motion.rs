@@ -1003,10 +1003,23 @@ impl Motion {
                 center,
                 clockwise,
                 feed,
+                plane,
             } => {
                 let feed = self.feed_mm_per_min(*feed)?;
                 self.check_limits(end)?;
-                let (h, v) = self.cfg.arc_plane;
+                let (h, v) = match plane {
+                    None => self.cfg.arc_plane,
+                    Some([h, v]) => (usize::from(*h), usize::from(*v)),
+                };
+                if h >= self.cfg.axes.len() || v >= self.cfg.axes.len() {
+                    return Err((
+                        alarm::BAD_BLOCK,
+                        format!(
+                            "arc plane axes {h}, {v}: the machine has {} axes",
+                            self.cfg.axes.len()
+                        ),
+                    ));
+                }
                 let end = self.to_slide(end);
                 let c = self.to_slide(center);
                 let seg = path::arc(start, &end, &c, (h, v), *clockwise)

@@ -105,6 +105,7 @@ fn program_runs_to_its_end_point_with_fin_handshake() {
             center: vec![50.0, -40.0],
             clockwise: false,
             feed: 600.0,
+            plane: None,
         },
     ));
     m.push(block(5, 5, Command::Aux(Aux::M(30))));
@@ -163,6 +164,7 @@ fn soft_limit_is_refused_before_any_motion() {
         center: vec![20.0, 70.0],
         clockwise,
         feed: 100.0,
+        plane: None,
     };
     m.push(Block {
         run_id: 2,
@@ -327,6 +329,7 @@ fn circle_program(m: &mut Motion) {
             center: vec![50.0, -20.0],
             clockwise: true,
             feed: 1200.0,
+            plane: None,
         },
     ));
     m.push(block(2, 2, Command::ProgramEnd));
@@ -703,4 +706,88 @@ fn plc_signals_drive_hold_start_overrides_and_reset_shows_as_rst() {
     assert!(m.f_image().get(f::RST));
     ticks(&mut m, &g, 2);
     assert!(!m.f_image().get(f::RST));
+}
+
+/// A 3-axis mill (X, Y, Z) on a perfect drive, arcs configured in X-Y.
+fn mill() -> MotionConfig {
+    let mut cfg = lathe();
+    let axis = |name: &str| AxisConfig {
+        name: name.into(),
+        diameter: false,
+        min: -500.0,
+        max: 500.0,
+        ..cfg.axes[1].clone()
+    };
+    cfg.axes = vec![axis("X"), axis("Y"), axis("Z")];
+    cfg.arc_plane = (0, 1);
+    cfg
+}
+
+/// Each arc turns in the plane it names (G18: Z-X, G19: Y-Z), whatever the configured arc
+/// plane; the third axis moves with it (a helix); an arc naming an axis the machine lacks is
+/// refused.
+#[test]
+fn arcs_turn_in_the_plane_they_name() {
+    // G18 half circle from X10 Z0 around X0 Z0 clockwise (seen from +Y) to X-10 Z0, rising
+    // in Y from 0 to 4: it passes Z+10 (Z→X counter-clockwise is the G18 sense).
+    let mut m = Motion::new(mill(), &[10.0, 0.0, 0.0]);
+    m.push(block(
+        1,
+        1,
+        Command::Arc {
+            end: vec![-10.0, 4.0, 0.0],
+            center: vec![0.0, 4.0, 0.0],
+            clockwise: true,
+            feed: 1200.0,
+            plane: Some([2, 0]),
+        },
+    ));
+    m.push(block(2, 2, Command::ProgramEnd));
+    let (trace, _) = run(&mut m, 100_000);
+    assert_eq!(m.state(), RunState::Idle);
+    for p in &trace {
+        let r = p[0].hypot(p[2]);
+        assert!((r - 10.0).abs() < 0.01, "{p:?} off the Z-X circle");
+        assert!(p[1] >= -1e-9 && p[1] <= 4.0 + 1e-9, "{p:?}");
+    }
+    let top = trace.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
+    assert!(
+        (top - 10.0).abs() < 0.01,
+        "clockwise in G18 goes over +Z: {top}"
+    );
+    // G19 quarter from Y10 Z0 counter-clockwise around Y0 Z0 to Y0 Z10.
+    let mut m = Motion::new(mill(), &[0.0, 10.0, 0.0]);
+    m.push(block(
+        1,
+        1,
+        Command::Arc {
+            end: vec![0.0, 0.0, 10.0],
+            center: vec![0.0, 0.0, 0.0],
+            clockwise: false,
+            feed: 1200.0,
+            plane: Some([1, 2]),
+        },
+    ));
+    m.push(block(2, 2, Command::ProgramEnd));
+    let (trace, _) = run(&mut m, 100_000);
+    assert_eq!(m.state(), RunState::Idle);
+    assert!(trace
+        .iter()
+        .all(|p| (p[1].hypot(p[2]) - 10.0).abs() < 0.01 && p[1] >= -1e-9 && p[2] >= -1e-9));
+    // An arc in a plane with an axis the machine does not have.
+    let mut m = Motion::new(mill(), &[10.0, 0.0, 0.0]);
+    m.push(block(
+        1,
+        7,
+        Command::Arc {
+            end: vec![-10.0, 0.0, 0.0],
+            center: vec![0.0, 0.0, 0.0],
+            clockwise: true,
+            feed: 1200.0,
+            plane: Some([0, 5]),
+        },
+    ));
+    run(&mut m, 100);
+    assert_eq!(m.state(), RunState::Alarm);
+    assert_eq!(m.commanded_display(), vec![10.0, 0.0, 0.0]);
 }
