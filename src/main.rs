@@ -130,6 +130,10 @@ struct ProgramArgs {
     /// default: the program's folder.
     #[arg(long)]
     library: Option<PathBuf>,
+    /// Mill tool table (`number length_mm diameter_mm` per line) instead of the config's
+    /// `machine.tool_table`: H<n> is the length, D<n> the radius of entry n.
+    #[arg(long)]
+    tools: Option<PathBuf>,
 }
 
 /// A program ready to interpret: the launch config, its text, the dialect (the command
@@ -145,7 +149,7 @@ struct LoadedProgram {
 impl ProgramArgs {
     fn load(&self) -> Result<LoadedProgram, String> {
         use cnc_interpreter::{Dialect, Library};
-        let cfg = LaunchConfig::load(&self.config)?;
+        let cfg = LaunchConfig::load_with_tool_table(&self.config, self.tools.as_deref())?;
         let text = read_program(&self.program)?;
         let name = self.dialect.as_deref().unwrap_or(&cfg.machine.dialect);
         let dialect = Dialect::from_name(name).ok_or_else(|| {

@@ -4,7 +4,8 @@
 //! both: `rs274 -g` and our interpreter with `trace::LinuxCnc` (what `cnc check --trace
 //! --format linuxcnc` prints). The motion calls (STRAIGHT_TRAVERSE, STRAIGHT_FEED,
 //! ARC_FEED, DWELL) must agree in order, kind and every number to 1e-4 mm, each feed move
-//! with the same feed rate.
+//! with the same feed rate. A straight move to where the tool already is counts as none
+//! (rs274 emits some inside canned cycles), and so does a dwell of 0 s.
 //!
 //! rs274 prints positions in the program frame and the work offset, G92 offset and tool
 //! length offset beside them (SET_G5X_OFFSET, SET_G92_OFFSET, USE_TOOL_LENGTH_OFFSET); our
@@ -17,8 +18,6 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command as Process;
-
-use cnc_interpreter::{Dialect, Interpreter, Setup};
 
 const TOLERANCE: f64 = 1e-4;
 
@@ -54,6 +53,8 @@ fn motion_calls(listing: &str) -> Vec<Call> {
     // rs274's ARC_FEED plane: (first, second, normal) as indices of x..c.
     let mut plane = (0, 1, 2);
     let mut feed = 0.0;
+    // Where the last move ended (NaN before the first).
+    let mut here = [f64::NAN; 6];
     let mut out = Vec::new();
     for line in listing.lines() {
         let Some((name, args)) = split(line) else {
@@ -73,13 +74,31 @@ fn motion_calls(listing: &str) -> Vec<Call> {
                 }
             }
             "SET_FEED_RATE" if n.len() == 1 => feed = n[0],
-            "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" if n.len() == 6 => out.push(Call {
-                name: name.to_string(),
-                args: (0..6).map(|k| n[k] + offset(k)).collect(),
-                feed: if name == "STRAIGHT_FEED" { feed } else { 0.0 },
-            }),
+            "STRAIGHT_TRAVERSE" | "STRAIGHT_FEED" if n.len() == 6 => {
+                let end: Vec<f64> = (0..6).map(|k| n[k] + offset(k)).collect();
+                // A move to where the tool already is moves nothing (rs274 emits some
+                // inside canned cycles).
+                let still = end
+                    .iter()
+                    .zip(&here)
+                    .all(|(a, b)| (a - b).abs() <= TOLERANCE);
+                here.copy_from_slice(&end);
+                if !still {
+                    out.push(Call {
+                        name: name.to_string(),
+                        args: end,
+                        feed: if name == "STRAIGHT_FEED" { feed } else { 0.0 },
+                    })
+                }
+            }
             "ARC_FEED" if n.len() == 9 => {
                 let (p, q, r) = plane;
+                here[p] = n[0] + offset(p);
+                here[q] = n[1] + offset(q);
+                here[r] = n[5] + offset(r);
+                for k in 3..6 {
+                    here[k] = n[k + 3] + offset(k);
+                }
                 out.push(Call {
                     name: name.to_string(),
                     args: vec![
@@ -96,7 +115,8 @@ fn motion_calls(listing: &str) -> Vec<Call> {
                     feed,
                 })
             }
-            "DWELL" if n.len() == 1 => out.push(Call {
+            // A dwell of no time is none (rs274's G86 demands P, FANUC's has none).
+            "DWELL" if n.len() == 1 && n[0] > 0.0 => out.push(Call {
                 name: name.to_string(),
                 args: n,
                 feed: 0.0,
@@ -111,20 +131,72 @@ fn oracle_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/oracle")
 }
 
+/// A scratch file for this test run.
+fn scratch(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("cnc_oracle_{}_{name}", std::process::id()))
+}
+
+/// The program as rs274 gets it: a line that ends in `(rs274: …)` is replaced by the text in
+/// those brackets. That is how a program names a FANUC/LinuxCNC difference by design (a
+/// dwell P in ms for FANUC, in seconds for LinuxCNC) and still runs on both.
+fn rs274_text(fanuc: &str) -> String {
+    fanuc
+        .lines()
+        .map(|l| match l.split_once("(rs274:") {
+            Some((_, alt)) => alt.trim_end().strip_suffix(')').unwrap_or(alt).trim(),
+            None => l,
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
+/// The metric tool table (`number length_mm diameter_mm`) as a LinuxCNC tool table, which
+/// standalone rs274 reads in inches (notes §1.2).
+fn rs274_tool_table(metric: &str) -> String {
+    let mut out = String::new();
+    for line in metric.lines() {
+        let f: Vec<f64> = line
+            .split('#')
+            .next()
+            .unwrap_or("")
+            .split_whitespace()
+            .filter_map(|w| w.parse().ok())
+            .collect();
+        if let [n, length, diameter] = f[..] {
+            out.push_str(&format!(
+                "T{n} P{n} Z{:.9} D{:.9}\n",
+                length / 25.4,
+                diameter / 25.4
+            ));
+        }
+    }
+    out
+}
+
 fn rs274(program: &Path) -> Result<String, String> {
-    let out = std::env::temp_dir().join(format!(
-        "cnc_oracle_{}_{}.canon",
-        std::process::id(),
-        program.file_stem().and_then(|s| s.to_str()).unwrap_or("p")
-    ));
+    let stem = program.file_stem().and_then(|s| s.to_str()).unwrap_or("p");
+    let fanuc = std::fs::read_to_string(program).map_err(|e| e.to_string())?;
+    let input = scratch(&format!("{stem}.ngc"));
+    let tools = scratch(&format!("{stem}.tbl"));
+    let out = scratch(&format!("{stem}.canon"));
+    let metric =
+        std::fs::read_to_string(oracle_dir().join("tools.tbl")).map_err(|e| e.to_string())?;
+    std::fs::write(&input, rs274_text(&fanuc)).map_err(|e| e.to_string())?;
+    std::fs::write(&tools, rs274_tool_table(&metric)).map_err(|e| e.to_string())?;
     let run = Process::new("rs274")
         .arg("-g")
-        .arg(program)
+        .arg("-t")
+        .arg(&tools)
+        .arg(&input)
         .arg(&out)
         .output()
         .map_err(|e| format!("rs274: {e} (Debian linuxcnc-uspace; scripts/test.sh installs it)"))?;
-    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let _ = std::fs::remove_file(&out);
+    let text = std::fs::read_to_string(&out).map_err(|e| format!("{}: {e}", out.display()));
+    for f in [&input, &tools, &out] {
+        let _ = std::fs::remove_file(f);
+    }
+    let text = text?;
     if !run.status.success() {
         return Err(format!(
             "rs274 rejected {}: {}",
@@ -135,21 +207,27 @@ fn rs274(program: &Path) -> Result<String, String> {
     Ok(text)
 }
 
-/// Our interpreter on the simulated mill (X, Y, Z from the machine zero, as rs274 starts).
+/// `cnc check --trace --format linuxcnc` on the simulated mill with the oracle's tool table
+/// (X, Y, Z from the machine zero, as rs274 starts).
 fn ours(program: &Path) -> Result<String, String> {
-    let text = std::fs::read_to_string(program).map_err(|e| e.to_string())?;
-    let letters = ['X', 'Y', 'Z'];
-    let setup = Setup::new(&letters, &[false; 3], &[0.0; 3]);
-    let mut interp = Interpreter::new(Dialect::FanucMill, &text, setup);
-    let mut fmt = cnc_interpreter::trace::LinuxCnc::new(&letters, &[false; 3], ['X', 'Y']);
-    let mut out = String::new();
-    while let Some(c) = interp
-        .next_command()
-        .map_err(|e| format!("{}: {e}", program.display()))?
-    {
-        out.push_str(&fmt.lines(&c));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let run = Process::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(root)
+        .args(["check", "--config", "launch_configs/sim_mill.yaml"])
+        .arg("--tools")
+        .arg(oracle_dir().join("tools.tbl"))
+        .args(["--trace", "--format", "linuxcnc"])
+        .arg(program)
+        .output()
+        .map_err(|e| format!("cnc check: {e}"))?;
+    if !run.status.success() {
+        return Err(format!(
+            "cnc check refused {}: {}",
+            program.display(),
+            String::from_utf8_lossy(&run.stderr)
+        ));
     }
-    Ok(out)
+    String::from_utf8(run.stdout).map_err(|e| e.to_string())
 }
 
 /// The first difference of two call lists, if any.

@@ -108,8 +108,48 @@ pub enum G {
     TurretMode {
         gang: bool,
     },
+    // FANUC 0-M mill codes (`003` Table 1.1).
+    HoleCycle(HoleKind),
+    CycleCancel,
+    /// G98 (`false`: back to the initial level) / G99 (`true`: to the R level).
+    CycleReturn {
+        r_level: bool,
+    },
+    /// G43 (+1), G44 (−1), G49 (0): tool length compensation.
+    LengthComp(i8),
+    /// G52: a local coordinate system inside the work system (not cumulative).
+    MillLocal,
     /// Defined by the manual but not implemented by this controller: alarm with the reason.
     Unsupported(&'static str),
+}
+
+/// The mill's hole-machining cycles (`003` §8.1, inventory Appendix A.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HoleKind {
+    /// G73 high-speed peck drilling.
+    HighSpeedPeck,
+    /// G74 left-hand tapping.
+    LeftTap,
+    /// G76 fine boring.
+    FineBore,
+    /// G81 drilling.
+    Drill,
+    /// G82 drilling with a dwell (counter-boring).
+    Counterbore,
+    /// G83 peck drilling.
+    Peck,
+    /// G84 tapping.
+    Tap,
+    /// G85 boring, feed out.
+    Bore,
+    /// G86 boring, spindle stop, rapid out.
+    BoreSpindleStop,
+    /// G87 back boring.
+    BackBore,
+    /// G88 boring, manual retract.
+    BoreManual,
+    /// G89 boring with a dwell, feed out.
+    BoreDwell,
 }
 
 /// A G code's modal group; group 0 is one-shot (non-modal).
@@ -463,8 +503,7 @@ fn iso_g(n: u32) -> Option<GCode> {
     Some(GCode { group, meaning })
 }
 
-/// The FANUC 0-M codes of `003` Table 1.1 that the motion benchmarks need; the rest of the
-/// table comes with issue 7.
+/// The FANUC 0-M codes of `003` Table 1.1 (issue 7).
 fn mill_g(n: u32) -> Option<GCode> {
     use G::*;
     let (group, meaning) = match n {
@@ -493,6 +532,25 @@ fn mill_g(n: u32) -> Option<GCode> {
         920 => (0, SetCoordinate),
         940 => (5, FeedPerMinute),
         950 => (5, FeedPerRevolution),
+        430 => (8, LengthComp(1)),
+        440 => (8, LengthComp(-1)),
+        490 => (8, LengthComp(0)),
+        520 => (0, MillLocal),
+        730 => (9, HoleCycle(HoleKind::HighSpeedPeck)),
+        740 => (9, HoleCycle(HoleKind::LeftTap)),
+        760 => (9, HoleCycle(HoleKind::FineBore)),
+        800 => (9, CycleCancel),
+        810 => (9, HoleCycle(HoleKind::Drill)),
+        820 => (9, HoleCycle(HoleKind::Counterbore)),
+        830 => (9, HoleCycle(HoleKind::Peck)),
+        840 => (9, HoleCycle(HoleKind::Tap)),
+        850 => (9, HoleCycle(HoleKind::Bore)),
+        860 => (9, HoleCycle(HoleKind::BoreSpindleStop)),
+        870 => (9, HoleCycle(HoleKind::BackBore)),
+        880 => (9, HoleCycle(HoleKind::BoreManual)),
+        890 => (9, HoleCycle(HoleKind::BoreDwell)),
+        980 => (10, CycleReturn { r_level: false }),
+        990 => (10, CycleReturn { r_level: true }),
         _ => return None,
     };
     Some(GCode { group, meaning })
@@ -505,8 +563,9 @@ fn mill_m(n: u32) -> Option<M> {
         0 => Stop,
         10 => OptionalStop,
         20 | 300 => ProgramEnd,
-        30 | 40 | 60 | 80 => AuxBefore,
-        50 | 90 => AuxAfter,
+        30 | 40 | 60 | 80 | 190 => AuxBefore,
+        50 | 90 | 180 => AuxAfter,
+        290 => Unsupported("M29 rigid tapping needs a position-controlled spindle"),
         980 => SubprogramCall,
         990 => SubprogramReturn,
         _ => return None,

@@ -13,7 +13,7 @@ use std::collections::{BTreeMap, HashMap, VecDeque};
 use std::sync::Arc;
 
 use crate::canon::{Aux, Canon, Command};
-use crate::dialect::{Dialect, ReturnOrder, Rules, ToolMacro, G, M};
+use crate::dialect::{Dialect, HoleKind, ReturnOrder, Rules, ToolMacro, G, M};
 use crate::error::{Fault, ProgramError};
 use crate::expr::{truth, variable_number, EvalError, Expr, Value, Variables};
 use crate::geometry::{self, ArcError, Elem, Pt};
@@ -208,6 +208,18 @@ pub struct Interpreter {
     groove_retract: f64,
     /// G83/G87 modal words (`000` §5.22.7).
     drill: drilling::DrillWords,
+    /// The mill's modal hole-machining cycle (G73–G89 until G80 or a group-01 code).
+    hole: Option<hole_cycle::HoleCycle>,
+    /// G99: cycles return to the R level (G98: to the initial level).
+    cycle_return_r: bool,
+    /// The way the spindle turned before a cycle stopped or oriented it.
+    cycle_spindle: SpindleDir,
+    /// G43 (+1) / G44 (−1) / G49 (0) on the mill.
+    length_sign: i8,
+    /// The H offset number of tool length compensation.
+    length_offset: u32,
+    /// G52 local system zero per axis, in work coordinates (mill).
+    local: Vec<f64>,
     /// G07 K L linear chip breaking while set (`000` §5.6).
     chip_break: Option<chip_break::ChipBreak>,
     /// G92 number of starts (`000` §5.23.5, modal).
@@ -287,6 +299,12 @@ impl Interpreter {
             groove_retract: 1.0,
             drill: drilling::DrillWords::default(),
             chip_break: None,
+            hole: None,
+            cycle_return_r: false,
+            cycle_spindle: SpindleDir::Cw,
+            length_sign: 0,
+            length_offset: 0,
+            local: vec![0.0; n],
             common,
             pending: VecDeque::new(),
             line: 0,
@@ -651,6 +669,7 @@ impl Interpreter {
                     c,
                     'F' | 'S' | 'T' | 'P' | 'Q' | 'R' | 'I' | 'J' | 'K' | 'L' | 'D' | 'E'
                 )
+                || (c == 'H' && !self.dialect.is_lathe())
                 || (c == 'U' || c == 'W')
                     && self.dialect.is_lathe()
                     && self.dialect != Dialect::IsoLathe;
@@ -727,7 +746,7 @@ impl Interpreter {
         } else {
             self.setup.offsets.work(self.work_system, letter)
         };
-        work + self.shift[i] + self.tool_offset[i]
+        work + self.shift[i] + self.local[i] + self.tool_offset[i]
     }
 
     /// Program zero per axis in machine coordinates (work offset, shifts, tool offset) as it
@@ -1299,8 +1318,13 @@ impl Interpreter {
                 G::NoseCancel => self.cancel_nose(&b)?,
                 G::TurretMode { gang } => self.gang_mode = gang,
                 G::OffsetShift(n) => self.gtc_offset_shift(n),
+                G::CycleReturn { r_level } => self.cycle_return_r = r_level,
+                G::LengthComp(sign) => self.length_compensation(&b, Some(sign))?,
                 _ => {}
             }
+        }
+        if !self.dialect.is_lathe() && b.group(8).is_none() && b.has('H') {
+            self.length_compensation(&b, None)?;
         }
         if let Some(f) = b.get('F') {
             // GTC2E's F is a feed; in G32/G92/G76 blocks F is the lead (handled there).
@@ -1315,7 +1339,11 @@ impl Interpreter {
         }
         self.spindle_words(&b)?;
         if let Some(t) = b.get('T') {
-            self.tool_word(t)?;
+            if self.dialect.is_lathe() {
+                self.tool_word(t)?;
+            } else {
+                self.mill_tool_word(t)?;
+            }
         }
         // In a G83/G87 block an M word is the spindle clamp code of the cycle (`000` §5.22.7).
         let drill_block = matches!(b.group(1).unwrap_or(self.motion), G::Drilling { .. })
@@ -1837,6 +1865,7 @@ impl Interpreter {
                     return Ok(());
                 }
                 G::ReferenceReturn => return self.reference_return(b),
+                G::MillLocal => return self.local_system(b),
                 G::ConditionalRepeat { high } => return self.conditional_repeat(b, high),
                 G::JumpRange | G::CallRange | G::LoopRange => return self.range(b, g),
                 G::RoughTurning | G::RoughFacing | G::PatternRepeat => {
@@ -1872,6 +1901,18 @@ impl Interpreter {
                 }
                 G::ThreadRetract => return self.gtc_g31(b),
                 _ => {}
+            }
+        }
+        if !self.dialect.is_lathe() {
+            // A group-01 code ends a canned cycle (`003` §1.2); G80 too.
+            if b.group(1).is_some() || b.group(9) == Some(G::CycleCancel) {
+                self.hole = None;
+            }
+            if let Some(G::HoleCycle(kind)) = b.group(9) {
+                self.select_hole_cycle(kind)?;
+            }
+            if self.hole.is_some() {
+                return self.hole_block(b);
             }
         }
         if let Some(m) = b.group(1) {
@@ -2709,6 +2750,8 @@ mod corner;
 mod drilling;
 mod grooving;
 mod gtc;
+mod hole_cycle;
+mod mill;
 mod nose;
 
 /// Interprets a whole program without running it: every command, or the first error.

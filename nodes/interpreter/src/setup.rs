@@ -29,7 +29,7 @@ impl Memory {
         self.kept
             .retain(|n, v| Memory::KEPT.contains(n) && v.is_finite());
         self.tools.retain(|n, t| {
-            (1..=99).contains(n)
+            (1..=cnc_runtime::tool_table::MAX_TOOL_NUMBER).contains(n)
                 && [t.x, t.z, t.wear_x, t.wear_z, t.radius]
                     .iter()
                     .all(|v| v.is_finite())

@@ -70,9 +70,13 @@ pub struct MachineConfig {
     /// `front` (toward the operator). G41/G42 swap sides with it (`000` §6.1, decision D30).
     #[serde(default)]
     pub tool_post: ToolPost,
-    /// The offset page: tool offsets by offset number (T0101 → 1), 1–99.
+    /// The offset page: tool offsets by offset number (T0101 → 1; on the mill H/D 1–200).
     #[serde(default)]
     pub tools: BTreeMap<u32, ToolEntry>,
+    /// A mill tool table file (`number length_mm diameter_mm` per line, [`crate::tool_table`]),
+    /// relative to the working directory; its entries join `tools` when the config loads.
+    #[serde(default)]
+    pub tool_table: Option<std::path::PathBuf>,
     /// Work offsets by code (`G54`…`G59`; on GTC2E the offset groups of G54–G57), per axis.
     #[serde(default)]
     pub work_offsets: BTreeMap<String, BTreeMap<String, f64>>,
@@ -507,9 +511,39 @@ impl LaunchConfig {
     /// does not apply stops the start with its entry named: the machine never runs on
     /// parameters nobody checked.
     pub fn load(path: &std::path::Path) -> Result<Self, String> {
+        Self::load_with_tool_table(path, None)
+    }
+
+    /// [`LaunchConfig::load`], with `tool_table` (if given) read instead of the config's
+    /// `machine.tool_table` (`cnc check --tools`).
+    pub fn load_with_tool_table(
+        path: &std::path::Path,
+        tool_table: Option<&std::path::Path>,
+    ) -> Result<Self, String> {
         let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let cfg = Self::from_yaml(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-        cfg.with_parameter_file()
+        let mut cfg = Self::from_yaml(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        if let Some(table) = tool_table {
+            cfg.machine.tool_table = Some(table.to_path_buf());
+        }
+        let cfg = cfg.with_parameter_file()?;
+        match cfg.machine.tool_table.clone() {
+            Some(table) => cfg.with_tool_table(&table),
+            None => Ok(cfg),
+        }
+    }
+
+    /// This config with the tools of a tool table file added to the offset page; a number
+    /// both name is refused.
+    pub fn with_tool_table(mut self, path: &std::path::Path) -> Result<Self, String> {
+        for (n, entry) in crate::tool_table::load(path)? {
+            if self.machine.tools.insert(n, entry).is_some() {
+                return Err(format!(
+                    "{}: tool {n} is also in machine.tools",
+                    path.display()
+                ));
+            }
+        }
+        Ok(self)
     }
 
     /// This config with the written parameters of `machine.parameter_file` applied.
@@ -622,9 +656,10 @@ impl LaunchConfig {
             let finite = [t.x, t.z, t.wear_x, t.wear_z, t.radius]
                 .iter()
                 .all(|v| v.is_finite() && v.abs() <= 10_000.0);
-            if !(1..=99).contains(n) || !finite || t.radius < 0.0 || t.tip > 9 {
+            let max = crate::tool_table::MAX_TOOL_NUMBER;
+            if !(1..=max).contains(n) || !finite || t.radius < 0.0 || t.tip > 9 {
                 return Err(format!(
-                    "machine.tools[{n}]: offset 1..99, finite values within ±10000, radius ≥ 0, tip 0..9"
+                    "machine.tools[{n}]: offset 1..{max}, finite values within ±10000, radius ≥ 0, tip 0..9"
                 ));
             }
         }
