@@ -125,6 +125,11 @@ pub struct EvalError(pub String);
 /// Reads and writes macro variables for the evaluator.
 pub trait Variables {
     fn read(&self, number: i64) -> Result<Value, EvalError>;
+    /// Decimal places ROUND keeps: 3 on Huaxing (`000` §5.27.4); FANUC's ROUND in an
+    /// expression rounds to a whole number (`003` inventory A.3).
+    fn round_decimals(&self) -> i32 {
+        3
+    }
 }
 
 /// Rounds half away from zero to `decimals` places (ROUND keeps 3 decimals, §5.27.4).
@@ -173,7 +178,7 @@ impl Expr {
                 for (slot, a) in v.iter_mut().zip(args) {
                     *slot = a.eval(vars)?.unwrap_or(0.0);
                 }
-                Some(call(*f, v[0], v[1])?)
+                Some(call(*f, v[0], v[1], vars.round_decimals())?)
             }
         })
     }
@@ -226,7 +231,7 @@ fn binary(op: BinOp, a: Value, b: Value) -> Result<Value, EvalError> {
     })
 }
 
-fn call(f: Func, a: f64, b: f64) -> Result<f64, EvalError> {
+fn call(f: Func, a: f64, b: f64, round_decimals: i32) -> Result<f64, EvalError> {
     use Func::*;
     let domain = |ok: bool, what: &str| {
         if ok {
@@ -263,7 +268,7 @@ fn call(f: Func, a: f64, b: f64) -> Result<f64, EvalError> {
             a.sqrt()
         }
         Abs => a.abs(),
-        Round => round_half_away(a, 3),
+        Round => round_half_away(a, round_decimals),
         Int => round_half_away(a, 0),
         Fix => a.trunc(),
         Fup => {

@@ -240,8 +240,18 @@ impl Interpreter {
         Interpreter::with_library(dialect, text, setup, Library::new())
     }
 
-    pub fn with_library(dialect: Dialect, text: &str, setup: Setup, library: Library) -> Self {
+    pub fn with_library(dialect: Dialect, text: &str, setup: Setup, mut library: Library) -> Self {
         let rules = dialect.rules();
+        // A tape of several programs: the first runs, the others go into program memory
+        // beside the library's (`003` §7.1; GTC2E has no O programs).
+        let mut text = text;
+        if dialect != Dialect::Gtc2eLathe {
+            let (main_end, others) = crate::program::split_programs(text);
+            for (number, sub) in others {
+                library.insert(number, &format!("O{number:04}"), sub);
+            }
+            text = &text[..main_end];
+        }
         let n = setup.axes.len();
         let mut common = HashMap::new();
         for (&k, &v) in &setup.kept {
@@ -2697,6 +2707,14 @@ fn gtc_m_group(x10: u32) -> u32 {
 }
 
 impl Variables for Interpreter {
+    fn round_decimals(&self) -> i32 {
+        if self.dialect == Dialect::FanucMill {
+            0
+        } else {
+            3
+        }
+    }
+
     fn read(&self, n: i64) -> Result<Value, EvalError> {
         let frame = self
             .frames

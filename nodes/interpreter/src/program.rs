@@ -76,6 +76,48 @@ pub fn find_number(text: &str, from: Pos, n: u32) -> Option<Pos> {
     scan(from, usize::MAX).or_else(|| scan(Pos::default(), from.offset))
 }
 
+/// The program number a line starts (`O2002`, `O2002 (SUB)`), if it is a program head.
+fn program_head(line: &str) -> Option<u32> {
+    let rest = line.trim_start().strip_prefix(['O', 'o'])?;
+    let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    let after = rest[digits.len()..].chars().next();
+    if digits.is_empty() || digits.len() > 4 || after.is_some_and(|c| c.is_ascii_alphanumeric()) {
+        return None;
+    }
+    digits.parse().ok()
+}
+
+/// A file that holds several programs, as a FANUC tape does (`%`, `O1002` … M30, `O2002` …
+/// M99, `%`): the byte length of the first program (from the top to the next program head)
+/// and each following program as (number, its text). A file of one program gives its whole
+/// length and no others.
+pub fn split_programs(text: &str) -> (usize, Vec<(u32, &str)>) {
+    let mut heads = Vec::new();
+    let mut pos = Pos::default();
+    let mut seen_block = false;
+    while let Some((line, next)) = read_line(text, pos) {
+        let t = line.trim();
+        match program_head(t) {
+            Some(n) if seen_block => heads.push((n, pos.offset)),
+            _ => {}
+        }
+        if !t.is_empty() && t != "%" && !t.starts_with('(') && !t.starts_with(';') {
+            seen_block = true;
+        }
+        pos = next;
+    }
+    let main_end = heads.first().map_or(text.len(), |h| h.1);
+    let others = heads
+        .iter()
+        .enumerate()
+        .map(|(k, &(n, start))| {
+            let end = heads.get(k + 1).map_or(text.len(), |h| h.1);
+            (n, &text[start..end])
+        })
+        .collect();
+    (main_end, others)
+}
+
 /// Programs the interpreter can call by number: the library folder's programs, found by the
 /// `O` number on their first line or by a file name like `O2011.nc` (issue 3).
 #[derive(Debug, Clone, Default)]
@@ -189,6 +231,15 @@ mod tests {
         assert_eq!(find_number(text, at(30), 10).map(|p| p.line), Some(0));
         assert_eq!(find_number(text, at(30), 20).map(|p| p.line), Some(1));
         assert_eq!(Library::declared_number("\n O0010 ;x\nN1"), Some(10));
+        // A tape: main program, then two subprograms; `%` and the program heads delimit them.
+        let tape = "%\nO1002 (MAIN)\nG0 X1\nM30\nO2002\nX2\nM99\no3 (x)\nX3\nM99\n%\n";
+        let (main, others) = split_programs(tape);
+        assert_eq!(&tape[..main], "%\nO1002 (MAIN)\nG0 X1\nM30\n");
+        assert_eq!(
+            others,
+            vec![(2002, "O2002\nX2\nM99\n"), (3, "o3 (x)\nX3\nM99\n%\n")]
+        );
+        assert_eq!(split_programs("G0 X1\nOR\nO12345\n"), (16, vec![]));
         assert_eq!(Library::file_number(Path::new("lib/O2011.nc")), Some(2011));
         assert_eq!(Library::file_number(Path::new("lib/part.nc")), None);
         assert_eq!(
