@@ -657,7 +657,8 @@ impl Interpreter {
         }
         // Group 00 and group 01 in one block (`000` alarm 8). G04 and the coordinate codes
         // are allowed with motion words only through their own meaning; G09 is group 15.
-        if self.dialect != Dialect::Gtc2eLathe {
+        // FANUC 0-M allows both (`G53 G00 Z0`): the group-00 code acts, the other stays modal.
+        if self.dialect.is_lathe() && self.dialect != Dialect::Gtc2eLathe {
             let g0 = b.g.iter().any(|g| g.0 == 0);
             let g1 = b.g.iter().any(|g| g.0 == 1);
             if g0 && g1 {
@@ -1848,6 +1849,13 @@ impl Interpreter {
 
     /// The body of a block: one-shot codes, cycles, motion.
     fn block_body(&mut self, b: &Block) -> Result<(), ProgramError> {
+        if !self.dialect.is_lathe() && b.g.iter().any(|g| g.0 == 0) {
+            // A motion code beside a one-shot code becomes modal for the blocks after it.
+            if let Some(m) = b.group(1) {
+                self.motion = m;
+                self.hole = None;
+            }
+        }
         // One-shot (group 00, and GTC2E's non-motion group-1 codes) first.
         for &(_, g, _) in &b.g {
             match g {
