@@ -1,0 +1,240 @@
+//! The FANUC 0-M mill dialect where LinuxCNC cannot be the oracle (`tests/linuxcnc_oracle.rs`
+//! names each difference): FANUC behaviour from the manual (`003`) and its inventory's
+//! Appendix A, asserted on the canonical stream. Decision D47.
+
+use cnc_interpreter::{trace, Canon, Dialect, Library, ProgramError, Setup};
+
+const XYZ: [char; 3] = ['X', 'Y', 'Z'];
+
+fn mill() -> Setup {
+    let mut setup = Setup::new(&XYZ, &[false; 3], &[0.0; 3]);
+    for (n, length, radius) in [(1, 100.0, 5.0), (2, 42.5, 3.0)] {
+        let t = setup.offsets.tools.entry(n).or_default();
+        t.z = length;
+        t.radius = radius;
+    }
+    setup
+}
+
+fn run(text: &str) -> Result<Vec<Canon>, ProgramError> {
+    cnc_interpreter::check(Dialect::FanucMill, text, mill())
+}
+
+/// The stream as trace lines without the source line: `RAPID X5.0000 Y5.0000 Z2.0000`.
+fn lines(text: &str) -> Vec<String> {
+    run(text)
+        .unwrap_or_else(|e| panic!("{e}\n{text}"))
+        .iter()
+        .map(|c| {
+            let l = trace::line(&XYZ, c);
+            l.split_once(' ').map_or(l.clone(), |(_, b)| b.to_string())
+        })
+        .collect()
+}
+
+fn alarm(text: &str) -> ProgramError {
+    match run(text) {
+        Ok(c) => panic!("no alarm for\n{text}\n{c:?}"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn g98_after_g99_moves_over_at_the_r_level_and_returns_to_the_initial_level() {
+    let l = lines("G0 X0 Y0 Z20\nG99 G81 X5 Y5 Z-5 R2 F100\nG98 X15\nG80\nM30\n");
+    assert_eq!(
+        l[1..9],
+        [
+            "RAPID X5.0000 Y5.0000 Z20.0000",
+            "RAPID X5.0000 Y5.0000 Z2.0000",
+            "LINEAR X5.0000 Y5.0000 Z-5.0000 F100.0000",
+            "RAPID X5.0000 Y5.0000 Z2.0000",
+            // LinuxCNC would climb to Z20 on the way over; FANUC moves at the level it is at.
+            "RAPID X15.0000 Y5.0000 Z2.0000",
+            "LINEAR X15.0000 Y5.0000 Z-5.0000 F100.0000",
+            "RAPID X15.0000 Y5.0000 Z20.0000",
+            "M30",
+        ]
+    );
+}
+
+#[test]
+fn tapping_reverses_the_spindle_at_the_bottom_and_back_at_r() {
+    let l = lines("G0 X0 Y0 Z10\nS500 M3\nG99 G84 X5 Y5 Z-8 R2 P300 F100\nG80\nM30\n");
+    assert_eq!(
+        l[4..11],
+        [
+            "RAPID X5.0000 Y5.0000 Z2.0000",
+            "LINEAR X5.0000 Y5.0000 Z-8.0000 F100.0000",
+            "DWELL 0.300",
+            "M4",
+            "LINEAR X5.0000 Y5.0000 Z2.0000 F100.0000",
+            "M3",
+            "M30",
+        ]
+    );
+    // G74 left-hand: the other way round; G98 returns to the initial level after R.
+    let l = lines("G0 X0 Y0 Z10\nS500 M4\nG98 G74 X5 Y5 Z-8 R2 F100\nG80\nM30\n");
+    assert_eq!(
+        l[6..10],
+        [
+            "M3",
+            "LINEAR X5.0000 Y5.0000 Z2.0000 F100.0000",
+            "M4",
+            "RAPID X5.0000 Y5.0000 Z10.0000",
+        ]
+    );
+    // Rigid tapping needs a position-controlled spindle.
+    assert_eq!(alarm("M29 S500\nM30\n").number, 7);
+}
+
+#[test]
+fn fine_boring_orients_and_shifts_off_the_wall_before_leaving() {
+    let l = lines("G0 X0 Y0 Z10\nS800 M3\nG98 G76 X5 Y5 Z-8 R2 Q0.4 F80\nG80\nM30\n");
+    assert_eq!(
+        l[5..11],
+        [
+            "LINEAR X5.0000 Y5.0000 Z-8.0000 F80.0000",
+            "M19",
+            "RAPID X5.4000 Y5.0000 Z-8.0000",
+            "RAPID X5.4000 Y5.0000 Z10.0000",
+            "RAPID X5.0000 Y5.0000 Z10.0000",
+            "M3",
+        ]
+    );
+}
+
+#[test]
+fn back_boring_goes_down_shifted_and_bores_upwards() {
+    let l = lines("G0 X0 Y0 Z10\nS800 M3\nG98 G87 X5 Y5 Z-3 R-12 Q0.5 F60\nG80\nM30\n");
+    assert_eq!(
+        l[3..15],
+        [
+            "RAPID X5.0000 Y5.0000 Z10.0000",
+            "M19",
+            "RAPID X5.5000 Y5.0000 Z10.0000",
+            "RAPID X5.5000 Y5.0000 Z-12.0000",
+            "RAPID X5.0000 Y5.0000 Z-12.0000",
+            "M3",
+            "LINEAR X5.0000 Y5.0000 Z-3.0000 F60.0000",
+            "M19",
+            "RAPID X5.5000 Y5.0000 Z-3.0000",
+            "RAPID X5.5000 Y5.0000 Z10.0000",
+            "RAPID X5.0000 Y5.0000 Z10.0000",
+            "M3",
+        ]
+    );
+    let e = alarm("G0 Z10\nG99 G87 X5 Y5 Z-3 R-12 Q0.5 F60\nM30\n");
+    assert_eq!((e.line, e.text.contains("G98")), (2, true), "{e}");
+}
+
+#[test]
+fn g86_and_g88_stop_the_spindle_and_restart_it_the_way_it_turned() {
+    let l = lines("G0 X0 Y0 Z10\nS800 M4\nG98 G86 X5 Y5 Z-8 R2 F80\nG80\nM30\n");
+    assert_eq!(l[6..9], ["M5", "RAPID X5.0000 Y5.0000 Z10.0000", "M4"]);
+    // G88: dwell, stop, a program stop for the manual retract, then out and on again.
+    let l = lines("G0 X0 Y0 Z10\nS800 M3\nG99 G88 X5 Y5 Z-8 R2 P1000 F80\nG80\nM30\n");
+    assert_eq!(
+        l[6..11],
+        [
+            "DWELL 1.000",
+            "M5",
+            "M0",
+            "RAPID X5.0000 Y5.0000 Z2.0000",
+            "M3"
+        ]
+    );
+}
+
+#[test]
+fn hole_data_stay_until_g80_and_l0_only_stores_them() {
+    // L0 stores the data without drilling; the next position drills with them.
+    let l = lines("G0 X0 Y0 Z10\nG98 G81 Z-4 R1 F90 L0\nX7\nG85 X9\nG80\nM30\n");
+    assert_eq!(l[1], "RAPID X7.0000 Y0.0000 Z10.0000", "{l:?}");
+    assert!(
+        l.contains(&"LINEAR X9.0000 Y0.0000 Z1.0000 F90.0000".to_string()),
+        "{l:?}"
+    );
+    // After G80 the data are gone.
+    let e = alarm("G0 Z10\nG81 X1 Z-4 R1 F90\nG80\nG81 X2\nM30\n");
+    assert_eq!((e.number, e.line), (23, 4), "{e}");
+    // A group-01 code ends the cycle: this X moves, nothing drills.
+    let l = lines("G0 Z10\nG81 X1 Z-4 R1 F90\nG0 X3\nX4\nM30\n");
+    assert_eq!(
+        l[l.len() - 3..l.len() - 2],
+        ["RAPID X4.0000 Y0.0000 Z10.0000"]
+    );
+}
+
+#[test]
+fn cycle_words_are_checked_with_their_line() {
+    for (text, number, line) in [
+        ("G0 Z10\nG81 X1 Z-4 F90\nM30\n", 23, 2),
+        ("G0 Z10\nG83 X1 Z-4 R1 Q0 F90\nM30\n", 13, 2),
+        ("G0 Z10\nG81 X1 Z-4 R-6 F90\nM30\n", 13, 2),
+        ("G0 Z10\nG81 X1 Z-4 R1 L2 K2 F90\nM30\n", 13, 2),
+        ("G0 Z10\nG81 X1 Z-4 R1 L2.5 F90\nM30\n", 13, 2),
+        ("G0 Z10\nG82 X1 Z-4 R1 P-5 F90\nM30\n", 1, 2),
+    ] {
+        let e = alarm(text);
+        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
+    }
+}
+
+#[test]
+fn g44_subtracts_the_length_and_h0_or_g49_cancel() {
+    let l = lines("G44 H2 G0 Z10\nH1 Z10\nH0 Z10\nG43 H2 Z10\nG49 Z10\nM30\n");
+    let z: Vec<&str> = l
+        .iter()
+        .map(|s| s.rsplit(' ').next().unwrap_or(""))
+        .collect();
+    assert_eq!(
+        z[..5],
+        ["Z-32.5000", "Z-90.0000", "Z10.0000", "Z52.5000", "Z10.0000"]
+    );
+    let e = alarm("G43 H201 Z10\nM30\n");
+    assert_eq!((e.number, e.line), (6, 1), "{e}");
+}
+
+#[test]
+fn t_only_selects_the_tool_on_the_mill() {
+    // No offset comes with T: the Z move is the programmed one.
+    let l = lines("T1 M6\nG0 Z10\nM30\n");
+    assert_eq!(l[..3], ["T1", "M6", "RAPID X0.0000 Y0.0000 Z10.0000"]);
+    assert_eq!(alarm("T100\nM30\n").number, 6);
+}
+
+#[test]
+fn a_tape_runs_its_first_program_and_calls_the_others() {
+    let tape = "%\nO1\nG0 X0 Y0 Z5\nM98 P2 L2\nM30\nO2\nG91 G1 X10 F100\nM99\n%\n";
+    let l = lines(tape);
+    assert_eq!(
+        l[..3],
+        [
+            "RAPID X0.0000 Y0.0000 Z5.0000",
+            "LINEAR X10.0000 Y0.0000 Z5.0000 F100.0000",
+            "LINEAR X20.0000 Y0.0000 Z5.0000 F100.0000",
+        ]
+    );
+    // A program of the tape replaces a library program of the same number.
+    let mut lib = Library::new();
+    lib.insert(2, "O0002", "G0 X99\nM99\n");
+    let cmds = cnc_interpreter::check_with_library(Dialect::FanucMill, tape, mill(), lib).unwrap();
+    assert_eq!(cmds[1].command.end(), Some(&[10.0, 0.0, 5.0][..]));
+    // An error inside a subprogram names it.
+    let e = alarm("O1\nM98 P3\nM30\nO3\nG1 X1 F-5\nM99\n");
+    assert_eq!(e.program, "O0003", "{e}");
+}
+
+#[test]
+fn a_one_shot_code_may_share_its_block_with_a_motion_code() {
+    let l = lines("G0 X5 Y5 Z5\nG53 G1 Z0 F100\nX7\nM30\n");
+    // G53 moves at rapid in machine coordinates; G01 stays modal for the next block.
+    assert_eq!(
+        l[1..3],
+        [
+            "RAPID X5.0000 Y5.0000 Z0.0000",
+            "LINEAR X7.0000 Y5.0000 Z0.0000 F100.0000"
+        ]
+    );
+}
