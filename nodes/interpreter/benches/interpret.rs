@@ -9,44 +9,13 @@
 //! - peak heap during interpretation, for a 20,000- and a 200,000-block program: the
 //!   interpreter streams, so its working memory must not grow with the program.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering};
 use std::time::Instant;
 
 use cnc_interpreter::syntax::parse_line;
 use cnc_interpreter::{Dialect, Interpreter, Setup};
 
-/// Counts heap bytes allocated and freed while `COUNTING` is on, and their peak, so memory is
-/// measured, not estimated. Off during the timed runs, where it would cost two atomics per
-/// allocation.
-struct Counting;
-
-static COUNTING: AtomicBool = AtomicBool::new(false);
-static LIVE: AtomicIsize = AtomicIsize::new(0);
-static PEAK: AtomicIsize = AtomicIsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: forwarded unchanged to the system allocator.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() && COUNTING.load(Ordering::Relaxed) {
-            let size = layout.size() as isize;
-            let now = LIVE.fetch_add(size, Ordering::Relaxed) + size;
-            PEAK.fetch_max(now, Ordering::Relaxed);
-        }
-        p
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: forwarded unchanged to the system allocator.
-        unsafe { System.dealloc(ptr, layout) };
-        if COUNTING.load(Ordering::Relaxed) {
-            LIVE.fetch_sub(layout.size() as isize, Ordering::Relaxed);
-        }
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
+#[path = "support/heap.rs"]
+mod heap;
 
 /// A Huaxing lathe program of at least `blocks` blocks (and fewer than `blocks` + 40).
 fn program(blocks: usize) -> String {
@@ -140,12 +109,9 @@ fn best_of(f: impl Fn() -> usize) -> (f64, usize) {
 
 /// Peak heap, above what was live before, while interpreting `text`.
 fn peak_heap(text: &str) -> usize {
-    LIVE.store(0, Ordering::Relaxed);
-    PEAK.store(0, Ordering::Relaxed);
-    COUNTING.store(true, Ordering::Relaxed);
-    std::hint::black_box(interpret(text));
-    COUNTING.store(false, Ordering::Relaxed);
-    PEAK.load(Ordering::Relaxed).max(0) as usize
+    heap::peak_heap(|| {
+        std::hint::black_box(interpret(text));
+    })
 }
 
 fn main() {
