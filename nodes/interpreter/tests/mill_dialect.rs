@@ -175,6 +175,9 @@ fn cycle_words_are_checked_with_their_line() {
         ("G0 Z10\nG81 X1 Z-4 R1 L2 K2 F90\nM30\n", 13, 2),
         ("G0 Z10\nG81 X1 Z-4 R1 L2.5 F90\nM30\n", 13, 2),
         ("G0 Z10\nG82 X1 Z-4 R1 P-5 F90\nM30\n", 1, 2),
+        ("G0 Z10\nG73 X1 Z-4 R1 F90\nM30\n", 23, 2),
+        ("G0 Z10\nG83 X1 Z-4 R1 Q0.000001 F90\nM30\n", 13, 2),
+        ("G0 Z10\nG81 X1 Z-4 R1 L1000 F90\nM30\n", 13, 2),
     ] {
         let e = alarm(text);
         assert_eq!((e.number, e.line), (number, line), "{text}: {e}");

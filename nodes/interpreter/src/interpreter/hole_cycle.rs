@@ -11,8 +11,8 @@ use super::*;
 /// The clearance of a peck: G73 backs off this far after each peck; G83 comes back down to
 /// this far above the last depth (FANUC parameters 531/532; the value LinuxCNC uses).
 pub(super) const PECK_CLEARANCE: f64 = 0.254;
-/// Most repetitions of one hole block (`003` table 7.1: L 1–999... repeat counts up to 9999).
-const MAX_REPEATS: f64 = 9999.0;
+/// Most repetitions of one hole block (`003` table 7.1: repeat counts 1–999).
+const MAX_REPEATS: f64 = 999.0;
 
 /// The cycle that is modal, with its hole data.
 #[derive(Debug, Clone, Copy)]
@@ -127,6 +127,18 @@ impl Interpreter {
         } else {
             (r, z)
         };
+        if matches!(h.kind, HoleKind::HighSpeedPeck | HoleKind::Peck) {
+            // Checked before any move: a peck of nothing, or of a hair, never ends.
+            if h.q <= 0.0 {
+                return Err(self.fault(Fault::MissingWord, "G73/G83 need Q (peck depth)"));
+            }
+            if (r_level - bottom) / h.q > MAX_CYCLE_STEPS as f64 {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("Q{}: more than {MAX_CYCLE_STEPS} pecks", show(h.q)),
+                ));
+            }
+        }
         if h.kind == HoleKind::BackBore {
             if self.cycle_return_r {
                 return Err(self.fault(Fault::IllegalWord, "G87 back boring returns only in G98"));
@@ -212,12 +224,7 @@ impl Interpreter {
         match h.kind {
             HoleKind::HighSpeedPeck | HoleKind::Peck => {
                 let mut depth = r_level;
-                let mut steps = 0;
                 while depth > bottom {
-                    steps += 1;
-                    if steps > MAX_CYCLE_STEPS {
-                        return Err(self.fault(Fault::CycleZero, "too many pecks"));
-                    }
                     let next = (depth - h.q).max(bottom);
                     if depth != r_level && h.kind == HoleKind::Peck {
                         // G83: back out to R, then rapid down to just above the last depth.
