@@ -266,21 +266,15 @@ impl Interpreter {
                 self.spindle_code(back);
                 self.rapid_to_level(d, clear)
             }
-            HoleKind::BoreSpindleStop => {
+            HoleKind::BoreSpindleStop | HoleKind::BoreManual => {
                 self.cycle_move(d, bottom, MoveKind::Feed(feed))?;
                 dwell(self);
                 self.stop_spindle();
-                self.cycle_move(d, clear, MoveKind::Rapid)?;
-                self.spindle_on();
-                Ok(())
-            }
-            HoleKind::BoreManual => {
-                // The operator retracts by hand during the stop (decision D47): the
-                // automatic return follows cycle start.
-                self.cycle_move(d, bottom, MoveKind::Feed(feed))?;
-                dwell(self);
-                self.stop_spindle();
-                self.aux(Aux::M(0));
+                if h.kind == HoleKind::BoreManual {
+                    // G88: the operator retracts by hand during this stop (decision D47);
+                    // the automatic return follows cycle start.
+                    self.aux(Aux::M(0));
+                }
                 self.cycle_move(d, clear, MoveKind::Rapid)?;
                 self.spindle_on();
                 Ok(())
