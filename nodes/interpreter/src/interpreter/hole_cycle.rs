@@ -203,23 +203,8 @@ impl Interpreter {
                 });
             }
         };
-        if h.kind == HoleKind::BackBore {
-            // Orient, shift off the bore, down to R under the part, shift back, spindle on,
-            // bore upwards to Z, then orient, shift and leave to the initial level.
-            self.orient_and_shift(h.q, true)?;
-            self.cycle_move(d, r_level, MoveKind::Rapid)?;
-            self.orient_and_shift(h.q, false)?;
-            self.spindle_on();
-            self.cycle_move(d, bottom, MoveKind::Feed(feed))?;
-            dwell(self);
-            self.orient_and_shift(h.q, true)?;
-            self.cycle_move(d, clear, MoveKind::Rapid)?;
-            self.orient_and_shift(h.q, false)?;
-            self.spindle_on();
-            return Ok(());
-        }
-        if self.work_position()[d] != r_level {
-            self.cycle_move(d, r_level, MoveKind::Rapid)?;
+        if h.kind != HoleKind::BackBore {
+            self.rapid_to_level(d, r_level)?;
         }
         match h.kind {
             HoleKind::HighSpeedPeck | HoleKind::Peck => {
@@ -282,13 +267,15 @@ impl Interpreter {
             HoleKind::FineBore => {
                 self.cycle_move(d, bottom, MoveKind::Feed(feed))?;
                 dwell(self);
-                self.orient_and_shift(h.q, true)?;
-                self.cycle_move(d, clear, MoveKind::Rapid)?;
-                self.orient_and_shift(h.q, false)?;
-                self.spindle_on();
-                Ok(())
+                self.leave_oriented(d, clear, h.q)
             }
-            HoleKind::BackBore => Ok(()),
+            HoleKind::BackBore => {
+                // Shifted off the bore down to R under the part, then bore upwards to Z.
+                self.leave_oriented(d, r_level, h.q)?;
+                self.cycle_move(d, bottom, MoveKind::Feed(feed))?;
+                dwell(self);
+                self.leave_oriented(d, clear, h.q)
+            }
         }
     }
 
@@ -328,6 +315,16 @@ impl Interpreter {
             3
         };
         self.spindle_code(m);
+    }
+
+    /// G76/G87: orients the spindle, shifts off the bore wall, rapids the drilling axis to
+    /// `level`, shifts back and starts the spindle again.
+    fn leave_oriented(&mut self, d: usize, level: f64, q: f64) -> Result<(), ProgramError> {
+        self.orient_and_shift(q, true)?;
+        self.cycle_move(d, level, MoveKind::Rapid)?;
+        self.orient_and_shift(q, false)?;
+        self.spindle_on();
+        Ok(())
     }
 
     /// G76/G87: `away` orients the spindle (M19) and moves the tool off the bore wall by the
