@@ -20,6 +20,7 @@
 //! - after a G99 hole, a G98 hole moves over at the R level on FANUC, LinuxCNC climbs to
 //!   the initial level on the way;
 //! - G91 G10 L2 adds to the offset on FANUC and replaces it on LinuxCNC;
+//! - LinuxCNC compensates the cutter radius only in G17 and G18, FANUC in G19 too;
 //! - it rejects U/W words, G65 and FANUC T-word forms (notes §"What rs274 accepts and
 //!   rejects"), and WHILE/IF/GOTO (it has O-word control flow instead).
 

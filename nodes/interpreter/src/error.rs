@@ -148,6 +148,10 @@ pub enum Fault {
     CompRadiusZero,
     /// A concave arc smaller than the nose radius (`000` 87).
     CompArcVanishes,
+    /// The offset path would cut into the contour: its direction reverses (FANUC P/S 041).
+    CompInterference,
+    /// Plane change while cutter compensation is active (FANUC P/S 037).
+    CompPlane,
     /// G00 while tool-nose compensation is active (`000` 118).
     CompRapid,
     /// Code must start the block (`000` 103, 92).
@@ -203,7 +207,8 @@ pub fn huaxing_number(f: Fault) -> u32 {
         ThreePointArc => 80,
         CompBlocks => 82,
         CompStartNotLine => 85,
-        CompNoIntersection => 88,
+        CompNoIntersection | CompInterference => 88,
+        CompPlane => 7,
         CompDirection => 89,
         CompRadiusZero => 21,
         CompArcVanishes => 87,

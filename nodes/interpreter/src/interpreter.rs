@@ -178,6 +178,8 @@ pub struct Interpreter {
     spindle: SpindleDir,
     /// Tool-nose radius compensation while G41/G42 is in force.
     nose_comp: Option<nose::NoseComp>,
+    /// The mill's D: the offset whose radius G41/G42 use (modal, D0 = no radius).
+    radius_offset: u32,
     /// G40 given: the next move leaves compensation.
     nose_cancel: bool,
     /// A G01 with chamfer L or rounding D, waiting for the next move.
@@ -287,6 +289,7 @@ impl Interpreter {
             gtc_css_from: (0.0, 0.0),
             spindle: SpindleDir::Stopped,
             nose_comp: None,
+            radius_offset: 0,
             nose_cancel: false,
             corner: None,
             emitting_comp: false,
@@ -844,6 +847,19 @@ impl Interpreter {
         }
     }
 
+    /// The axis along the plane's normal on the mill (Z in G17, Y in G18, X in G19): cutter
+    /// compensation carries it along unchanged. None on the lathe.
+    fn plane_normal(&self) -> Option<usize> {
+        if self.dialect.is_lathe() {
+            return None;
+        }
+        self.axis(match self.plane {
+            G::PlaneZx => 'Y',
+            G::PlaneYz => 'X',
+            _ => 'Z',
+        })
+    }
+
     /// Display units → plane units: a diameter axis counts half.
     fn axis_scale(&self, i: usize) -> f64 {
         if self.setup.diameter.get(i) == Some(&true) {
@@ -1014,31 +1030,41 @@ impl Interpreter {
             ));
         }
         let mut side = self.nose_side(g);
-        let (radius, tip, startup_line) = if self.dialect == Dialect::Gtc2eLathe {
-            let r = b
-                .get('R')
-                .ok_or_else(|| self.fault(Fault::MissingWord, "G41/G42 needs R (nose radius)"))?;
-            if r < 0.0 {
-                side = side.other();
+        let (radius, tip, startup) = match self.dialect {
+            Dialect::Gtc2eLathe => {
+                let r = b.get('R').ok_or_else(|| {
+                    self.fault(Fault::MissingWord, "G41/G42 needs R (nose radius)")
+                })?;
+                if r < 0.0 {
+                    side = side.other();
+                }
+                (self.nose_radius(r.abs(), "R")?, 0, nose::Startup::Connect)
             }
-            (self.nose_radius(r.abs(), "R")?, 0, false)
-        } else {
-            if !self.compensation_line(b) {
-                return Err(self.fault(
-                    Fault::CompStartNotLine,
-                    "G41/G42 must be given in a G01 block with X/Z (or U/W)",
-                ));
+            Dialect::FanucMill => {
+                let r = self.cutter_radius(b)?;
+                if r < 0.0 {
+                    side = side.other();
+                }
+                (r.abs(), 0, nose::Startup::AlongEntry)
             }
-            let offset = self.nose_offset_number(b);
-            let t = self.setup.offsets.tool(offset);
-            (
-                self.nose_radius(t.radius, &format!("offset {offset}"))?,
-                t.tip,
-                true,
-            )
+            _ => {
+                if !self.compensation_line(b) {
+                    return Err(self.fault(
+                        Fault::CompStartNotLine,
+                        "G41/G42 must be given in a G01 block with X/Z (or U/W)",
+                    ));
+                }
+                let offset = self.nose_offset_number(b);
+                let t = self.setup.offsets.tool(offset);
+                (
+                    self.nose_radius(t.radius, &format!("offset {offset}"))?,
+                    t.tip,
+                    nose::Startup::ToNextElement,
+                )
+            }
         };
         let from = self.plane_point(&self.work_position())?;
-        self.nose_comp = Some(nose::NoseComp::new(side, radius, tip, from, startup_line));
+        self.nose_comp = Some(nose::NoseComp::new(side, radius, tip, from, startup));
         self.nose_cancel = false;
         Ok(())
     }
@@ -1088,16 +1114,22 @@ impl Interpreter {
     }
 
     /// G40: the next move leaves compensation. Huaxing wants it in a G01 block with axis words
-    /// (alarm 85); GTC2E allows it alone (the next move cancels).
+    /// (alarm 85); GTC2E allows it alone (the next move cancels); the FANUC mill allows it
+    /// alone or with G00/G01, never in an arc (P/S 034).
     fn cancel_nose(&mut self, b: &Block) -> Result<(), ProgramError> {
         if self.nose_comp.is_none() {
             return Ok(());
         }
-        if self.dialect != Dialect::Gtc2eLathe && !self.compensation_line(b) {
-            return Err(self.fault(
-                Fault::CompStartNotLine,
-                "G40 must be given in a G01 block with X/Z (or U/W)",
-            ));
+        match self.dialect {
+            Dialect::Gtc2eLathe => {}
+            Dialect::FanucMill => self.refuse_arc_for_comp(b, "G40")?,
+            _ if !self.compensation_line(b) => {
+                return Err(self.fault(
+                    Fault::CompStartNotLine,
+                    "G40 must be given in a G01 block with X/Z (or U/W)",
+                ))
+            }
+            _ => {}
         }
         self.nose_cancel = true;
         Ok(())
@@ -1118,16 +1150,27 @@ impl Interpreter {
                 Fault::CompArcVanishes,
                 "tool-nose compensation: arc radius smaller than the nose radius",
             ),
+            nose::CompError::ArcStartup => self.fault(
+                Fault::CompStartNotLine,
+                "cutter compensation cannot start in an arc: start it in a G00/G01 block",
+            ),
+            nose::CompError::Interference => self.fault(
+                Fault::CompInterference,
+                "cutter compensation: the tool would cut into the contour here (interference)",
+            ),
         }
     }
 
     /// A move while compensation is active: handed to the compensation, which returns the
     /// moves of the controlled point that are now certain.
     fn emit_compensated(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
-        let from = self.plane_point(&self.work_position())?;
+        let here = self.work_position();
+        let from = self.plane_point(&here)?;
         let to = self.plane_point(end)?;
+        let normal = self.plane_normal();
+        let depth = normal.map_or(0.0, |i| end[i]);
         let (path, ck) = match kind {
-            MoveKind::Rapid if self.dialect != Dialect::Gtc2eLathe => {
+            MoveKind::Rapid if self.dialect.is_lathe() && self.dialect != Dialect::Gtc2eLathe => {
                 return Err(self.fault(
                     Fault::CompRapid,
                     "G00 while tool-nose compensation is active: cancel with G40 first",
@@ -1152,18 +1195,25 @@ impl Interpreter {
             }
         };
         let line = self.line;
+        let still = (from.z - to.z).hypot(from.r - to.r) < 1e-9;
         let outs = if self.nose_cancel {
             self.nose_cancel = false;
             match self.nose_comp.take() {
-                Some(mut comp) => comp.cancel(to, ck, line),
+                Some(mut comp) => comp.cancel(to, depth, ck, line),
                 None => Vec::new(),
             }
-        } else if (from.z - to.z).hypot(from.r - to.r) < 1e-9 {
-            // No move: nothing to compensate.
-            return Ok(());
+        } else if still {
+            // No move in the plane: a move along the normal waits for the held element's
+            // end (decision D48); no move at all compensates nothing.
+            match (normal, self.nose_comp.as_mut()) {
+                (Some(i), Some(comp)) if (end[i] - here[i]).abs() > 1e-9 => {
+                    comp.push_still(from, depth, ck, line)
+                }
+                _ => return Ok(()),
+            }
         } else {
             let pushed = match self.nose_comp.as_mut() {
-                Some(comp) => comp.push(path, ck, line),
+                Some(comp) => comp.push(path, depth, ck, line),
                 None => Ok(Vec::new()),
             };
             pushed.map_err(|e| self.comp_fault(e))?
@@ -1205,7 +1255,10 @@ impl Interpreter {
             for o in outs {
                 me.line = o.line;
                 let base = me.work_position();
-                let end = me.with_point(&base, o.path.end());
+                let mut end = me.with_point(&base, o.path.end());
+                if let Some(i) = me.plane_normal() {
+                    end[i] = o.depth;
+                }
                 let kind = match (o.path, o.kind) {
                     (Elem::Arc { c, ccw, .. }, nose::Kind::Feed(feed)) => MoveKind::Arc {
                         center: c,
@@ -1317,7 +1370,15 @@ impl Interpreter {
                     // Keep the machine position; the work coordinates change.
                     self.work_system = n;
                 }
-                G::PlaneXy | G::PlaneZx | G::PlaneYz if !self.dialect.is_lathe() => self.plane = g,
+                G::PlaneXy | G::PlaneZx | G::PlaneYz if !self.dialect.is_lathe() => {
+                    if self.nose_comp.is_some() && g != self.plane {
+                        return Err(self.fault(
+                            Fault::CompPlane,
+                            "the plane cannot change while cutter compensation is active: G40 first",
+                        ));
+                    }
+                    self.plane = g;
+                }
                 G::MetricInput => {}
                 G::PlaneXy | G::PlaneYz => {
                     return Err(self.fault(
@@ -1336,6 +1397,12 @@ impl Interpreter {
         }
         if !self.dialect.is_lathe() && b.group(8).is_none() && b.has('H') {
             self.length_compensation(&b, None)?;
+        }
+        if !self.dialect.is_lathe() && b.group(7).is_none() {
+            // D is modal: the next G41/G42 uses it.
+            if let Some(d) = self.offset_word(&b, 'D')? {
+                self.radius_offset = d;
+            }
         }
         if let Some(f) = b.get('F') {
             // GTC2E's F is a feed; in G32/G92/G76 blocks F is the lead (handled there).
@@ -1849,6 +1916,9 @@ impl Interpreter {
 
     /// The body of a block: one-shot codes, cycles, motion.
     fn block_body(&mut self, b: &Block) -> Result<(), ProgramError> {
+        if !self.dialect.is_lathe() && self.nose_comp.is_some() {
+            self.refuse_under_cutter_comp(b)?;
+        }
         if !self.dialect.is_lathe() && b.g.iter().any(|g| g.0 == 0) {
             // A motion code beside a one-shot code becomes modal for the blocks after it.
             if let Some(m) = b.group(1) {

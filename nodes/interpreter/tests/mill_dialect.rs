@@ -241,3 +241,68 @@ fn a_one_shot_code_may_share_its_block_with_a_motion_code() {
         ]
     );
 }
+
+#[test]
+fn cutter_compensation_works_in_g19_which_linuxcnc_refuses() {
+    // G19: Y across, Z up; G42 keeps the cutter right of a path going +Y at Z0, so below it.
+    let l = lines("G19 G0 X5 Y-10 Z0\nG42 D1 G1 Y0 F100\nY30\nG40 Y40\nM30\n");
+    assert_eq!(
+        l[1..4],
+        [
+            "LINEAR X5.0000 Y0.0000 Z-5.0000 F100.0000",
+            "LINEAR X5.0000 Y30.0000 Z-5.0000 F100.0000",
+            "LINEAR X5.0000 Y40.0000 Z0.0000 F100.0000",
+        ]
+    );
+}
+
+#[test]
+fn d0_compensates_with_no_radius_and_d_is_modal() {
+    let l = lines("G0 X-10 Y0\nG41 D0 G1 X0 F100\nY10\nG40 X-10\nM30\n");
+    assert_eq!(l[1], "LINEAR X0.0000 Y0.0000 Z0.0000 F100.0000");
+    // D2 given in a block of its own is used by the G41 after it: radius 3.
+    let l = lines("G0 X-10 Y0\nD2\nG41 G1 X0 F100\nX20\nG40 X30\nM30\n");
+    assert_eq!(l[1], "LINEAR X0.0000 Y3.0000 Z0.0000 F100.0000");
+}
+
+#[test]
+fn cutter_compensation_alarms_name_the_block() {
+    let cases = [
+        // Start-up in an arc block (P/S 034).
+        ("G0 X0 Y0\nG41 D1 G2 X10 Y0 R5 F100\nM30\n", 2, "arc"),
+        // Cancel in an arc block.
+        (
+            "G0 X0 Y0\nG41 D1 G1 X10 F100\nY10\nG40 G3 X0 Y20 R10\nM30\n",
+            4,
+            "arc",
+        ),
+        // Plane change under compensation (P/S 037).
+        ("G0 X0 Y0\nG41 D1 G1 X10 F100\nG18\nM30\n", 3, "plane"),
+        // Reference return, machine coordinates and canned cycles need G40 first.
+        ("G0 X0 Y0\nG41 D1 G1 X10 F100\nG28 Z0\nM30\n", 3, "G28"),
+        ("G0 X0 Y0\nG41 D1 G1 X10 F100\nG53 Z0\nM30\n", 3, "G53"),
+        (
+            "G0 X0 Y0 Z10\nG41 D1 G1 X10 F100\nG81 X20 Z-5 R2\nM30\n",
+            3,
+            "canned cycle",
+        ),
+        // A step smaller than the cutter radius between two inner corners: the offset line
+        // would run backwards (interference, P/S 041), seen when block 5 shows the corner.
+        (
+            "G0 X-10 Y0\nG41 D1 G1 X0 Y0 F100\nX20\nY4\nX40\nY20\nG40 X50\nM30\n",
+            5,
+            "interference",
+        ),
+        // G41 on top of G41.
+        (
+            "G0 X0 Y0\nG41 D1 G1 X10 F100\nG42 X20\nM30\n",
+            3,
+            "G40 first",
+        ),
+    ];
+    for (program, line, text) in cases {
+        let e = alarm(program);
+        assert_eq!(e.line, line, "{e} for\n{program}");
+        assert!(e.text.contains(text), "{e} for\n{program}");
+    }
+}

@@ -468,18 +468,19 @@ impl Interpreter {
             .get(first)
             .map(|e| e.start())
             .map_or_else(|| self.plane_point(here), Ok)?;
-        let mut comp = nose::NoseComp::new(side, radius, tool.tip, start, true);
+        let mut comp =
+            nose::NoseComp::new(side, radius, tool.tip, start, nose::Startup::ToNextElement);
         let mut outs = Vec::new();
         let mut out_elems: Vec<Elem> = elems[..first.min(elems.len())].to_vec();
         for (i, e) in elems.iter().enumerate().skip(first) {
             if Some(i) == cancel {
-                outs.extend(comp.cancel(e.end(), nose::Kind::Feed(1.0), 0));
+                outs.extend(comp.cancel(e.end(), 0.0, nose::Kind::Feed(1.0), 0));
                 out_elems.extend(outs.drain(..).map(|o| o.path));
                 out_elems.extend(elems[i + 1..].iter().copied());
                 return Ok(out_elems);
             }
             outs.extend(
-                comp.push(*e, nose::Kind::Feed(1.0), 0)
+                comp.push(*e, 0.0, nose::Kind::Feed(1.0), 0)
                     .map_err(|x| self.comp_fault(x))?,
             );
         }

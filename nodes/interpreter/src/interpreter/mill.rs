@@ -1,6 +1,6 @@
 //! Mill-only words and codes (`003`, inventory Appendix A.2): the T word that only selects a
-//! tool, G43/G44/G49 tool length compensation with H, and G52 local coordinate systems.
-//! Decision D47.
+//! tool, G43/G44/G49 tool length compensation with H, the D word of cutter compensation and
+//! G52 local coordinate systems. Decisions D47, D48.
 
 use super::*;
 
@@ -58,6 +58,63 @@ impl Interpreter {
             f64::from(self.length_sign) * (t.z + t.wear_z)
         };
         Ok(())
+    }
+
+    /// The cutter radius G41/G42 use: offset D of this block, else the modal D (D0: none).
+    /// A negative value swaps the side, as on FANUC; beyond ±1000 mm it is P/S 029.
+    pub(super) fn cutter_radius(&mut self, b: &Block) -> Result<f64, ProgramError> {
+        self.refuse_arc_for_comp(b, "G41/G42")?;
+        if let Some(d) = self.offset_word(b, 'D')? {
+            self.radius_offset = d;
+        }
+        if self.radius_offset == 0 {
+            return Ok(0.0);
+        }
+        let r = self.setup.offsets.tool(self.radius_offset).radius;
+        if r.is_finite() && r.abs() <= 1000.0 {
+            Ok(r)
+        } else {
+            Err(self.fault(
+                Fault::CompRadiusZero,
+                format!("D{}: radius {} is not usable", self.radius_offset, show(r)),
+            ))
+        }
+    }
+
+    /// Cutter compensation starts and ends in G00/G01 blocks, never in an arc (P/S 034).
+    pub(super) fn refuse_arc_for_comp(&self, b: &Block, code: &str) -> Result<(), ProgramError> {
+        if matches!(b.group(1).unwrap_or(self.motion), G::ArcCw | G::ArcCcw) {
+            return Err(self.fault(
+                Fault::CompStartNotLine,
+                format!("{code} in an arc block: start and cancel compensation with G00/G01"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// What needs the tool's own position, not a compensated one, is refused while G41/G42
+    /// is in force: G28, G53, G92, G52 and canned cycles (decision D48; LinuxCNC refuses the
+    /// same, FANUC ignores compensation in cycles).
+    pub(super) fn refuse_under_cutter_comp(&self, b: &Block) -> Result<(), ProgramError> {
+        let code = b.g.iter().find_map(|&(_, g, _)| match g {
+            G::ReferenceReturn => Some("G28"),
+            G::MachineCoordinates => Some("G53"),
+            G::SetCoordinate => Some("G92"),
+            G::MillLocal => Some("G52"),
+            G::HoleCycle(_) => Some("a canned cycle"),
+            _ => None,
+        });
+        let code = match code {
+            Some(c) => c,
+            None if self.hole.is_some() && b.group(1).is_none() && b.group(9).is_none() => {
+                "a canned cycle"
+            }
+            None => return Ok(()),
+        };
+        Err(self.fault(
+            Fault::CompInCycle,
+            format!("{code} while cutter compensation is active: cancel it with G40 first"),
+        ))
     }
 
     /// G52: the local system's zero at the given work coordinates, for every work system;

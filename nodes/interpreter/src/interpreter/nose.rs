@@ -9,10 +9,12 @@
 //! `docs/decisions.md`):
 //! - inner corner: both offset elements are cut back to their intersection;
 //! - outer corner: an arc of radius R around the corner joins them;
-//! - start-up (`startup_line`, Huaxing): the start-up G01 goes from the uncompensated point
-//!   to the offset start of the next element; otherwise (GTC2E) the first element is offset
-//!   from its start and a connecting move gets there;
+//! - start-up: see [`Startup`];
 //! - cancel: the held element ends at its offset end, then a line to the uncompensated point.
+//!
+//! On the mill the same geometry serves cutter radius compensation (tip 0: the programmed
+//! point is the cutter's centre line). Moves along the plane's normal (Z in G17) with no
+//! motion in the plane wait with the held element and follow its end (decision D48).
 //!
 //! Pure geometry: no interpreter state, errors as [`CompError`].
 
@@ -44,10 +46,26 @@ pub enum Kind {
     Feed(f64),
 }
 
-/// One move for the controlled point (imaginary tip), in the plane, with its source line.
+/// How compensation starts (decisions D30, D48).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Startup {
+    /// Huaxing: the start-up G01 goes from the uncompensated point to the offset start of the
+    /// next element.
+    ToNextElement,
+    /// GTC2E: the first element is offset from its start; a connecting move gets there.
+    Connect,
+    /// FANUC mill: the start-up move itself is compensated, its start left where the tool
+    /// is, and meets the next element as any corner does (FANUC's type B start-up, and
+    /// LinuxCNC's).
+    AlongEntry,
+}
+
+/// One move for the controlled point (imaginary tip), in the plane, with its source line and
+/// the coordinate along the plane's normal at its end (`depth`, unused on the lathe).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Out {
     pub path: Elem,
+    pub depth: f64,
     pub kind: Kind,
     pub line: u32,
 }
@@ -58,22 +76,38 @@ pub enum CompError {
     NoIntersection,
     /// The nose radius is larger than a concave arc's radius.
     ArcVanishes,
+    /// An arc cannot be the start-up move of [`Startup::AlongEntry`].
+    ArcStartup,
+    /// Trimmed at both corners, an offset line would run against its programmed direction:
+    /// the tool would cut into the contour (FANUC's interference check, P/S 041).
+    Interference,
 }
 
 #[derive(Debug, Clone, Copy)]
 struct Held {
     /// The offset element, its start already joined to what came before.
     path: Elem,
+    /// The uncompensated point a [`Startup::AlongEntry`] start-up move leaves from.
+    from: Option<Pt>,
+    /// The programmed line's direction (None for arcs), for the interference check.
+    course: Option<Pt>,
+    depth: f64,
+    kind: Kind,
+    line: u32,
+}
+
+/// A move along the plane's normal only, waiting for the held element to end.
+#[derive(Debug, Clone, Copy)]
+struct Still {
+    depth: f64,
     kind: Kind,
     line: u32,
 }
 
 #[derive(Debug, Clone, Copy)]
 enum Start {
-    /// The next element is the start-up move from this uncompensated point (Huaxing).
-    StartupLine(Pt),
-    /// The next element is offset from its start; a connecting move leaves this point (GTC2E).
-    Connect(Pt),
+    /// The next element is the start-up move from this uncompensated point.
+    Pending(Startup, Pt),
     Running,
 }
 
@@ -85,8 +119,10 @@ pub struct NoseComp {
     tip: Pt,
     start: Start,
     /// The Huaxing start-up element, waiting for the element after it.
-    startup: Option<(Pt, Elem, Kind, u32)>,
+    startup: Option<(Pt, Elem, f64, Kind, u32)>,
     held: Option<Held>,
+    /// Moves along the normal after the held element, in program order.
+    stills: Vec<Still>,
 }
 
 /// The vector from the nose centre to the imaginary tip for tip direction 0–9, with Z to the
@@ -263,9 +299,8 @@ fn circle_circle(c1: Pt, r1: f64, c2: Pt, r2: f64) -> Vec<Pt> {
 }
 
 impl NoseComp {
-    /// Compensation from the uncompensated point `from`; `startup_line` as on the Huaxing
-    /// control (the next block is the start-up move).
-    pub fn new(side: Side, radius: f64, tip: u8, from: Pt, startup_line: bool) -> NoseComp {
+    /// Compensation from the uncompensated point `from`, starting as `startup` says.
+    pub fn new(side: Side, radius: f64, tip: u8, from: Pt, startup: Startup) -> NoseComp {
         let offset = match side {
             Side::Left => radius,
             Side::Right => -radius,
@@ -273,66 +308,124 @@ impl NoseComp {
         NoseComp {
             offset,
             tip: tip_vector(tip, radius),
-            start: if startup_line {
-                Start::StartupLine(from)
-            } else {
-                Start::Connect(from)
-            },
+            start: Start::Pending(startup, from),
             startup: None,
             held: None,
+            stills: Vec::new(),
         }
     }
 
-    fn out(&self, path: Elem, kind: Kind, line: u32) -> Out {
+    fn out(&self, path: Elem, depth: f64, kind: Kind, line: u32) -> Out {
         Out {
             path: path.translated(self.tip),
+            depth,
             kind,
             line,
         }
     }
 
-    /// Takes the next programmed element; returns the moves now certain.
-    pub fn push(&mut self, path: Elem, kind: Kind, line: u32) -> Result<Vec<Out>, CompError> {
-        let off = path.offset(self.offset)?;
-        let mut out = Vec::new();
-        match self.start {
-            Start::StartupLine(from) => {
-                // The start-up element waits for the element after it.
-                self.startup = Some((from, path, kind, line));
-                self.start = Start::Running;
-                return Ok(out);
+    /// The held element as it is cut: from the uncompensated point if it is the start-up
+    /// move, then the moves along the normal that waited for its end.
+    fn release(&mut self, h: Held, out: &mut Vec<Out>) -> Result<(), CompError> {
+        if let (None, Some(course), Elem::Line { a, b }) = (h.from, h.course, h.path) {
+            if dot(sub(b, a), course) < -1e-6 {
+                return Err(CompError::Interference);
             }
-            Start::Connect(from) => {
-                out.push(Out {
-                    path: Elem::Line {
-                        a: from,
-                        b: add(off.start(), self.tip),
-                    },
-                    kind,
-                    line,
-                });
-                self.held = Some(Held {
-                    path: off,
-                    kind,
-                    line,
-                });
-                self.start = Start::Running;
-                return Ok(out);
-            }
-            Start::Running => {}
         }
-        if let Some((from, _, s_kind, s_line)) = self.startup.take() {
+        let path = match h.from {
+            Some(from) => h.path.with_start(from),
+            None => h.path,
+        };
+        out.push(self.out(path, h.depth, h.kind, h.line));
+        self.release_stills(add(path.end(), self.tip), out);
+        Ok(())
+    }
+
+    /// The moves along the normal that waited, at `end` (a controlled point).
+    fn release_stills(&mut self, end: Pt, out: &mut Vec<Out>) {
+        for s in std::mem::take(&mut self.stills) {
+            out.push(Out {
+                path: Elem::Line { a: end, b: end },
+                depth: s.depth,
+                kind: s.kind,
+                line: s.line,
+            });
+        }
+    }
+
+    /// The depth the tool is at once everything released so far has run.
+    fn depth_after(&self, h: &Held) -> f64 {
+        self.stills.last().map(|s| s.depth).unwrap_or(h.depth)
+    }
+
+    /// Takes the next programmed element, ending at `depth` along the normal; returns the
+    /// moves now certain.
+    pub fn push(
+        &mut self,
+        path: Elem,
+        depth: f64,
+        kind: Kind,
+        line: u32,
+    ) -> Result<Vec<Out>, CompError> {
+        let off = path.offset(self.offset)?;
+        let course = match path {
+            Elem::Line { a, b } => Some(unit(sub(b, a))),
+            Elem::Arc { .. } => None,
+        };
+        let mut out = Vec::new();
+        if let Start::Pending(startup, from) = self.start {
+            let held = |from| Held {
+                path: off,
+                from,
+                course,
+                depth,
+                kind,
+                line,
+            };
+            match startup {
+                Startup::ToNextElement => {
+                    // The start-up element waits for the element after it.
+                    self.startup = Some((from, path, depth, kind, line));
+                }
+                Startup::Connect => {
+                    out.push(Out {
+                        path: Elem::Line {
+                            a: from,
+                            b: add(off.start(), self.tip),
+                        },
+                        depth,
+                        kind,
+                        line,
+                    });
+                    self.held = Some(held(None));
+                }
+                Startup::AlongEntry => {
+                    if matches!(path, Elem::Arc { .. }) {
+                        return Err(CompError::ArcStartup);
+                    }
+                    self.held = Some(held(Some(sub(from, self.tip))));
+                }
+            }
+            self.start = Start::Running;
+            return Ok(out);
+        }
+        if let Some((from, _, s_depth, s_kind, s_line)) = self.startup.take() {
             // Start-up move: to the offset start of this element (perpendicular to it).
             out.push(Out {
                 path: Elem::Line {
                     a: from,
                     b: add(off.start(), self.tip),
                 },
+                depth: s_depth,
                 kind: s_kind,
                 line: s_line,
             });
+            self.release_stills(add(off.start(), self.tip), &mut out);
             self.held = Some(Held {
                 path: off,
+                from: None,
+                course,
+                depth,
                 kind,
                 line,
             });
@@ -341,43 +434,65 @@ impl NoseComp {
         let Some(held) = self.held.take() else {
             self.held = Some(Held {
                 path: off,
+                from: None,
+                course,
+                depth,
                 kind,
                 line,
             });
             return Ok(out);
         };
-        let (prev, next) = self.join(held, path, off, kind, line)?;
-        out.extend(prev);
+        let next = self.join(held, path, off, kind, line, &mut out)?;
         self.held = Some(Held {
             path: next,
+            from: None,
+            course,
+            depth,
             kind,
             line,
         });
         Ok(out)
     }
 
-    /// Joins the held offset element to the offset of `path`: the held element (trimmed, and a
-    /// corner arc after it when the corner is outside) and the next offset element's start.
+    /// A move along the plane's normal only (a plunge in G17): it runs where the held element
+    /// ends, so it waits for it; with nothing held it runs where the tool is.
+    pub fn push_still(&mut self, here: Pt, depth: f64, kind: Kind, line: u32) -> Vec<Out> {
+        if self.holding() {
+            self.stills.push(Still { depth, kind, line });
+            return Vec::new();
+        }
+        vec![Out {
+            path: Elem::Line { a: here, b: here },
+            depth,
+            kind,
+            line,
+        }]
+    }
+
+    /// Joins the held offset element to the offset of `path`: queues the held element
+    /// (trimmed, and a corner arc after it when the corner is outside) and returns the next
+    /// offset element from where it starts.
     fn join(
-        &self,
+        &mut self,
         held: Held,
         path: Elem,
         off: Elem,
         kind: Kind,
         line: u32,
-    ) -> Result<(Vec<Out>, Elem), CompError> {
-        // An offset element runs parallel to its programmed one: same tangents.
-        let t1 = held.path.end_tangent();
+        out: &mut Vec<Out>,
+    ) -> Result<Elem, CompError> {
+        // An offset element runs parallel to its programmed one: same tangents (a line's
+        // from its programmed course: trimmed at its start it may already point backwards).
+        let t1 = held.course.unwrap_or_else(|| held.path.end_tangent());
         let t2 = path.start_tangent();
         let turn = cross(t1, t2);
         let along = dot(t1, t2);
         let corner = sub(held.path.end(), scale(left(t1), self.offset));
         if turn.abs() < 1e-9 && along > 0.0 {
             // Tangent: the offsets meet (within rounding); go straight on.
-            return Ok((
-                vec![self.out(held.path, held.kind, held.line)],
-                off.with_start(held.path.end()),
-            ));
+            let end = held.path.end();
+            self.release(held, out)?;
+            return Ok(off.with_start(end));
         }
         // The nose is on the outside of the turn when it turns away from the offset side.
         let outside = turn * self.offset < 0.0 || along <= -1.0 + 1e-9;
@@ -389,13 +504,10 @@ impl NoseComp {
                 // Around an outer corner the nose turns the way the contour turns.
                 ccw: self.offset < 0.0,
             };
-            return Ok((
-                vec![
-                    self.out(held.path, held.kind, held.line),
-                    self.out(arc, kind, line),
-                ],
-                off,
-            ));
+            let depth = self.depth_after(&held);
+            self.release(held, out)?;
+            out.push(self.out(arc, depth, kind, line));
+            return Ok(off);
         }
         // Inside: both are cut back to where they cross, the crossing nearest the corner.
         let x = intersections(&held.path, &off)
@@ -406,14 +518,19 @@ impl NoseComp {
                     .unwrap_or(std::cmp::Ordering::Equal)
             })
             .ok_or(CompError::NoIntersection)?;
-        Ok((
-            vec![self.out(held.path.with_end(x), held.kind, held.line)],
-            off.with_start(x),
-        ))
+        self.release(
+            Held {
+                path: held.path.with_end(x),
+                ..held
+            },
+            out,
+        )?;
+        Ok(off.with_start(x))
     }
 
-    /// Cancel (G40): the held element to its offset end, then `path`'s end uncompensated.
-    pub fn cancel(&mut self, target: Pt, kind: Kind, line: u32) -> Vec<Out> {
+    /// Cancel (G40): the held element to its offset end, then a line to `target`
+    /// uncompensated, ending at `depth`.
+    pub fn cancel(&mut self, target: Pt, depth: f64, kind: Kind, line: u32) -> Vec<Out> {
         let mut out = self.flush();
         let from = out
             .last()
@@ -421,6 +538,7 @@ impl NoseComp {
             .unwrap_or_else(|| self.startup_point().unwrap_or(target));
         out.push(Out {
             path: Elem::Line { a: from, b: target },
+            depth,
             kind,
             line,
         });
@@ -429,7 +547,7 @@ impl NoseComp {
 
     fn startup_point(&self) -> Option<Pt> {
         match self.start {
-            Start::StartupLine(p) | Start::Connect(p) => Some(p),
+            Start::Pending(_, p) => Some(p),
             Start::Running => self.startup.map(|s| s.0),
         }
     }
@@ -442,7 +560,7 @@ impl NoseComp {
     /// Ends compensation where it is (program end): the held element to its offset end.
     pub fn flush(&mut self) -> Vec<Out> {
         let mut out = Vec::new();
-        if let Some((from, path, kind, line)) = self.startup.take() {
+        if let Some((from, path, depth, kind, line)) = self.startup.take() {
             // Only the start-up element was given: it ends offset from its own end.
             let off = path.offset(self.offset).unwrap_or(path);
             out.push(Out {
@@ -450,12 +568,15 @@ impl NoseComp {
                     a: from,
                     b: add(off.end(), self.tip),
                 },
+                depth,
                 kind,
                 line,
             });
+            self.release_stills(add(off.end(), self.tip), &mut out);
         }
         if let Some(h) = self.held.take() {
-            out.push(self.out(h.path, h.kind, h.line));
+            // At the end nothing trims the element's end: it cannot have turned around.
+            let _ = self.release(h, &mut out);
         }
         out
     }
@@ -476,7 +597,7 @@ mod tests {
     #[test]
     fn outside_turning_with_tip_3_keeps_the_diameter_on_straight_cuts() {
         // G42, R1, tip 3: turning toward the chuck along r = 15, then facing up to r = 20.
-        let mut c = NoseComp::new(Side::Right, 1.0, 3, p(10.0, 15.0), false);
+        let mut c = NoseComp::new(Side::Right, 1.0, 3, p(10.0, 15.0), Startup::Connect);
         let f = Kind::Feed(100.0);
         let out = c
             .push(
@@ -484,6 +605,7 @@ mod tests {
                     a: p(10.0, 15.0),
                     b: p(-20.0, 15.0),
                 },
+                0.0,
                 f,
                 1,
             )
@@ -496,6 +618,7 @@ mod tests {
                     a: p(-20.0, 15.0),
                     b: p(-20.0, 20.0),
                 },
+                0.0,
                 f,
                 2,
             )
@@ -511,13 +634,14 @@ mod tests {
 
     #[test]
     fn outer_corners_get_an_arc_of_the_nose_radius() {
-        let mut c = NoseComp::new(Side::Left, 3.0, 0, p(0.0, 0.0), false);
+        let mut c = NoseComp::new(Side::Left, 3.0, 0, p(0.0, 0.0), Startup::Connect);
         let f = Kind::Feed(100.0);
         c.push(
             Elem::Line {
                 a: p(0.0, 0.0),
                 b: p(0.0, 10.0),
             },
+            0.0,
             f,
             1,
         )
@@ -529,6 +653,7 @@ mod tests {
                     a: p(0.0, 10.0),
                     b: p(20.0, 10.0),
                 },
+                0.0,
                 f,
                 2,
             )
@@ -540,6 +665,7 @@ mod tests {
                     a: p(20.0, 10.0),
                     b: p(20.0, 0.0),
                 },
+                0.0,
                 f,
                 3,
             )
@@ -558,7 +684,7 @@ mod tests {
 
     #[test]
     fn a_concave_arc_smaller_than_the_nose_is_an_error() {
-        let mut c = NoseComp::new(Side::Left, 5.0, 0, p(0.0, 0.0), false);
+        let mut c = NoseComp::new(Side::Left, 5.0, 0, p(0.0, 0.0), Startup::Connect);
         // Counter-clockwise arc of radius 2: its left side is inside.
         let e = c.push(
             Elem::Arc {
@@ -567,6 +693,7 @@ mod tests {
                 c: p(-2.0, 0.0),
                 ccw: true,
             },
+            0.0,
             Kind::Feed(1.0),
             1,
         );
