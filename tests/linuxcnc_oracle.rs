@@ -22,7 +22,8 @@
 //! - G91 G10 L2 adds to the offset on FANUC and replaces it on LinuxCNC;
 //! - LinuxCNC compensates the cutter radius only in G17 and G18, FANUC in G19 too;
 //! - it rejects U/W words, G65 and FANUC T-word forms (notes §"What rs274 accepts and
-//!   rejects"), and WHILE/IF/GOTO (it has O-word control flow instead).
+//!   rejects"), and WHILE/IF/GOTO: it has O-word control flow instead, so a WHILE … DO m
+//!   and its END m carry `(rs274: oN while […])` and `(rs274: oN endwhile)`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command as Process;

@@ -9,7 +9,7 @@
 //! - `iso-lathe`: the skeleton's FANUC lathe "system B" subset with G90/G91 absolute/incremental
 //!   (decision D1), kept for programs written for it.
 
-use crate::error::{gtc2e_number, huaxing_number, Fault};
+use crate::error::{fanuc_number, gtc2e_number, huaxing_number, Fault};
 
 /// What a G code does in the shared core.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -121,6 +121,8 @@ pub enum G {
     MillLocal,
     /// Defined by the manual but not implemented by this controller: alarm with the reason.
     Unsupported(&'static str),
+    /// G65 user macro call (FANUC mill): run by the statement itself, never as a block.
+    MacroCall,
 }
 
 /// The mill's hole-machining cycles (`003` §8.1, inventory Appendix A.1).
@@ -314,6 +316,7 @@ impl Dialect {
     pub fn alarm(self, f: Fault) -> u32 {
         match self {
             Dialect::Gtc2eLathe => gtc2e_number(f),
+            Dialect::FanucMill => fanuc_number(f),
             _ => huaxing_number(f),
         }
     }
@@ -535,6 +538,11 @@ fn mill_g(n: u32) -> Option<GCode> {
         400 => (7, NoseCancel),
         410 => (7, NoseLeft),
         420 => (7, NoseRight),
+        650 => (0, MacroCall),
+        660 | 670 => (
+            12,
+            Unsupported("G66/G67 modal macro calls are not built: call with G65 per block"),
+        ),
         430 => (8, LengthComp(1)),
         440 => (8, LengthComp(-1)),
         490 => (8, LengthComp(0)),

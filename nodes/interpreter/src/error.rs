@@ -2,8 +2,9 @@
 //!
 //! The interpreter raises a [`Fault`] (what went wrong, in the controller's own terms); the
 //! dialect turns it into the number of its manual's alarm table: the Huaxing list (`000`
-//! Appendix 1, inventory §11.1) or the GTC2E list (`002` §6.3, inventory §10, numbered 1–28 in
-//! the order printed, decision D13).
+//! Appendix 1, inventory §11.1), the GTC2E list (`002` §6.3, inventory §10, numbered 1–28 in
+//! the order printed, decision D13) or FANUC's P/S numbers (`003` inventory Appendix A.4,
+//! decision D49).
 
 use std::fmt;
 
@@ -162,6 +163,39 @@ pub enum Fault {
     G50S,
     /// A function this controller does not implement yet: alarm 7 with the reason.
     NotSupported,
+    /// A number with no address letter before it (FANUC P/S 004; `000` 13, `002` 15).
+    NoAddress,
+    /// An address with no number after it (FANUC P/S 005).
+    NoNumber,
+    /// A sign where none may be: `X--5` (FANUC P/S 006).
+    IllegalMinus,
+    /// A number with two decimal points (FANUC P/S 007).
+    DecimalPoint,
+    /// A number with more digits than the control reads (FANUC P/S 003).
+    TooManyDigits,
+    /// An address letter that is neither a word nor an axis of this machine (`000` 7,
+    /// `002` 15, FANUC P/S 009).
+    NoSuchAddress,
+    /// The plane names an axis the machine lacks (FANUC P/S 021).
+    PlaneAxis,
+    /// Subprograms or macros nested too deep (FANUC P/S 077).
+    CallDepth,
+    /// Division by zero in an expression (FANUC P/S 112).
+    MacroDivide,
+    /// A variable number that does not exist (FANUC P/S 115).
+    MacroVariable,
+    /// A write to a read-only variable (FANUC P/S 116).
+    MacroReadOnly,
+    /// A function argument outside its domain, SQRT of a negative (FANUC P/S 119).
+    MacroArgument,
+    /// Brackets nested too deep or not closed (FANUC P/S 118).
+    MacroBrackets,
+    /// DO/END number other than 1–3, or END without its DO (FANUC P/S 126).
+    MacroLoop,
+    /// WHILE … DO m without its END m (FANUC P/S 124).
+    MacroEnd,
+    /// A G65 address that is no argument (FANUC P/S 129).
+    MacroCallFormat,
 }
 
 /// The alarm number a fault has in the Huaxing table (`000` Appendix 1).
@@ -173,13 +207,14 @@ pub fn huaxing_number(f: Fault) -> u32 {
         TaperTooLarge => 3,
         CssWithoutS => 4,
         ToolNumber => 6,
-        UndefinedCode | IllegalWord | NotSupported => 7,
+        UndefinedCode | IllegalWord | NotSupported | NoSuchAddress => 7,
         Group00With01 => 8,
         AbsAndInc => 9,
         TooManyM => 10,
         ArcRadius => 11,
         Chamfer => 12,
-        DataFormat | SameGroup | RepeatedWord | OutOfRange => 13,
+        DataFormat | SameGroup | RepeatedWord | OutOfRange | NoAddress | NoNumber
+        | IllegalMinus | DecimalPoint | TooManyDigits => 13,
         AxisAddress => 14,
         ArcRAndIk => 15,
         FeedRange => 16,
@@ -216,6 +251,10 @@ pub fn huaxing_number(f: Fault) -> u32 {
         MustStartBlock => 103,
         ChamferTooShort => 119,
         G50S => 112,
+        PlaneAxis => 14,
+        CallDepth => 21,
+        MacroDivide | MacroVariable | MacroReadOnly | MacroArgument | MacroBrackets | MacroLoop
+        | MacroEnd | MacroCallFormat => 20,
     }
 }
 
@@ -225,11 +264,14 @@ pub fn huaxing_number(f: Fault) -> u32 {
 pub fn gtc2e_number(f: Fault) -> u32 {
     use Fault::*;
     match f {
-        UndefinedCode | DataFormat | NotSupported | Macro | MustStartBlock => 15,
+        UndefinedCode | DataFormat | NotSupported | Macro | MustStartBlock | NoSuchAddress
+        | NoAddress | NoNumber | IllegalMinus | DecimalPoint | TooManyDigits | MacroVariable
+        | MacroReadOnly | MacroBrackets | MacroLoop | MacroEnd | MacroCallFormat => 15,
         SameGroup | Group00With01 | TooManyM => 16,
         RepeatedWord | AbsAndInc => 17,
         MissingWord | ThreadDepthMissing | CssWithoutS => 18,
-        IllegalWord | AxisAddress | ArcRAndIk | CycleFormat | ContourStart | Call => 19,
+        IllegalWord | AxisAddress | PlaneAxis | ArcRAndIk | CycleFormat | ContourStart | Call
+        | CallDepth => 19,
         TargetNotFound | RangeError => 20,
         LoopWithoutStart => 21,
         ReturnWithoutCall => 22,
@@ -237,5 +279,52 @@ pub fn gtc2e_number(f: Fault) -> u32 {
         ProgramNotFound | UndefinedSubprogram => 10,
         // Geometry that cannot be made is an operand error on this control.
         _ => 23,
+    }
+}
+
+/// The P/S alarm number a fault has on the FANUC 0-M (`003` inventory Appendix A.4; decision
+/// D49). The appendix lists the numbers, not which of this controller's checks raises each:
+/// a fault with no number of its own takes the nearest family (003 a value beyond its
+/// address's range, 009 a word or character where it may not be, 010 a code used wrongly
+/// or not built).
+pub fn fanuc_number(f: Fault) -> u32 {
+    use Fault::*;
+    match f {
+        DwellTime | OutOfRange | TooManyDigits => 3,
+        NoAddress => 4,
+        NoNumber => 5,
+        IllegalMinus => 6,
+        DecimalPoint => 7,
+        DataFormat | IllegalWord | AbsAndInc | TooManyM | RepeatedWord | AxisAddress
+        | NoSuchAxis | ArcRAndIk | NoSuchAddress => 9,
+        UndefinedCode | NotSupported | SameGroup | Group00With01 | MissingWord | ThreadLead
+        | TaperTooLarge | CssWithoutS | Chamfer | ChamferTooShort | RangeError
+        | LoopWithoutStart | NoProgramEnd | CompInCycle | CycleZero | CycleFormat
+        | ContourTooLong | ContourData | ContourStart | ContourBeyondStart | ThreadDepthMissing
+        | PatternReliefZero | ThreePointArc | CompBlocks | CompDirection | CompRapid
+        | MustStartBlock | G50S => 10,
+        FeedRange => 11,
+        ArcRadius | ArcEnd => 20,
+        PlaneAxis => 21,
+        CompRadiusZero => 29,
+        ToolNumber | WorkOffset => 30,
+        CompNoIntersection => 33,
+        CompStartNotLine => 34,
+        CompPlane => 37,
+        CompInterference | CompArcVanishes => 41,
+        ProgramNotFound => 59,
+        Call => 76,
+        CallDepth => 77,
+        UndefinedSubprogram | ReturnWithoutCall => 78,
+        MacroDivide => 112,
+        Macro => 114,
+        MacroVariable => 115,
+        MacroReadOnly => 116,
+        MacroBrackets => 118,
+        MacroArgument => 119,
+        MacroEnd => 124,
+        MacroLoop => 126,
+        TargetNotFound => 128,
+        MacroCallFormat => 129,
     }
 }

@@ -4,6 +4,8 @@
 //! rules (§5.27.3): in arithmetic null counts as 0, in `==`/`!=` null differs from 0, in
 //! `<`/`<=`/`>`/`>=` null counts as 0 (decision D10).
 
+use crate::error::Fault;
+
 /// A macro value; `None` is null.
 pub type Value = Option<f64>;
 
@@ -118,9 +120,10 @@ impl Func {
     }
 }
 
-/// Why an expression could not be evaluated; the interpreter turns it into alarm 20.
+/// Why an expression could not be evaluated, and the fault the interpreter raises for it
+/// (alarm 20 on Huaxing; FANUC tells them apart).
 #[derive(Debug, Clone, PartialEq)]
-pub struct EvalError(pub String);
+pub struct EvalError(pub String, pub Fault);
 
 /// Reads and writes macro variables for the evaluator.
 pub trait Variables {
@@ -143,9 +146,10 @@ pub fn round_half_away(x: f64, decimals: i32) -> f64 {
 pub fn variable_number(v: f64) -> Result<i64, EvalError> {
     let r = v.round();
     if (v - r).abs() > 1e-6 || r.abs() > 1e9 {
-        return Err(EvalError(format!(
-            "variable number {v} is not a whole number"
-        )));
+        return Err(EvalError(
+            format!("variable number {v} is not a whole number"),
+            Fault::MacroVariable,
+        ));
     }
     Ok(r as i64)
 }
@@ -159,9 +163,9 @@ impl Expr {
         Ok(match self {
             Expr::Num { value, .. } => Some(*value),
             Expr::Var(index) => {
-                let n = index
-                    .eval(vars)?
-                    .ok_or_else(|| EvalError("variable number is null".into()))?;
+                let n = index.eval(vars)?.ok_or_else(|| {
+                    EvalError("variable number is null".into(), Fault::MacroVariable)
+                })?;
                 vars.read(variable_number(n)?)?
             }
             Expr::Unary(op, a) => {
@@ -213,7 +217,7 @@ fn binary(op: BinOp, a: Value, b: Value) -> Result<Value, EvalError> {
         Mul => Some(x * y),
         Div => {
             if y == 0.0 {
-                return Err(EvalError("division by zero".into()));
+                return Err(EvalError("division by zero".into(), Fault::MacroDivide));
             }
             Some(x / y)
         }
@@ -237,7 +241,10 @@ fn call(f: Func, a: f64, b: f64, round_decimals: i32) -> Result<f64, EvalError> 
         if ok {
             Ok(())
         } else {
-            Err(EvalError(format!("{what} outside its domain")))
+            Err(EvalError(
+                format!("{what} outside its domain"),
+                Fault::MacroArgument,
+            ))
         }
     };
     let v = match f {
@@ -287,7 +294,10 @@ fn call(f: Func, a: f64, b: f64, round_decimals: i32) -> Result<f64, EvalError> 
         Pi => std::f64::consts::PI,
     };
     if !v.is_finite() {
-        return Err(EvalError(format!("{f:?} gives no finite number")));
+        return Err(EvalError(
+            format!("{f:?} gives no finite number"),
+            Fault::MacroArgument,
+        ));
     }
     Ok(v)
 }

@@ -99,6 +99,8 @@ struct Frame {
     remaining: u32,
     repeats: Vec<Repeat>,
     locals: Vec<Value>,
+    /// Open WHILE … DO loops: loop number and where its WHILE line starts.
+    loops: Vec<(u32, Pos)>,
 }
 
 /// Retained words of a Huaxing single cycle (G90/G92/G94, `000` §5.21.3).
@@ -178,6 +180,8 @@ pub struct Interpreter {
     spindle: SpindleDir,
     /// Tool-nose radius compensation while G41/G42 is in force.
     nose_comp: Option<nose::NoseComp>,
+    /// Where the line being run starts (a WHILE comes back to it).
+    block_start: Pos,
     /// The mill's D: the offset whose radius G41/G42 use (modal, D0 = no radius).
     radius_offset: u32,
     /// G40 given: the next move leaves compensation.
@@ -270,6 +274,7 @@ impl Interpreter {
                 remaining: 0,
                 repeats: Vec::new(),
                 locals: vec![None; LOCALS],
+                loops: Vec::new(),
             }],
             pos: setup.start.clone(),
             program_start: Vec::new(),
@@ -290,6 +295,7 @@ impl Interpreter {
             spindle: SpindleDir::Stopped,
             nose_comp: None,
             radius_offset: 0,
+            block_start: Pos::default(),
             nose_cancel: false,
             corner: None,
             emitting_comp: false,
@@ -340,7 +346,7 @@ impl Interpreter {
             kept: self
                 .common
                 .iter()
-                .filter(|(n, _)| crate::setup::Memory::KEPT.contains(n))
+                .filter(|(n, _)| crate::setup::Memory::is_kept(**n))
                 .map(|(&n, &v)| (n, v))
                 .collect(),
             tools: self.setup.offsets.tools.clone(),
@@ -390,7 +396,7 @@ impl Interpreter {
     }
 
     fn eval_err(&self, e: EvalError) -> ProgramError {
-        self.fault(Fault::Macro, e.0)
+        self.fault(e.1, e.0)
     }
 
     // ---------------------------------------------------------------- reading
@@ -410,6 +416,7 @@ impl Interpreter {
             return self.end_of_text();
         };
         self.frame().pos = next;
+        self.block_start = pos;
         self.line = next.line;
         let line = parse_line(raw, self.rules.macros).map_err(|e| self.fault(e.fault, e.text))?;
         if line.percent && !self.saw_any_block() && line.stmt == Stmt::Empty {
@@ -541,6 +548,17 @@ impl Interpreter {
                     Ok(())
                 }
             }
+            Stmt::While { cond, id } => self.while_loop(cond.as_ref(), *id),
+            Stmt::End(id) => self.end_loop(*id),
+            Stmt::Words(words)
+                if self.dialect == Dialect::FanucMill
+                    && words.iter().any(|w| {
+                        w.letter == 'G'
+                            && matches!(w.value, Expr::Num { value, .. } if value == 65.0)
+                    }) =>
+            {
+                self.macro_call(words)
+            }
             Stmt::Words(words) => {
                 let mut b = Block {
                     number: line.number,
@@ -556,7 +574,7 @@ impl Interpreter {
         let v = var
             .eval(self)
             .map_err(|e| self.eval_err(e))?
-            .ok_or_else(|| self.fault(Fault::Macro, "variable number is null"))?;
+            .ok_or_else(|| self.fault(Fault::MacroVariable, "variable number is null"))?;
         variable_number(v).map_err(|e| self.eval_err(e))
     }
 
@@ -571,6 +589,9 @@ impl Interpreter {
     // ---------------------------------------------------------------- variables
 
     fn write_var(&mut self, n: i64, v: Value) -> Result<(), ProgramError> {
+        if self.dialect == Dialect::FanucMill {
+            return self.fanuc_write(n, v);
+        }
         match n {
             1..=40 => {
                 self.frame().locals[n as usize] = v;
@@ -612,7 +633,7 @@ impl Interpreter {
                 }
                 Ok(())
             }
-            _ => Err(self.fault(Fault::Macro, format!("#{n} cannot be written"))),
+            _ => Err(self.fault(Fault::MacroReadOnly, format!("#{n} cannot be written"))),
         }
     }
 
@@ -689,7 +710,7 @@ impl Interpreter {
                     && self.dialect != Dialect::IsoLathe;
             if !known {
                 return Err(self.fault(
-                    Fault::UndefinedCode,
+                    Fault::NoSuchAddress,
                     format!("address {c}: no such word or axis on this machine"),
                 ));
             }
@@ -841,7 +862,7 @@ impl Interpreter {
         match (self.axis(h), self.axis(v)) {
             (Some(h), Some(v)) => Ok((h, v)),
             _ => Err(self.fault(
-                Fault::AxisAddress,
+                Fault::PlaneAxis,
                 format!("{name} needs the {h} and {v} axes"),
             )),
         }
@@ -1141,24 +1162,30 @@ impl Interpreter {
     }
 
     fn comp_fault(&self, e: nose::CompError) -> ProgramError {
-        match e {
-            nose::CompError::NoIntersection => self.fault(
+        let what = if self.dialect.is_lathe() {
+            "tool-nose compensation"
+        } else {
+            "cutter compensation"
+        };
+        let (fault, text) = match e {
+            nose::CompError::NoIntersection => (
                 Fault::CompNoIntersection,
-                "tool-nose compensation: the offset path has no intersection here",
+                "the offset path has no intersection here",
             ),
-            nose::CompError::ArcVanishes => self.fault(
+            nose::CompError::ArcVanishes => (
                 Fault::CompArcVanishes,
-                "tool-nose compensation: arc radius smaller than the nose radius",
+                "arc radius smaller than the tool radius",
             ),
-            nose::CompError::ArcStartup => self.fault(
+            nose::CompError::ArcStartup => (
                 Fault::CompStartNotLine,
-                "cutter compensation cannot start in an arc: start it in a G00/G01 block",
+                "it cannot start in an arc: start it in a G00/G01 block",
             ),
-            nose::CompError::Interference => self.fault(
+            nose::CompError::Interference => (
                 Fault::CompInterference,
-                "cutter compensation: the tool would cut into the contour here (interference)",
+                "the tool would cut into the contour here (interference)",
             ),
-        }
+        };
+        self.fault(fault, format!("{what}: {text}"))
     }
 
     /// A move while compensation is active: handed to the compensation, which returns the
@@ -1842,7 +1869,7 @@ impl Interpreter {
         what: &str,
     ) -> Result<(), ProgramError> {
         if self.frames.len() > MAX_CALL_DEPTH {
-            return Err(self.fault(Fault::Call, "subprograms nested deeper than 4 levels"));
+            return Err(self.fault(Fault::CallDepth, "subprograms nested deeper than 4 levels"));
         }
         let (name, text) = self.library.get(number).ok_or_else(|| {
             self.fault(
@@ -1858,6 +1885,7 @@ impl Interpreter {
             remaining: count.saturating_sub(1),
             repeats: Vec::new(),
             locals,
+            loops: Vec::new(),
         });
         Ok(())
     }
@@ -1905,6 +1933,7 @@ impl Interpreter {
             f.remaining -= 1;
             f.pos = Pos::default();
             f.repeats.clear();
+            f.loops.clear();
         } else {
             self.frames.pop();
             if self.tool_macro_depth.is_some_and(|d| self.frames.len() < d) {
@@ -2794,18 +2823,22 @@ impl Variables for Interpreter {
     }
 
     fn read(&self, n: i64) -> Result<Value, EvalError> {
+        if self.dialect == Dialect::FanucMill {
+            return self.fanuc_read(n);
+        }
         let frame = self
             .frames
             .last()
-            .ok_or_else(|| EvalError("no program".into()))?;
+            .ok_or_else(|| EvalError("no program".into(), Fault::Macro))?;
         Ok(match n {
             0 => None,
             1..=40 => frame.locals[n as usize],
             100..=289 => self.common.get(&n).copied(),
             1000..=1033 => {
-                return Err(EvalError(format!(
-                    "#{n}: PLC inputs are not connected to the interpreter yet"
-                )))
+                return Err(EvalError(
+                    format!("#{n}: PLC inputs are not connected to the interpreter yet"),
+                    Fault::MacroVariable,
+                ))
             }
             4001..=4499 => {
                 let (table, num) = (n / 100 - 40, (n % 100) as u32);
@@ -2834,7 +2867,12 @@ impl Variables for Interpreter {
                 let letter = ['X', 'Y', 'Z', 'A', 'B', 'C'][((n - 5220) % 20) as usize];
                 Some(self.setup.offsets.work(sys, letter))
             }
-            _ => return Err(EvalError(format!("#{n} is not a variable of this control"))),
+            _ => {
+                return Err(EvalError(
+                    format!("#{n} is not a variable of this control"),
+                    Fault::MacroVariable,
+                ))
+            }
         })
     }
 }
@@ -2847,6 +2885,7 @@ mod drilling;
 mod grooving;
 mod gtc;
 mod hole_cycle;
+mod macro_b;
 mod mill;
 mod nose;
 

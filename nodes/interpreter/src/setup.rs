@@ -7,6 +7,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use serde::{Deserialize, Serialize};
 
 /// What the control keeps across power-off and between programs (`000` §5.27: #200–#289;
+/// `003` inventory A.3: #500–#999 on the FANUC mill;
 /// the offset page, which programs write through #4001–#4499). The node shell stores it in
 /// the launch config's `machine.memory_file`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -21,13 +22,16 @@ pub struct Memory {
 }
 
 impl Memory {
-    /// The range of macro variables kept across power-off.
-    pub const KEPT: std::ops::RangeInclusive<i64> = 200..=289;
+    /// The macro variables kept across power-off: Huaxing's #200–#289, FANUC's #500–#999
+    /// (each control reads only its own).
+    pub fn is_kept(n: i64) -> bool {
+        (200..=289).contains(&n) || (500..=999).contains(&n)
+    }
 
     /// Only what a program may store there, with finite values.
     pub fn sanitized(mut self) -> Memory {
         self.kept
-            .retain(|n, v| Memory::KEPT.contains(n) && v.is_finite());
+            .retain(|&n, v| Memory::is_kept(n) && v.is_finite());
         self.tools.retain(|n, t| {
             (1..=cnc_runtime::tool_table::MAX_TOOL_NUMBER).contains(n)
                 && [t.x, t.z, t.wear_x, t.wear_z, t.radius]

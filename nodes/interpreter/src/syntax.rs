@@ -22,9 +22,22 @@ pub struct Word {
 pub enum Stmt {
     Empty,
     Words(Vec<Word>),
-    Assign { var: Expr, value: Expr },
+    Assign {
+        var: Expr,
+        value: Expr,
+    },
     Goto(Expr),
-    If { cond: Expr, then: Box<Stmt> },
+    If {
+        cond: Expr,
+        then: Box<Stmt>,
+    },
+    /// `WHILE [cond] DO m`, or `DO m` alone (a loop without end condition; FANUC macro B).
+    While {
+        cond: Option<Expr>,
+        id: u32,
+    },
+    /// `END m`: back to the `WHILE … DO m` that opened the loop.
+    End(u32),
 }
 
 /// One parsed line.
@@ -45,6 +58,16 @@ pub struct Line {
 pub struct SyntaxError {
     pub fault: Fault,
     pub text: String,
+}
+
+/// A character where an address letter should be: a number without its address (FANUC
+/// P/S 004) or any other stray character (009).
+fn stray_fault(c: u8) -> Fault {
+    if c.is_ascii_digit() || matches!(c, b'-' | b'+' | b'.') {
+        Fault::NoAddress
+    } else {
+        Fault::DataFormat
+    }
 }
 
 fn err<T>(fault: Fault, text: impl Into<String>) -> Result<T, SyntaxError> {
@@ -200,7 +223,8 @@ impl Parser<'_> {
         }
         if !self.at_end() {
             let rest = String::from_utf8_lossy(&self.s[self.i..]).into_owned();
-            return err(Fault::DataFormat, format!("unexpected text {rest:?}"));
+            let fault = rest.bytes().next().map_or(Fault::DataFormat, stray_fault);
+            return err(fault, format!("unexpected text {rest:?}"));
         }
         Ok(line)
     }
@@ -240,7 +264,10 @@ impl Parser<'_> {
         f: impl FnOnce(&mut Self) -> Result<T, SyntaxError>,
     ) -> Result<T, SyntaxError> {
         if self.depth >= MAX_DEPTH {
-            return err(Fault::Macro, "statement or expression nested too deeply");
+            return err(
+                Fault::MacroBrackets,
+                "statement or expression nested too deeply",
+            );
         }
         self.depth += 1;
         let r = f(self);
@@ -280,6 +307,41 @@ impl Parser<'_> {
                         then: Box::new(then),
                     })
                 }
+                "WHILE" => {
+                    self.require_macros("WHILE")?;
+                    self.i += 5;
+                    if !self.eat(b'[') {
+                        return err(Fault::Macro, "WHILE needs a condition in [ ]");
+                    }
+                    let cond = self.expr()?;
+                    if !self.eat(b']') {
+                        return err(Fault::Macro, "']' missing after the WHILE condition");
+                    }
+                    self.skip_ws();
+                    if self.ident() != "DO" {
+                        return err(Fault::Macro, "WHILE [...] needs DO and a loop number");
+                    }
+                    self.i += 2;
+                    self.skip_ws();
+                    let id = self.unsigned("DO")?;
+                    Ok(Stmt::While {
+                        cond: Some(cond),
+                        id,
+                    })
+                }
+                "DO" | "END" => {
+                    let word = self.ident();
+                    let end = word == "END";
+                    self.require_macros(if end { "END" } else { "DO" })?;
+                    self.i += word.len();
+                    self.skip_ws();
+                    let id = self.unsigned(if end { "END" } else { "DO" })?;
+                    Ok(if end {
+                        Stmt::End(id)
+                    } else {
+                        Stmt::While { cond: None, id }
+                    })
+                }
                 "GOTO" => {
                     self.require_macros("GOTO")?;
                     self.i += 4;
@@ -288,7 +350,7 @@ impl Parser<'_> {
                 _ => self.words(),
             },
             Some(c) => err(
-                Fault::DataFormat,
+                stray_fault(c),
                 format!("unexpected character {:?}", c as char),
             ),
         }
@@ -311,7 +373,7 @@ impl Parser<'_> {
             let Some(c) = self.peek() else { break };
             if !c.is_ascii_uppercase() {
                 return err(
-                    Fault::DataFormat,
+                    stray_fault(c),
                     format!("unexpected character {:?}", c as char),
                 );
             }
@@ -335,6 +397,12 @@ impl Parser<'_> {
             negative = sign == b'-';
             self.i += 1;
             self.skip_ws();
+            if matches!(self.peek(), Some(b'-' | b'+')) {
+                return err(
+                    Fault::IllegalMinus,
+                    format!("address {letter}: a second sign"),
+                );
+            }
         }
         let value = match self.peek() {
             Some(b'#') => {
@@ -347,12 +415,7 @@ impl Parser<'_> {
                 self.bracketed()?
             }
             Some(c) if c.is_ascii_digit() || c == b'.' => self.number(letter)?,
-            _ => {
-                return err(
-                    Fault::DataFormat,
-                    format!("address {letter} needs a number"),
-                )
-            }
+            _ => return err(Fault::NoNumber, format!("address {letter} needs a number")),
         };
         Ok(if negative {
             match value {
@@ -372,14 +435,23 @@ impl Parser<'_> {
         while self.peek().is_some_and(|c| c.is_ascii_digit() || c == b'.') {
             self.i += 1;
             if self.i - start > MAX_NUMBER_CHARS {
-                return err(Fault::DataFormat, format!("number after {letter} too long"));
+                return err(
+                    Fault::TooManyDigits,
+                    format!("number after {letter} too long"),
+                );
             }
         }
         let text = std::str::from_utf8(&self.s[start..self.i]).unwrap_or("");
         let point = text.contains('.');
-        if text.matches('.').count() > 1 || !text.bytes().any(|c| c.is_ascii_digit()) {
+        if text.matches('.').count() > 1 {
             return err(
-                Fault::DataFormat,
+                Fault::DecimalPoint,
+                format!("address {letter}: {text:?} has two decimal points"),
+            );
+        }
+        if !text.bytes().any(|c| c.is_ascii_digit()) {
+            return err(
+                Fault::NoNumber,
                 format!("address {letter} needs a number, found {text:?}"),
             );
         }
@@ -412,7 +484,7 @@ impl Parser<'_> {
         self.i += 1;
         let e = self.expr()?;
         if !self.eat(b']') {
-            return err(Fault::Macro, "']' missing");
+            return err(Fault::MacroBrackets, "']' missing");
         }
         Ok(e)
     }
@@ -451,6 +523,26 @@ impl Parser<'_> {
         };
         if let Some(op) = op2 {
             return Some((op, 2));
+        }
+        // FANUC macro B writes its operators as words (`003` inventory A.3).
+        let word_end = self.s[self.i..]
+            .iter()
+            .position(|c| !c.is_ascii_uppercase())
+            .unwrap_or(self.s.len() - self.i);
+        let word = match &self.s[self.i..self.i + word_end] {
+            b"EQ" => Some(BinOp::Eq),
+            b"NE" => Some(BinOp::Ne),
+            b"GT" => Some(BinOp::Gt),
+            b"GE" => Some(BinOp::Ge),
+            b"LT" => Some(BinOp::Lt),
+            b"LE" => Some(BinOp::Le),
+            b"AND" => Some(BinOp::BitAnd),
+            b"OR" => Some(BinOp::BitOr),
+            b"XOR" => Some(BinOp::BitXor),
+            _ => None,
+        };
+        if let Some(op) = word {
+            return Some((op, word_end));
         }
         let op = match self.peek()? {
             b'+' => BinOp::Add,

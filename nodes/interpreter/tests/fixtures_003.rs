@@ -132,12 +132,13 @@ fn fixture_004_work_offsets_and_g53() {
             &[-430.0, -330.0, -120.0],
         ],
     );
-    // On the 3-axis mill (launch_configs/sim_mill.yaml) the A word of N6 is alarm 7 there.
+    // On the 3-axis mill (launch_configs/sim_mill.yaml) the A word of N6 is P/S 009, an
+    // address the machine does not have.
     let mut setup = mill(&XYZ, &[0.0; 3]);
     work_offsets(&mut setup);
     let e = run(&text, setup).unwrap_err();
     let n6 = text.lines().position(|l| l.starts_with("N6 ")).expect("N6") as u32 + 1;
-    assert_eq!((e.number, e.line), (7, n6), "{e}");
+    assert_eq!((e.number, e.line), (9, n6), "{e}");
 }
 
 #[test]

@@ -1,0 +1,327 @@
+//! FANUC user macro B on the mill (`003` inventory Appendix A.3; decision D49): WHILE … DO m
+//! … END m loops, G65 calls with argument specification I, the #3000 alarm, and the mill's
+//! variable map (#1–#33 local, #100–#199 and #500–#999 common, #2001– offsets, #4001–
+//! modal information, #5001– positions, #5221– work offsets).
+
+use super::*;
+use crate::syntax::Word;
+
+/// Loop numbers DO and END may carry; three loops can nest (A.3).
+const LOOP_IDS: std::ops::RangeInclusive<u32> = 1..=3;
+
+/// Argument specification I: the local variable each address of a G65 block sets (A.3).
+fn argument_number(letter: char) -> Option<usize> {
+    Some(match letter {
+        'A' => 1,
+        'B' => 2,
+        'C' => 3,
+        'I' => 4,
+        'J' => 5,
+        'K' => 6,
+        'D' => 7,
+        'E' => 8,
+        'F' => 9,
+        'H' => 11,
+        'M' => 13,
+        'Q' => 17,
+        'R' => 18,
+        'S' => 19,
+        'T' => 20,
+        'U' => 21,
+        'V' => 22,
+        'W' => 23,
+        'X' => 24,
+        'Y' => 25,
+        'Z' => 26,
+        _ => return None,
+    })
+}
+
+impl Interpreter {
+    fn loop_id(&self, id: u32, word: &str) -> Result<(), ProgramError> {
+        if LOOP_IDS.contains(&id) {
+            Ok(())
+        } else {
+            Err(self.fault(
+                Fault::MacroLoop,
+                format!("{word}{id}: loop numbers are 1–3"),
+            ))
+        }
+    }
+
+    /// `WHILE [cond] DO m` (or `DO m`): while the condition holds the loop runs on; else the
+    /// program goes on after `END m` (P/S 124 when there is none).
+    pub(super) fn while_loop(&mut self, cond: Option<&Expr>, id: u32) -> Result<(), ProgramError> {
+        self.loop_id(id, "DO")?;
+        let go_on = match cond {
+            Some(c) => truth(c.eval(self).map_err(|e| self.eval_err(e))?),
+            None => true,
+        };
+        let start = self.block_start;
+        let again = self
+            .frames
+            .last()
+            .is_some_and(|f| f.loops.contains(&(id, start)));
+        // Entering the loop: its END must be there (P/S 124), as when leaving it.
+        let after_end = if again && go_on {
+            None
+        } else {
+            Some(self.after_end(id)?)
+        };
+        let frame = self.frame();
+        // Coming round again (or after a GOTO out of the loop): the loop starts afresh.
+        if let Some(k) = frame.loops.iter().position(|&(m, _)| m == id) {
+            frame.loops.truncate(k);
+        }
+        match after_end {
+            Some(pos) if !go_on => frame.pos = pos,
+            _ => frame.loops.push((id, start)),
+        }
+        Ok(())
+    }
+
+    /// Where the program goes on after the `END m` that closes the loop being read.
+    fn after_end(&self, id: u32) -> Result<Pos, ProgramError> {
+        let Some(frame) = self.frames.last() else {
+            return Err(self.fault(Fault::MacroEnd, "no program"));
+        };
+        let mut pos = frame.pos;
+        while let Some((raw, next)) = read_line(&frame.text, pos) {
+            if parse_line(raw, true).map(|l| l.stmt) == Ok(Stmt::End(id)) {
+                return Ok(next);
+            }
+            pos = next;
+        }
+        Err(self.fault(Fault::MacroEnd, format!("WHILE … DO{id} has no END{id}")))
+    }
+
+    /// `END m`: back to the `WHILE … DO m` that opened the loop (P/S 126 without one).
+    pub(super) fn end_loop(&mut self, id: u32) -> Result<(), ProgramError> {
+        self.loop_id(id, "END")?;
+        let frame = self.frame();
+        let Some(k) = frame.loops.iter().rposition(|&(m, _)| m == id) else {
+            return Err(self.fault(Fault::MacroLoop, format!("END{id} without DO{id}")));
+        };
+        // Inner loops end here; this one stays open for its WHILE to test again.
+        let (_, start) = frame.loops[k];
+        frame.loops.truncate(k + 1);
+        frame.pos = start;
+        Ok(())
+    }
+
+    /// `G65 P<program> L<count> <arguments>`: calls the macro with its locals set from the
+    /// argument table; P missing is P/S 076, an address that is no argument P/S 129.
+    pub(super) fn macro_call(&mut self, words: &[Word]) -> Result<(), ProgramError> {
+        let mut locals = vec![None; LOCALS];
+        let (mut program, mut count) = (None, 1);
+        for w in words {
+            let v = w.value.eval(self).map_err(|e| self.eval_err(e))?;
+            match w.letter {
+                'G' if v == Some(65.0) => {}
+                'P' => program = v,
+                'L' => {
+                    count = v
+                        .and_then(integer_word)
+                        .filter(|c| (1..=9999).contains(c))
+                        .ok_or_else(|| {
+                            self.fault(Fault::OutOfRange, "G65 L: a repeat count 1–9999")
+                        })?;
+                }
+                letter => {
+                    let n = argument_number(letter).ok_or_else(|| {
+                        self.fault(
+                            Fault::MacroCallFormat,
+                            format!("G65: address {letter} cannot be an argument"),
+                        )
+                    })?;
+                    if locals[n].is_some() {
+                        return Err(self.fault(
+                            Fault::RepeatedWord,
+                            format!("G65: argument {letter} given twice"),
+                        ));
+                    }
+                    locals[n] = v;
+                }
+            }
+        }
+        let number = program
+            .and_then(integer_word)
+            .filter(|&p| p <= 9999)
+            .ok_or_else(|| self.fault(Fault::Call, "G65 needs P (the macro's program number)"))?;
+        self.call_program(number, count, locals, "G65: macro")
+    }
+
+    /// Reads a variable of the mill's map.
+    pub(super) fn fanuc_read(&self, n: i64) -> Result<Value, EvalError> {
+        let frame = self
+            .frames
+            .last()
+            .ok_or_else(|| EvalError("no program".into(), Fault::Macro))?;
+        let axis = |base: i64| {
+            usize::try_from(n - base)
+                .ok()
+                .filter(|&i| i < self.pos.len())
+        };
+        Ok(match n {
+            0 => None,
+            1..=33 => frame.locals[n as usize],
+            100..=199 | 500..=999 => self.common.get(&n).copied(),
+            2001..=2200 => {
+                let t = self.setup.offsets.tool((n - 2000) as u32);
+                Some(t.z + t.wear_z)
+            }
+            2201..=2400 => Some(self.setup.offsets.tool((n - 2200) as u32).radius),
+            4001..=4022 | 4107 | 4109 | 4111 | 4119 | 4120 => self.modal_information(n),
+            5001..=5020 | 5041..=5060 => {
+                let i = axis(if n < 5041 { 5001 } else { 5041 });
+                i.map(|i| self.work_position()[i])
+            }
+            5021..=5040 => axis(5021).map(|i| self.pos[i]),
+            5081..=5100 => axis(5081).map(|i| self.tool_offset[i]),
+            5221..=5340 => {
+                let (system, i) = ((n - 5221) / 20, (n - 5221) % 20);
+                let letter = usize::try_from(i)
+                    .ok()
+                    .and_then(|i| self.setup.axes.get(i).copied());
+                match letter {
+                    Some(a) => Some(self.setup.offsets.work(system as u8, a)),
+                    None => return Err(no_variable(n)),
+                }
+            }
+            _ => return Err(no_variable(n)),
+        })
+    }
+
+    /// #4001– : the modal G codes (group numbers of Table 1.1) and #4107– D, F, H, S, T.
+    fn modal_information(&self, n: i64) -> Value {
+        let code = |g: G| -> f64 {
+            match g {
+                G::Rapid => 0.0,
+                G::Linear => 1.0,
+                G::ArcCw => 2.0,
+                G::ArcCcw => 3.0,
+                G::PlaneZx => 18.0,
+                G::PlaneYz => 19.0,
+                _ => 17.0,
+            }
+        };
+        Some(match n {
+            4001 => code(self.motion),
+            4002 => code(self.plane),
+            4003 => {
+                if self.incremental {
+                    91.0
+                } else {
+                    90.0
+                }
+            }
+            4005 => {
+                if self.feed_per_rev {
+                    95.0
+                } else {
+                    94.0
+                }
+            }
+            4006 => 21.0,
+            4007 => match &self.nose_comp {
+                None => 40.0,
+                Some(_) => 41.0,
+            },
+            4008 => match self.length_sign {
+                _ if self.length_offset == 0 => 49.0,
+                -1 => 44.0,
+                _ => 43.0,
+            },
+            4009 => {
+                if self.hole.is_some() {
+                    81.0
+                } else {
+                    80.0
+                }
+            }
+            4010 => {
+                if self.cycle_return_r {
+                    99.0
+                } else {
+                    98.0
+                }
+            }
+            4014 => 54.0 + f64::from(self.work_system),
+            4015 => {
+                if self.exact_stop_mode {
+                    61.0
+                } else {
+                    64.0
+                }
+            }
+            4107 => f64::from(self.radius_offset),
+            4109 => self.feed,
+            4111 => f64::from(self.length_offset),
+            4119 => self.sent_rpm.unwrap_or(0.0),
+            4120 => f64::from(self.tool),
+            _ => return None,
+        })
+    }
+
+    /// Writes a variable of the mill's map: #3000 = n raises macro alarm 3000 + n.
+    pub(super) fn fanuc_write(&mut self, n: i64, v: Value) -> Result<(), ProgramError> {
+        match n {
+            1..=33 => self.frame().locals[n as usize] = v,
+            100..=199 | 500..=999 => {
+                match v {
+                    Some(x) => self.common.insert(n, x),
+                    None => self.common.remove(&n),
+                };
+            }
+            2001..=2400 => {
+                let x = v.unwrap_or(0.0);
+                if !x.is_finite() || x.abs() > 9999.0 {
+                    return Err(self.fault(Fault::CompRadiusZero, format!("#{n}: {x} mm")));
+                }
+                let number = if n <= 2200 { n - 2000 } else { n - 2200 };
+                let t = self.setup.offsets.tools.entry(number as u32).or_default();
+                if n <= 2200 {
+                    t.z = x;
+                    t.wear_z = 0.0;
+                } else {
+                    t.radius = x;
+                }
+            }
+            3000 => {
+                let code = v.and_then(integer_word).filter(|&c| c <= 999).unwrap_or(0);
+                let mut e = self.fault(Fault::Macro, format!("macro alarm {code} (#3000)"));
+                e.number = 3000 + code;
+                return Err(e);
+            }
+            5221..=5340 => {
+                let (system, i) = ((n - 5221) / 20, (n - 5221) % 20);
+                let letter = usize::try_from(i)
+                    .ok()
+                    .and_then(|i| self.setup.axes.get(i).copied())
+                    .ok_or_else(|| self.fault(Fault::MacroVariable, no_variable(n).0))?;
+                let x = v.unwrap_or(0.0);
+                if !x.is_finite() || x.abs() > 99_999.0 {
+                    return Err(self.fault(Fault::OutOfRange, format!("#{n}: offset {x}")));
+                }
+                self.setup
+                    .offsets
+                    .work
+                    .entry(system as u8)
+                    .or_default()
+                    .insert(letter, x);
+            }
+            _ if self.fanuc_read(n).is_ok() => {
+                return Err(self.fault(Fault::MacroReadOnly, format!("#{n} is read-only")))
+            }
+            _ => return Err(self.fault(Fault::MacroVariable, no_variable(n).0)),
+        }
+        Ok(())
+    }
+}
+
+fn no_variable(n: i64) -> EvalError {
+    EvalError(
+        format!("#{n} is not a variable of this control"),
+        Fault::MacroVariable,
+    )
+}
