@@ -92,12 +92,21 @@ fn interpret(text: &str, mut sink: impl Write) -> Result<usize, String> {
     let mut interp = Interpreter::new(Dialect::FanucMill, text, setup);
     let mut fmt = LinuxCnc::new(&XYZ, &[false; 3], ['X', 'Y']);
     let mut calls = 0;
+    // One buffer for the whole trace, written out whenever it holds 64 KiB.
+    let mut buf = String::with_capacity(1 << 17);
+    let mut flush = |buf: &mut String, sink: &mut dyn Write| -> Result<(), String> {
+        calls += buf.bytes().filter(|&b| b == b'\n').count();
+        sink.write_all(buf.as_bytes()).map_err(|e| e.to_string())?;
+        buf.clear();
+        Ok(())
+    };
     while let Some(c) = interp.next_command().map_err(|e| e.to_string())? {
-        let lines = fmt.lines(&c);
-        calls += lines.lines().count();
-        sink.write_all(lines.as_bytes())
-            .map_err(|e| e.to_string())?;
+        fmt.write(&c, &mut buf);
+        if buf.len() >= 1 << 16 {
+            flush(&mut buf, &mut sink)?;
+        }
     }
+    flush(&mut buf, &mut sink)?;
     sink.flush().map_err(|e| e.to_string())?;
     Ok(calls)
 }

@@ -164,7 +164,9 @@ impl LinuxCnc {
                 (1, 2) => "CANON_PLANE_YZ",
                 _ => "CANON_PLANE_XY",
             };
-            self.push(out, &format!("SELECT_PLANE({name})"));
+            self.call(out, "SELECT_PLANE(");
+            out.push_str(name);
+            out.push_str(")\n");
         }
     }
 
@@ -183,37 +185,57 @@ impl LinuxCnc {
         }
     }
 
-    fn six(&self, p: &[f64]) -> String {
-        (0..6)
-            .map(|k| num(self.value(p, k)))
-            .collect::<Vec<_>>()
-            .join(", ")
+    /// `name(x, y, z, a, b, c)` of a position, with its line's start and end.
+    fn six(&mut self, out: &mut String, name: &str, p: &[f64]) {
+        self.call(out, name);
+        for k in 0..6 {
+            if k > 0 {
+                out.push_str(", ");
+            }
+            write_num(out, self.value(p, k));
+        }
+        out.push_str(")\n");
     }
 
-    fn push(&mut self, out: &mut String, call: &str) {
+    /// Starts a line: sequence number, rs274's `N.....`, and `head` (the call's name and
+    /// whatever fixed text follows it). The caller writes the rest and the newline.
+    fn call(&mut self, out: &mut String, head: &str) {
         self.seq += 1;
-        let _ = writeln!(out, "{:5} N..... {call}", self.seq);
+        push_uint(out, self.seq, 5);
+        out.push_str(" N..... ");
+        out.push_str(head);
+    }
+
+    /// A whole line of fixed text.
+    fn push(&mut self, out: &mut String, call: &str) {
+        self.call(out, call);
+        out.push('\n');
     }
 
     fn set_feed(&mut self, out: &mut String, feed: f64) {
         if self.feed != Some(feed) {
             self.feed = Some(feed);
-            self.push(out, &format!("SET_FEED_RATE({})", num(feed)));
+            self.call(out, "SET_FEED_RATE(");
+            write_num(out, feed);
+            out.push_str(")\n");
         }
     }
 
     /// The rs274 lines of one command (none for commands rs274 has no call for).
     pub fn lines(&mut self, c: &Canon) -> String {
         let mut out = String::new();
+        self.write(c, &mut out);
+        out
+    }
+
+    /// Appends the rs274 lines of one command to `out`: a long trace reuses one buffer and
+    /// formats every number in place.
+    pub fn write(&mut self, c: &Canon, out: &mut String) {
         match &c.command {
-            Command::Rapid { end } => {
-                let call = format!("STRAIGHT_TRAVERSE({})", self.six(end));
-                self.push(&mut out, &call);
-            }
+            Command::Rapid { end } => self.six(out, "STRAIGHT_TRAVERSE(", end),
             Command::Linear { end, feed } => {
-                self.set_feed(&mut out, *feed);
-                let call = format!("STRAIGHT_FEED({})", self.six(end));
-                self.push(&mut out, &call);
+                self.set_feed(out, *feed);
+                self.six(out, "STRAIGHT_FEED(", end);
             }
             Command::Arc {
                 end,
@@ -222,43 +244,41 @@ impl LinuxCnc {
                 feed,
                 plane,
             } => {
-                self.set_feed(&mut out, *feed);
+                self.set_feed(out, *feed);
                 if let Some([a, b]) = plane {
-                    self.select_plane(&mut out, self.rs274_plane(*a, *b));
+                    self.select_plane(out, self.rs274_plane(*a, *b));
                 }
                 let (p, q) = self.plane;
                 let normal = 3 - p - q;
-                let call = format!(
-                    "ARC_FEED({}, {}, {}, {}, {}, {}, {}, {}, {})",
-                    num(self.value(end, p)),
-                    num(self.value(end, q)),
-                    num(self.value(center, p)),
-                    num(self.value(center, q)),
-                    if *clockwise { -1 } else { 1 },
-                    num(self.value(end, normal)),
-                    num(self.value(end, 3)),
-                    num(self.value(end, 4)),
-                    num(self.value(end, 5)),
-                );
-                self.push(&mut out, &call);
+                self.call(out, "ARC_FEED(");
+                for v in [
+                    self.value(end, p),
+                    self.value(end, q),
+                    self.value(center, p),
+                    self.value(center, q),
+                ] {
+                    write_num(out, v);
+                    out.push_str(", ");
+                }
+                out.push_str(if *clockwise { "-1" } else { "1" });
+                for k in [normal, 3, 4, 5] {
+                    out.push_str(", ");
+                    write_num(out, self.value(end, k));
+                }
+                out.push_str(")\n");
             }
             Command::Thread { end, lead, .. } => {
-                self.push(
-                    &mut out,
-                    &format!("START_SPEED_FEED_SYNCH(0, {lead:.6}, 0)"),
-                );
-                let call = format!("STRAIGHT_FEED({})", self.six(end));
-                self.push(&mut out, &call);
-                self.push(&mut out, "STOP_SPEED_FEED_SYNCH()");
+                self.push(out, &format!("START_SPEED_FEED_SYNCH(0, {lead:.6}, 0)"));
+                self.six(out, "STRAIGHT_FEED(", end);
+                self.push(out, "STOP_SPEED_FEED_SYNCH()");
             }
             Command::Dwell { seconds } => {
-                self.push(&mut out, &format!("DWELL({})", num(*seconds)));
+                self.call(out, "DWELL(");
+                write_num(out, *seconds);
+                out.push_str(")\n");
             }
             Command::FeedMode { per_rev } => {
-                self.push(
-                    &mut out,
-                    &format!("SET_FEED_MODE(0, {})", u8::from(*per_rev)),
-                );
+                self.push(out, &format!("SET_FEED_MODE(0, {})", u8::from(*per_rev)));
             }
             Command::PathMode { exact_stop } => {
                 let mode = if *exact_stop {
@@ -266,17 +286,16 @@ impl LinuxCnc {
                 } else {
                     "CANON_CONTINUOUS"
                 };
-                self.push(
-                    &mut out,
-                    &format!("SET_MOTION_CONTROL_MODE({mode}, 0.000000)"),
-                );
+                self.push(out, &format!("SET_MOTION_CONTROL_MODE({mode}, 0.000000)"));
             }
             Command::Aux(Aux::S(v)) => {
-                self.push(&mut out, &format!("SET_SPINDLE_SPEED(0, {})", num(*v)));
+                self.call(out, "SET_SPINDLE_SPEED(0, ");
+                write_num(out, *v);
+                out.push_str(")\n");
             }
             Command::Aux(Aux::T(t)) => {
                 self.tool = *t;
-                self.push(&mut out, &format!("SELECT_TOOL({t})"));
+                self.push(out, &format!("SELECT_TOOL({t})"));
             }
             Command::Aux(Aux::M(m)) => {
                 let call = match m {
@@ -290,14 +309,13 @@ impl LinuxCnc {
                     8 => "FLOOD_ON()".to_string(),
                     9 => "FLOOD_OFF()".to_string(),
                     30 => "PALLET_SHUTTLE()".to_string(),
-                    2 => return out,
+                    2 => return,
                     other => format!("COMMENT(\"M{other}\")"),
                 };
-                self.push(&mut out, &call);
+                self.push(out, &call);
             }
-            Command::ProgramEnd => self.push(&mut out, "PROGRAM_END()"),
+            Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
         }
-        out
     }
 }
 
@@ -310,7 +328,32 @@ fn cyclic(p: usize, q: usize) -> (usize, usize) {
 }
 
 /// rs274's `%.4f`, without a negative zero.
+#[cfg(test)]
 fn num(v: f64) -> String {
+    let mut s = String::new();
+    write_num(&mut s, v);
+    s
+}
+
+/// Appends `n` in decimal, right-aligned in `width` characters (`%5d`), without going
+/// through the formatting machinery: a trace writes millions of them.
+fn push_uint(out: &mut String, mut n: u64, width: usize) {
+    let mut digits = [b' '; 20];
+    let mut i = digits.len();
+    loop {
+        i -= 1;
+        digits[i] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    let start = i.min(digits.len().saturating_sub(width));
+    out.extend(digits[start..].iter().map(|&b| char::from(b)));
+}
+
+/// Appends rs274's `%.4f` of `v`, without a negative zero.
+fn write_num(out: &mut String, v: f64) {
     let v = if v.abs() < 5e-5 { 0.0 } else { v };
     // Fast path: the value in ten-thousandths as an integer, unless it lies so near a
     // rounding tie that only the exact decimal expansion can decide (the formatter's slow
@@ -320,15 +363,38 @@ fn num(v: f64) -> String {
     if k.abs() < 1e15 && ((scaled - k).abs() - 0.5).abs() > 1e-6 {
         let k = k as i64;
         let (whole, frac) = (k.unsigned_abs() / 10_000, k.unsigned_abs() % 10_000);
-        let sign = if k < 0 { "-" } else { "" };
-        return format!("{sign}{whole}.{frac:04}");
+        if k < 0 {
+            out.push('-');
+        }
+        push_uint(out, whole, 0);
+        out.push('.');
+        let digits = [frac / 1000, frac / 100 % 10, frac / 10 % 10, frac % 10];
+        out.extend(digits.iter().map(|&d| char::from(b'0' + d as u8)));
+        return;
     }
-    format!("{v:.4}")
+    let _ = write!(out, "{v:.4}");
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `push_uint` prints as `%{width}d` does.
+    #[test]
+    fn integers_as_printf_pads_them() {
+        for (n, width) in [
+            (0_u64, 0),
+            (7, 5),
+            (12345, 5),
+            (123456, 5),
+            (u64::MAX, 5),
+            (40, 1),
+        ] {
+            let mut s = String::new();
+            push_uint(&mut s, n, width);
+            assert_eq!(s, format!("{n:width$}"));
+        }
+    }
 
     /// The fast `%.4f` agrees with the exact formatter, ties and signs included.
     #[test]
