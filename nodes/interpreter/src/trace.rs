@@ -327,14 +327,6 @@ fn cyclic(p: usize, q: usize) -> (usize, usize) {
     }
 }
 
-/// rs274's `%.4f`, without a negative zero.
-#[cfg(test)]
-fn num(v: f64) -> String {
-    let mut s = String::new();
-    write_num(&mut s, v);
-    s
-}
-
 /// Appends `n` in decimal, right-aligned in `width` characters (`%5d`), without going
 /// through the formatting machinery: a trace writes millions of them.
 fn push_uint(out: &mut String, mut n: u64, width: usize) {
@@ -378,6 +370,13 @@ fn write_num(out: &mut String, v: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// rs274's `%.4f`, without a negative zero.
+    fn num(v: f64) -> String {
+        let mut s = String::new();
+        write_num(&mut s, v);
+        s
+    }
 
     /// `push_uint` prints as `%{width}d` does.
     #[test]
