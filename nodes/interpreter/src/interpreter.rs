@@ -608,17 +608,7 @@ impl Interpreter {
             5220..=5325 if (n - 5220) % 20 < 6 => {
                 let system = ((n - 5220) / 20) as u8;
                 let letter = ['X', 'Y', 'Z', 'A', 'B', 'C'][((n - 5220) % 20) as usize];
-                let x = v.unwrap_or(0.0);
-                if !x.is_finite() || x.abs() > 99_999.0 {
-                    return Err(self.fault(Fault::Macro, format!("#{n}: offset {x} out of range")));
-                }
-                self.setup
-                    .offsets
-                    .work
-                    .entry(system)
-                    .or_default()
-                    .insert(letter, x);
-                Ok(())
+                self.write_work_offset(n, system, letter, v, Fault::Macro)
             }
             4001..=4499 => {
                 let (table, num) = (n / 100 - 40, (n % 100) as u32);
@@ -635,6 +625,29 @@ impl Interpreter {
             }
             _ => Err(self.fault(Fault::MacroReadOnly, format!("#{n} cannot be written"))),
         }
+    }
+
+    /// Variable `n` sets work system `system`'s zero on axis `letter` (`fault` when the value
+    /// is beyond ±99999.999).
+    fn write_work_offset(
+        &mut self,
+        n: i64,
+        system: u8,
+        letter: char,
+        v: Value,
+        fault: Fault,
+    ) -> Result<(), ProgramError> {
+        let x = v.unwrap_or(0.0);
+        if !x.is_finite() || x.abs() > 99_999.0 {
+            return Err(self.fault(fault, format!("#{n}: offset {x} out of range")));
+        }
+        self.setup
+            .offsets
+            .work
+            .entry(system)
+            .or_default()
+            .insert(letter, x);
+        Ok(())
     }
 
     // ---------------------------------------------------------------- decoding

@@ -291,13 +291,7 @@ impl Parser<'_> {
                 "IF" => {
                     self.require_macros("IF")?;
                     self.i += 2;
-                    if !self.eat(b'[') {
-                        return err(Fault::Macro, "IF needs a condition in [ ]");
-                    }
-                    let cond = self.expr()?;
-                    if !self.eat(b']') {
-                        return err(Fault::Macro, "']' missing after the IF condition");
-                    }
+                    let cond = self.condition("IF")?;
                     let then = self.statement()?;
                     if then == Stmt::Empty {
                         return err(Fault::Macro, "IF without GOTO, assignment or block");
@@ -310,13 +304,7 @@ impl Parser<'_> {
                 "WHILE" => {
                     self.require_macros("WHILE")?;
                     self.i += 5;
-                    if !self.eat(b'[') {
-                        return err(Fault::Macro, "WHILE needs a condition in [ ]");
-                    }
-                    let cond = self.expr()?;
-                    if !self.eat(b']') {
-                        return err(Fault::Macro, "']' missing after the WHILE condition");
-                    }
+                    let cond = self.condition("WHILE")?;
                     self.skip_ws();
                     if self.ident() != "DO" {
                         return err(Fault::Macro, "WHILE [...] needs DO and a loop number");
@@ -354,6 +342,21 @@ impl Parser<'_> {
                 format!("unexpected character {:?}", c as char),
             ),
         }
+    }
+
+    /// The `[condition]` after IF or WHILE.
+    fn condition(&mut self, what: &str) -> Result<Expr, SyntaxError> {
+        if !self.eat(b'[') {
+            return err(Fault::Macro, format!("{what} needs a condition in [ ]"));
+        }
+        let cond = self.expr()?;
+        if !self.eat(b']') {
+            return err(
+                Fault::Macro,
+                format!("']' missing after the {what} condition"),
+            );
+        }
+        Ok(cond)
     }
 
     fn assignment(&mut self) -> Result<Stmt, SyntaxError> {

@@ -178,18 +178,19 @@ impl Interpreter {
             }
             5021..=5040 => axis(5021).map(|i| self.pos[i]),
             5081..=5100 => axis(5081).map(|i| self.tool_offset[i]),
-            5221..=5340 => {
-                let (system, i) = ((n - 5221) / 20, (n - 5221) % 20);
-                let letter = usize::try_from(i)
-                    .ok()
-                    .and_then(|i| self.setup.axes.get(i).copied());
-                match letter {
-                    Some(a) => Some(self.setup.offsets.work(system as u8, a)),
-                    None => return Err(no_variable(n)),
-                }
-            }
+            5221..=5340 => match self.work_offset_slot(n) {
+                Some((system, a)) => Some(self.setup.offsets.work(system, a)),
+                None => return Err(no_variable(n)),
+            },
             _ => return Err(no_variable(n)),
         })
+    }
+
+    /// #5221–#5340: G54–G59 in blocks of 20, one variable per axis in the machine's order.
+    fn work_offset_slot(&self, n: i64) -> Option<(u8, char)> {
+        let (system, i) = ((n - 5221) / 20, (n - 5221) % 20);
+        let letter = self.setup.axes.get(usize::try_from(i).ok()?).copied()?;
+        Some((u8::try_from(system).ok()?, letter))
     }
 
     /// #4001– : the modal G codes (group numbers of Table 1.1) and #4107– D, F, H, S, T.
@@ -294,21 +295,10 @@ impl Interpreter {
                 return Err(e);
             }
             5221..=5340 => {
-                let (system, i) = ((n - 5221) / 20, (n - 5221) % 20);
-                let letter = usize::try_from(i)
-                    .ok()
-                    .and_then(|i| self.setup.axes.get(i).copied())
+                let (system, letter) = self
+                    .work_offset_slot(n)
                     .ok_or_else(|| self.fault(Fault::MacroVariable, no_variable(n).0))?;
-                let x = v.unwrap_or(0.0);
-                if !x.is_finite() || x.abs() > 99_999.0 {
-                    return Err(self.fault(Fault::OutOfRange, format!("#{n}: offset {x}")));
-                }
-                self.setup
-                    .offsets
-                    .work
-                    .entry(system as u8)
-                    .or_default()
-                    .insert(letter, x);
+                return self.write_work_offset(n, system, letter, v, Fault::OutOfRange);
             }
             _ if self.fanuc_read(n).is_ok() => {
                 return Err(self.fault(Fault::MacroReadOnly, format!("#{n} is read-only")))
