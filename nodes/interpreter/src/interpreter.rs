@@ -9,7 +9,7 @@
 //! program flow, and motion-producing blocks end in [`Interpreter::emit`], which turns work
 //! coordinates into machine coordinates.
 
-use std::collections::{BTreeMap, HashMap, VecDeque};
+use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 
 use crate::canon::{Aux, Canon, Command};
@@ -47,7 +47,34 @@ struct Block {
     g: Vec<(u8, G, u32)>,
     m: Vec<(M, u32)>,
     /// Address values other than G, M, N, O: letter → (value, written with a decimal point).
-    words: BTreeMap<char, (f64, bool)>,
+    words: Words,
+}
+
+/// A block's address values by letter A–Z: a fixed table, so reading a block allocates
+/// nothing for its words (the parser gives only upper-case letters).
+#[derive(Debug, Default)]
+struct Words([Option<(f64, bool)>; 26]);
+
+impl Words {
+    fn slot(c: char) -> Option<usize> {
+        c.is_ascii_uppercase().then(|| usize::from(c as u8 - b'A'))
+    }
+    fn get(&self, c: &char) -> Option<&(f64, bool)> {
+        Self::slot(*c).and_then(|i| self.0[i].as_ref())
+    }
+    fn contains_key(&self, c: &char) -> bool {
+        self.get(c).is_some()
+    }
+    /// Sets the letter's value; returns the value it had.
+    fn insert(&mut self, c: char, w: (f64, bool)) -> Option<(f64, bool)> {
+        Self::slot(c).and_then(|i| self.0[i].replace(w))
+    }
+    /// The letters given, in alphabetical order.
+    fn iter(&self) -> impl Iterator<Item = (char, (f64, bool))> + '_ {
+        (b'A'..=b'Z')
+            .zip(self.0.iter())
+            .filter_map(|(c, w)| w.map(|w| (char::from(c), w)))
+    }
 }
 
 impl Block {
@@ -705,7 +732,7 @@ impl Interpreter {
                 ));
             }
         }
-        for (&c, &(v, _)) in &b.words {
+        for (c, (v, _)) in b.words.iter() {
             let axis_word = self.setup.axes.contains(&c)
                 || self
                     .setup

@@ -23,7 +23,7 @@ pub fn read_line(text: &str, pos: Pos) -> Option<(&str, Pos)> {
         return None;
     }
     let rest = &text[pos.offset..];
-    let (line, advance) = match rest.find('\n') {
+    let (line, advance) = match rest.bytes().position(|b| b == b'\n') {
         Some(i) => (&rest[..i], i + 1),
         None => (rest, rest.len()),
     };

@@ -329,19 +329,23 @@ fn cyclic(p: usize, q: usize) -> (usize, usize) {
 
 /// Appends `n` in decimal, right-aligned in `width` characters (`%5d`), without going
 /// through the formatting machinery: a trace writes millions of them.
-fn push_uint(out: &mut String, mut n: u64, width: usize) {
-    let mut digits = [b' '; 20];
-    let mut i = digits.len();
+fn push_uint(out: &mut String, n: u64, width: usize) {
+    let mut buf = [b' '; 24];
+    let start = uint_digits(&mut buf, n).min(buf.len().saturating_sub(width));
+    out.push_str(std::str::from_utf8(&buf[start..]).unwrap_or(""));
+}
+
+/// Writes `n`'s digits at the end of `buf`; returns where they start.
+fn uint_digits(buf: &mut [u8; 24], mut n: u64) -> usize {
+    let mut i = buf.len();
     loop {
         i -= 1;
-        digits[i] = b'0' + (n % 10) as u8;
+        buf[i] = b'0' + (n % 10) as u8;
         n /= 10;
         if n == 0 {
-            break;
+            return i;
         }
     }
-    let start = i.min(digits.len().saturating_sub(width));
-    out.extend(digits[start..].iter().map(|&b| char::from(b)));
 }
 
 /// Appends rs274's `%.4f` of `v`, without a negative zero.
@@ -354,14 +358,21 @@ fn write_num(out: &mut String, v: f64) {
     let k = scaled.round();
     if k.abs() < 1e15 && ((scaled - k).abs() - 0.5).abs() > 1e-6 {
         let k = k as i64;
-        let (whole, frac) = (k.unsigned_abs() / 10_000, k.unsigned_abs() % 10_000);
+        // Ten-thousandths with at least five digits, then the point four from the end.
+        let mut buf = [b'0'; 24];
+        let start = uint_digits(&mut buf, k.unsigned_abs()).min(buf.len() - 5);
+        let mut text = [0u8; 26];
+        let mut n = 0;
         if k < 0 {
-            out.push('-');
+            text[0] = b'-';
+            n = 1;
         }
-        push_uint(out, whole, 0);
-        out.push('.');
-        let digits = [frac / 1000, frac / 100 % 10, frac / 10 % 10, frac % 10];
-        out.extend(digits.iter().map(|&d| char::from(b'0' + d as u8)));
+        let whole = &buf[start..buf.len() - 4];
+        text[n..n + whole.len()].copy_from_slice(whole);
+        n += whole.len();
+        text[n] = b'.';
+        text[n + 1..n + 5].copy_from_slice(&buf[buf.len() - 4..]);
+        out.push_str(std::str::from_utf8(&text[..n + 5]).unwrap_or(""));
         return;
     }
     let _ = write!(out, "{v:.4}");
