@@ -123,6 +123,14 @@ pub enum G {
     Unsupported(&'static str),
     /// G65 user macro call (FANUC mill): run by the statement itself, never as a block.
     MacroCall,
+    /// G27 reference position return check (mill).
+    ReferenceCheck,
+    /// G29 return from the reference point through G28's intermediate point (mill).
+    FromReference,
+    /// G30 return to the second reference point (mill).
+    SecondReference,
+    /// G60 single-direction positioning (mill).
+    OneDirection,
 }
 
 /// The mill's hole-machining cycles (`003` §8.1, inventory Appendix A.1).
@@ -525,7 +533,11 @@ fn mill_g(n: u32) -> Option<GCode> {
         ),
         210 => (6, MetricInput),
         100 => (0, SetOffsetData),
+        270 => (0, ReferenceCheck),
         280 => (0, ReferenceReturn),
+        290 => (0, FromReference),
+        300 => (0, SecondReference),
+        600 => (0, OneDirection),
         530 => (0, MachineCoordinates),
         540..=590 if n.is_multiple_of(10) => (14, WorkSystem(((n - 540) / 10) as u8)),
         610 => (15, ExactStopMode),

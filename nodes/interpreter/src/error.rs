@@ -196,6 +196,10 @@ pub enum Fault {
     MacroEnd,
     /// A G65 address that is no argument (FANUC P/S 129).
     MacroCallFormat,
+    /// G27 ended away from the reference point (FANUC P/S 092).
+    ReferenceCheck,
+    /// M06 away from the second reference point (a machine alarm on the 0-M, decision D50).
+    ToolChangePosition,
 }
 
 /// The alarm number a fault has in the Huaxing table (`000` Appendix 1).
@@ -255,6 +259,7 @@ pub fn huaxing_number(f: Fault) -> u32 {
         CallDepth => 21,
         MacroDivide | MacroVariable | MacroReadOnly | MacroArgument | MacroBrackets | MacroLoop
         | MacroEnd | MacroCallFormat => 20,
+        ReferenceCheck | ToolChangePosition => 7,
     }
 }
 
@@ -266,7 +271,8 @@ pub fn gtc2e_number(f: Fault) -> u32 {
     match f {
         UndefinedCode | DataFormat | NotSupported | Macro | MustStartBlock | NoSuchAddress
         | NoAddress | NoNumber | IllegalMinus | DecimalPoint | TooManyDigits | MacroVariable
-        | MacroReadOnly | MacroBrackets | MacroLoop | MacroEnd | MacroCallFormat => 15,
+        | ReferenceCheck | ToolChangePosition | MacroReadOnly | MacroBrackets | MacroLoop
+        | MacroEnd | MacroCallFormat => 15,
         SameGroup | Group00With01 | TooManyM => 16,
         RepeatedWord | AbsAndInc => 17,
         MissingWord | ThreadDepthMissing | CssWithoutS => 18,
@@ -324,7 +330,9 @@ pub fn fanuc_number(f: Fault) -> u32 {
         MacroArgument => 119,
         MacroEnd => 124,
         MacroLoop => 126,
+        ReferenceCheck => 92,
         TargetNotFound => 128,
         MacroCallFormat => 129,
+        ToolChangePosition => 1006,
     }
 }

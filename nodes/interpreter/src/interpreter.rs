@@ -207,6 +207,8 @@ pub struct Interpreter {
     spindle: SpindleDir,
     /// Tool-nose radius compensation while G41/G42 is in force.
     nose_comp: Option<nose::NoseComp>,
+    /// Machine position of the last G28/G30 intermediate point, for G29.
+    intermediate: Option<Vec<f64>>,
     /// Where the line being run starts (a WHILE comes back to it).
     block_start: Pos,
     /// The mill's D: the offset whose radius G41/G42 use (modal, D0 = no radius).
@@ -323,6 +325,7 @@ impl Interpreter {
             nose_comp: None,
             radius_offset: 0,
             block_start: Pos::default(),
+            intermediate: None,
             nose_cancel: false,
             corner: None,
             emitting_comp: false,
@@ -1497,6 +1500,9 @@ impl Interpreter {
             match m {
                 M::AuxBefore | M::AuxAfter if drill_block => {}
                 M::AuxBefore => {
+                    if code == 60 && self.dialect == Dialect::FanucMill {
+                        self.check_tool_change_position()?;
+                    }
                     self.track_spindle(code);
                     self.aux(Aux::M((code / 10) as i32));
                 }
@@ -2022,6 +2028,10 @@ impl Interpreter {
                     return Ok(());
                 }
                 G::ReferenceReturn => return self.reference_return(b),
+                G::SecondReference => return self.second_reference(b),
+                G::ReferenceCheck => return self.reference_check(b),
+                G::FromReference => return self.return_from_reference(b),
+                G::OneDirection => return self.one_direction(b),
                 G::MillLocal => return self.local_system(b),
                 G::ConditionalRepeat { high } => return self.conditional_repeat(b, high),
                 G::JumpRange | G::CallRange | G::LoopRange => return self.range(b, g),
@@ -2283,25 +2293,24 @@ impl Interpreter {
     }
 
     fn reference_return(&mut self, b: &Block) -> Result<(), ProgramError> {
-        // G28: rapid to the intermediate point, then to the reference point; named axes only.
-        let here = self.work_position();
+        let reference = self.setup.reference.clone();
+        self.return_through(b, &reference)
+    }
+
+    /// G28/G30: rapid to the intermediate point, then to `reference` (machine coordinates);
+    /// named axes only. The intermediate point is kept for G29.
+    fn return_through(&mut self, b: &Block, reference: &[f64]) -> Result<(), ProgramError> {
         let mid = self.end_point(b)?;
-        let named: Vec<bool> = (0..here.len())
-            .map(|i| {
-                (mid[i] - here[i]).abs() > 0.0 || {
-                    let a = self.setup.axes[i];
-                    b.has(a) || self.inc_letter(a).is_some_and(|c| b.has(c))
-                }
-            })
-            .collect();
+        let named = self.named_axes(b, &mid);
         if !named.iter().any(|&n| n) {
             return Ok(());
         }
         self.emit(&mid, MoveKind::Rapid)?;
+        self.intermediate = Some(self.pos.clone());
         let mut target = self.pos.clone();
         for i in 0..target.len() {
             if named[i] {
-                target[i] = self.setup.reference.get(i).copied().unwrap_or(target[i]);
+                target[i] = reference.get(i).copied().unwrap_or(target[i]);
             }
         }
         self.push(Command::Rapid {
@@ -2309,6 +2318,19 @@ impl Interpreter {
         });
         self.pos = target;
         Ok(())
+    }
+
+    /// The axes a block names (or moves, incremental words included).
+    fn named_axes(&self, b: &Block, end: &[f64]) -> Vec<bool> {
+        let here = self.work_position();
+        (0..here.len())
+            .map(|i| {
+                (end[i] - here[i]).abs() > 0.0 || {
+                    let a = self.setup.axes[i];
+                    b.has(a) || self.inc_letter(a).is_some_and(|c| b.has(c))
+                }
+            })
+            .collect()
     }
 
     fn range(&mut self, b: &Block, g: G) -> Result<(), ProgramError> {

@@ -80,6 +80,7 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     let letters = cfg.axis_letters();
     let mut setup = Setup::new(&letters, &cfg.diameter_axes(), start);
     setup.reference = cfg.home();
+    setup.second_reference = cfg.second_reference();
     setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
     setup.tool_change_macro = cfg.machine.tool_change_macro;
     for (&n, t) in &cfg.machine.tools {

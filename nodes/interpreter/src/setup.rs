@@ -101,6 +101,9 @@ pub struct Setup {
     pub start: Vec<f64>,
     /// Machine coordinates of the reference point (G28).
     pub reference: Vec<f64>,
+    /// Machine coordinates of the second reference point (G30, where the mill changes
+    /// tools).
+    pub second_reference: Vec<f64>,
     pub offsets: Offsets,
     /// Kept macro variables (#200–#289 on Huaxing), by number.
     pub kept: BTreeMap<i64, f64>,
@@ -136,6 +139,7 @@ impl Setup {
                 .map(|i| diameter.get(i).copied().unwrap_or(false))
                 .collect(),
             reference: start.clone(),
+            second_reference: start.clone(),
             start,
             offsets: Offsets::default(),
             kept: BTreeMap::new(),

@@ -54,6 +54,7 @@ fn every_listed_program_alarm_is_raised_with_its_number_and_line() {
         // Line 2 of O0002, the subprogram that calls itself once too often.
         (77, "%\nO0001\nM98 P2\nM30\nO0002\nM98 P2\nM99\n%\n", 2),
         (78, "G0 X0\nM98 P4321\nM30\n", 2),
+        (92, "G0 X10\nG27 X5\nM30\n", 2),
         (112, "#1 = 1\n#2 = #1 / 0\nM30\n", 2),
         (114, "#1 = \nM30\n", 1),
         (115, "#1 = #40\nM30\n", 1),

@@ -392,3 +392,56 @@ fn common_variables_500_to_999_are_kept_for_the_next_program() {
     // #100–#199 are cleared at power-off (A.3).
     assert_eq!(kept.get(&100), None);
 }
+
+#[test]
+fn g27_checks_g29_returns_and_g60_approaches_from_one_side() {
+    // G28 through X10 Y5 to the reference point (0, 0, 0); G29 back through the same
+    // intermediate point to X30 Y20.
+    let l = lines("G0 X10 Y5 Z20\nG28 X10 Y5\nG29 X30 Y20\nG27 X0 Y0\nM30\n");
+    assert_eq!(
+        l[1..6],
+        [
+            "RAPID X10.0000 Y5.0000 Z20.0000",
+            "RAPID X0.0000 Y0.0000 Z20.0000",
+            "RAPID X10.0000 Y5.0000 Z20.0000",
+            "RAPID X30.0000 Y20.0000 Z20.0000",
+            // G27 to the reference point: there, so no alarm.
+            "RAPID X0.0000 Y0.0000 Z20.0000",
+        ]
+    );
+    // G27 to a point that is not the reference point: P/S 092 on its line.
+    let e = alarm("G0 X10\nG27 X5\nM30\n");
+    assert_eq!((e.number, e.line), (92, 2), "{e}");
+    // G29 with no G28 before it.
+    assert_eq!(alarm("G29 X5\nM30\n").number, 10);
+    // G60: each moving axis stops 1 mm short and comes the last millimetre from below.
+    let l = lines("G0 X10 Y10\nG60 X-5 Y10\nM30\n");
+    assert_eq!(
+        l[1..3],
+        [
+            "RAPID X-6.0000 Y10.0000 Z0.0000",
+            "RAPID X-5.0000 Y10.0000 Z0.0000"
+        ]
+    );
+}
+
+#[test]
+fn m06_needs_the_tool_axis_at_the_second_reference_point() {
+    let mut setup = mill();
+    setup.second_reference = vec![0.0, 0.0, 150.0];
+    let run = |text: &str| cnc_interpreter::check(Dialect::FanucMill, text, setup.clone());
+    // Z is at 0, the tool change position is Z150: a machine alarm, before the change.
+    let e = run("T2\nM06\nM30\n").unwrap_err();
+    assert_eq!((e.number, e.line), (1006, 2), "{e}");
+    // G91 G30 Z0 takes Z there (only Z moves); then M06 changes the tool.
+    let c = run("G0 X20 Y10\nG91 G30 Z0\nT2 M06\nM30\n").expect("tool change at G30");
+    let text: Vec<String> = c.iter().map(|c| trace::line(&XYZ, c)).collect();
+    assert!(
+        text.iter()
+            .any(|l| l.ends_with("RAPID X20.0000 Y10.0000 Z150.0000")),
+        "{text:?}"
+    );
+    assert!(text.iter().any(|l| l.ends_with(" M6")), "{text:?}");
+    // A third reference point is not configured.
+    assert_eq!(run("G30 P3 Z0\nM30\n").unwrap_err().number, 3);
+}

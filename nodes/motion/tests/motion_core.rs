@@ -20,6 +20,7 @@ fn lathe() -> MotionConfig {
         in_position: 0.0005,
         drive_lag: 0.008,
         home: 0.0,
+        second_reference: None,
     };
     MotionConfig {
         axes: vec![

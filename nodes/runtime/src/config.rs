@@ -173,6 +173,10 @@ pub struct AxisEntry {
     /// Simulated power-on position, display units.
     #[serde(default)]
     pub home: f64,
+    /// The second reference point (FANUC G30, the mill's tool-change position), machine
+    /// coordinates, display units; default: the reference point (`home`).
+    #[serde(default)]
+    pub second_reference: Option<f64>,
 }
 
 impl AxisEntry {
@@ -721,6 +725,14 @@ impl LaunchConfig {
     }
 
     /// Power-on position in display units.
+    pub fn second_reference(&self) -> Vec<f64> {
+        self.machine
+            .axes
+            .iter()
+            .map(|a| a.second_reference.unwrap_or(a.home))
+            .collect()
+    }
+
     pub fn home(&self) -> Vec<f64> {
         self.machine.axes.iter().map(|a| a.home).collect()
     }

@@ -4,6 +4,10 @@
 
 use super::*;
 
+/// How far short of its end point G60 stops an axis before the final approach, mm (FANUC
+/// parameters 0204–0207, no value in the seed; decision D50).
+const G60_OVERRUN: f64 = 1.0;
+
 impl Interpreter {
     /// T on the mill: the tool to put ready in the magazine (`003` §6.2, T 0–99); M06 changes
     /// it. Lengths come from H, radii from D, never from T.
@@ -115,6 +119,109 @@ impl Interpreter {
             Fault::CompInCycle,
             format!("{code} while cutter compensation is active: cancel it with G40 first"),
         ))
+    }
+
+    /// G30 (P2, the default): through the intermediate point to the second reference point,
+    /// where the mill changes tools. P3/P4 name reference points this machine has not got.
+    pub(super) fn second_reference(&mut self, b: &Block) -> Result<(), ProgramError> {
+        if let Some(p) = b.get('P').filter(|&p| p != 2.0) {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!(
+                    "G30 P{}: this machine has a second reference point only (P2)",
+                    show(p)
+                ),
+            ));
+        }
+        let second = self.setup.second_reference.clone();
+        self.return_through(b, &second)
+    }
+
+    /// G27: rapid to the point given, then check it is the reference point (P/S 092 when an
+    /// axis named is not there).
+    pub(super) fn reference_check(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let end = self.end_point(b)?;
+        let named = self.named_axes(b, &end);
+        self.emit(&end, MoveKind::Rapid)?;
+        for (i, &n) in named.iter().enumerate() {
+            let reference = self.setup.reference.get(i).copied().unwrap_or(0.0);
+            if n && (self.pos[i] - reference).abs() > 1e-3 {
+                return Err(self.fault(
+                    Fault::ReferenceCheck,
+                    format!(
+                        "G27: {} ends at {} in machine coordinates, not at the reference point {}",
+                        self.setup.axes[i],
+                        show(self.pos[i]),
+                        show(reference)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// G29: from the reference point through the last G28/G30 intermediate point to the point
+    /// given, named axes only.
+    pub(super) fn return_from_reference(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let end = self.end_point(b)?;
+        let named = self.named_axes(b, &end);
+        let Some(mid) = self.intermediate.clone() else {
+            return Err(self.fault(
+                Fault::MissingWord,
+                "G29 needs a G28 or G30 before it (no intermediate point)",
+            ));
+        };
+        let mut via = self.pos.clone();
+        for (i, &n) in named.iter().enumerate() {
+            if n {
+                via[i] = mid[i];
+            }
+        }
+        self.push(Command::Rapid { end: via.clone() });
+        self.pos = via;
+        self.emit(&end, MoveKind::Rapid)
+    }
+
+    /// G60: every axis that moves comes to its end point from below, rapid to
+    /// `G60_OVERRUN` short of it first, so backlash is always taken up the same way.
+    pub(super) fn one_direction(&mut self, b: &Block) -> Result<(), ProgramError> {
+        let end = self.end_point(b)?;
+        let here = self.work_position();
+        let short: Vec<f64> = end
+            .iter()
+            .zip(&here)
+            .map(|(&e, &h)| {
+                if (e - h).abs() > 1e-9 {
+                    e - G60_OVERRUN
+                } else {
+                    e
+                }
+            })
+            .collect();
+        if short != end {
+            self.emit(&short, MoveKind::Rapid)?;
+        }
+        self.emit(&end, MoveKind::Rapid)
+    }
+
+    /// M06 on the mill: the tool axis must stand at the second reference point (G30), where
+    /// the changer reaches the spindle (decision D50).
+    pub(super) fn check_tool_change_position(&self) -> Result<(), ProgramError> {
+        let Some(z) = self.axis('Z') else {
+            return Ok(());
+        };
+        let at = self.pos[z];
+        let second = self.setup.second_reference.get(z).copied().unwrap_or(at);
+        if (at - second).abs() > 1e-3 {
+            return Err(self.fault(
+                Fault::ToolChangePosition,
+                format!(
+                    "M06 with Z at {} (machine): return it to the tool change position with G30 first",
+                    show(at)
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// G52: the local system's zero at the given work coordinates, for every work system;
