@@ -542,6 +542,10 @@ fn mill_g(n: u32) -> Option<GCode> {
         540..=590 if n.is_multiple_of(10) => (14, WorkSystem(((n - 540) / 10) as u8)),
         610 => (15, ExactStopMode),
         640 => (15, ContinuousMode),
+        630 => (
+            15,
+            Unsupported("G63 tapping mode: feed override suppression is not built"),
+        ),
         900 => (3, Absolute),
         910 => (3, Incremental),
         920 => (0, SetCoordinate),
