@@ -1239,6 +1239,19 @@ impl Interpreter {
         let to = self.plane_point(end)?;
         let normal = self.plane_normal();
         let depth = normal.map_or(0.0, |i| end[i]);
+        // Compensation carries the plane and its normal; a rotary axis would be left behind.
+        let (h, v) = self.plane_axes()?;
+        let other = (0..end.len())
+            .find(|&i| i != h && i != v && Some(i) != normal && (end[i] - here[i]).abs() > 1e-9);
+        if let Some(i) = other {
+            return Err(self.fault(
+                Fault::CompInCycle,
+                format!(
+                    "{} cannot move while compensation is active: G40 first",
+                    self.setup.axes[i]
+                ),
+            ));
+        }
         let (path, ck) = match kind {
             MoveKind::Rapid if self.dialect.is_lathe() && self.dialect != Dialect::Gtc2eLathe => {
                 return Err(self.fault(

@@ -445,3 +445,16 @@ fn m06_needs_the_tool_axis_at_the_second_reference_point() {
     // A third reference point is not configured.
     assert_eq!(run("G30 P3 Z0\nM30\n").unwrap_err().number, 3);
 }
+
+#[test]
+fn a_rotary_axis_cannot_move_under_cutter_compensation() {
+    let setup = Setup::new(&['X', 'Y', 'Z', 'A'], &[false; 4], &[0.0; 4]);
+    let e = cnc_interpreter::check(
+        Dialect::FanucMill,
+        "G0 X-10 Y0\nG41 D0 G1 X0 F100\nX10 A30\nG40 X20\nM30\n",
+        setup,
+    )
+    .unwrap_err();
+    assert_eq!(e.line, 3, "{e}");
+    assert!(e.text.contains("A cannot move"), "{e}");
+}
