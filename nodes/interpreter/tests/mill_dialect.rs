@@ -458,3 +458,19 @@ fn a_rotary_axis_cannot_move_under_cutter_compensation() {
     assert_eq!(e.line, 3, "{e}");
     assert!(e.text.contains("A cannot move"), "{e}");
 }
+
+#[test]
+fn modal_information_names_the_codes_in_force() {
+    let text = "G0 X0 Y-10 Z20\nG56 G61 G44 H1 Z20\nG42 D1 G1 X5 Y0 F100\n\
+                #500 = #4007 * 100 + #4008\n#501 = #4001\nG40 G1 X10\n\
+                G99 G83 Z-5 R2 Q2 F50 L0\n#502 = #4009 * 100 + #4010\nG80\n\
+                G18 G91\n#503 = #4002 * 100 + #4003\n#504 = #4014 * 100 + #4015\nM30\n";
+    let mut it = cnc_interpreter::Interpreter::new(Dialect::FanucMill, text, mill());
+    while let Ok(Some(_)) = it.next_command() {}
+    let kept = it.memory().kept;
+    let got: Vec<f64> = (500..=504)
+        .map(|n| kept.get(&n).copied().unwrap_or(-1.0))
+        .collect();
+    // G42 G44, G01, G83 G99, G18 G91, G56 G61.
+    assert_eq!(got, [4244.0, 1.0, 8399.0, 1891.0, 5661.0]);
+}

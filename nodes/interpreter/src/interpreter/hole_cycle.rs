@@ -50,6 +50,11 @@ impl Interpreter {
 
     /// G73/G74/G76/G81–G89: makes the cycle modal, keeping the hole data of one that is
     /// already modal.
+    /// The canned cycle in force, if any.
+    pub(super) fn hole_kind(&self) -> Option<HoleKind> {
+        self.hole.map(|h| h.kind)
+    }
+
     pub(super) fn select_hole_cycle(&mut self, kind: HoleKind) -> Result<(), ProgramError> {
         let d = self.drill_axis()?;
         let initial = self.work_position()[d];

@@ -193,75 +193,42 @@ impl Interpreter {
         Some((u8::try_from(system).ok()?, letter))
     }
 
-    /// #4001– : the modal G codes (group numbers of Table 1.1) and #4107– D, F, H, S, T.
+    /// #4001– : the modal G codes (group numbers of Table 1.1) and #4107– D, F, H, S, T. Each
+    /// G code is looked up in the dialect's own table, so the numbers cannot drift from it.
     fn modal_information(&self, n: i64) -> Value {
-        let code = |g: G| -> f64 {
-            match g {
-                G::Rapid => 0.0,
-                G::Linear => 1.0,
-                G::ArcCw => 2.0,
-                G::ArcCcw => 3.0,
-                G::PlaneZx => 18.0,
-                G::PlaneYz => 19.0,
-                _ => 17.0,
-            }
-        };
-        Some(match n {
-            4001 => code(self.motion),
-            4002 => code(self.plane),
-            4003 => {
-                if self.incremental {
-                    91.0
-                } else {
-                    90.0
-                }
-            }
-            4005 => {
-                if self.feed_per_rev {
-                    95.0
-                } else {
-                    94.0
-                }
-            }
-            4006 => 21.0,
-            4007 => match &self.nose_comp {
-                None => 40.0,
-                Some(_) => 41.0,
+        let pick = |on: bool, yes: G, no: G| if on { yes } else { no };
+        let g = match n {
+            4001 => self.motion,
+            4002 => self.plane,
+            4003 => pick(self.incremental, G::Incremental, G::Absolute),
+            4005 => pick(self.feed_per_rev, G::FeedPerRevolution, G::FeedPerMinute),
+            4006 => G::MetricInput,
+            4007 => match self.nose_comp.as_ref().map(|c| c.side()) {
+                None => G::NoseCancel,
+                Some(nose::Side::Left) => G::NoseLeft,
+                Some(nose::Side::Right) => G::NoseRight,
             },
             4008 => match self.length_sign {
-                _ if self.length_offset == 0 => 49.0,
-                -1 => 44.0,
-                _ => 43.0,
+                _ if self.length_offset == 0 => G::LengthComp(0),
+                s => G::LengthComp(s),
             },
-            4009 => {
-                if self.hole.is_some() {
-                    81.0
-                } else {
-                    80.0
-                }
-            }
-            4010 => {
-                if self.cycle_return_r {
-                    99.0
-                } else {
-                    98.0
-                }
-            }
-            4014 => 54.0 + f64::from(self.work_system),
-            4015 => {
-                if self.exact_stop_mode {
-                    61.0
-                } else {
-                    64.0
-                }
-            }
-            4107 => f64::from(self.radius_offset),
-            4109 => self.feed,
-            4111 => f64::from(self.length_offset),
-            4119 => self.sent_rpm.unwrap_or(0.0),
-            4120 => f64::from(self.tool),
+            4009 => self.hole_kind().map_or(G::CycleCancel, G::HoleCycle),
+            4010 => G::CycleReturn {
+                r_level: self.cycle_return_r,
+            },
+            4014 => G::WorkSystem(self.work_system),
+            4015 => pick(self.exact_stop_mode, G::ExactStopMode, G::ContinuousMode),
+            4107 => return Some(f64::from(self.radius_offset)),
+            4109 => return Some(self.feed),
+            4111 => return Some(f64::from(self.length_offset)),
+            4119 => return Some(self.sent_rpm.unwrap_or(0.0)),
+            4120 => return Some(f64::from(self.tool)),
             _ => return None,
-        })
+        };
+        (0..1000)
+            .step_by(10)
+            .find(|&x10| self.dialect.g_code(x10).is_some_and(|c| c.meaning == g))
+            .map(|x10| f64::from(x10) / 10.0)
     }
 
     /// Writes a variable of the mill's map: #3000 = n raises macro alarm 3000 + n.

@@ -552,6 +552,15 @@ impl NoseComp {
         }
     }
 
+    /// The side the tool runs on (radius 0 keeps the side it was given).
+    pub fn side(&self) -> Side {
+        if self.offset.is_sign_negative() {
+            Side::Right
+        } else {
+            Side::Left
+        }
+    }
+
     /// True while an element waits for the next one.
     pub fn holding(&self) -> bool {
         self.held.is_some() || self.startup.is_some()
