@@ -344,13 +344,16 @@ fn check(args: &ProgramArgs, trace: Option<&str>) -> Result<(), String> {
         let mut linuxcnc = cnc_interpreter::trace::LinuxCnc::new(&letters, &diameter, plane);
         let mut out = std::io::BufWriter::new(std::io::stdout().lock());
         let mut count = 0;
+        let mut calls = String::new();
         while let Ok(Some(c)) = interp.next_command() {
             count += 1;
             if count > cnc_interpreter::interpreter::MAX_CHECK_COMMANDS {
                 break; // the diagnosis above reports the endless program
             }
             let written = if format == "linuxcnc" {
-                out.write_all(linuxcnc.lines(&c).as_bytes())
+                calls.clear();
+                linuxcnc.write(&c, &mut calls);
+                out.write_all(calls.as_bytes())
             } else {
                 writeln!(out, "{}", cnc_interpreter::trace::line(&letters, &c))
             };

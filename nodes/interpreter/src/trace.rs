@@ -221,15 +221,8 @@ impl LinuxCnc {
         }
     }
 
-    /// The rs274 lines of one command (none for commands rs274 has no call for).
-    pub fn lines(&mut self, c: &Canon) -> String {
-        let mut out = String::new();
-        self.write(c, &mut out);
-        out
-    }
-
-    /// Appends the rs274 lines of one command to `out`: a long trace reuses one buffer and
-    /// formats every number in place.
+    /// Appends the rs274 lines of one command to `out` (none for commands rs274 has no call
+    /// for): a long trace reuses one buffer and formats every number in place.
     pub fn write(&mut self, c: &Canon, out: &mut String) {
         match &c.command {
             Command::Rapid { end } => self.six(out, "STRAIGHT_TRAVERSE(", end),
