@@ -620,6 +620,12 @@ impl LaunchConfig {
             if !ok || a.home < a.min || a.home > a.max {
                 return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, jerk, in_position", a.name));
             }
+            if let Some(r) = a.second_reference.filter(|r| !(a.min..=a.max).contains(r)) {
+                return Err(format!(
+                    "axis {}: second_reference {r} lies outside min..max",
+                    a.name
+                ));
+            }
         }
         for p in &self.machine.arc_plane {
             if !self.machine.axes.iter().any(|a| &a.name == p) {
@@ -735,5 +741,27 @@ impl LaunchConfig {
 
     pub fn home(&self) -> Vec<f64> {
         self.machine.axes.iter().map(|a| a.home).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The mill's config with `second_reference: z` on its Z axis.
+    fn mill_with_second_reference(z: &str) -> Result<LaunchConfig, String> {
+        let text = include_str!("../../../launch_configs/sim_mill.yaml").replace(
+            "max: 100.0, home: 0.0,",
+            &format!("max: 100.0, home: 0.0, second_reference: {z},"),
+        );
+        LaunchConfig::from_yaml(&text)
+    }
+
+    #[test]
+    fn the_second_reference_point_must_lie_within_the_axis_travel() {
+        let cfg = mill_with_second_reference("80.0").expect("within travel");
+        assert_eq!(cfg.second_reference(), [0.0, 0.0, 80.0]);
+        let e = mill_with_second_reference("150.0").unwrap_err();
+        assert!(e.contains("second_reference 150"), "{e}");
     }
 }
