@@ -4,4 +4,5 @@
 pub mod bench_paths;
 pub mod cell;
 pub mod client;
+pub mod machines;
 pub mod simulate;

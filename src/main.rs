@@ -1,8 +1,9 @@
 //! `cnc`: run a cell on the simulated machine, or check a part program.
 //!
-//! `cnc run CONFIG` runs until Ctrl-C; with `--program FILE --cycles N` it loads and runs the
+//! `cnc run [CONFIG]` runs until Ctrl-C; with `--program FILE --cycles N` it loads and runs the
 //! program N times through the cell's own ROS 2 services and exits 0 when done, 1 on any alarm.
-//! With no arguments it runs `launch_configs/sim_lathe.yaml` with the demo part, looping.
+//! With no arguments it runs the built-in simulated lathe with the demo part, looping. Where no
+//! config is named, the built-in lathe is used ([`cnc::machines`]).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -12,12 +13,10 @@ use std::time::{Duration, Instant};
 use clap::{Parser, Subcommand};
 use cnc::cell::Cell;
 use cnc::client::CellClient;
+use cnc::machines;
 use cnc_msgs::msg::MachineState;
 use cnc_runtime::LaunchConfig;
 use ros2_client::ServiceMapping;
-
-const DEFAULT_CONFIG: &str = "launch_configs/sim_lathe.yaml";
-const DEMO_PROGRAM: &str = "examples/lathe/demo_shaft.nc";
 
 #[derive(Parser)]
 #[command(name = "cnc", about = "Soft CNC for robot-tended machine cells")]
@@ -30,7 +29,13 @@ struct Cli {
 enum Verb {
     /// Start every node of the cell in this process.
     Run {
-        config: PathBuf,
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill); default:
+        /// the built-in sim_lathe.
+        #[arg(value_name = "CONFIG")]
+        config_file: Option<PathBuf>,
+        /// The same as CONFIG.
+        #[arg(long, conflicts_with = "config_file")]
+        config: Option<PathBuf>,
         /// Load and run this program, then exit.
         #[arg(long)]
         program: Option<PathBuf>,
@@ -40,7 +45,16 @@ enum Verb {
     },
     /// Run one node of the cell in this process (the others run in their own processes or on
     /// other hosts), until Ctrl-C or SIGTERM.
-    Node { node: NodeName, config: PathBuf },
+    Node {
+        node: NodeName,
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill); default:
+        /// the built-in sim_lathe.
+        #[arg(value_name = "CONFIG")]
+        config_file: Option<PathBuf>,
+        /// The same as CONFIG.
+        #[arg(long, conflicts_with = "config_file")]
+        config: Option<PathBuf>,
+    },
     /// Interpret a program without running it; report every error with line and alarm number.
     Check {
         #[command(flatten)]
@@ -89,9 +103,10 @@ enum Verb {
     /// `/<namespace>_replay/...` unless `--namespace` names another.
     Replay {
         bag: PathBuf,
-        /// The launch config whose network section (domain, interfaces) is used.
-        #[arg(long, default_value = DEFAULT_CONFIG)]
-        config: PathBuf,
+        /// The launch config whose network section (domain, interfaces) is used: a file, or a
+        /// built-in machine (sim_lathe, sim_mill); default: the built-in sim_lathe.
+        #[arg(long)]
+        config: Option<PathBuf>,
         #[arg(long)]
         namespace: Option<String>,
         /// 2 = twice as fast.
@@ -120,11 +135,12 @@ enum AuditVerb {
 #[derive(clap::Args)]
 struct ProgramArgs {
     program: PathBuf,
-    /// The launch config that describes the machine.
-    #[arg(long, visible_alias = "launch", default_value = DEFAULT_CONFIG)]
-    config: PathBuf,
-    /// Dialect (huaxing-lathe, gtc2e-lathe, iso-lathe); default: the config's.
-    #[arg(long)]
+    /// The launch config that describes the machine: a file, or a built-in machine
+    /// (sim_lathe, sim_mill); default: the built-in sim_lathe.
+    #[arg(long, visible_alias = "launch")]
+    config: Option<PathBuf>,
+    /// The program's dialect; default: the config's.
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(cnc_runtime::config::DIALECTS))]
     dialect: Option<String>,
     /// Folder of subprograms (O number on the first line or file name O1234.nc);
     /// default: the program's folder.
@@ -149,7 +165,7 @@ struct LoadedProgram {
 impl ProgramArgs {
     fn load(&self) -> Result<LoadedProgram, String> {
         use cnc_interpreter::{Dialect, Library};
-        let cfg = LaunchConfig::load_with_tool_table(&self.config, self.tools.as_deref())?;
+        let (cfg, _) = machines::load(self.config.as_deref(), self.tools.as_deref())?;
         let text = read_program(&self.program)?;
         let name = self.dialect.as_deref().unwrap_or(&cfg.machine.dialect);
         let dialect = Dialect::from_name(name).ok_or_else(|| {
@@ -191,16 +207,25 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Verb::Run {
+            config_file,
             config,
             program,
             cycles,
-        }) => run(&config, program.as_deref(), cycles),
+        }) => program
+            .as_deref()
+            .map(read_named_program)
+            .transpose()
+            .and_then(|p| run(config_file.or(config).as_deref(), p, cycles)),
         Some(Verb::Check {
             program,
             trace,
             format,
         }) => check(&program, trace.then_some(format.as_str())),
-        Some(Verb::Node { node, config }) => run_node(node, &config),
+        Some(Verb::Node {
+            node,
+            config_file,
+            config,
+        }) => run_node(node, config_file.or(config).as_deref()),
         Some(Verb::Simulate {
             program,
             svg,
@@ -233,14 +258,17 @@ fn main() -> ExitCode {
             wait_for,
         }) => replay(
             &bag,
-            &config,
+            config.as_deref(),
             cnc_recorder::replay::ReplayOptions {
                 namespace,
                 speed,
                 wait_for,
             },
         ),
-        None => run(Path::new(DEFAULT_CONFIG), Some(Path::new(DEMO_PROGRAM)), 0),
+        None => {
+            let (name, text) = machines::DEMO_PROGRAM;
+            run(None, Some((name.into(), text.into())), 0)
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -272,10 +300,10 @@ fn audit_verify(bag: &Path) -> Result<(), String> {
 
 fn replay(
     bag: &Path,
-    config: &Path,
+    config: Option<&Path>,
     options: cnc_recorder::replay::ReplayOptions,
 ) -> Result<(), String> {
-    let cfg = LaunchConfig::load(config)?;
+    let (cfg, _) = machines::load(config, None)?;
     install_signal_handlers();
     let r =
         cnc_recorder::replay::replay(bag, &cfg.network, &options, &|| STOP.load(Ordering::SeqCst))?;
@@ -430,8 +458,8 @@ enum NodeName {
     Recorder,
 }
 
-fn run_node(node: NodeName, config: &Path) -> Result<(), String> {
-    let cfg = LaunchConfig::load(config)?;
+fn run_node(node: NodeName, config: Option<&Path>) -> Result<(), String> {
+    let (cfg, _) = machines::load(config, None)?;
     install_signal_handlers();
     let inst =
         cnc_runtime::shm::instance(&cfg.machine.namespace, cfg.network.effective_domain_id()?);
@@ -458,18 +486,27 @@ fn run_node(node: NodeName, config: &Path) -> Result<(), String> {
     Ok(())
 }
 
-fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String> {
-    let cfg = LaunchConfig::load(config)?;
-    let text = program.map(read_program).transpose()?;
+/// A program to run: its name in program memory and its text.
+type NamedProgram = (String, String);
+
+fn read_named_program(path: &Path) -> Result<NamedProgram, String> {
+    Ok((program_name(path), read_program(path)?))
+}
+
+fn run(config: Option<&Path>, program: Option<NamedProgram>, cycles: u32) -> Result<(), String> {
+    let (cfg, described) = machines::load(config, None)?;
     install_signal_handlers();
     let domain = cfg.network.effective_domain_id()?;
     let ns = cfg.machine.namespace.clone();
     let cell = Cell::start(&cfg)?;
     println!(
-        "cell '{ns}' running: DDS domain {domain} on {:?}; services /{ns}/load_program, /{ns}/start_program, /{ns}/stop, /{ns}/reset; topics /{ns}/machine_state, /{ns}/spindle, /{ns}/axes, /{ns}/part_count, /{ns}/alarms, /{ns}/alarm_events",
+        "cell '{ns}' running ({described}): DDS domain {domain} on {:?}; services /{ns}/load_program, /{ns}/start_program, /{ns}/stop, /{ns}/reset; topics /{ns}/machine_state, /{ns}/spindle, /{ns}/axes, /{ns}/part_count, /{ns}/alarms, /{ns}/alarm_events",
         cfg.network.interfaces
     );
-    let outcome = supervise(&cfg, &cell, program, text.as_deref(), cycles);
+    for (what, path) in cfg.written_files() {
+        println!("{what}: {}", path.display());
+    }
+    let outcome = supervise(&cfg, &cell, program, cycles);
     let (summary, errors) = cell.stop();
     if !summary.is_empty() {
         println!("{summary}");
@@ -489,8 +526,7 @@ fn run(config: &Path, program: Option<&Path>, cycles: u32) -> Result<(), String>
 fn supervise(
     cfg: &LaunchConfig,
     cell: &Cell,
-    program: Option<&Path>,
-    text: Option<&str>,
+    program: Option<NamedProgram>,
     cycles: u32,
 ) -> Result<(), String> {
     let mut client = CellClient::new(
@@ -499,11 +535,9 @@ fn supervise(
         "cnc_cli",
         ServiceMapping::Enhanced,
     )?;
-    let name = program.map(program_name);
-    if name.is_some() {
+    let name = program.as_ref().map(|(name, _)| name.clone());
+    if let Some((name, text)) = &program {
         client.wait_ready(Duration::from_secs(30))?;
-    }
-    if let (Some(name), Some(text)) = (&name, text) {
         let r = client.load_program(name, text)?;
         if !r.accepted {
             return Err(format!("load refused: {}", r.message));

@@ -11,9 +11,18 @@ fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, Str
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
+    // The launch config file, its kept memory and recordings in this test's own folder.
+    let config = dir.join("sim_lathe.yaml");
+    std::fs::copy(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/launch_configs/sim_lathe.yaml"),
+        &config,
+    )
+    .unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_cnc"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["run", "launch_configs/sim_lathe.yaml", "--program"])
+        .arg("run")
+        .arg(&config)
+        .arg("--program")
         .arg(&path)
         .args(["--cycles", cycles])
         .env("ROS_DOMAIN_ID", domain)

@@ -33,7 +33,7 @@ fn killing_io_stops_the_motion_output_within_three_ticks() {
     let text = base
         .replace("namespace: lathe1", "namespace: faults")
         .replace("feedback_lost_ticks: 25", "feedback_lost_ticks: 3")
-        .replace("memory_file: target/cnc_memory_lathe1.yaml", "")
+        .replace("memory_file: state/lathe1_memory.yaml", "")
         .replace(
             "interfaces: [127.0.0.1]",
             &format!("interfaces: [127.0.0.1]\n  domain_id: {DOMAIN}"),

@@ -3,6 +3,7 @@
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::net::IpAddr;
+use std::path::Path;
 
 /// Top level of `launch_configs/*.yaml`.
 #[derive(Debug, Clone, Deserialize, serde::Serialize)]
@@ -74,14 +75,14 @@ pub struct MachineConfig {
     #[serde(default)]
     pub tools: BTreeMap<u32, ToolEntry>,
     /// A mill tool table file (`number length_mm diameter_mm` per line, [`crate::tool_table`]),
-    /// relative to the working directory; its entries join `tools` when the config loads.
+    /// relative to the config file's folder; its entries join `tools` when the config loads.
     #[serde(default)]
     pub tool_table: Option<std::path::PathBuf>,
     /// Work offsets by code (`G54`…`G59`; on GTC2E the offset groups of G54–G57), per axis.
     #[serde(default)]
     pub work_offsets: BTreeMap<String, BTreeMap<String, f64>>,
     /// Where the kept variables (#200–#289) and the offset page as programs leave them are
-    /// stored (YAML, relative to the working directory); absent: kept for this run of the
+    /// stored (YAML, relative to the config file's folder); absent: kept for this run of the
     /// cell only.
     #[serde(default)]
     pub memory_file: Option<std::path::PathBuf>,
@@ -90,7 +91,8 @@ pub struct MachineConfig {
     #[serde(default)]
     pub tool_change_macro: Option<u32>,
     /// Where parameters written from the cell (SetParameter) are stored; they are applied over
-    /// this file at start (decisions D44). Absent: parameters cannot be written.
+    /// this file at start (decisions D44), relative to the config file's folder. Absent:
+    /// parameters cannot be written.
     #[serde(default)]
     pub parameter_file: Option<std::path::PathBuf>,
 }
@@ -391,7 +393,8 @@ pub struct PlcConfig {
     /// Level 2 runs in this many slices, one per scan.
     #[serde(default = "default_level2_divisions")]
     pub level2_divisions: u32,
-    /// The ladder program (mnemonic text); default: the built-in standard lathe program.
+    /// The ladder program (mnemonic text), relative to the config file's folder; default: the
+    /// built-in standard lathe program.
     /// The node reloads it when the file changes; a program with an error is refused and the
     /// running one stays.
     #[serde(default)]
@@ -428,7 +431,7 @@ pub struct RecorderConfig {
     #[serde(default = "yes")]
     pub enabled: bool,
     /// Folder of the bags: one bag (a folder with `metadata.yaml` and `.mcap` files) per start
-    /// of the cell.
+    /// of the cell; relative to the config file's folder.
     #[serde(default = "default_records")]
     pub directory: std::path::PathBuf,
     /// Topic paths under the namespace to record (`*` matches anything); default all.
@@ -513,19 +516,29 @@ impl LaunchConfig {
 
     /// Reads the launch config and applies the parameter file over it. A parameter file that
     /// does not apply stops the start with its entry named: the machine never runs on
-    /// parameters nobody checked.
-    pub fn load(path: &std::path::Path) -> Result<Self, String> {
+    /// parameters nobody checked. Relative paths in the file are taken from its folder.
+    pub fn load(path: &Path) -> Result<Self, String> {
         Self::load_with_tool_table(path, None)
     }
 
     /// [`LaunchConfig::load`], with `tool_table` (if given) read instead of the config's
     /// `machine.tool_table` (`cnc check --tools`).
-    pub fn load_with_tool_table(
-        path: &std::path::Path,
-        tool_table: Option<&std::path::Path>,
-    ) -> Result<Self, String> {
+    pub fn load_with_tool_table(path: &Path, tool_table: Option<&Path>) -> Result<Self, String> {
         let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let mut cfg = Self::from_yaml(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Self::from_yaml_in(&text, dir, tool_table).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// A launch config read from `text` as if it were a file in `dir` (the built-in machines
+    /// of the `cnc` binary have a data folder instead of a file): relative file paths in it
+    /// are taken from `dir`; then the parameter file and the tool table (`tool_table` if
+    /// given, as the command line names it, else the config's) are applied.
+    pub fn from_yaml_in(text: &str, dir: &Path, tool_table: Option<&Path>) -> Result<Self, String> {
+        let mut cfg = Self::from_yaml(text)?;
+        cfg.resolve_paths(dir);
         if let Some(table) = tool_table {
             cfg.machine.tool_table = Some(table.to_path_buf());
         }
@@ -534,6 +547,46 @@ impl LaunchConfig {
             Some(table) => cfg.with_tool_table(&table),
             None => Ok(cfg),
         }
+    }
+
+    /// Takes every relative file path of the config from `dir`: a config names its files
+    /// from where it lies, so `cnc` finds them from any working directory.
+    fn resolve_paths(&mut self, dir: &Path) {
+        let m = &mut self.machine;
+        let files = [
+            &mut m.tool_table,
+            &mut m.memory_file,
+            &mut m.parameter_file,
+            &mut self.plc.program,
+            &mut self.plc.memory_file,
+        ];
+        for file in files.into_iter().flatten() {
+            if file.is_relative() {
+                *file = dir.join(&*file);
+            }
+        }
+        if self.recorder.directory.is_relative() {
+            self.recorder.directory = dir.join(&self.recorder.directory);
+        }
+    }
+
+    /// The files this config writes, as `(what, path)`, for the user to know where they are.
+    pub fn written_files(&self) -> Vec<(&'static str, &Path)> {
+        let mut out = Vec::new();
+        let m = &self.machine;
+        if let Some(f) = &m.memory_file {
+            out.push(("kept variables and offsets", f.as_path()));
+        }
+        if let Some(f) = &m.parameter_file {
+            out.push(("parameters", f.as_path()));
+        }
+        if let Some(f) = &self.plc.memory_file {
+            out.push(("PLC memory", f.as_path()));
+        }
+        if self.recorder.enabled {
+            out.push(("recordings", self.recorder.directory.as_path()));
+        }
+        out
     }
 
     /// This config with the tools of a tool table file added to the offset page; a number

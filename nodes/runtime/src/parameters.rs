@@ -18,10 +18,11 @@ const SECTIONS: [&str; 4] = ["machine", "servo", "plc", "sim"];
 
 /// Settings that are not parameters: identity, file paths, and the offset pages (written
 /// through the offset services).
-const NOT_PARAMETERS: [&str; 8] = [
+const NOT_PARAMETERS: [&str; 9] = [
     "machine.namespace",
     "machine.memory_file",
     "machine.parameter_file",
+    "machine.tool_table",
     "machine.tools",
     "machine.work_offsets",
     "plc.program",
@@ -195,6 +196,7 @@ mod tests {
             "machine.namespace",
             "machine.axes.X.name",
             "machine.memory_file",
+            "machine.tool_table",
             "plc.program",
             "hmi.allowed_clients.0",
             "network.interfaces.0",
@@ -205,6 +207,8 @@ mod tests {
         assert!(list(&cfg)
             .iter()
             .all(|(n, _)| !n.starts_with("machine.tools")));
+        // A file path is not a parameter: a client could point the next start at any file.
+        assert!(set(&cfg, "machine.tool_table", "/etc/passwd").is_err());
     }
 
     #[test]

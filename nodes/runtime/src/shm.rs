@@ -36,11 +36,27 @@ fn err(what: &str, e: impl Debug) -> String {
     format!("iceoryx2 {what}: {e:?}")
 }
 
+/// iceoryx2's global config, looked up once with its log at errors only: without an
+/// `iceoryx2.toml` (the usual case; its defaults are what the cell is built for) the lookup
+/// warns "No config file was loaded" on every start, which tells a user nothing. After the
+/// lookup the log level is `IOX2_LOG_LEVEL`, else iceoryx2's default (info).
+fn quiet_global_config() -> &'static iceoryx2::config::Config {
+    static CONFIG: std::sync::OnceLock<&'static iceoryx2::config::Config> =
+        std::sync::OnceLock::new();
+    CONFIG.get_or_init(|| {
+        set_log_level(LogLevel::Error);
+        let config = iceoryx2::config::Config::global_config();
+        set_log_level_from_env_or(LogLevel::Info);
+        config
+    })
+}
+
 impl ShmNode {
     pub fn new(instance: &str, node_name: &str) -> Result<Self, String> {
         let name: NodeName = node_name.try_into().map_err(|e| err("node name", e))?;
         let node = NodeBuilder::new()
             .name(&name)
+            .config(quiet_global_config())
             .create::<ipc::Service>()
             .map_err(|e| err("node", e))?;
         Ok(ShmNode {
