@@ -268,3 +268,52 @@ fn finish(child: &mut std::process::Child, lines: &[String]) -> std::process::Ex
         std::thread::sleep(Duration::from_millis(50));
     }
 }
+
+/// A failed install names its step, the command and apt's own reason, and stops the script.
+/// Run with a PATH that has no `ip` and no Python and an `apt-get` that refuses, so nothing on
+/// this machine is touched.
+#[test]
+fn a_failed_install_step_says_which_and_why() {
+    let base = std::env::temp_dir().join(format!("cnc_setup_{}", std::process::id()));
+    let bin = base.join("bin");
+    let _ = std::fs::remove_dir_all(&base);
+    std::fs::create_dir_all(&bin).unwrap();
+    let apt = "#!/bin/sh\n[ \"$1\" = update ] && exit 0\n\
+               for p; do last=$p; done\n\
+               echo \"E: Unable to locate package $last\" >&2\nexit 100\n";
+    std::fs::write(bin.join("apt-get"), apt).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(bin.join("apt-get"), std::fs::Permissions::from_mode(0o755)).unwrap();
+    for tool in ["dirname", "mktemp", "rm", "tail", "sed", "cat"] {
+        let real = ["/usr/bin", "/bin"]
+            .iter()
+            .map(|d| PathBuf::from(d).join(tool))
+            .find(|p| p.exists())
+            .unwrap_or_else(|| panic!("{tool} not found"));
+        std::os::unix::fs::symlink(real, bin.join(tool)).unwrap();
+    }
+    let out = Command::new("/bin/bash")
+        .arg(format!("{REPO}/scripts/setup.sh"))
+        .env_clear()
+        .env("PATH", &bin)
+        .output()
+        .unwrap();
+    let all = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{all}");
+    assert!(
+        all.contains(
+            "setup: system: missing ip python3-venv: apt-get install iproute2 python3-venv"
+        ),
+        "{all}"
+    );
+    assert!(
+        all.contains("setup: step 'system' FAILED: `apt-get install -y --no-install-recommends iproute2 python3-venv` exited 100"),
+        "{all}"
+    );
+    assert!(
+        all.contains("E: Unable to locate package python3-venv"),
+        "{all}"
+    );
+    // Nothing after the failed step ran.
+    assert!(!all.contains("setup: chromium"), "{all}");
+}
