@@ -10,6 +10,10 @@ use std::time::Duration;
 use cnc_interpreter::interpreter::check_limited;
 use cnc_interpreter::{Command, Dialect, Library, Setup};
 
+#[path = "support/mutate.rs"]
+mod mutate;
+use mutate::Rng;
+
 /// Mutants made of each seed program (`MILL_FUZZ_MUTANTS` and `MILL_FUZZ_SEED` change the
 /// run for a longer search by hand).
 const MUTANTS: usize = 60;
@@ -85,60 +89,6 @@ const TOKENS: &[&str] = &[
     "ROUND[#1]",
 ];
 
-const ALPHABET: &[u8] = b"GXYZIJKRFPQLDHMSTNO#[]=.-+0123456789 \n()%/EQNTWHILDO";
-
-/// A small deterministic generator (xorshift64*).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
-
-fn mutate(seed: &str, rng: &mut Rng) -> String {
-    let mut text: Vec<u8> = seed.as_bytes().to_vec();
-    for _ in 0..1 + rng.below(4) {
-        let at = rng.below(text.len() + 1);
-        match rng.below(6) {
-            0 if at < text.len() => {
-                text.remove(at);
-            }
-            1 => text.insert(at, ALPHABET[rng.below(ALPHABET.len())]),
-            2 if at < text.len() => text[at] = ALPHABET[rng.below(ALPHABET.len())],
-            3 => {
-                let token = TOKENS[rng.below(TOKENS.len())].as_bytes();
-                text.splice(at..at, token.iter().copied());
-            }
-            _ => {
-                // Duplicate, drop or move a whole line.
-                let lines: Vec<&[u8]> = text.split(|&c| c == b'\n').collect();
-                let mut lines: Vec<Vec<u8>> = lines.into_iter().map(<[u8]>::to_vec).collect();
-                let i = rng.below(lines.len());
-                let j = rng.below(lines.len());
-                match rng.below(3) {
-                    0 => {
-                        let l = lines[i].clone();
-                        lines.insert(j, l);
-                    }
-                    1 => {
-                        lines.remove(i);
-                    }
-                    _ => lines.swap(i, j),
-                }
-                text = lines.join(&b'\n');
-            }
-        }
-    }
-    String::from_utf8_lossy(&text).into_owned()
-}
-
 fn setup() -> Setup {
     let mut setup = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
     for (n, length, radius) in [(1, 120.0, 5.0), (2, 85.5, 3.0), (3, 150.25, 10.0)] {
@@ -198,7 +148,7 @@ fn mutated_mill_programs_end_in_commands_or_an_alarm() {
         let (mut alarms, mut runs) = (0, 0);
         for (name, seed) in &seeds {
             for _ in 0..mutants {
-                let text = mutate(seed, &mut rng);
+                let text = mutate::mutate(seed, TOKENS, &mut rng);
                 // Tell the watcher which program runs, so a hang names it.
                 let _ = tx.send(Err(format!("running a mutant of {name}:\n{text}")));
                 match examine(&text) {
