@@ -12,6 +12,7 @@
 use std::collections::VecDeque;
 use std::time::Instant;
 
+use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_motion::path::{self, Point, Segment, MAX_AXES};
 use cnc_motion::{Aux, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
@@ -160,7 +161,7 @@ pub fn simulate(
         _ => None,
     };
     let setup = cnc_interpreter::node::setup_from_config(cfg, &cfg.home());
-    let mut interp = Interpreter::with_library(dialect, text, setup, library);
+    let mut stream = ProgramRun::new(Interpreter::with_library(dialect, text, setup, library));
     let mut mcfg = MotionConfig::from_launch(cfg);
     if let Some(shape) = options.profile {
         mcfg.shape = shape;
@@ -182,8 +183,6 @@ pub fn simulate(
     // Ideal drives: each axis is where it was commanded one period earlier.
     let mut actual = start.clone();
     let mut plc = GImage::released();
-    let mut sent = 0u64;
-    let mut finished = false;
     let mut ticks = 0u64;
     let mut lathe_path = Vec::new();
     let mut last = motion.commanded_display();
@@ -201,30 +200,26 @@ pub fn simulate(
     // The last two setpoints, for velocity and acceleration.
     let (mut p1, mut p2) = (start.clone(), start.clone());
     loop {
-        // Keep motion's queue full, as the interpreter node does.
-        while !finished && sent - motion.done_seq() < capacity {
-            match interp.next_command() {
-                Ok(Some(Canon { line, command })) => {
-                    if let Command::Aux(Aux::S(s)) = command {
-                        spindle_rpm = s;
-                    }
-                    sent += 1;
-                    if command == Command::ProgramEnd {
-                        finished = true;
-                    }
-                    programmed.push(sent, &command, &slide, plane);
-                    motion.push(Block {
-                        run_id: 1,
-                        seq: sent,
-                        line,
-                        kind: command,
-                    });
+        // Keep motion's queue full, with the interpreter node's credit loop.
+        let done = motion.done_seq();
+        stream
+            .feed(done, capacity, |seq, Canon { line, command }, _| {
+                if let Command::Aux(Aux::S(s)) = command {
+                    spindle_rpm = s;
                 }
-                Ok(None) => finished = true,
-                Err(e) => return Err(format!("alarm {} at line {}: {}", e.number, e.line, e.text)),
-            }
-        }
-        if finished && motion.done_seq() == sent && motion.state() == RunState::Idle {
+                programmed.push(seq, &command, &slide, plane);
+                motion.push(Block {
+                    run_id: 1,
+                    seq,
+                    line,
+                    kind: command,
+                });
+            })
+            .map_err(|e| format!("alarm {} at line {}: {}", e.number, e.line, e.text))?;
+        if stream.all_sent()
+            && motion.done_seq() == stream.sent()
+            && motion.state() == RunState::Idle
+        {
             break;
         }
         if ticks >= max_ticks {
@@ -298,7 +293,7 @@ pub fn simulate(
     Ok(Simulation {
         cycle_time: ticks as f64 * period,
         path: lathe_path,
-        commands: sent as usize,
+        commands: stream.sent() as usize,
         stats,
         tick_nanos,
     })

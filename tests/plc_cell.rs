@@ -3,10 +3,11 @@
 //! one simulated clock (servo 4 ms, PLC scan 10 ms). Deterministic and fast; the same cores run
 //! in the nodes over DDS and iceoryx2 (`cell_end_to_end.rs`).
 
+use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
-use cnc_motion::{Block, Command, Motion, MotionConfig, RunState};
+use cnc_motion::{Block, Motion, MotionConfig, RunState};
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{f, g, x, y, FImage, GImage, SignalTable, XImage, YImage};
 use cnc_plc::memory::Retained;
@@ -17,7 +18,7 @@ const DT: f64 = 0.004;
 const SCAN: f64 = 0.010;
 
 struct Rig {
-    interp: Interpreter,
+    stream: ProgramRun,
     motion: Motion,
     plc: Plc,
     sim: SimLathe,
@@ -27,8 +28,6 @@ struct Rig {
     yi: YImage,
     xi: XImage,
     fb: ServoFeedback,
-    sent: u64,
-    finished: bool,
     events: Vec<(f64, PlcEvent)>,
     n: usize,
     /// Cycle start given: the interpreter feeds motion.
@@ -61,7 +60,7 @@ impl Rig {
             2,
         );
         Rig {
-            interp,
+            stream: ProgramRun::new(interp),
             motion: Motion::new(mcfg, &start),
             plc,
             sim,
@@ -71,8 +70,6 @@ impl Rig {
             yi: YImage::default(),
             xi: XImage::default(),
             fb,
-            sent: 0,
-            finished: false,
             events: Vec::new(),
             n,
             started: false,
@@ -81,21 +78,19 @@ impl Rig {
 
     /// One servo period; the PLC scans when its 10 ms are due.
     fn tick(&mut self) {
-        while self.started && !self.finished && self.sent - self.motion.done_seq() < 32 {
-            match self.interp.next_command() {
-                Ok(Some(Canon { line, command })) => {
-                    self.sent += 1;
-                    self.finished = command == Command::ProgramEnd;
-                    self.motion.push(Block {
+        if self.started {
+            let done = self.motion.done_seq();
+            let motion = &mut self.motion;
+            self.stream
+                .feed(done, 32, |seq, Canon { line, command }, _| {
+                    motion.push(Block {
                         run_id: 1,
-                        seq: self.sent,
+                        seq,
                         line,
                         kind: command,
-                    });
-                }
-                Ok(None) => self.finished = true,
-                Err(e) => panic!("alarm {} at line {}: {}", e.number, e.line, e.text),
-            }
+                    })
+                })
+                .unwrap_or_else(|e| panic!("alarm {} at line {}: {}", e.number, e.line, e.text));
         }
         let mut actual = [0.0; MAX_AXES];
         actual[..self.n].copy_from_slice(&self.fb.position[..self.n]);
@@ -139,8 +134,8 @@ impl Rig {
     }
 
     fn program_done(&self) -> bool {
-        self.finished
-            && self.motion.done_seq() == self.sent
+        self.stream.all_sent()
+            && self.motion.done_seq() == self.stream.sent()
             && self.motion.state() == RunState::Idle
     }
 

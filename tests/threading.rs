@@ -5,10 +5,11 @@
 //! 0.1 µm per revolution, measured on the simulated slides against the spindle encoder, with
 //! the feed override at 50 % (threads ignore it).
 
+use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
-use cnc_motion::{Block, Command, Motion, MotionConfig, MotionEvent, Panel, RunState};
+use cnc_motion::{Block, Motion, MotionConfig, MotionEvent, Panel, RunState};
 use cnc_msgs::servo::{ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{f, g, y as out, GImage, SignalTable, YImage};
 use cnc_runtime::LaunchConfig;
@@ -45,8 +46,12 @@ fn run(program: &str, factors: &[f64]) -> Vec<Pass> {
     .expect("config");
     let zi = cfg.axis_index("Z").expect("a Z axis");
     let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
-    let mut interp =
-        Interpreter::with_library(Dialect::HuaxingLathe, program, setup, Library::new());
+    let mut stream = ProgramRun::new(Interpreter::with_library(
+        Dialect::HuaxingLathe,
+        program,
+        setup,
+        Library::new(),
+    ));
     let mcfg = MotionConfig::from_launch(&cfg);
     let n = mcfg.axes.len();
     let dt = mcfg.period;
@@ -62,30 +67,27 @@ fn run(program: &str, factors: &[f64]) -> Vec<Pass> {
     let (mut s_command, mut factor_index) = (0.0, 0);
     let mut plc = GImage::released();
     let mut direction = 0;
-    let mut sent = 0u64;
-    let mut finished = false;
     let mut passes: Vec<Pass> = Vec::new();
     let mut was_cutting = false;
     let mut fb = sim.step(&ServoSetpoint::default(), &y, dt);
     let mut revs = 0.0;
     let mut last_angle = fb.spindle_angle_deg;
     for _tick in 0..2_000_000 {
-        while !finished && sent - motion.done_seq() < 64 {
-            match interp.next_command().expect("program interprets") {
-                Some(Canon { line, command }) => {
-                    sent += 1;
-                    finished = command == Command::ProgramEnd;
-                    motion.push(Block {
-                        run_id: 1,
-                        seq: sent,
-                        line,
-                        kind: command,
-                    });
-                }
-                None => finished = true,
-            }
-        }
-        if finished && motion.done_seq() == sent && motion.state() == RunState::Idle {
+        let done = motion.done_seq();
+        stream
+            .feed(done, 64, |seq, Canon { line, command }, _| {
+                motion.push(Block {
+                    run_id: 1,
+                    seq,
+                    line,
+                    kind: command,
+                })
+            })
+            .expect("program interprets");
+        if stream.all_sent()
+            && motion.done_seq() == stream.sent()
+            && motion.state() == RunState::Idle
+        {
             return passes;
         }
         // A PLC that answers M and S at once, M03/M04 once the spindle is at speed.

@@ -16,6 +16,7 @@ pub mod node;
 pub mod offset_page;
 pub mod program;
 pub mod rough;
+pub mod run;
 pub mod setup;
 pub mod syntax;
 pub mod trace;

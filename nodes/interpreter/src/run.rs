@@ -1,0 +1,639 @@
+//! The program run as a pure core: program memory, the mode switch, cycle start, feed hold,
+//! cycle stop and reset, the credit-based block stream to motion, completion, and alarms that
+//! stop the run. No clock, no thread, no DDS: the node shell feeds it what arrives and carries
+//! out the [`Effect`]s it asks for; `cnc simulate` and the in-process cell tests use its credit
+//! loop, [`ProgramRun::feed`].
+//!
+//! The machine's execution state follows MTConnect's names (`MachineState`): WAIT until motion
+//! has told where the axes are, READY, ACTIVE while a run goes, FEED_HOLD, STOPPED after an
+//! alarm or a cycle stop, PROGRAM_COMPLETED when motion has finished the program's last block.
+
+use std::collections::{BTreeMap, VecDeque};
+
+use cnc_msgs::canon::to_motion_block;
+use cnc_msgs::msg::{
+    Alarm, AlarmEvent, CommandResult, MachineState, MotionBlock, MotionStatus, ProgramCommand,
+};
+use cnc_runtime::MDI_PROGRAM;
+
+use crate::offset_page;
+use crate::setup::Memory;
+use crate::{Canon, Command, Dialect, Interpreter, Library, ProgramError, Setup};
+
+pub use cnc_runtime::MAX_PROGRAM_BYTES;
+/// Programs kept in memory.
+pub const MAX_PROGRAMS: usize = 1000;
+/// The longest MDI entry: a few blocks typed at the panel.
+pub const MAX_MDI_BYTES: usize = 4096;
+/// Answers remembered so that a repeated command (same id) is answered, not executed again.
+const ANSWERS_KEPT: usize = 64;
+/// The alarm source of the interpreter's own alarms.
+pub const SOURCE: &str = "interpreter";
+
+/// A program name: what a control's directory shows, e.g. `O0001` or `part7.nc`.
+pub fn valid_program_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= 64
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c))
+        && !name.starts_with('.')
+}
+
+/// One program run's block stream: commands go to motion while fewer than the queue's
+/// capacity are unfinished; the run is complete when motion has finished the program end.
+pub struct ProgramRun {
+    interp: Interpreter,
+    /// Sequence number of the last command sent (the first is 1).
+    sent: u64,
+    /// Sequence number of the program end, once sent.
+    end: Option<u64>,
+}
+
+impl ProgramRun {
+    pub fn new(interp: Interpreter) -> Self {
+        ProgramRun {
+            interp,
+            sent: 0,
+            end: None,
+        }
+    }
+
+    /// Sends commands to `send(seq, command, interpreter)` while fewer than `capacity` (at
+    /// least 2) are unfinished, motion having finished every block up to `done`. Returns how
+    /// many it sent; an interpreter alarm ends the stream (nothing of the bad block is sent).
+    pub fn feed(
+        &mut self,
+        done: u64,
+        capacity: u64,
+        mut send: impl FnMut(u64, Canon, &Interpreter),
+    ) -> Result<u64, ProgramError> {
+        let credit = capacity
+            .max(2)
+            .saturating_sub(self.sent.saturating_sub(done));
+        let mut count = 0;
+        for _ in 0..credit {
+            if self.end.is_some() {
+                break;
+            }
+            match self.interp.next_command()? {
+                Some(canon) => {
+                    self.sent += 1;
+                    count += 1;
+                    if canon.command == Command::ProgramEnd {
+                        self.end = Some(self.sent);
+                    }
+                    send(self.sent, canon, &self.interp);
+                }
+                None => break,
+            }
+        }
+        Ok(count)
+    }
+
+    /// Every command of the program has been sent.
+    pub fn all_sent(&self) -> bool {
+        self.end.is_some()
+    }
+
+    /// Motion has finished the program end (`done` its last finished block).
+    pub fn completed(&self, done: u64) -> bool {
+        self.end == Some(done)
+    }
+
+    pub fn sent(&self) -> u64 {
+        self.sent
+    }
+
+    pub fn interpreter(&self) -> &Interpreter {
+        &self.interp
+    }
+}
+
+/// What the run core asks its shell to do.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Effect {
+    /// Send this block to motion.
+    Block(MotionBlock),
+    /// Send this command to motion (a cycle stop when an alarm ends the run).
+    ToMotion(ProgramCommand),
+    /// Raise the interpreter's alarm (error severity).
+    Raise {
+        number: u32,
+        text: String,
+        program: String,
+        line: u32,
+    },
+    /// Clear the interpreter's alarm of this number.
+    Clear(u32),
+    /// The machine memory changed: store [`RunCore::memory`].
+    StoreMemory,
+}
+
+/// What `/machine_state` says, without its time stamp.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StateView {
+    pub mode: u8,
+    pub execution: u8,
+    pub program: String,
+    pub line: u32,
+    pub emergency_stop: bool,
+    pub alarm_active: bool,
+}
+
+struct Run {
+    id: u64,
+    program: String,
+    stream: ProgramRun,
+    /// Stopped by an alarm or a cycle stop: nothing more is sent.
+    failed: bool,
+}
+
+/// The interpreter node's logic.
+pub struct RunCore {
+    dialect: Dialect,
+    /// The machine as the launch config describes it; each start sets the start position and
+    /// the memory.
+    base: Setup,
+    programs: BTreeMap<String, String>,
+    run: Option<Run>,
+    answered: VecDeque<CommandResult>,
+    /// The last run id given; ids grow across restarts of the node (the shell starts them
+    /// from its clock).
+    run_counter: u64,
+    status: MotionStatus,
+    position: Option<Vec<f64>>,
+    /// Active error alarms by (source, number): a start is refused while any is active.
+    active_alarms: Vec<(String, u32)>,
+    execution: u8,
+    mode: u8,
+    program_name: String,
+    stop_command_id: u64,
+    memory: Memory,
+    effects: Vec<Effect>,
+}
+
+impl RunCore {
+    /// A core for a machine `base` (its start position is replaced at each start), with
+    /// `memory` as stored, giving run ids after `first_run_id`.
+    pub fn new(dialect: Dialect, base: Setup, memory: Memory, first_run_id: u64) -> Self {
+        RunCore {
+            dialect,
+            base,
+            programs: BTreeMap::new(),
+            run: None,
+            answered: VecDeque::with_capacity(ANSWERS_KEPT),
+            run_counter: first_run_id,
+            status: MotionStatus::default(),
+            position: None,
+            active_alarms: Vec::new(),
+            // Cycle start needs the axes' position from motion; until then the machine waits.
+            execution: MachineState::WAIT,
+            // The cell's machine powers up in AUTO (DESIGN: a robot cell runs programs
+            // without an operator turning the switch).
+            mode: MachineState::MODE_AUTO,
+            program_name: String::new(),
+            stop_command_id: 0,
+            memory,
+            effects: Vec::new(),
+        }
+    }
+
+    /// The effects asked for since the last call, in order.
+    pub fn take_effects(&mut self) -> Vec<Effect> {
+        std::mem::take(&mut self.effects)
+    }
+
+    pub fn memory(&self) -> &Memory {
+        &self.memory
+    }
+
+    pub fn execution(&self) -> u8 {
+        self.execution
+    }
+
+    fn running(&self) -> bool {
+        matches!(
+            self.execution,
+            MachineState::ACTIVE | MachineState::FEED_HOLD
+        )
+    }
+
+    fn stop_execution(&mut self) {
+        if self.running() {
+            self.execution = MachineState::STOPPED;
+        }
+    }
+
+    /// Motion's latest status.
+    pub fn motion_status(&mut self, status: MotionStatus) {
+        self.status = status;
+    }
+
+    /// The axes' commanded positions as motion reports them; a report that is not of this
+    /// machine's axes, or not finite, is not a start position.
+    pub fn axes(&mut self, commanded: &[f64]) {
+        if commanded.len() == self.base.axes.len() && commanded.iter().all(|x| x.is_finite()) {
+            self.position = Some(commanded.to_vec());
+            if self.execution == MachineState::WAIT {
+                self.execution = MachineState::READY;
+            }
+        }
+    }
+
+    /// An alarm event of any node. Messages and warnings (a refused request, a refused PLC
+    /// file) inform; errors and fatal alarms stop the run and block the next start until they
+    /// clear.
+    pub fn alarm_event(&mut self, e: &AlarmEvent) {
+        if e.kind == AlarmEvent::RAISED && e.alarm.severity < Alarm::SEVERITY_ERROR {
+            return;
+        }
+        let key = (e.alarm.source.clone(), e.alarm.number);
+        if e.kind != AlarmEvent::RAISED {
+            self.active_alarms.retain(|k| k != &key);
+            return;
+        }
+        if !self.active_alarms.contains(&key) {
+            self.active_alarms.push(key);
+        }
+        // Any alarm stops the run: nothing more is sent; motion stops on its own or by the
+        // cycle stop.
+        if let Some(r) = self.run.as_mut() {
+            if !r.failed {
+                r.failed = true;
+                self.stop_command_id += 1;
+                self.effects.push(Effect::ToMotion(ProgramCommand {
+                    id: self.stop_command_id,
+                    command: ProgramCommand::CYCLE_STOP,
+                    program: String::new(),
+                    text: String::new(),
+                }));
+            }
+        }
+        self.stop_execution();
+    }
+
+    /// A command from hmi_bridge, answered. hmi_bridge repeats a command until it is
+    /// answered: a repeat gets the same answer again and is not acted on twice.
+    pub fn command(&mut self, c: ProgramCommand) -> CommandResult {
+        if let Some(done) = self.answered.iter().find(|r| r.id == c.id) {
+            return done.clone();
+        }
+        let (accepted, message) = match self.carry_out(c.clone()) {
+            Ok(m) => (true, m),
+            Err(m) => (false, m),
+        };
+        let result = CommandResult {
+            id: c.id,
+            accepted,
+            message,
+        };
+        if self.answered.len() == ANSWERS_KEPT {
+            self.answered.pop_front();
+        }
+        self.answered.push_back(result.clone());
+        result
+    }
+
+    fn carry_out(&mut self, c: ProgramCommand) -> Result<String, String> {
+        let running = self.running();
+        match c.command {
+            // An MDI entry is stored as the program `MDI` and started as a program is
+            // (decisions D43); cycle start runs programs in AUTO only.
+            ProgramCommand::MDI => {
+                if let Some(why) = mdi_refusal(self.mode, running, &c.text) {
+                    return Err(why);
+                }
+                self.programs.insert(MDI_PROGRAM.into(), c.text.clone());
+                self.start(MDI_PROGRAM)
+            }
+            ProgramCommand::START
+                if self.mode != MachineState::MODE_AUTO
+                    && self.execution != MachineState::FEED_HOLD =>
+            {
+                Err(format!(
+                    "cycle start refused: mode {}, not AUTO",
+                    MachineState::mode_name_of(self.mode)
+                ))
+            }
+            ProgramCommand::START => self.start(&c.program),
+            ProgramCommand::MODE => self.set_mode(&c.text),
+            ProgramCommand::READ => self
+                .programs
+                .get(&c.program)
+                .cloned()
+                .ok_or_else(|| not_found(&c.program)),
+            ProgramCommand::OFFSETS => Ok(offset_page::format(&self.memory, &self.base.axes)),
+            ProgramCommand::SET_TOOL_OFFSET | ProgramCommand::SET_WORK_OFFSET => {
+                if running {
+                    return Err("offsets cannot change while a program runs (stop it first)".into());
+                }
+                // A stopped run's offsets are taken first, so the edit is not overwritten by
+                // them later.
+                self.remember();
+                self.run = None;
+                let mut edited = self.memory.clone();
+                let message = if c.command == ProgramCommand::SET_TOOL_OFFSET {
+                    offset_page::set_tool(&mut edited, &c.program, &c.text)
+                } else {
+                    offset_page::set_work(&mut edited, &c.program, &c.text, &self.base.axes)
+                }?;
+                self.memory = edited;
+                self.effects.push(Effect::StoreMemory);
+                Ok(message)
+            }
+            ProgramCommand::LOAD => self.load(&c.program, &c.text),
+            ProgramCommand::FEED_HOLD => {
+                if self.execution == MachineState::ACTIVE {
+                    self.execution = MachineState::FEED_HOLD;
+                    Ok("feed hold".into())
+                } else {
+                    Err("no program running".into())
+                }
+            }
+            ProgramCommand::CYCLE_STOP => {
+                if let Some(r) = self.run.as_mut() {
+                    r.failed = true;
+                }
+                self.stop_execution();
+                Ok("cycle stop".into())
+            }
+            ProgramCommand::RESET => {
+                self.remember();
+                self.run = None;
+                // Program alarms are cleared by reset; alarms whose cause persists (emergency
+                // stop) stay until their source clears them.
+                for (source, number) in self.active_alarms.clone() {
+                    if source == SOURCE {
+                        self.effects.push(Effect::Clear(number));
+                        self.active_alarms
+                            .retain(|k| k != &(source.clone(), number));
+                    }
+                }
+                self.execution = if self.position.is_some() {
+                    MachineState::READY
+                } else {
+                    MachineState::WAIT
+                };
+                Ok("reset".into())
+            }
+            ProgramCommand::LIST => Ok(self
+                .programs
+                .iter()
+                .map(|(name, text)| format!("{name}\t{}", text.len()))
+                .collect::<Vec<_>>()
+                .join("\n")),
+            ProgramCommand::DELETE => {
+                let this_runs = self.run.as_ref().is_some_and(|r| r.program == c.program);
+                if this_runs && running {
+                    Err(format!("{} is running: stop it first", c.program))
+                } else if self.programs.remove(&c.program).is_some() {
+                    Ok(format!("{} deleted", c.program))
+                } else {
+                    Err(not_found(&c.program))
+                }
+            }
+            other => Err(format!("unknown command {other}")),
+        }
+    }
+
+    fn set_mode(&mut self, text: &str) -> Result<String, String> {
+        match text.trim().parse::<u8>() {
+            Ok(m) if m <= MachineState::MODE_HANDWHEEL => {
+                if self.running() && m != self.mode {
+                    Err("mode change refused: a program is running (stop it first)".into())
+                } else {
+                    self.mode = m;
+                    Ok(format!("mode {}", MachineState::mode_name_of(m)))
+                }
+            }
+            _ => Err(format!(
+                "unknown mode {text:?}: 0 AUTO, 1 MDI, 2 JOG, 3 HOME, 4 EDIT, 5 HANDWHEEL"
+            )),
+        }
+    }
+
+    fn load(&mut self, name: &str, text: &str) -> Result<String, String> {
+        if !valid_program_name(name) {
+            return Err(format!(
+                "invalid program name {name:?}: letters, digits, '.', '_', '-', at most 64"
+            ));
+        }
+        if text.len() > MAX_PROGRAM_BYTES {
+            return Err(format!(
+                "program too large: {} bytes, limit {MAX_PROGRAM_BYTES}",
+                text.len()
+            ));
+        }
+        if self.programs.len() >= MAX_PROGRAMS && !self.programs.contains_key(name) {
+            return Err(format!("program memory full ({MAX_PROGRAMS} programs)"));
+        }
+        if self.run.as_ref().is_some_and(|r| r.program == name)
+            && self.execution == MachineState::ACTIVE
+        {
+            return Err(format!("{name} is running"));
+        }
+        let lines = text.lines().count();
+        self.programs.insert(name.to_string(), text.to_string());
+        Ok(format!("{name} stored ({lines} lines)"))
+    }
+
+    fn start(&mut self, name: &str) -> Result<String, String> {
+        if !self.active_alarms.is_empty() {
+            return Err(format!(
+                "alarm active ({} alarms): reset first",
+                self.active_alarms.len()
+            ));
+        }
+        if self.execution == MachineState::ACTIVE {
+            return Err("a program is running".into());
+        }
+        if self.execution == MachineState::FEED_HOLD && name.is_empty() {
+            self.execution = MachineState::ACTIVE;
+            return Ok("resumed".into());
+        }
+        let Some(text) = self.programs.get(name).cloned() else {
+            return Err(not_found(name));
+        };
+        let Some(start) = self.position.clone() else {
+            return Err("no axis position from motion yet".into());
+        };
+        // What the last run left is taken first: this run starts from it.
+        self.remember();
+        let mut setup = self.base.clone();
+        setup.start = start;
+        setup.kept = self.memory.kept.clone();
+        setup.offsets.tools = self.memory.tools.clone();
+        setup.offsets.work = self.memory.work.clone();
+        // The cell runs programs as the operator would: M99 or G27 loops go on until stop.
+        setup.single_pass = false;
+        let interp = Interpreter::with_library(self.dialect, &text, setup, library(&self.programs));
+        self.run_counter += 1;
+        self.run = Some(Run {
+            id: self.run_counter,
+            program: name.to_string(),
+            stream: ProgramRun::new(interp),
+            failed: false,
+        });
+        self.program_name = name.to_string();
+        self.execution = MachineState::ACTIVE;
+        Ok(format!("{name} started"))
+    }
+
+    /// Feeds motion while credit lasts, notes completion and feed hold. Returns whether it
+    /// sent anything.
+    pub fn step(&mut self) -> bool {
+        let mut busy = false;
+        if let Some(r) = self.run.as_mut() {
+            let done = if self.status.run_id == r.id {
+                self.status.done_seq
+            } else {
+                0
+            };
+            if !r.failed {
+                let (id, program) = (r.id, r.program.clone());
+                let effects = &mut self.effects;
+                let sent = r.stream.feed(
+                    done,
+                    u64::from(self.status.capacity),
+                    |seq, canon, interp| {
+                        let mut msg =
+                            to_motion_block(id, seq, &program, canon.line, &canon.command);
+                        msg.origin = interp.program_origin();
+                        effects.push(Effect::Block(msg));
+                    },
+                );
+                match sent {
+                    Ok(n) => busy = n > 0,
+                    Err(e) => {
+                        busy = true;
+                        r.failed = true;
+                        self.effects.push(Effect::Raise {
+                            number: e.number,
+                            text: e.text.clone(),
+                            program: program.clone(),
+                            line: e.line,
+                        });
+                        // The interpreter knows its own alarm at once: it does not wait for the
+                        // event to come back over DDS to stop the program.
+                        let key = (SOURCE.to_string(), e.number);
+                        if !self.active_alarms.contains(&key) {
+                            self.active_alarms.push(key);
+                        }
+                        if matches!(
+                            self.execution,
+                            MachineState::ACTIVE | MachineState::FEED_HOLD
+                        ) {
+                            self.execution = MachineState::STOPPED;
+                        }
+                    }
+                }
+            }
+            let complete = self.status.run_id == r.id && r.stream.completed(self.status.done_seq);
+            if complete && self.execution == MachineState::ACTIVE {
+                self.execution = MachineState::PROGRAM_COMPLETED;
+                self.remember();
+                self.run = None;
+            }
+        }
+        if let Some(r) = self.run.as_ref() {
+            if self.status.run_id == r.id {
+                if self.status.state == MotionStatus::STATE_HOLD
+                    && self.execution == MachineState::ACTIVE
+                {
+                    self.execution = MachineState::FEED_HOLD;
+                } else if self.status.state == MotionStatus::STATE_RUNNING
+                    && self.execution == MachineState::FEED_HOLD
+                {
+                    self.execution = MachineState::ACTIVE;
+                }
+            }
+        }
+        busy
+    }
+
+    /// The machine state as it stands.
+    pub fn state(&self) -> StateView {
+        let ours = self
+            .run
+            .as_ref()
+            .is_some_and(|r| r.id == self.status.run_id);
+        let line = if ours || !matches!(self.execution, MachineState::READY | MachineState::WAIT) {
+            self.status.line
+        } else {
+            0
+        };
+        StateView {
+            mode: self.mode,
+            execution: self.execution,
+            program: self.program_name.clone(),
+            line,
+            emergency_stop: self
+                .active_alarms
+                .iter()
+                .any(|(s, n)| s == "plc" && *n == 65),
+            alarm_active: !self.active_alarms.is_empty(),
+        }
+    }
+
+    /// The node stops: a program stopped by shutdown keeps what it had stored so far.
+    pub fn shutdown(&mut self) {
+        self.remember();
+    }
+
+    /// Takes what the run left in memory (kept variables, offsets); asks to store it if it
+    /// changed.
+    fn remember(&mut self) {
+        let Some(r) = self.run.as_ref() else { return };
+        let now = r.stream.interpreter().memory();
+        if now != self.memory {
+            self.memory = now;
+            self.effects.push(Effect::StoreMemory);
+        }
+    }
+}
+
+fn not_found(name: &str) -> String {
+    format!("program {name:?} not found (alarm 22)")
+}
+
+/// Why an MDI entry is not run, if it is not.
+fn mdi_refusal(mode: u8, running: bool, text: &str) -> Option<String> {
+    if mode != MachineState::MODE_MDI {
+        Some(format!(
+            "MDI refused: mode {}, not MDI",
+            MachineState::mode_name_of(mode)
+        ))
+    } else if running {
+        Some("MDI refused: a program is running".into())
+    } else if text.trim().is_empty() {
+        Some("MDI refused: no block entered".into())
+    } else if text.len() > MAX_MDI_BYTES {
+        Some(format!(
+            "MDI refused: {} bytes, limit {MAX_MDI_BYTES}",
+            text.len()
+        ))
+    } else {
+        None
+    }
+}
+
+/// Program memory as a subprogram library: every stored program with an O number on its first
+/// line or in its name (`O0010`, `O0010.nc`).
+fn library(programs: &BTreeMap<String, String>) -> Library {
+    let mut lib = Library::new();
+    for (name, text) in programs {
+        let number = Library::declared_number(text)
+            .or_else(|| Library::file_number(std::path::Path::new(name)));
+        if let Some(n) = number {
+            if lib.get(n).is_none() {
+                lib.insert(n, name, text);
+            }
+        }
+    }
+    lib
+}
+
+#[cfg(test)]
+#[path = "run_tests.rs"]
+mod tests;

@@ -1,0 +1,321 @@
+//! The run core without DDS: commands in, effects and state out, motion played by hand.
+
+use super::*;
+use crate::setup::ToolOffset;
+
+const PART: &str = "G00 X100 Z20\nS500 M03\nG01 Z10 F3000\nG01 Z5\nM05\nM30\n";
+
+fn core() -> RunCore {
+    let mut base = Setup::lathe([200.0, 100.0]);
+    base.offsets.tools.insert(
+        1,
+        ToolOffset {
+            radius: 0.4,
+            tip: 3,
+            ..ToolOffset::default()
+        },
+    );
+    let memory = Memory {
+        tools: base.offsets.tools.clone(),
+        ..Memory::default()
+    };
+    RunCore::new(Dialect::HuaxingLathe, base, memory, 1000)
+}
+
+fn command(core: &mut RunCore, id: u64, command: u8, program: &str, text: &str) -> CommandResult {
+    core.command(ProgramCommand {
+        id,
+        command,
+        program: program.into(),
+        text: text.into(),
+    })
+}
+
+fn status(run_id: u64, done_seq: u64, capacity: u32, state: u8) -> MotionStatus {
+    MotionStatus {
+        run_id,
+        accepted_seq: done_seq,
+        done_seq,
+        capacity,
+        line: 0,
+        state,
+    }
+}
+
+fn blocks(effects: &[Effect]) -> Vec<&MotionBlock> {
+    effects
+        .iter()
+        .filter_map(|e| match e {
+            Effect::Block(b) => Some(b),
+            _ => None,
+        })
+        .collect()
+}
+
+/// A core with the part loaded and the axes' position known, READY.
+fn ready() -> RunCore {
+    let mut c = core();
+    assert_eq!(c.execution(), MachineState::WAIT);
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "part.nc", PART).accepted);
+    let refused = command(&mut c, 2, ProgramCommand::START, "part.nc", "");
+    assert!(!refused.accepted && refused.message.contains("no axis position"));
+    c.axes(&[200.0, 100.0]);
+    assert_eq!(c.execution(), MachineState::READY);
+    c
+}
+
+#[test]
+fn credit_limits_the_blocks_in_flight_and_completion_follows_motion() {
+    let mut c = ready();
+    assert!(command(&mut c, 3, ProgramCommand::START, "part.nc", "").accepted);
+    assert_eq!(c.execution(), MachineState::ACTIVE);
+    c.motion_status(status(0, 0, 3, MotionStatus::STATE_IDLE));
+    assert!(c.step());
+    let sent = c.take_effects();
+    let b = blocks(&sent);
+    // Capacity 3, nothing done: three blocks, numbered from 1, of run 1001.
+    assert_eq!(b.len(), 3);
+    assert_eq!(b.iter().map(|b| b.seq).collect::<Vec<_>>(), [1, 2, 3]);
+    assert!(b.iter().all(|b| b.run_id == 1001 && b.program == "part.nc"));
+    assert_eq!(b[0].origin.len(), 2);
+    // No credit left: nothing more.
+    assert!(!c.step());
+    assert!(c.take_effects().is_empty());
+    // Motion finishes two: two more.
+    c.motion_status(status(1001, 2, 3, MotionStatus::STATE_RUNNING));
+    c.step();
+    assert_eq!(
+        blocks(&c.take_effects())
+            .iter()
+            .map(|b| b.seq)
+            .collect::<Vec<_>>(),
+        [4, 5]
+    );
+    // The rest; the program end is the last block.
+    // Motion stays one block behind until all are sent.
+    let mut last = 5;
+    loop {
+        c.motion_status(status(1001, last - 1, 3, MotionStatus::STATE_RUNNING));
+        c.step();
+        match blocks(&c.take_effects()).last() {
+            Some(b) => last = b.seq,
+            None => break,
+        }
+    }
+    assert_eq!(
+        c.execution(),
+        MachineState::ACTIVE,
+        "motion has not finished"
+    );
+    c.motion_status(status(1001, last, 3, MotionStatus::STATE_IDLE));
+    c.step();
+    assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
+    assert_eq!(c.state().program, "part.nc");
+    // A new start is a new run id.
+    assert!(command(&mut c, 4, ProgramCommand::START, "part.nc", "").accepted);
+    c.motion_status(status(1001, last, 3, MotionStatus::STATE_IDLE));
+    c.step();
+    assert!(blocks(&c.take_effects()).iter().all(|b| b.run_id == 1002));
+}
+
+#[test]
+fn feed_hold_follows_motion_and_resumes_on_cycle_start() {
+    let mut c = ready();
+    command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    c.motion_status(status(1001, 0, 2, MotionStatus::STATE_RUNNING));
+    c.step();
+    assert!(command(&mut c, 4, ProgramCommand::FEED_HOLD, "", "").accepted);
+    assert_eq!(c.execution(), MachineState::FEED_HOLD);
+    // A start while held with no program named resumes.
+    let r = command(&mut c, 5, ProgramCommand::START, "", "");
+    assert!(r.accepted && r.message == "resumed", "{r:?}");
+    assert_eq!(c.execution(), MachineState::ACTIVE);
+    // Motion holding (panel feed hold) shows as FEED_HOLD, running again as ACTIVE.
+    c.motion_status(status(1001, 0, 2, MotionStatus::STATE_HOLD));
+    c.step();
+    assert_eq!(c.execution(), MachineState::FEED_HOLD);
+    c.motion_status(status(1001, 0, 2, MotionStatus::STATE_RUNNING));
+    c.step();
+    assert_eq!(c.execution(), MachineState::ACTIVE);
+    assert!(command(&mut c, 6, ProgramCommand::FEED_HOLD, "", "").accepted);
+}
+
+#[test]
+fn cycle_stop_ends_the_stream_and_reset_makes_the_machine_ready() {
+    let mut c = ready();
+    command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    c.motion_status(status(1001, 0, 2, MotionStatus::STATE_RUNNING));
+    c.step();
+    c.take_effects();
+    assert!(command(&mut c, 4, ProgramCommand::CYCLE_STOP, "", "").accepted);
+    assert_eq!(c.execution(), MachineState::STOPPED);
+    c.motion_status(status(1001, 2, 2, MotionStatus::STATE_IDLE));
+    c.step();
+    assert!(
+        blocks(&c.take_effects()).is_empty(),
+        "a stopped run sends nothing"
+    );
+    // Offsets and mode may change once stopped.
+    assert!(command(&mut c, 5, ProgramCommand::MODE, "", "1").accepted);
+    assert!(command(&mut c, 6, ProgramCommand::RESET, "", "").accepted);
+    assert_eq!(c.execution(), MachineState::READY);
+    assert_eq!(c.state().line, 0);
+}
+
+#[test]
+fn a_program_alarm_stops_the_run_and_blocks_starts_until_reset() {
+    let mut c = ready();
+    let bad = "G00 X100 Z20\nG01 Z10 F3000\nG02 X120 Z-20 R5\nM30\n";
+    command(&mut c, 3, ProgramCommand::LOAD, "bad.nc", bad);
+    command(&mut c, 4, ProgramCommand::START, "bad.nc", "");
+    c.motion_status(status(0, 0, 16, MotionStatus::STATE_IDLE));
+    c.step();
+    let effects = c.take_effects();
+    // The two good blocks went out, then the alarm with the run's program and the line.
+    assert_eq!(blocks(&effects).len(), 2);
+    let raised = effects.iter().find_map(|e| match e {
+        Effect::Raise {
+            number,
+            program,
+            line,
+            ..
+        } => Some((*number, program.clone(), *line)),
+        _ => None,
+    });
+    assert_eq!(raised, Some((11, "bad.nc".to_string(), 3)));
+    assert_eq!(c.execution(), MachineState::STOPPED);
+    assert!(c.state().alarm_active);
+    let r = command(&mut c, 5, ProgramCommand::START, "part.nc", "");
+    assert!(!r.accepted && r.message.contains("reset first"), "{r:?}");
+    // Reset clears the interpreter's own alarm.
+    command(&mut c, 6, ProgramCommand::RESET, "", "");
+    assert!(c.take_effects().contains(&Effect::Clear(11)));
+    assert!(!c.state().alarm_active);
+    assert!(command(&mut c, 7, ProgramCommand::START, "part.nc", "").accepted);
+}
+
+#[test]
+fn another_nodes_alarm_stops_the_run_with_a_cycle_stop_and_needs_its_source_to_clear() {
+    let mut c = ready();
+    command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    let mut event = AlarmEvent {
+        kind: AlarmEvent::RAISED,
+        alarm: Alarm {
+            number: 65,
+            severity: Alarm::SEVERITY_FATAL,
+            source: "plc".into(),
+            ..Alarm::default()
+        },
+    };
+    c.alarm_event(&event);
+    let effects = c.take_effects();
+    assert!(
+        matches!(&effects[..], [Effect::ToMotion(p)] if p.command == ProgramCommand::CYCLE_STOP)
+    );
+    assert_eq!(c.execution(), MachineState::STOPPED);
+    assert!(c.state().emergency_stop);
+    // Reset does not clear another node's alarm; its CLEARED does.
+    command(&mut c, 4, ProgramCommand::RESET, "", "");
+    assert!(c.state().alarm_active);
+    assert!(!command(&mut c, 5, ProgramCommand::START, "part.nc", "").accepted);
+    event.kind = AlarmEvent::CLEARED;
+    c.alarm_event(&event);
+    assert!(!c.state().alarm_active && !c.state().emergency_stop);
+    // A warning informs and stops nothing.
+    assert!(command(&mut c, 6, ProgramCommand::START, "part.nc", "").accepted);
+    c.alarm_event(&AlarmEvent {
+        kind: AlarmEvent::RAISED,
+        alarm: Alarm {
+            number: 1,
+            severity: Alarm::SEVERITY_WARNING,
+            source: "hmi_bridge".into(),
+            ..Alarm::default()
+        },
+    });
+    assert_eq!(c.execution(), MachineState::ACTIVE);
+    assert!(c.take_effects().is_empty());
+}
+
+#[test]
+fn mdi_runs_in_mdi_mode_only_and_programs_in_auto_only() {
+    let mut c = ready();
+    let r = command(&mut c, 3, ProgramCommand::MDI, "", "G00 X80 Z20");
+    assert!(!r.accepted && r.message.contains("not MDI"), "{r:?}");
+    assert!(command(&mut c, 4, ProgramCommand::MODE, "", "1").accepted);
+    let r = command(&mut c, 5, ProgramCommand::START, "part.nc", "");
+    assert!(!r.accepted && r.message.contains("not AUTO"), "{r:?}");
+    assert!(!command(&mut c, 6, ProgramCommand::MDI, "", "  ").accepted);
+    assert!(command(&mut c, 7, ProgramCommand::MDI, "", "G00 X80 Z20").accepted);
+    assert_eq!(c.state().program, MDI_PROGRAM);
+    // No mode change while it runs.
+    let r = command(&mut c, 8, ProgramCommand::MODE, "", "0");
+    assert!(!r.accepted && r.message.contains("running"), "{r:?}");
+    assert!(!command(&mut c, 9, ProgramCommand::MODE, "", "9").accepted);
+}
+
+#[test]
+fn a_repeated_command_is_answered_again_not_done_twice() {
+    let mut c = ready();
+    let first = command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    let again = command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    assert_eq!(first, again);
+    assert!(first.accepted);
+    // A new id is a new start, refused while one runs.
+    assert!(!command(&mut c, 4, ProgramCommand::START, "part.nc", "").accepted);
+}
+
+#[test]
+fn program_memory_refuses_bad_names_and_keeps_a_running_program() {
+    let mut c = ready();
+    assert!(!command(&mut c, 3, ProgramCommand::LOAD, "../etc", "M30").accepted);
+    assert!(!command(&mut c, 4, ProgramCommand::LOAD, ".hidden", "M30").accepted);
+    let big = "G00 X1\n".repeat(MAX_PROGRAM_BYTES / 7 + 1);
+    assert!(!command(&mut c, 5, ProgramCommand::LOAD, "big.nc", &big).accepted);
+    command(&mut c, 6, ProgramCommand::START, "part.nc", "");
+    assert!(!command(&mut c, 7, ProgramCommand::LOAD, "part.nc", "M30").accepted);
+    assert!(!command(&mut c, 8, ProgramCommand::DELETE, "part.nc", "").accepted);
+    let list = command(&mut c, 9, ProgramCommand::LIST, "", "");
+    assert_eq!(list.message, format!("part.nc\t{}", PART.len()));
+    let read = command(&mut c, 10, ProgramCommand::READ, "part.nc", "");
+    assert_eq!(read.message, PART);
+    assert!(!command(&mut c, 11, ProgramCommand::READ, "none.nc", "").accepted);
+}
+
+#[test]
+fn what_a_run_leaves_in_memory_is_stored_and_offsets_wait_for_a_stop() {
+    let mut c = ready();
+    command(
+        &mut c,
+        3,
+        ProgramCommand::LOAD,
+        "kept.nc",
+        "#200=7\nG00 X100\nM30\n",
+    );
+    command(&mut c, 4, ProgramCommand::START, "kept.nc", "");
+    let r = command(&mut c, 5, ProgramCommand::SET_TOOL_OFFSET, "1", "x=0.5");
+    assert!(
+        !r.accepted && r.message.contains("while a program runs"),
+        "{r:?}"
+    );
+    c.motion_status(status(0, 0, 16, MotionStatus::STATE_IDLE));
+    c.step();
+    let last = blocks(&c.take_effects()).last().map(|b| b.seq).unwrap_or(0);
+    c.motion_status(status(1001, last, 16, MotionStatus::STATE_IDLE));
+    c.step();
+    assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
+    assert!(c.take_effects().contains(&Effect::StoreMemory));
+    assert_eq!(c.memory().kept.get(&200), Some(&7.0));
+    // The next run starts from it.
+    command(
+        &mut c,
+        6,
+        ProgramCommand::LOAD,
+        "use.nc",
+        "G00 X[#200*10]\nM30\n",
+    );
+    command(&mut c, 7, ProgramCommand::START, "use.nc", "");
+    c.motion_status(status(1001, last, 16, MotionStatus::STATE_IDLE));
+    c.step();
+    let b = c.take_effects();
+    assert_eq!(blocks(&b)[0].end.first(), Some(&70.0), "{b:?}");
+}
