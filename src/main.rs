@@ -164,7 +164,7 @@ struct LoadedProgram {
 
 impl ProgramArgs {
     fn load(&self) -> Result<LoadedProgram, String> {
-        use cnc_interpreter::{Dialect, Library};
+        use cnc_interpreter::Dialect;
         let (cfg, _) = machines::load(self.config.as_deref(), self.tools.as_deref())?;
         let text = read_program(&self.program)?;
         let name = self.dialect.as_deref().unwrap_or(&cfg.machine.dialect);
@@ -182,8 +182,8 @@ impl ProgramArgs {
                 .to_path_buf(),
         };
         // Files that are not programs or repeat a number are left out of the library.
-        let (library, _skipped) =
-            Library::load_dir(&dir).map_err(|e| format!("library {}: {e}", dir.display()))?;
+        let (library, _skipped) = cnc_interpreter::library::load_dir(&dir)
+            .map_err(|e| format!("library {}: {e}", dir.display()))?;
         Ok(LoadedProgram {
             cfg,
             text,

@@ -1,29 +1,31 @@
 //! The interpreter: part program text in, canonical commands out.
 //!
-//! Read a block's path through it in this order: [`syntax`] (text → statements and words,
-//! with [`expr`] for macro expressions), [`dialect`] (which codes exist and what they mean),
-//! [`interpreter`] (modal state, offsets, program flow, cycles; [`rough`] and [`geometry`] for
-//! contour work) → [`canon`] (what motion receives). [`trace`] prints the stream for checks and
-//! golden files; [`node`] binds the core to the ROS 2 topics.
+//! The dialect-free core is its own crate, `cnc_interpreter_core`: machine state, transforms,
+//! program flow, path filters, the canonical command stream. This crate holds the front ends
+//! that read the dialects and lower them onto the core: the FANUC family base ([`fanuc`]) and
+//! its dialects [`huaxing`], [`gtc2e`], [`iso`] and [`mill`], named in one place
+//! ([`dialect`]). Around them: the public [`interpreter`], program libraries ([`library`]),
+//! the program run ([`run`]), [`trace`] (the stream as text for checks and golden files) and
+//! [`node`] (the ROS 2 shell).
 
-pub mod canon;
 pub mod dialect;
 pub mod error;
-pub mod expr;
-pub mod geometry;
+pub mod fanuc;
+pub mod gtc2e;
+pub mod huaxing;
 pub mod interpreter;
+pub mod iso;
+pub mod library;
+pub mod mill;
 pub mod node;
 pub mod offset_page;
-pub mod program;
-pub mod rough;
 pub mod run;
 pub mod setup;
-pub mod syntax;
 pub mod trace;
 
-pub use canon::{Aux, Canon, Command};
+pub use cnc_interpreter_core::{canon, geometry, rough, Aux, Canon, Command, Library};
 pub use dialect::Dialect;
 pub use error::ProgramError;
+pub use fanuc::syntax;
 pub use interpreter::{check, check_with_library, diagnose, Interpreter};
-pub use program::Library;
 pub use setup::Setup;

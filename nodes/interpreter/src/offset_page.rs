@@ -3,7 +3,8 @@
 //! work offsets G54–G59. Every value is checked before anything changes, so a bad entry leaves
 //! the page as it was.
 
-use crate::setup::{Memory, ToolOffset, MAX_OFFSET};
+use crate::fanuc::lathe::MAX_OFFSET;
+use crate::setup::{Memory, ToolOffset};
 
 /// Largest offset value accepted, mm (the address table's 4+3 digits).
 pub const LIMIT_MM: f64 = 9999.999;

@@ -623,8 +623,8 @@ fn mdi_refusal(mode: u8, running: bool, text: &str) -> Option<String> {
 fn library(programs: &BTreeMap<String, String>) -> Library {
     let mut lib = Library::new();
     for (name, text) in programs {
-        let number = Library::declared_number(text)
-            .or_else(|| Library::file_number(std::path::Path::new(name)));
+        let number = crate::library::declared_number(text)
+            .or_else(|| crate::library::file_number(std::path::Path::new(name)));
         if let Some(n) = number {
             if lib.get(n).is_none() {
                 lib.insert(n, name, text);

@@ -13,7 +13,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use cnc_interpreter::dialect::{G, M};
+use cnc_interpreter::dialect::CodeStatus;
 use cnc_interpreter::error::Fault;
 use cnc_interpreter::syntax::code_part;
 use cnc_interpreter::{check, Dialect, Setup};
@@ -298,11 +298,8 @@ fn status(dialect: Dialect, l: &Listed) -> Result<String, String> {
     // counts too where the alarm number says so unambiguously (on FANUC, P/S 010 is also a
     // code missing its words).
     let table_says = match l.letter {
-        'G' => matches!(
-            dialect.g_code(l.x10).map(|c| c.meaning),
-            Some(G::Unsupported(_))
-        ),
-        _ => matches!(dialect.m_code(l.x10), Some(M::Unsupported(_))),
+        'G' => matches!(dialect.g_code(l.x10), Some(CodeStatus::Unsupported(_))),
+        _ => matches!(dialect.m_code(l.x10), Some(CodeStatus::Unsupported(_))),
     };
     let number_says = dialect.alarm(Fault::MissingWord) != not_supported;
     match check(dialect, &program, setup) {

@@ -1,22 +1,26 @@
-//! Chamfer `L` and corner rounding `D` in a G01 block (`000` §5.11, decision D31): the corner
-//! between this block's line and the next move is cut by a straight chamfer whose ends lie L
-//! from the corner on both elements, or rounded by an arc of radius D tangent to both lines.
+//! A path filter: a chamfered or rounded corner (decision D31). The corner between a line and
+//! the next move is cut by a straight chamfer whose ends lie L from the corner on both
+//! elements, or rounded by an arc of radius D tangent to both lines.
 //!
-//! The line is held back until the next move shows the corner, like an element under nose
+//! The line is held back until the next move shows the corner, like an element under radius
 //! compensation; commands queued after it wait for it.
 
-use super::*;
+use crate::emit::MoveKind;
+use crate::error::{Fault, ProgramError};
+use crate::geometry::Pt;
+use crate::show;
+use crate::state::Core;
 
 /// What the corner gets.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Chamfer {
+pub enum Chamfer {
     Line(f64),
     Round(f64),
 }
 
 /// A G01 whose end is a chamfered or rounded corner, waiting for the next move.
 #[derive(Debug, Clone)]
-pub(super) struct Corner {
+pub struct Corner {
     /// Work positions where the line starts and ends (the corner).
     pub start: Vec<f64>,
     pub end: Vec<f64>,
@@ -30,33 +34,15 @@ fn unit(z: f64, r: f64) -> Option<(f64, f64)> {
     (l > 1e-9).then(|| (z / l, r / l))
 }
 
-impl Interpreter {
-    /// The chamfer or rounding words of a Huaxing G01 block; a value outside 0–1000 is
-    /// ignored, as the manual says.
-    pub(super) fn chamfer_words(&self, b: &Block) -> Result<Option<Chamfer>, ProgramError> {
-        if self.dialect != Dialect::HuaxingLathe {
-            return Ok(None);
-        }
-        let usable = |v: f64| v > 0.0 && v <= 1000.0;
-        match (b.get('L'), b.get('D')) {
-            (Some(_), Some(_)) => Err(self.fault(
-                Fault::Chamfer,
-                "chamfer L and corner rounding D in one block",
-            )),
-            (Some(l), None) if usable(l) => Ok(Some(Chamfer::Line(l))),
-            (None, Some(d)) if usable(d) => Ok(Some(Chamfer::Round(d))),
-            _ => Ok(None),
-        }
-    }
-
+impl Core {
     /// A G01 to `end` with a chamfer at its end: held until the next move.
-    pub(super) fn hold_corner(
+    pub fn hold_corner(
         &mut self,
         end: Vec<f64>,
         feed: f64,
         chamfer: Chamfer,
     ) -> Result<(), ProgramError> {
-        if self.nose_comp.is_some() {
+        if self.comp.is_some() {
             return Err(self.fault(
                 Fault::NotSupported,
                 "chamfer L / rounding D while tool-nose compensation is active",
@@ -82,10 +68,7 @@ impl Interpreter {
     /// the given work position) makes with it, and the chamfer or rounding; the current
     /// position is then where the next move starts. Without a usable next move (program end,
     /// a rapid, a cycle) the line runs to its corner unchamfered.
-    pub(super) fn resolve_corner(
-        &mut self,
-        next: Option<(&[f64], MoveKind)>,
-    ) -> Result<(), ProgramError> {
+    pub fn resolve_corner(&mut self, next: Option<(&[f64], MoveKind)>) -> Result<(), ProgramError> {
         let Some(corner) = self.corner.take() else {
             return Ok(());
         };
@@ -124,7 +107,7 @@ impl Interpreter {
                 let cross = t1.0 * t2.1 - t1.1 * t2.0;
                 let dot = t1.0 * t2.0 + t1.1 * t2.1;
                 if cross.abs() < 1e-9 && dot > 0.0 {
-                    return plain(self); // collinear: nothing to cut (`000` §5.11)
+                    return plain(self); // collinear: nothing to cut
                 }
                 let len2 = p.dist(b);
                 let (d, round) = match chamfer {

@@ -6,7 +6,15 @@
 //! The drilling axis is the one normal to the plane (Z in G17). Hole data (Z, R, Q, P) are
 //! modal until G80 or a group-01 code. Decision D47 records what the appendix leaves open.
 
-use super::*;
+use cnc_interpreter_core::{show, Aux, Command, Fault, MoveKind, ProgramError, SpindleDir};
+
+use super::{HoleKind, Mill};
+use crate::fanuc::block::Block;
+use crate::fanuc::codes::G;
+use crate::fanuc::Fanuc;
+
+/// Most passes or pecks one cycle block may generate.
+const MAX_CYCLE_STEPS: usize = 1_000_000;
 
 /// The clearance of a peck: G73 backs off this far after each peck; G83 comes back down to
 /// this far above the last depth (FANUC parameters 531/532; the value LinuxCNC uses).
@@ -16,7 +24,7 @@ const MAX_REPEATS: f64 = 999.0;
 
 /// The cycle that is modal, with its hole data.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct HoleCycle {
+pub struct HoleCycle {
     kind: HoleKind,
     /// Z word as written: the bottom (G90) or its distance from R (G91).
     z: Option<f64>,
@@ -30,15 +38,15 @@ pub(super) struct HoleCycle {
     initial: f64,
 }
 
-impl Interpreter {
+impl Fanuc<Mill> {
     /// The drilling axis: the one normal to the plane (G17 Z, G18 Y, G19 X).
     fn drill_axis(&self) -> Result<usize, ProgramError> {
-        let letter = match self.plane {
+        let letter = match self.d.plane {
             G::PlaneZx => 'Y',
             G::PlaneYz => 'X',
             _ => 'Z',
         };
-        self.axis(letter).ok_or_else(|| {
+        self.core.axis(letter).ok_or_else(|| {
             self.fault(
                 Fault::AxisAddress,
                 format!(
@@ -52,13 +60,13 @@ impl Interpreter {
     /// already modal.
     /// The canned cycle in force, if any.
     pub(super) fn hole_kind(&self) -> Option<HoleKind> {
-        self.hole.map(|h| h.kind)
+        self.d.hole.map(|h| h.kind)
     }
 
     pub(super) fn select_hole_cycle(&mut self, kind: HoleKind) -> Result<(), ProgramError> {
         let d = self.drill_axis()?;
-        let initial = self.work_position()[d];
-        self.hole = Some(match self.hole {
+        let initial = self.core.work_position()[d];
+        self.d.hole = Some(match self.d.hole {
             Some(h) => HoleCycle { kind, ..h },
             None => HoleCycle {
                 kind,
@@ -74,12 +82,12 @@ impl Interpreter {
 
     /// A block while a cycle is modal: takes its hole data and machines the hole when the
     /// block has a position, Z or R (`003` Appendix A.1).
-    pub(super) fn hole_block(&mut self, b: &Block) -> Result<(), ProgramError> {
-        let Some(mut h) = self.hole else {
+    pub(super) fn hole_block(&mut self, b: &Block<Mill>) -> Result<(), ProgramError> {
+        let Some(mut h) = self.d.hole else {
             return Ok(());
         };
         let d = self.drill_axis()?;
-        let drill_letter = self.setup.axes[d];
+        let drill_letter = self.core.setup.axes[d];
         if let Some(z) = b.get(drill_letter) {
             h.z = Some(z);
         }
@@ -104,7 +112,7 @@ impl Interpreter {
             }
             h.dwell_ms = p;
         }
-        self.hole = Some(h);
+        self.d.hole = Some(h);
         let repeats = match (b.get('L'), b.get('K')) {
             (Some(_), Some(_)) => {
                 return Err(self.fault(Fault::RepeatedWord, "L and K both give the repeat count"))
@@ -145,7 +153,7 @@ impl Interpreter {
             }
         }
         if h.kind == HoleKind::BackBore {
-            if self.cycle_return_r {
+            if self.d.cycle_return_r {
                 return Err(self.fault(Fault::IllegalWord, "G87 back boring returns only in G98"));
             }
             if r_level > bottom {
@@ -162,8 +170,8 @@ impl Interpreter {
             ));
         }
         for _ in 0..repeats as u32 {
-            let mut target = self.work_position();
-            for (i, &letter) in self.setup.axes.iter().enumerate() {
+            let mut target = self.core.work_position();
+            for (i, &letter) in self.core.setup.axes.iter().enumerate() {
                 if i == d {
                     continue;
                 }
@@ -185,25 +193,25 @@ impl Interpreter {
         r_level: f64,
         bottom: f64,
     ) -> Result<(), ProgramError> {
-        let clear = if self.cycle_return_r {
+        let clear = if self.d.cycle_return_r {
             r_level
         } else {
             h.initial.max(r_level)
         };
         // Below the R level, rise to it before moving across (never drag the tool sideways
         // through the part).
-        if self.work_position()[d] < r_level && h.kind != HoleKind::BackBore {
+        if self.core.work_position()[d] < r_level && h.kind != HoleKind::BackBore {
             self.cycle_move(d, r_level, MoveKind::Rapid)?;
         }
         let mut over = target.to_vec();
-        over[d] = self.work_position()[d];
-        if over != self.work_position() {
-            self.emit(&over, MoveKind::Rapid)?;
+        over[d] = self.core.work_position()[d];
+        if over != self.core.work_position() {
+            self.core.emit(&over, MoveKind::Rapid)?;
         }
-        let feed = self.feed;
-        let dwell = |it: &mut Interpreter| {
+        let feed = self.core.feed;
+        let dwell = |it: &mut Self| {
             if h.dwell_ms > 0.0 {
-                it.push(Command::Dwell {
+                it.core.push(Command::Dwell {
                     seconds: h.dwell_ms / 1000.0,
                 });
             }
@@ -263,7 +271,7 @@ impl Interpreter {
                 if h.kind == HoleKind::BoreManual {
                     // G88: the operator retracts by hand during this stop (decision D47);
                     // the automatic return follows cycle start.
-                    self.aux(Aux::M(0));
+                    self.core.aux(Aux::M(0));
                 }
                 self.cycle_move(d, clear, MoveKind::Rapid)?;
                 self.spindle_on();
@@ -286,13 +294,13 @@ impl Interpreter {
 
     /// Moves the drilling axis alone to `level`.
     fn cycle_move(&mut self, d: usize, level: f64, kind: MoveKind) -> Result<(), ProgramError> {
-        let mut end = self.work_position();
+        let mut end = self.core.work_position();
         end[d] = level;
-        self.emit(&end, kind)
+        self.core.emit(&end, kind)
     }
 
     fn rapid_to_level(&mut self, d: usize, level: f64) -> Result<(), ProgramError> {
-        if self.work_position()[d] != level {
+        if self.core.work_position()[d] != level {
             self.cycle_move(d, level, MoveKind::Rapid)?;
         }
         Ok(())
@@ -300,13 +308,13 @@ impl Interpreter {
 
     fn spindle_code(&mut self, m: i32) {
         self.track_spindle((m * 10) as u32);
-        self.aux(Aux::M(m));
+        self.core.aux(Aux::M(m));
     }
 
-    /// M05, remembering which way the spindle turned for [`Interpreter::spindle_on`].
+    /// M05, remembering which way the spindle turned for [`Self::spindle_on`].
     fn stop_spindle(&mut self) {
-        if self.spindle != SpindleDir::Stopped {
-            self.cycle_spindle = self.spindle;
+        if self.core.spindle != SpindleDir::Stopped {
+            self.d.cycle_spindle = self.core.spindle;
         }
         self.spindle_code(5);
     }
@@ -314,7 +322,7 @@ impl Interpreter {
     /// The spindle back on in the direction it turned before the cycle stopped it (M03 if
     /// it was not turning: boring runs clockwise).
     fn spindle_on(&mut self) {
-        let m = if self.cycle_spindle == SpindleDir::Ccw {
+        let m = if self.d.cycle_spindle == SpindleDir::Ccw {
             4
         } else {
             3
@@ -336,20 +344,21 @@ impl Interpreter {
     /// shift Q along +X (FANUC's default shift direction); otherwise it moves back.
     fn orient_and_shift(&mut self, q: f64, away: bool) -> Result<(), ProgramError> {
         if away {
-            if self.spindle != SpindleDir::Stopped {
-                self.cycle_spindle = self.spindle;
+            if self.core.spindle != SpindleDir::Stopped {
+                self.d.cycle_spindle = self.core.spindle;
             }
-            self.aux(Aux::M(19));
-            self.spindle = SpindleDir::Stopped;
+            self.core.aux(Aux::M(19));
+            self.core.spindle = SpindleDir::Stopped;
         }
         if q == 0.0 {
             return Ok(());
         }
         let x = self
+            .core
             .axis('X')
             .ok_or_else(|| self.fault(Fault::AxisAddress, "the G76/G87 shift needs an X axis"))?;
-        let mut end = self.work_position();
+        let mut end = self.core.work_position();
         end[x] += if away { q } else { -q };
-        self.emit(&end, MoveKind::Rapid)
+        self.core.emit(&end, MoveKind::Rapid)
     }
 }

@@ -5,10 +5,19 @@
 //! the end point. Steps are in least-input increments without a decimal point (decision D12)
 //! and radius values (decision D23).
 
-use super::*;
+use cnc_interpreter_core::{Fault, MoveKind, ProgramError};
 
-impl Interpreter {
-    pub(super) fn grooving(&mut self, b: &Block, radial: bool) -> Result<(), ProgramError> {
+use super::compound::MAX_CYCLE_STEPS;
+use super::Huaxing;
+use crate::fanuc::block::Block;
+use crate::fanuc::Fanuc;
+
+impl Fanuc<Huaxing> {
+    pub(super) fn grooving(
+        &mut self,
+        b: &Block<Huaxing>,
+        radial: bool,
+    ) -> Result<(), ProgramError> {
         let runs = if radial {
             b.has('X') || b.has('U')
         } else {
@@ -18,14 +27,14 @@ impl Interpreter {
         if !runs || !b.has(step_word) {
             // First block `G74 R(e)` / `G75 R(e)`: the retract per peck.
             if let Some(e) = b.get('R') {
-                self.groove_retract = e.abs();
+                self.d.groove_retract = e.abs();
             }
             return Ok(());
         }
-        let here = self.work_position();
-        let (xi, zi) = self.xz()?;
+        let here = self.core.work_position();
+        let (xi, zi) = self.core.xz()?;
         let end = self.end_point(b)?;
-        let s = self.x_scale();
+        let s = self.core.x_scale();
         // Work in the plane: peck coordinate p and shift coordinate q.
         let (p0, q0, pe, qe) = if radial {
             (here[xi] * s, here[zi], end[xi] * s, end[zi])
@@ -41,7 +50,7 @@ impl Interpreter {
             .unwrap_or(0.0)
             .abs();
         let bottom_retract = b.get('R').unwrap_or(0.0).abs() * if radial { 1.0 } else { 0.5 };
-        let e = self.groove_retract;
+        let e = self.d.groove_retract;
         if peck <= 0.0 {
             return Err(self.fault(Fault::MissingWord, "peck depth is 0"));
         }
@@ -69,7 +78,7 @@ impl Interpreter {
             }
             v
         };
-        let feed = self.feed;
+        let feed = self.core.feed;
         let mut q = q0;
         loop {
             // Pecks down to the end along the peck axis.
@@ -80,20 +89,21 @@ impl Interpreter {
                 } else {
                     pe
                 };
-                self.emit(&point(next, q), MoveKind::Feed(feed))?;
+                self.core.emit(&point(next, q), MoveKind::Feed(feed))?;
                 p = next;
                 if (pe - p) * dir_p > 1e-9 && e > 0.0 {
-                    self.emit(&point(p - dir_p * e.min(peck), q), MoveKind::Rapid)?;
-                    self.emit(&point(p, q), MoveKind::Feed(feed))?;
+                    self.core
+                        .emit(&point(p - dir_p * e.min(peck), q), MoveKind::Rapid)?;
+                    self.core.emit(&point(p, q), MoveKind::Feed(feed))?;
                 }
             }
             // At the bottom: retract along the shift axis, away from the end, then back out.
             let last = (qe - q) * dir_q <= 1e-9;
             let q_out = if last { q } else { q - dir_q * bottom_retract };
             if (q_out - q).abs() > 1e-12 {
-                self.emit(&point(pe, q_out), MoveKind::Rapid)?;
+                self.core.emit(&point(pe, q_out), MoveKind::Rapid)?;
             }
-            self.emit(&point(p0, q_out), MoveKind::Rapid)?;
+            self.core.emit(&point(p0, q_out), MoveKind::Rapid)?;
             if last {
                 break;
             }
@@ -105,10 +115,10 @@ impl Interpreter {
             if shift <= 0.0 && (qe - q).abs() > 1e-9 {
                 return Err(self.fault(Fault::MissingWord, "shift between passes is 0"));
             }
-            self.emit(&point(p0, next_q), MoveKind::Rapid)?;
+            self.core.emit(&point(p0, next_q), MoveKind::Rapid)?;
             q = next_q;
         }
-        self.emit(&point(p0, q0), MoveKind::Rapid)?;
+        self.core.emit(&point(p0, q0), MoveKind::Rapid)?;
         Ok(())
     }
 }

@@ -8,8 +8,8 @@
 //! letters and digits, so such text can only be a comment written on a PC (decision D2).
 //! A `%` alone marks the start or end of the program text; `%NN` names a GTC2E program.
 
-use crate::error::Fault;
-use crate::expr::{BinOp, Expr, Func, UnOp};
+use super::expr::{BinOp, Expr, Func, UnOp};
+use cnc_interpreter_core::Fault;
 use std::borrow::Cow;
 
 /// One address word; the value is evaluated when the block runs.
@@ -689,7 +689,7 @@ mod tests {
             assert_eq!(value.to_bits(), expected.to_bits(), "{t}");
         }
     }
-    use crate::expr::{EvalError, Value, Variables};
+    use crate::fanuc::expr::{EvalError, Value, Variables};
 
     struct Vars;
     impl Variables for Vars {

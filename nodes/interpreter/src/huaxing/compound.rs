@@ -1,7 +1,22 @@
 //! Multiple repetitive cycles of the Huaxing dialect: G70–G73 from a finishing contour and the
 //! G76 threading cycle (`000` §5.22, §5.23.6).
 
-use super::*;
+use cnc_interpreter_core::comp;
+use cnc_interpreter_core::cycles::thread_depths;
+use cnc_interpreter_core::geometry::{self, ArcError, Elem, Pt};
+use cnc_interpreter_core::rough::{Move, Rough};
+use cnc_interpreter_core::{find_number, read_line, Fault, MoveKind, Pos, ProgramError, Repeat};
+
+use super::{Huaxing, HuaxingG};
+use crate::fanuc::block::{incremental_letter, whole, Block};
+use crate::fanuc::codes::{G, M};
+use crate::fanuc::syntax::{parse_line, Stmt};
+use crate::fanuc::Fanuc;
+
+/// Most blocks in a G70–G73 contour (alarm 45).
+const MAX_CONTOUR_BLOCKS: usize = 100;
+/// Most passes or pecks one cycle block may generate.
+pub(super) const MAX_CYCLE_STEPS: usize = 1_000_000;
 
 /// What a contour's first block and position say about the cycle.
 pub(super) struct Contour {
@@ -18,7 +33,7 @@ pub(super) struct Contour {
 
 /// Settings of the first block of G71/G72/G73 and G76, kept until changed (modal).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct CompoundWords {
+pub struct CompoundWords {
     pub depth: f64,
     pub retract: f64,
     pub relief_x: f64,
@@ -53,14 +68,11 @@ impl Default for CompoundWords {
     }
 }
 
-impl Interpreter {
+impl Fanuc<Huaxing> {
     /// Reads blocks `ns`..`nf` as a contour from the work position `here`.
     pub(super) fn contour(&self, ns: u32, nf: u32, here: &[f64]) -> Result<Contour, ProgramError> {
-        let (text, from) = self
-            .frames
-            .last()
-            .map(|f| (f.text.clone(), f.pos))
-            .unwrap_or_else(|| (Arc::from(""), Pos::default()));
+        let level = self.core.current();
+        let (text, from) = (level.text.clone(), level.pos);
         let first = find_number(&text, from, ns).ok_or_else(|| {
             self.fault(
                 Fault::TargetNotFound,
@@ -73,7 +85,7 @@ impl Interpreter {
         let mut elems = Vec::new();
         // Tool-nose compensation inside the contour: (G41/G42, offset, first element) and the
         // element whose block cancels it (`000` §3.6: G71–G73 rough to the compensated contour).
-        let mut nose: Option<(G, u32, usize)> = None;
+        let mut nose: Option<(G<HuaxingG>, u32, usize)> = None;
         let mut nose_cancel: Option<usize> = None;
         let mut info = (false, false, false);
         let mut blocks = 0;
@@ -96,7 +108,7 @@ impl Interpreter {
                 err
             };
             if let Stmt::Words(words) = &line.stmt {
-                let mut b = Block::default();
+                let mut b = Block::<Huaxing>::default();
                 self.decode(words, &mut b).map_err(|mut e| {
                     e.line = next.line;
                     e
@@ -129,7 +141,7 @@ impl Interpreter {
                         other => {
                             return Err(at(
                                 Fault::CycleFormat,
-                                format!("{other:?} is not allowed in a cycle contour"),
+                                format!("{} is not allowed in a cycle contour", other.name()),
                             ))
                         }
                     }
@@ -166,14 +178,14 @@ impl Interpreter {
                 }
                 if self.has_axis_words(&b) {
                     let mut end = cur.clone();
-                    for (i, &letter) in self.setup.axes.iter().enumerate() {
+                    for (i, &letter) in self.core.setup.axes.iter().enumerate() {
                         if let Some(v) = b.get(letter) {
                             end[i] = v;
                         } else if let Some(d) = incremental_letter(letter).and_then(|c| b.get(c)) {
                             end[i] += d;
                         }
                     }
-                    let (a, e) = (self.plane_point(&cur)?, self.plane_point(&end)?);
+                    let (a, e) = (self.core.plane_point(&cur)?, self.core.plane_point(&end)?);
                     let elem = match motion {
                         G::ArcCw | G::ArcCcw => {
                             let ccw = motion == G::ArcCcw;
@@ -217,7 +229,7 @@ impl Interpreter {
             elems = self
                 .compensated_contour(&elems, g, offset, first_elem, nose_cancel, here)
                 .map_err(|mut e| {
-                    e.line = self.line;
+                    e.line = self.core.line;
                     e
                 })?;
         }
@@ -231,20 +243,24 @@ impl Interpreter {
         })
     }
 
-    fn p_q(&self, b: &Block) -> Result<(u32, u32), ProgramError> {
+    fn p_q(&self, b: &Block<Huaxing>) -> Result<(u32, u32), ProgramError> {
         match (b.get('P'), b.get('Q')) {
             (Some(p), Some(q)) => Ok((whole(p), whole(q))),
             _ => Err(self.fault(Fault::MissingWord, "P(ns) and Q(nf) needed")),
         }
     }
 
-    pub(super) fn compound_cycle(&mut self, b: &Block, g: G) -> Result<(), ProgramError> {
+    pub(super) fn compound_cycle(
+        &mut self,
+        b: &Block<Huaxing>,
+        g: HuaxingG,
+    ) -> Result<(), ProgramError> {
         if !(b.has('P') && b.has('Q')) {
             // First block: depth and retract (G71 U R, G72 W R, G73 U W R).
-            let w = &mut self.compound;
+            let w = &mut self.d.compound;
             match g {
-                G::RoughTurning | G::RoughFacing => {
-                    let d = if g == G::RoughTurning {
+                HuaxingG::RoughTurning | HuaxingG::RoughFacing => {
+                    let d = if g == HuaxingG::RoughTurning {
                         b.get('U')
                     } else {
                         b.get('W')
@@ -271,28 +287,28 @@ impl Interpreter {
             }
             return Ok(());
         }
-        if self.nose_comp.is_some() {
+        if self.core.comp.is_some() {
             return Err(self.fault(
                 Fault::CompInCycle,
                 "tool-nose compensation active on entering the cycle",
             ));
         }
         let (ns, nf) = self.p_q(b)?;
-        let here = self.work_position();
-        let a = self.plane_point(&here)?;
+        let here = self.core.work_position();
+        let a = self.core.plane_point(&here)?;
         let contour = self.contour(ns, nf, &here)?;
         let (du, dw) = (b.get('U').unwrap_or(0.0), b.get('W').unwrap_or(0.0));
-        let (dr, dz) = (du * self.x_scale(), dw);
+        let (dr, dz) = (du * self.core.x_scale(), dw);
         let shifted: Vec<Elem> = contour.elems.iter().map(|e| e.shifted(dz, dr)).collect();
         let Some(first) = shifted.first().copied() else {
             return Err(self.fault(Fault::ContourData, "the contour has no motion"));
         };
-        let feed = self.feed;
+        let feed = self.core.feed;
         let moves = match g {
-            G::PatternRepeat => self.g73_moves(a, &contour, dz, dr)?,
+            HuaxingG::PatternRepeat => self.g73_moves(a, &contour, dz, dr)?,
             _ => {
-                let radial = g == G::RoughTurning;
-                let w = self.compound;
+                let radial = g == HuaxingG::RoughTurning;
+                let w = self.d.compound;
                 if w.depth <= 0.0 {
                     return Err(self.fault(Fault::CycleZero, "depth of cut is 0"));
                 }
@@ -409,11 +425,11 @@ impl Interpreter {
                 rough.moves(a, &elems)
             }
         };
-        self.emit_plane(&moves, feed)?;
+        self.core.emit_plane(&moves, feed)?;
         // Continue after nf when the contour follows the cycle block, else after the block
         // (`000` §5.22.2).
-        if contour.first == self.frame().pos {
-            self.frame().pos = contour.after;
+        if contour.first == self.core.level().pos {
+            self.core.level().pos = contour.after;
         }
         Ok(())
     }
@@ -425,7 +441,7 @@ impl Interpreter {
         dz: f64,
         dr: f64,
     ) -> Result<Vec<Move>, ProgramError> {
-        let w = self.compound;
+        let w = self.d.compound;
         if w.relief_x == 0.0 && w.relief_z == 0.0 {
             return Err(self.fault(Fault::PatternReliefZero, "G73 relief U and W are both 0"));
         }
@@ -455,33 +471,33 @@ impl Interpreter {
     fn compensated_contour(
         &self,
         elems: &[Elem],
-        g: G,
+        g: G<HuaxingG>,
         offset: u32,
         first: usize,
         cancel: Option<usize>,
         here: &[f64],
     ) -> Result<Vec<Elem>, ProgramError> {
-        let tool = self.setup.offsets.tool(offset);
+        let tool = self.core.setup.offsets.tool(offset);
         let radius = self.nose_radius(tool.radius, &format!("offset {offset}"))?;
-        let side = self.nose_side(g);
+        let side = self.comp_side(g);
         let start = elems
             .get(first)
             .map(|e| e.start())
-            .map_or_else(|| self.plane_point(here), Ok)?;
+            .map_or_else(|| self.core.plane_point(here), Ok)?;
         let mut comp =
-            nose::NoseComp::new(side, radius, tool.tip, start, nose::Startup::ToNextElement);
+            comp::RadiusComp::new(side, radius, tool.tip, start, comp::Startup::ToNextElement);
         let mut outs = Vec::new();
         let mut out_elems: Vec<Elem> = elems[..first.min(elems.len())].to_vec();
         for (i, e) in elems.iter().enumerate().skip(first) {
             if Some(i) == cancel {
-                outs.extend(comp.cancel(e.end(), 0.0, nose::Kind::Feed(1.0), 0));
+                outs.extend(comp.cancel(e.end(), 0.0, comp::Kind::Feed(1.0), 0));
                 out_elems.extend(outs.drain(..).map(|o| o.path));
                 out_elems.extend(elems[i + 1..].iter().copied());
                 return Ok(out_elems);
             }
             outs.extend(
-                comp.push(*e, 0.0, nose::Kind::Feed(1.0), 0)
-                    .map_err(|x| self.comp_fault(x))?,
+                comp.push(*e, 0.0, comp::Kind::Feed(1.0), 0)
+                    .map_err(|x| self.core.comp_fault(x))?,
             );
         }
         outs.extend(comp.flush());
@@ -490,22 +506,22 @@ impl Interpreter {
     }
 
     /// G70: runs the contour blocks as written, then returns to the start point.
-    pub(super) fn finishing(&mut self, b: &Block) -> Result<(), ProgramError> {
+    pub(super) fn finishing(&mut self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         let (ns, nf) = self.p_q(b)?;
-        let text = self.frame().text.clone();
-        let first = find_number(&text, self.frame().pos, ns)
+        let text = self.core.level().text.clone();
+        let first = find_number(&text, self.core.level().pos, ns)
             .ok_or_else(|| self.fault(Fault::TargetNotFound, format!("N{ns} not found")))?;
         if find_number(&text, first, nf).is_none() {
             return Err(self.fault(Fault::TargetNotFound, format!("N{nf} not found")));
         }
-        let home = self.work_position();
-        let then = self.frame().pos;
+        let home = self.core.work_position();
+        let then = self.core.level().pos;
         // A program end in the G70 block itself (`G70 P Q M30`) comes after the cycle.
         let end_code =
             b.m.iter()
                 .find(|m| m.0 == M::ProgramEnd)
                 .map(|m| (m.1 / 10) as i32);
-        let f = self.frame();
+        let f = self.core.level();
         f.repeats.push(Repeat::Range {
             first,
             last: nf,
@@ -519,14 +535,14 @@ impl Interpreter {
     }
 
     /// G76 multiple threading cycle (`000` §5.23.6).
-    pub(super) fn g76(&mut self, b: &Block) -> Result<(), ProgramError> {
+    pub(super) fn g76(&mut self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         let has_end = b.has('X') || b.has('U') || b.has('Z') || b.has('W');
         if !has_end {
             // First block: P(mmrraa) Q(Δdmin) R(d) J K.
             if let Some(p) = b.get('P') {
                 let p = whole(p);
                 let digits = p.to_string().len();
-                let w = &mut self.compound;
+                let w = &mut self.d.compound;
                 w.g76_angle = (p % 100) as f64;
                 if digits > 2 {
                     w.g76_runout = ((p / 100) % 100) as f64;
@@ -536,13 +552,13 @@ impl Interpreter {
                 }
             }
             if let Some(q) = self.increments(b, 'Q') {
-                self.compound.g76_min_depth = q.abs();
+                self.d.compound.g76_min_depth = q.abs();
             }
             if let Some(r) = b.get('R') {
-                self.compound.g76_allowance = r.abs();
+                self.d.compound.g76_allowance = r.abs();
             }
-            self.compound.g76_j = b.get('J');
-            self.compound.g76_k = b.get('K');
+            self.d.compound.g76_j = b.get('J');
+            self.d.compound.g76_k = b.get('K');
             return Ok(());
         }
         let lead = self.lead(b, true)?;
@@ -553,15 +569,15 @@ impl Interpreter {
             ));
         };
         let (k, d1) = (k.abs(), d1.abs());
-        let w = self.compound;
+        let w = self.d.compound;
         if d1 <= 0.0 || k <= 0.0 || w.g76_allowance >= k {
             return Err(self.fault(
                 Fault::ThreadDepthMissing,
                 "G76: depths must be positive and the allowance smaller than the height",
             ));
         }
-        let here = self.work_position();
-        let (xi, zi) = self.xz()?;
+        let here = self.core.work_position();
+        let (xi, zi) = self.core.xz()?;
         let end = self.end_point(b)?;
         let (x0, z0) = (here[xi], here[zi]);
         let (xe, ze) = (end[xi], end[zi]);
@@ -585,32 +601,17 @@ impl Interpreter {
             v
         };
         // Depths of the rough passes, then the finish allowance, then spring passes.
-        let mut depths = Vec::new();
-        let mut n = 1.0f64;
-        let mut prev = 0.0f64;
-        loop {
-            let d = (d1 * n.sqrt()).max(prev + w.g76_min_depth);
-            if d >= k - w.g76_allowance - 1e-9 || depths.len() > 10_000 {
-                depths.push(k - w.g76_allowance);
-                break;
-            }
-            depths.push(d);
-            prev = d;
-            n += 1.0;
-        }
-        for _ in 0..w.g76_finish_passes.max(1) {
-            depths.push(k);
-        }
+        let depths = thread_depths(d1, k, w.g76_min_depth, w.g76_allowance, w.g76_finish_passes);
         for d in depths {
             // Single-flank infeed along the flank at half the tool angle.
             let zs = z0 + zeta * d * tan;
             let xs = xe + 2.0 * taper + 2.0 * sigma * (k - d);
             let xend = xe + 2.0 * sigma * (k - d);
-            self.emit(&at(xs, zs), MoveKind::Rapid)?;
+            self.core.emit(&at(xs, zs), MoveKind::Rapid)?;
             self.thread_to(&at(xend, ze), lead, 0.0, sigma * runout.0, runout.1)?;
-            let cur = self.work_position();
-            self.emit(&at(x0, cur[zi]), MoveKind::Rapid)?;
-            self.emit(&at(x0, z0), MoveKind::Rapid)?;
+            let cur = self.core.work_position();
+            self.core.emit(&at(x0, cur[zi]), MoveKind::Rapid)?;
+            self.core.emit(&at(x0, z0), MoveKind::Rapid)?;
         }
         Ok(())
     }

@@ -1,11 +1,11 @@
-//! Rough turning and facing from a finishing contour: G71 and G72 (`000` §5.22.1–5.22.2).
+//! Rough turning and facing from a finishing contour (the G71/G72 cycles of lathe controls).
 //!
 //! The contour, already shifted by the finishing allowance, starts at the cycle's start point
 //! A' (the `ns` move A'→B' is its first element). Depth is measured from A' into the material
 //! along X (G71) or Z (G72). Each level k cuts the layer between depths (k−1)·Δd and k·Δd: where
 //! the contour lies in that layer the tool follows it, where the contour lies deeper it cuts
 //! straight at depth k·Δd. One rule covers Type I (monotonic contour: one straight cut per level,
-//! then up the contour to the previous level, `000` §5.22.1 step 4) and Type II (pockets: the
+//! then up the contour to the previous level) and Type II (pockets: the
 //! tool also follows the contour down into each pocket). A last pass follows the whole contour.
 //! So the material left is exactly the shifted contour, no pass is deeper than Δd, and the
 //! travel moves stay in material already removed (decision D15).
@@ -31,7 +31,7 @@ pub struct Rough {
     pub retract: f64,
     /// Type I: retract at 45°; Type II: along the depth axis only.
     pub type_one: bool,
-    /// Skip the last pass along the contour (`000` B11.7, Type I only).
+    /// Skip the last pass along the contour (Type I only).
     pub skip_final: bool,
 }
 

@@ -4,10 +4,8 @@
 //! rules (§5.27.3): in arithmetic null counts as 0, in `==`/`!=` null differs from 0, in
 //! `<`/`<=`/`>`/`>=` null counts as 0 (decision D10).
 
-use crate::error::Fault;
-
-/// A macro value; `None` is null.
-pub type Value = Option<f64>;
+use cnc_interpreter_core::Fault;
+pub use cnc_interpreter_core::Value;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Expr {

@@ -6,7 +6,11 @@
 //! G76 and G74, whose first move is a rapid or an infeed, and at the cycle's feed for G24,
 //! G75 and G83, where the manual gives feed (decision D24).
 
-use super::*;
+use cnc_interpreter_core::{show, Aux, Command, Fault, MoveKind, ProgramError, Repeat, SpindleDir};
+
+use super::{Gtc2e, GtcCycle, GtcG, ReturnOrder};
+use crate::fanuc::block::{whole, Block};
+use crate::fanuc::Fanuc;
 
 /// GTC2E E word: threads per inch, where `.2` means ½ (`E10.2` = 10½; `002` §4.3.2-4).
 fn tpi(e: f64) -> Option<f64> {
@@ -22,9 +26,9 @@ fn tpi(e: f64) -> Option<f64> {
     }
 }
 
-impl Interpreter {
+impl Fanuc<Gtc2e> {
     /// K (metric lead, 0.25–24 mm) or E (threads per inch, 2–99½).
-    fn gtc_lead(&self, b: &Block) -> Result<f64, ProgramError> {
+    pub(super) fn gtc_lead(&self, b: &Block<Gtc2e>) -> Result<f64, ProgramError> {
         match (b.get('K'), b.get('E')) {
             (Some(_), Some(_)) => Err(self.fault(Fault::RepeatedWord, "K and E in one block")),
             (Some(k), None) if (0.25..=24.0).contains(&k) => Ok(k),
@@ -44,7 +48,7 @@ impl Interpreter {
         }
     }
 
-    fn gtc_starts(&self, b: &Block) -> Result<u32, ProgramError> {
+    pub(super) fn gtc_starts(&self, b: &Block<Gtc2e>) -> Result<u32, ProgramError> {
         match b.get('L') {
             None => Ok(1),
             Some(l) => {
@@ -59,17 +63,21 @@ impl Interpreter {
     }
 
     /// A cycle block: remember the shape, then run it from the current point.
-    pub(super) fn gtc_cycle_define(&mut self, b: &Block, g: G) -> Result<(), ProgramError> {
-        let here = self.work_position();
-        let (xi, zi) = self.xz()?;
+    pub(super) fn gtc_cycle_define(
+        &mut self,
+        b: &Block<Gtc2e>,
+        g: GtcG,
+    ) -> Result<(), ProgramError> {
+        let here = self.core.work_position();
+        let (xi, zi) = self.core.xz()?;
         let end = self.end_point(b)?;
         let needs_z = !(b.has('Z') || b.has('W'));
         if needs_z {
             return Err(self.fault(Fault::MissingWord, "the cycle needs Z or W"));
         }
         let (lead, starts, dwell) = match g {
-            G::GtcThreadCycle | G::GtcTapping => (self.gtc_lead(b)?, self.gtc_starts(b)?, 0.0),
-            G::GtcDrillCycle => {
+            GtcG::ThreadCycle | GtcG::Tapping => (self.gtc_lead(b)?, self.gtc_starts(b)?, 0.0),
+            GtcG::DrillCycle => {
                 let d = b.get('D').unwrap_or(0.0);
                 if !(0.0..=5.0).contains(&d) {
                     return Err(self.fault(Fault::OutOfRange, format!("D{}: 0.01–5 s", show(d))));
@@ -80,7 +88,7 @@ impl Interpreter {
         };
         if matches!(
             g,
-            G::GtcTaperCycle | G::GtcCylinderCycle | G::GtcGroovingCycle
+            GtcG::TaperCycle | GtcG::CylinderCycle | GtcG::GroovingCycle
         ) && !(b.has('X') || b.has('U'))
         {
             return Err(self.fault(Fault::MissingWord, "the cycle needs X or U"));
@@ -93,31 +101,31 @@ impl Interpreter {
             starts,
             dwell,
         };
-        self.gtc_cycle = Some(cycle);
+        self.d.gtc_cycle = Some(cycle);
         self.gtc_run(cycle)
     }
 
     /// A follow-on block: move the start point, run the shape again.
-    pub(super) fn gtc_cycle_follow_on(&mut self, b: &Block) -> Result<(), ProgramError> {
-        let Some(cycle) = self.gtc_cycle else {
+    pub(super) fn gtc_cycle_follow_on(&mut self, b: &Block<Gtc2e>) -> Result<(), ProgramError> {
+        let Some(cycle) = self.d.gtc_cycle else {
             return Err(self.fault(Fault::MissingWord, "no cycle defined for this block"));
         };
         let end = self.end_point(b)?;
         let kind = if matches!(
             cycle.kind,
-            G::GtcTaperCycle | G::GtcGroovingCycle | G::GtcDrillCycle
+            GtcG::TaperCycle | GtcG::GroovingCycle | GtcG::DrillCycle
         ) {
-            MoveKind::Feed(self.feed)
+            MoveKind::Feed(self.core.feed)
         } else {
             MoveKind::Rapid
         };
-        self.emit(&end, kind)?;
+        self.core.emit(&end, kind)?;
         self.gtc_run(cycle)
     }
 
-    fn gtc_run(&mut self, c: GtcCycle) -> Result<(), ProgramError> {
-        let a = self.work_position();
-        let (xi, zi) = self.xz()?;
+    pub(super) fn gtc_run(&mut self, c: GtcCycle) -> Result<(), ProgramError> {
+        let a = self.core.work_position();
+        let (xi, zi) = self.core.xz()?;
         let at = |x: f64, z: f64| {
             let mut v = a.clone();
             v[xi] = x;
@@ -126,70 +134,70 @@ impl Interpreter {
         };
         let (x0, z0) = (a[xi], a[zi]);
         let (x1, z1) = (x0 + c.dx, z0 + c.dz);
-        let f = self.feed;
+        let f = self.core.feed;
         match c.kind {
-            G::GtcCylinderCycle => {
+            GtcG::CylinderCycle => {
                 // A→B rapid (X infeed), B→C feed along Z, C→D rapid (X out), D→A rapid.
-                self.emit(&at(x1, z0), MoveKind::Rapid)?;
-                self.emit(&at(x1, z1), MoveKind::Feed(f))?;
-                self.emit(&at(x0, z1), MoveKind::Rapid)?;
-                self.emit(&at(x0, z0), MoveKind::Rapid)?;
+                self.core.emit(&at(x1, z0), MoveKind::Rapid)?;
+                self.core.emit(&at(x1, z1), MoveKind::Feed(f))?;
+                self.core.emit(&at(x0, z1), MoveKind::Rapid)?;
+                self.core.emit(&at(x0, z0), MoveKind::Rapid)?;
             }
-            G::GtcGroovingCycle => {
+            GtcG::GroovingCycle => {
                 // A→B→C feed (three cutting surfaces), C→D→A rapid.
-                self.emit(&at(x1, z0), MoveKind::Feed(f))?;
-                self.emit(&at(x1, z1), MoveKind::Feed(f))?;
-                self.emit(&at(x0, z1), MoveKind::Rapid)?;
-                self.emit(&at(x0, z0), MoveKind::Rapid)?;
+                self.core.emit(&at(x1, z0), MoveKind::Feed(f))?;
+                self.core.emit(&at(x1, z1), MoveKind::Feed(f))?;
+                self.core.emit(&at(x0, z1), MoveKind::Rapid)?;
+                self.core.emit(&at(x0, z0), MoveKind::Rapid)?;
             }
-            G::GtcTaperCycle => {
+            GtcG::TaperCycle => {
                 // B→C feed; back Z first then X when X grew, else X first then Z.
-                self.emit(&at(x1, z1), MoveKind::Feed(f))?;
+                self.core.emit(&at(x1, z1), MoveKind::Feed(f))?;
                 if c.dx >= 0.0 {
-                    self.emit(&at(x1, z0), MoveKind::Rapid)?;
+                    self.core.emit(&at(x1, z0), MoveKind::Rapid)?;
                 } else {
-                    self.emit(&at(x0, z1), MoveKind::Rapid)?;
+                    self.core.emit(&at(x0, z1), MoveKind::Rapid)?;
                 }
-                self.emit(&at(x0, z0), MoveKind::Rapid)?;
+                self.core.emit(&at(x0, z0), MoveKind::Rapid)?;
             }
-            G::GtcDrillCycle => {
-                self.emit(&at(x0, z1), MoveKind::Feed(f))?;
+            GtcG::DrillCycle => {
+                self.core.emit(&at(x0, z1), MoveKind::Feed(f))?;
                 if c.dwell > 0.0 {
-                    self.push(Command::Dwell { seconds: c.dwell });
+                    self.core.push(Command::Dwell { seconds: c.dwell });
                 }
-                self.emit(&at(x0, z0), MoveKind::Rapid)?;
+                self.core.emit(&at(x0, z0), MoveKind::Rapid)?;
             }
-            G::GtcTapping => {
+            GtcG::Tapping => {
                 // Tap in synchronised, stop, reverse, back, stop (`002` §4.3.2-6).
-                let reverse = if self.spindle == SpindleDir::Ccw {
+                let reverse = if self.core.spindle == SpindleDir::Ccw {
                     3
                 } else {
                     4
                 };
-                self.emit(
+                self.core.emit(
                     &at(x0, z1),
                     MoveKind::Thread {
                         lead: c.lead,
                         angle: 0.0,
                     },
                 )?;
-                self.aux(Aux::M(5));
-                self.aux(Aux::M(reverse));
-                self.emit(
+                self.core.aux(Aux::M(5));
+                self.core.aux(Aux::M(reverse));
+                self.core.emit(
                     &at(x0, z0),
                     MoveKind::Thread {
                         lead: c.lead,
                         angle: 0.0,
                     },
                 )?;
-                self.aux(Aux::M(5));
-                self.spindle = SpindleDir::Stopped;
+                self.core.aux(Aux::M(5));
+                self.core.spindle = SpindleDir::Stopped;
             }
             _ => {
                 // G76: thread toward Z; W (G31) before the end X retracts U (G31) while Z runs
                 // on; Z rapid back; X back to the infeed point (`002` §4.3.2-5).
-                let retract = self.gtc_retract.u.unwrap_or(c.lead / 2.0);
-                let early = self.gtc_retract.w.min(c.dz.abs());
+                let retract = self.d.gtc_retract.u.unwrap_or(c.lead / 2.0);
+                let early = self.d.gtc_retract.w.min(c.dz.abs());
                 let away = -self.last_x_direction;
                 for n in 0..c.starts {
                     let angle = 360.0 * n as f64 / c.starts as f64;
@@ -197,14 +205,14 @@ impl Interpreter {
                     let zr = z1 - zdir * early;
                     let xr = x0 + c.dx * if c.dz != 0.0 { (zr - z0) / c.dz } else { 1.0 };
                     if early > 0.0 {
-                        self.emit(
+                        self.core.emit(
                             &at(xr, zr),
                             MoveKind::Thread {
                                 lead: c.lead,
                                 angle,
                             },
                         )?;
-                        self.emit(
+                        self.core.emit(
                             &at(x1 + away * retract, z1),
                             MoveKind::Thread {
                                 lead: c.lead,
@@ -212,17 +220,19 @@ impl Interpreter {
                             },
                         )?;
                     } else {
-                        self.emit(
+                        self.core.emit(
                             &at(x1, z1),
                             MoveKind::Thread {
                                 lead: c.lead,
                                 angle,
                             },
                         )?;
-                        self.emit(&at(x1 + away * retract, z1), MoveKind::Rapid)?;
+                        self.core
+                            .emit(&at(x1 + away * retract, z1), MoveKind::Rapid)?;
                     }
-                    self.emit(&at(x1 + away * retract, z0), MoveKind::Rapid)?;
-                    self.emit(&at(x0, z0), MoveKind::Rapid)?;
+                    self.core
+                        .emit(&at(x1 + away * retract, z0), MoveKind::Rapid)?;
+                    self.core.emit(&at(x0, z0), MoveKind::Rapid)?;
                 }
             }
         }
@@ -231,30 +241,30 @@ impl Interpreter {
 
     /// G33: one thread pass (`002` §4.3.2-4); with L starts, each further start after a return
     /// by the G31 retract (decision D25).
-    pub(super) fn gtc_thread(&mut self, b: &Block) -> Result<(), ProgramError> {
+    pub(super) fn gtc_thread(&mut self, b: &Block<Gtc2e>) -> Result<(), ProgramError> {
         let lead = self.gtc_lead(b)?;
         let starts = self.gtc_starts(b)?;
-        let start = self.work_position();
+        let start = self.core.work_position();
         let end = self.end_point(b)?;
-        let (xi, _) = self.xz()?;
-        let retract = self.gtc_retract.u.unwrap_or(lead / 2.0);
+        let (xi, _) = self.core.xz()?;
+        let retract = self.d.gtc_retract.u.unwrap_or(lead / 2.0);
         for n in 0..starts {
             let angle = 360.0 * n as f64 / starts as f64;
             if n > 0 {
-                let mut out = self.work_position();
+                let mut out = self.core.work_position();
                 out[xi] -= self.last_x_direction * retract;
-                self.emit(&out, MoveKind::Rapid)?;
+                self.core.emit(&out, MoveKind::Rapid)?;
                 let mut back = start.clone();
                 back[xi] = out[xi];
-                self.emit(&back, MoveKind::Rapid)?;
-                self.emit(&start, MoveKind::Rapid)?;
+                self.core.emit(&back, MoveKind::Rapid)?;
+                self.core.emit(&start, MoveKind::Rapid)?;
             }
-            self.emit(&end, MoveKind::Thread { lead, angle })?;
+            self.core.emit(&end, MoveKind::Thread { lead, angle })?;
         }
         Ok(())
     }
 
-    pub(super) fn gtc_g31(&mut self, b: &Block) -> Result<(), ProgramError> {
+    pub(super) fn gtc_g31(&mut self, b: &Block<Gtc2e>) -> Result<(), ProgramError> {
         let (u, w, l) = (b.get('U'), b.get('W'), b.get('L'));
         for (c, v) in [('U', u), ('W', w), ('L', l)] {
             if v.is_some_and(|v| v < 0.0) {
@@ -268,15 +278,15 @@ impl Interpreter {
             // The retract speed is the planner's business (issue 4); only its range is checked.
         }
         if u.is_some() {
-            self.gtc_retract.u = u;
+            self.d.gtc_retract.u = u;
         }
         if let Some(w) = w {
-            self.gtc_retract.w = w;
+            self.d.gtc_retract.w = w;
         }
         Ok(())
     }
 
-    pub(super) fn gtc_loop_start(&mut self, b: &Block) -> Result<(), ProgramError> {
+    pub(super) fn gtc_loop_start(&mut self, b: &Block<Gtc2e>) -> Result<(), ProgramError> {
         let l = b
             .get('L')
             .ok_or_else(|| self.fault(Fault::MissingWord, "G22 needs L"))?;
@@ -284,7 +294,7 @@ impl Interpreter {
         if !(1..=99).contains(&n) {
             return Err(self.fault(Fault::OutOfRange, "G22 L: 1–99"));
         }
-        let f = self.frame();
+        let f = self.core.level();
         let first = f.pos;
         f.repeats.push(Repeat::Loop {
             first,
@@ -294,7 +304,7 @@ impl Interpreter {
     }
 
     pub(super) fn gtc_loop_end(&mut self) -> Result<(), ProgramError> {
-        let f = self.frame();
+        let f = self.core.level();
         match f.repeats.last_mut() {
             Some(Repeat::Loop { first, remaining }) => {
                 if *remaining > 1 {
@@ -317,8 +327,8 @@ impl Interpreter {
         x: bool,
         z: bool,
     ) -> Result<(), ProgramError> {
-        let (xi, zi) = self.xz()?;
-        let here = self.work_position();
+        let (xi, zi) = self.core.xz()?;
+        let here = self.core.work_position();
         let mut goal = here.clone();
         if x {
             goal[xi] = target[xi];
@@ -327,16 +337,16 @@ impl Interpreter {
             goal[zi] = target[zi];
         }
         let mut via = here.clone();
-        match self.return_order {
+        match self.d.return_order {
             ReturnOrder::XThenZ => via[xi] = goal[xi],
             ReturnOrder::ZThenX => via[zi] = goal[zi],
             ReturnOrder::Together => via = goal.clone(),
         }
         if via != here && via != goal {
-            self.emit(&via, MoveKind::Rapid)?;
+            self.core.emit(&via, MoveKind::Rapid)?;
         }
-        if goal != self.work_position() {
-            self.emit(&goal, MoveKind::Rapid)?;
+        if goal != self.core.work_position() {
+            self.core.emit(&goal, MoveKind::Rapid)?;
         }
         Ok(())
     }

@@ -6,11 +6,18 @@
 //! give the pecks in least-input increments (Q, decision D12) and R in mm, both radius values.
 //! Decision D45 records what the manual leaves open.
 
-use super::*;
+use cnc_interpreter_core::cycles::{pecks, Pecking};
+use cnc_interpreter_core::{show, Aux, Command, Fault, MoveKind, ProgramError};
+
+use super::compound::MAX_CYCLE_STEPS;
+use super::Huaxing;
+use crate::fanuc::block::Block;
+use crate::fanuc::codes::M;
+use crate::fanuc::Fanuc;
 
 /// The cycle's modal words; positions, K and M are not modal.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct DrillWords {
+pub struct DrillWords {
     /// P: dwell at the bottom.
     dwell_ms: f64,
     /// Q: depth of one peck (0: straight to the bottom).
@@ -35,17 +42,17 @@ impl Default for DrillWords {
 /// Most repetitions of one drilling block (`000` §3.3.2: K up to 9999).
 const MAX_REPEATS: f64 = 9999.0;
 
-impl Interpreter {
+impl Fanuc<Huaxing> {
     /// Takes the modal words P, Q, R and J of a G83/G87 block.
-    pub(super) fn drill_words(&mut self, b: &Block) -> Result<(), ProgramError> {
+    pub(super) fn drill_words(&mut self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         if let Some(p) = b.get('P') {
             if p.abs() > 99_999_999.0 {
                 return Err(self.fault(Fault::DwellTime, "G83/G87 P dwell out of range"));
             }
-            self.drill.dwell_ms = p.max(0.0);
+            self.d.drill.dwell_ms = p.max(0.0);
         }
         if let Some(q) = self.increments(b, 'Q') {
-            self.drill.peck = q.abs();
+            self.d.drill.peck = q.abs();
         }
         if let Some(r) = b.get('R') {
             if r.abs() > 9999.999 {
@@ -54,10 +61,10 @@ impl Interpreter {
                     format!("G83/G87 R{}: 0–9999.999 mm", show(r)),
                 ));
             }
-            self.drill.retract = r.abs();
+            self.d.drill.retract = r.abs();
         }
         if let Some(j) = b.get('J') {
-            self.drill.deep_hole = match j {
+            self.d.drill.deep_hole = match j {
                 0.0 => false,
                 1.0 => true,
                 _ => {
@@ -70,8 +77,12 @@ impl Interpreter {
         Ok(())
     }
 
-    pub(super) fn drilling(&mut self, b: &Block, radial: bool) -> Result<(), ProgramError> {
-        let (xi, zi) = self.xz()?;
+    pub(super) fn drilling(
+        &mut self,
+        b: &Block<Huaxing>,
+        radial: bool,
+    ) -> Result<(), ProgramError> {
+        let (xi, zi) = self.core.xz()?;
         let name = if radial { "G87" } else { "G83" };
         // G83 drills along Z at hole position X; G87 along X at hole position Z.
         let (hole_axis, drill_axis) = if radial { (zi, xi) } else { (xi, zi) };
@@ -97,7 +108,7 @@ impl Interpreter {
             }
         };
         let clamp = self.clamp_code(b, name)?;
-        let here = self.work_position();
+        let here = self.core.work_position();
         let end = self.end_point(b)?;
         // With an incremental hole position each repetition drills the next hole.
         let step = if b.has(hole_inc) {
@@ -105,12 +116,12 @@ impl Interpreter {
         } else {
             0.0
         };
-        let s = if radial { self.x_scale() } else { 1.0 };
+        let s = if radial { self.core.x_scale() } else { 1.0 };
         let (top, depth) = (
             here[drill_axis] * s,
             end[drill_axis] * s - here[drill_axis] * s,
         );
-        let words = self.drill;
+        let words = self.d.drill;
         if words.peck > 0.0
             && (depth.abs() / words.peck + 1.0) * f64::from(repeats) > MAX_CYCLE_STEPS as f64
         {
@@ -129,25 +140,30 @@ impl Interpreter {
             };
             self.rapid_unless_there(&at(top))?;
             if let Some(m) = clamp {
-                self.aux(Aux::M(m));
+                self.core.aux(Aux::M(m));
             }
-            for (p, kind) in pecks(top, depth, words) {
+            let pecking = Pecking {
+                peck: words.peck,
+                retract: words.retract,
+                deep_hole: words.deep_hole,
+            };
+            for (p, kind) in pecks(top, depth, pecking) {
                 let kind = if kind {
-                    MoveKind::Feed(self.feed)
+                    MoveKind::Feed(self.core.feed)
                 } else {
                     MoveKind::Rapid
                 };
-                self.emit(&at(p), kind)?;
+                self.core.emit(&at(p), kind)?;
             }
             if words.dwell_ms > 0.0 {
-                self.push(Command::Dwell {
+                self.core.push(Command::Dwell {
                     seconds: words.dwell_ms / 1000.0,
                 });
             }
-            self.emit(&at(top), MoveKind::Rapid)?;
+            self.core.emit(&at(top), MoveKind::Rapid)?;
             if let Some(m) = clamp {
                 // The unclamp code is the clamp code + 1 (decision D45).
-                self.aux(Aux::M(m + 1));
+                self.core.aux(Aux::M(m + 1));
             }
             hole += step;
         }
@@ -155,7 +171,7 @@ impl Interpreter {
     }
 
     /// The spindle clamp code Mα of a drilling block, if it has one.
-    fn clamp_code(&self, b: &Block, name: &str) -> Result<Option<i32>, ProgramError> {
+    fn clamp_code(&self, b: &Block<Huaxing>, name: &str) -> Result<Option<i32>, ProgramError> {
         let mut codes =
             b.m.iter()
                 .filter(|(m, _)| matches!(m, M::AuxBefore | M::AuxAfter))
@@ -181,102 +197,10 @@ impl Interpreter {
     }
 
     fn rapid_unless_there(&mut self, target: &[f64]) -> Result<(), ProgramError> {
-        let here = self.work_position();
+        let here = self.core.work_position();
         if here.iter().zip(target).any(|(a, b)| (a - b).abs() > 1e-9) {
-            self.emit(target, MoveKind::Rapid)?;
+            self.core.emit(target, MoveKind::Rapid)?;
         }
         Ok(())
-    }
-}
-
-/// The moves down the hole from level `top` by `depth` (signed), as (level, is-feed): the
-/// manual's steps ②–⑤ for J0 and J1. Q = 0, or J0 with R = 0, drills straight to the bottom.
-fn pecks(top: f64, depth: f64, w: DrillWords) -> Vec<(f64, bool)> {
-    let (total, dir) = (depth.abs(), if depth < 0.0 { -1.0 } else { 1.0 });
-    let level = |d: f64| top + dir * d;
-    if w.peck <= 0.0 || (!w.deep_hole && w.retract <= 0.0) {
-        return vec![(level(total), true)];
-    }
-    let mut moves = Vec::new();
-    let mut done = 0.0;
-    loop {
-        done = (done + w.peck).min(total);
-        moves.push((level(done), true));
-        if done >= total - 1e-9 {
-            return moves;
-        }
-        let back = (done - w.retract).max(0.0);
-        if w.deep_hole {
-            // Out of the hole, then rapid back to R short of the depth reached.
-            moves.push((top, false));
-            if back > 0.0 {
-                moves.push((level(back), false));
-            }
-        } else {
-            moves.push((level(back), false));
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn words(peck: f64, retract: f64, deep_hole: bool) -> DrillWords {
-        DrillWords {
-            dwell_ms: 0.0,
-            peck,
-            retract,
-            deep_hole,
-        }
-    }
-
-    #[test]
-    fn high_speed_pecks_back_off_r_and_feed_q_plus_r() {
-        let m = pecks(0.0, -10.0, words(4.0, 1.0, false));
-        assert_eq!(
-            m,
-            [
-                (-4.0, true),
-                (-3.0, false),
-                (-8.0, true),
-                (-7.0, false),
-                (-10.0, true)
-            ]
-        );
-    }
-
-    #[test]
-    fn deep_hole_pecks_leave_the_hole_each_time() {
-        let m = pecks(5.0, -6.0, words(2.5, 0.5, true));
-        assert_eq!(
-            m,
-            [
-                (2.5, true),
-                (5.0, false),
-                (3.0, false),
-                (0.0, true),
-                (5.0, false),
-                (0.5, false),
-                (-1.0, true)
-            ]
-        );
-    }
-
-    #[test]
-    fn no_peck_or_no_back_off_drills_straight() {
-        assert_eq!(pecks(0.0, -10.0, words(0.0, 1.0, false)), [(-10.0, true)]);
-        assert_eq!(pecks(0.0, -10.0, words(3.0, 0.0, false)), [(-10.0, true)]);
-        // A back-off larger than the depth reached stops at the start level.
-        assert_eq!(
-            pecks(0.0, -3.0, words(1.0, 5.0, false)),
-            [
-                (-1.0, true),
-                (0.0, false),
-                (-2.0, true),
-                (0.0, false),
-                (-3.0, true)
-            ]
-        );
     }
 }

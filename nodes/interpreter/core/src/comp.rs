@@ -1,5 +1,5 @@
-//! Tool-nose radius compensation (G41/G42, `000` Chapter 6, `002` §4.3.2-18): the tool's
-//! nose is a circle of radius R, and the programmed point is its imaginary tip. With
+//! Radius compensation, a path filter: the tool's nose (a lathe tool) or the cutter (a mill)
+//! is a circle of radius R, and the programmed point is its imaginary tip. With
 //! compensation the nose circle runs along the programmed contour on the chosen side, and the
 //! controlled point (the imaginary tip) follows the nose centre's path shifted by the tip
 //! vector of the tool's tip direction.
@@ -49,13 +49,13 @@ pub enum Kind {
 /// How compensation starts (decisions D30, D48).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Startup {
-    /// Huaxing: the start-up G01 goes from the uncompensated point to the offset start of the
-    /// next element.
+    /// The start-up line goes from the uncompensated point to the offset start of the next
+    /// element.
     ToNextElement,
-    /// GTC2E: the first element is offset from its start; a connecting move gets there.
+    /// The first element is offset from its start; a connecting move gets there.
     Connect,
-    /// FANUC mill: the start-up move itself is compensated, its start left where the tool
-    /// is, and meets the next element as any corner does (FANUC's type B start-up, and
+    /// The start-up move itself is compensated, its start left where the tool is, and meets
+    /// the next element as any corner does (the type B start-up of ISO controls, and
     /// LinuxCNC's).
     AlongEntry,
 }
@@ -79,7 +79,7 @@ pub enum CompError {
     /// An arc cannot be the start-up move of [`Startup::AlongEntry`].
     ArcStartup,
     /// Trimmed at both corners, an offset line would run against its programmed direction:
-    /// the tool would cut into the contour (FANUC's interference check, P/S 041).
+    /// the tool would cut into the contour (the interference check of ISO controls).
     Interference,
 }
 
@@ -112,13 +112,13 @@ enum Start {
 }
 
 #[derive(Debug, Clone)]
-pub struct NoseComp {
+pub struct RadiusComp {
     /// Signed offset: +R to the left, −R to the right.
     offset: f64,
     /// From nose centre to imaginary tip.
     tip: Pt,
     start: Start,
-    /// The Huaxing start-up element, waiting for the element after it.
+    /// The [`Startup::ToNextElement`] start-up element, waiting for the element after it.
     startup: Option<(Pt, Elem, f64, Kind, u32)>,
     held: Option<Held>,
     /// Moves along the normal after the held element, in program order.
@@ -298,14 +298,14 @@ fn circle_circle(c1: Pt, r1: f64, c2: Pt, r2: f64) -> Vec<Pt> {
     vec![add(m, scale(n, h)), add(m, scale(n, -h))]
 }
 
-impl NoseComp {
+impl RadiusComp {
     /// Compensation from the uncompensated point `from`, starting as `startup` says.
-    pub fn new(side: Side, radius: f64, tip: u8, from: Pt, startup: Startup) -> NoseComp {
+    pub fn new(side: Side, radius: f64, tip: u8, from: Pt, startup: Startup) -> RadiusComp {
         let offset = match side {
             Side::Left => radius,
             Side::Right => -radius,
         };
-        NoseComp {
+        RadiusComp {
             offset,
             tip: tip_vector(tip, radius),
             start: Start::Pending(startup, from),
@@ -606,7 +606,7 @@ mod tests {
     #[test]
     fn outside_turning_with_tip_3_keeps_the_diameter_on_straight_cuts() {
         // G42, R1, tip 3: turning toward the chuck along r = 15, then facing up to r = 20.
-        let mut c = NoseComp::new(Side::Right, 1.0, 3, p(10.0, 15.0), Startup::Connect);
+        let mut c = RadiusComp::new(Side::Right, 1.0, 3, p(10.0, 15.0), Startup::Connect);
         let f = Kind::Feed(100.0);
         let out = c
             .push(
@@ -643,7 +643,7 @@ mod tests {
 
     #[test]
     fn outer_corners_get_an_arc_of_the_nose_radius() {
-        let mut c = NoseComp::new(Side::Left, 3.0, 0, p(0.0, 0.0), Startup::Connect);
+        let mut c = RadiusComp::new(Side::Left, 3.0, 0, p(0.0, 0.0), Startup::Connect);
         let f = Kind::Feed(100.0);
         c.push(
             Elem::Line {
@@ -693,7 +693,7 @@ mod tests {
 
     #[test]
     fn a_concave_arc_smaller_than_the_nose_is_an_error() {
-        let mut c = NoseComp::new(Side::Left, 5.0, 0, p(0.0, 0.0), Startup::Connect);
+        let mut c = RadiusComp::new(Side::Left, 5.0, 0, p(0.0, 0.0), Startup::Connect);
         // Counter-clockwise arc of radius 2: its left side is inside.
         let e = c.push(
             Elem::Arc {

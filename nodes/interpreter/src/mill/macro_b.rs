@@ -1,13 +1,17 @@
-//! FANUC user macro B on the mill (`003` inventory Appendix A.3; decision D49): WHILE … DO m
-//! … END m loops, G65 calls with argument specification I, the #3000 alarm, and the mill's
-//! variable map (#1–#33 local, #100–#199 and #500–#999 common, #2001– offsets, #4001–
-//! modal information, #5001– positions, #5221– work offsets).
+//! FANUC user macro B on the mill (`003` inventory Appendix A.3; decision D49): G65 calls
+//! with argument specification I, the #3000 alarm, and the mill's variable map (#1–#33 local,
+//! #100–#199 and #500–#999 common, #2001– offsets, #4001– modal information, #5001–
+//! positions, #5221– work offsets). WHILE … DO m … END m loops are the family's.
 
-use super::*;
-use crate::syntax::Word;
+use cnc_interpreter_core::comp::Side;
+use cnc_interpreter_core::{Fault, ProgramError};
 
-/// Loop numbers DO and END may carry; three loops can nest (A.3).
-const LOOP_IDS: std::ops::RangeInclusive<u32> = 1..=3;
+use super::{Mill, MillG};
+use crate::fanuc::block::integer_word;
+use crate::fanuc::codes::G;
+use crate::fanuc::expr::{EvalError, Value};
+use crate::fanuc::syntax::Word;
+use crate::fanuc::{Family, Fanuc};
 
 /// Argument specification I: the local variable each address of a G65 block sets (A.3).
 fn argument_number(letter: char) -> Option<usize> {
@@ -37,82 +41,11 @@ fn argument_number(letter: char) -> Option<usize> {
     })
 }
 
-impl Interpreter {
-    fn loop_id(&self, id: u32, word: &str) -> Result<(), ProgramError> {
-        if LOOP_IDS.contains(&id) {
-            Ok(())
-        } else {
-            Err(self.fault(
-                Fault::MacroLoop,
-                format!("{word}{id}: loop numbers are 1–3"),
-            ))
-        }
-    }
-
-    /// `WHILE [cond] DO m` (or `DO m`): while the condition holds the loop runs on; else the
-    /// program goes on after `END m` (P/S 124 when there is none).
-    pub(super) fn while_loop(&mut self, cond: Option<&Expr>, id: u32) -> Result<(), ProgramError> {
-        self.loop_id(id, "DO")?;
-        let go_on = match cond {
-            Some(c) => truth(c.eval(self).map_err(|e| self.eval_err(e))?),
-            None => true,
-        };
-        let start = self.block_start;
-        let again = self
-            .frames
-            .last()
-            .is_some_and(|f| f.loops.contains(&(id, start)));
-        // Entering the loop: its END must be there (P/S 124), as when leaving it.
-        let after_end = if again && go_on {
-            None
-        } else {
-            Some(self.after_end(id)?)
-        };
-        let frame = self.frame();
-        // Coming round again (or after a GOTO out of the loop): the loop starts afresh.
-        if let Some(k) = frame.loops.iter().position(|&(m, _)| m == id) {
-            frame.loops.truncate(k);
-        }
-        match after_end {
-            Some(pos) if !go_on => frame.pos = pos,
-            _ => frame.loops.push((id, start)),
-        }
-        Ok(())
-    }
-
-    /// Where the program goes on after the `END m` that closes the loop being read.
-    fn after_end(&self, id: u32) -> Result<Pos, ProgramError> {
-        let Some(frame) = self.frames.last() else {
-            return Err(self.fault(Fault::MacroEnd, "no program"));
-        };
-        let mut pos = frame.pos;
-        while let Some((raw, next)) = read_line(&frame.text, pos) {
-            if parse_line(raw, true).map(|l| l.stmt) == Ok(Stmt::End(id)) {
-                return Ok(next);
-            }
-            pos = next;
-        }
-        Err(self.fault(Fault::MacroEnd, format!("WHILE … DO{id} has no END{id}")))
-    }
-
-    /// `END m`: back to the `WHILE … DO m` that opened the loop (P/S 126 without one).
-    pub(super) fn end_loop(&mut self, id: u32) -> Result<(), ProgramError> {
-        self.loop_id(id, "END")?;
-        let frame = self.frame();
-        let Some(k) = frame.loops.iter().rposition(|&(m, _)| m == id) else {
-            return Err(self.fault(Fault::MacroLoop, format!("END{id} without DO{id}")));
-        };
-        // Inner loops end here; this one stays open for its WHILE to test again.
-        let (_, start) = frame.loops[k];
-        frame.loops.truncate(k + 1);
-        frame.pos = start;
-        Ok(())
-    }
-
+impl Fanuc<Mill> {
     /// `G65 P<program> L<count> <arguments>`: calls the macro with its locals set from the
     /// argument table; P missing is P/S 076, an address that is no argument P/S 129.
     pub(super) fn macro_call(&mut self, words: &[Word]) -> Result<(), ProgramError> {
-        let mut locals = vec![None; LOCALS];
+        let mut locals = vec![None; Mill::LOCALS];
         let (mut program, mut count) = (None, 1);
         for w in words {
             let v = w.value.eval(self).map_err(|e| self.eval_err(e))?;
@@ -148,38 +81,35 @@ impl Interpreter {
             .and_then(integer_word)
             .filter(|&p| p <= 9999)
             .ok_or_else(|| self.fault(Fault::Call, "G65 needs P (the macro's program number)"))?;
-        self.call_program(number, count, locals, "G65: macro")
+        self.core.call_program(number, count, locals, "G65: macro")
     }
 
     /// Reads a variable of the mill's map.
     pub(super) fn fanuc_read(&self, n: i64) -> Result<Value, EvalError> {
-        let frame = self
-            .frames
-            .last()
-            .ok_or_else(|| EvalError("no program".into(), Fault::Macro))?;
+        let frame = self.core.current();
         let axis = |base: i64| {
             usize::try_from(n - base)
                 .ok()
-                .filter(|&i| i < self.pos.len())
+                .filter(|&i| i < self.core.pos.len())
         };
         Ok(match n {
             0 => None,
             1..=33 => frame.locals[n as usize],
-            100..=199 | 500..=999 => self.common.get(&n).copied(),
+            100..=199 | 500..=999 => self.core.common.get(&n).copied(),
             2001..=2200 => {
-                let t = self.setup.offsets.tool((n - 2000) as u32);
+                let t = self.core.setup.offsets.tool((n - 2000) as u32);
                 Some(t.z + t.wear_z)
             }
-            2201..=2400 => Some(self.setup.offsets.tool((n - 2200) as u32).radius),
+            2201..=2400 => Some(self.core.setup.offsets.tool((n - 2200) as u32).radius),
             4001..=4022 | 4107 | 4109 | 4111 | 4119 | 4120 => self.modal_information(n),
             5001..=5020 | 5041..=5060 => {
                 let i = axis(if n < 5041 { 5001 } else { 5041 });
-                i.map(|i| self.work_position()[i])
+                i.map(|i| self.core.work_position()[i])
             }
-            5021..=5040 => axis(5021).map(|i| self.pos[i]),
-            5081..=5100 => axis(5081).map(|i| self.tool_offset[i]),
+            5021..=5040 => axis(5021).map(|i| self.core.pos[i]),
+            5081..=5100 => axis(5081).map(|i| self.core.tool_offset[i]),
             5221..=5340 => match self.work_offset_slot(n) {
-                Some((system, a)) => Some(self.setup.offsets.work(system, a)),
+                Some((system, a)) => Some(self.core.setup.offsets.work(system, a)),
                 None => return Err(no_variable(n)),
             },
             _ => return Err(no_variable(n)),
@@ -189,56 +119,72 @@ impl Interpreter {
     /// #5221–#5340: G54–G59 in blocks of 20, one variable per axis in the machine's order.
     fn work_offset_slot(&self, n: i64) -> Option<(u8, char)> {
         let (system, i) = ((n - 5221) / 20, (n - 5221) % 20);
-        let letter = self.setup.axes.get(usize::try_from(i).ok()?).copied()?;
+        let letter = self
+            .core
+            .setup
+            .axes
+            .get(usize::try_from(i).ok()?)
+            .copied()?;
         Some((u8::try_from(system).ok()?, letter))
     }
 
     /// #4001– : the modal G codes (group numbers of Table 1.1) and #4107– D, F, H, S, T. Each
     /// G code is looked up in the dialect's own table, so the numbers cannot drift from it.
     fn modal_information(&self, n: i64) -> Value {
-        let pick = |on: bool, yes: G, no: G| if on { yes } else { no };
+        let pick = |on: bool, yes: G<MillG>, no: G<MillG>| if on { yes } else { no };
         let g = match n {
             4001 => self.motion,
-            4002 => self.plane,
+            4002 => self.d.plane,
             4003 => pick(self.incremental, G::Incremental, G::Absolute),
-            4005 => pick(self.feed_per_rev, G::FeedPerRevolution, G::FeedPerMinute),
+            4005 => pick(
+                self.core.feed_per_rev,
+                G::FeedPerRevolution,
+                G::FeedPerMinute,
+            ),
             4006 => G::MetricInput,
-            4007 => match self.nose_comp.as_ref().map(|c| c.side()) {
+            4007 => match self.core.comp.as_ref().map(|c| c.side()) {
                 None => G::NoseCancel,
-                Some(nose::Side::Left) => G::NoseLeft,
-                Some(nose::Side::Right) => G::NoseRight,
+                Some(Side::Left) => G::NoseLeft,
+                Some(Side::Right) => G::NoseRight,
             },
-            4008 => match self.length_sign {
-                _ if self.length_offset == 0 => G::LengthComp(0),
-                s => G::LengthComp(s),
+            4008 => match self.d.length_sign {
+                _ if self.d.length_offset == 0 => G::Own(MillG::LengthComp(0)),
+                s => G::Own(MillG::LengthComp(s)),
             },
-            4009 => self.hole_kind().map_or(G::CycleCancel, G::HoleCycle),
-            4010 => G::CycleReturn {
-                r_level: self.cycle_return_r,
-            },
-            4014 => G::WorkSystem(self.work_system),
-            4015 => pick(self.exact_stop_mode, G::ExactStopMode, G::ContinuousMode),
-            4107 => return Some(f64::from(self.radius_offset)),
-            4109 => return Some(self.feed),
-            4111 => return Some(f64::from(self.length_offset)),
-            4119 => return Some(self.sent_rpm.unwrap_or(0.0)),
+            4009 => G::Own(
+                self.hole_kind()
+                    .map_or(MillG::CycleCancel, MillG::HoleCycle),
+            ),
+            4010 => G::Own(MillG::CycleReturn {
+                r_level: self.d.cycle_return_r,
+            }),
+            4014 => G::WorkSystem(self.core.work_system),
+            4015 => pick(
+                self.core.exact_stop_mode,
+                G::ExactStopMode,
+                G::ContinuousMode,
+            ),
+            4107 => return Some(f64::from(self.d.radius_offset)),
+            4109 => return Some(self.core.feed),
+            4111 => return Some(f64::from(self.d.length_offset)),
+            4119 => return Some(self.core.sent_rpm.unwrap_or(0.0)),
             4120 => return Some(f64::from(self.tool)),
             _ => return None,
         };
         (0..1000)
             .step_by(10)
-            .find(|&x10| self.dialect.g_code(x10).is_some_and(|c| c.meaning == g))
+            .find(|&x10| Mill::g_code(x10).is_some_and(|c| c.meaning == g))
             .map(|x10| f64::from(x10) / 10.0)
     }
 
     /// Writes a variable of the mill's map: #3000 = n raises macro alarm 3000 + n.
     pub(super) fn fanuc_write(&mut self, n: i64, v: Value) -> Result<(), ProgramError> {
         match n {
-            1..=33 => self.frame().locals[n as usize] = v,
+            1..=33 => self.core.level().locals[n as usize] = v,
             100..=199 | 500..=999 => {
                 match v {
-                    Some(x) => self.common.insert(n, x),
-                    None => self.common.remove(&n),
+                    Some(x) => self.core.common.insert(n, x),
+                    None => self.core.common.remove(&n),
                 };
             }
             2001..=2400 => {
@@ -247,7 +193,13 @@ impl Interpreter {
                     return Err(self.fault(Fault::CompRadiusZero, format!("#{n}: {x} mm")));
                 }
                 let number = if n <= 2200 { n - 2000 } else { n - 2200 };
-                let t = self.setup.offsets.tools.entry(number as u32).or_default();
+                let t = self
+                    .core
+                    .setup
+                    .offsets
+                    .tools
+                    .entry(number as u32)
+                    .or_default();
                 if n <= 2200 {
                     t.z = x;
                     t.wear_z = 0.0;

@@ -1,0 +1,51 @@
+//! The loop a front end plugs into: commands leave the queue as they are asked for, and when
+//! the queue is empty (or everything in it waits behind a held element) the front end reads
+//! the next block. An error stops the run for good: nothing after the bad line is produced,
+//! and nothing of the bad block.
+
+use crate::canon::Canon;
+use crate::error::{Fault, ProgramError};
+use crate::state::{Core, MAX_SILENT_BLOCKS};
+
+/// A dialect's front end: it reads its language and lowers each block onto the core.
+pub trait FrontEnd {
+    fn core(&self) -> &Core;
+    fn core_mut(&mut self) -> &mut Core;
+    /// Reads the next line of the innermost call level ([`Core::next_line`]) and runs it,
+    /// queuing its commands; at the end of a text, returns or ends the program.
+    fn read_block(&mut self) -> Result<(), ProgramError>;
+}
+
+/// The next canonical command of `front`'s program; `Ok(None)` once the program has ended.
+pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>, ProgramError> {
+    loop {
+        let core = front.core_mut();
+        if let Some(e) = &core.error {
+            return Err(e.clone());
+        }
+        if core.hold_at != Some(0) {
+            if let Some(c) = core.pending.pop_front() {
+                if let Some(h) = core.hold_at.as_mut() {
+                    *h -= 1;
+                }
+                core.silent_blocks = 0;
+                return Ok(Some(c));
+            }
+        }
+        if core.done {
+            return Ok(None);
+        }
+        core.silent_blocks += 1;
+        let result = if core.silent_blocks > MAX_SILENT_BLOCKS {
+            Err(core.fault(Fault::Macro, "program loops without producing any command"))
+        } else {
+            front.read_block()
+        };
+        if let Err(e) = result {
+            let core = front.core_mut();
+            core.error = Some(e.clone());
+            core.pending.clear();
+            return Err(e);
+        }
+    }
+}

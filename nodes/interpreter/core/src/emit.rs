@@ -1,0 +1,331 @@
+//! The emitter: a move in work coordinates becomes a canonical command in machine
+//! coordinates. On its way it passes the path filters in this order:
+//!
+//! 1. a chamfered or rounded corner waiting for the move after it ([`crate::corner`]);
+//! 2. radius compensation ([`crate::comp`]), which holds one element back until the next one
+//!    shows how the two meet;
+//! 3. the range check, the feed check, the spindle speed under constant surface speed, the
+//!    transform chain.
+//!
+//! A filter that holds an element back makes every command queued after it wait behind it
+//! (`hold_at`), so commands leave in program order.
+
+use crate::canon::{Canon, Command};
+use crate::comp::{self, CompError, RadiusComp};
+use crate::error::{Fault, ProgramError};
+use crate::geometry::{Elem, Pt};
+use crate::rough::Move;
+use crate::show;
+use crate::state::Core;
+
+/// How a move is made.
+#[derive(Debug, Clone, Copy)]
+pub enum MoveKind {
+    Rapid,
+    Feed(f64),
+    /// An arc around `center` (a plane point) at the feed.
+    Arc {
+        center: Pt,
+        ccw: bool,
+        feed: f64,
+    },
+    /// A thread locked to the spindle, with its lead and start angle.
+    Thread {
+        lead: f64,
+        angle: f64,
+    },
+}
+
+/// Largest feed per revolution, mm/rev.
+const MAX_FEED_PER_REV: f64 = 500.0;
+
+impl Core {
+    /// Emits a move to work position `end` and makes it the current position.
+    pub fn emit(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        if self.corner.is_some() {
+            self.resolve_corner(Some((end, kind)))?;
+        }
+        if self.comp.is_some() && !self.emitting_comp {
+            return self.emit_compensated(end, kind);
+        }
+        for (i, v) in end.iter().enumerate() {
+            if !v.is_finite() || v.abs() > 1e6 {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!("{} end point {v} out of range", self.setup.axes[i]),
+                ));
+            }
+        }
+        // Feed and lead are checked before anything changes: a bad block moves nothing.
+        let feed = match kind {
+            MoveKind::Feed(feed) | MoveKind::Arc { feed, .. } => self.check_feed(feed)?,
+            MoveKind::Rapid => 0.0,
+            MoveKind::Thread { lead, .. } => {
+                if !(lead > 0.0 && lead.is_finite()) {
+                    return Err(self.fault(
+                        Fault::ThreadLead,
+                        format!("thread lead {lead} is not valid"),
+                    ));
+                }
+                0.0
+            }
+        };
+        self.spindle_for(end);
+        let m = self.to_machine(end);
+        // The machine position becomes `m`; the command takes `m` itself (no copy per move).
+        self.pos.copy_from_slice(&m);
+        let command = match kind {
+            MoveKind::Rapid => Command::Rapid { end: m },
+            MoveKind::Feed(_) => Command::Linear { end: m, feed },
+            MoveKind::Arc { center, ccw, .. } => {
+                // Axes outside the plane keep the end's value (a helix's centre is at its end).
+                let c = self.to_machine(&self.with_point(end, center));
+                let plane = self
+                    .plane_axes()
+                    .ok()
+                    .and_then(|(h, v)| Some([u8::try_from(h).ok()?, u8::try_from(v).ok()?]));
+                Command::Arc {
+                    end: m,
+                    center: c,
+                    clockwise: !ccw,
+                    feed,
+                    plane,
+                }
+            }
+            MoveKind::Thread { lead, angle } => Command::Thread {
+                end: m,
+                lead,
+                start_angle: angle,
+            },
+        };
+        self.push(command);
+        Ok(())
+    }
+
+    /// A feed a cutting move can use: above 0 and within the control's range.
+    pub fn check_feed(&self, feed: f64) -> Result<f64, ProgramError> {
+        if feed.is_nan() || feed <= 0.0 {
+            return Err(self.fault(
+                Fault::FeedRange,
+                "no feed programmed for a cutting move (F missing or 0)",
+            ));
+        }
+        let limit = if self.feed_per_rev {
+            MAX_FEED_PER_REV
+        } else {
+            self.rules.max_feed
+        };
+        if feed > limit {
+            return Err(self.fault(
+                Fault::FeedRange,
+                format!("feed F{} out of range (max {limit})", show(feed)),
+            ));
+        }
+        Ok(feed)
+    }
+
+    /// A rapid to a point computed from known positions (it cannot fail the range check).
+    pub fn rapid_to(&mut self, work: &[f64]) {
+        let _ = self.emit(work, MoveKind::Rapid);
+    }
+
+    /// Emits moves given in the plane (radius), starting from the current position.
+    pub fn emit_plane(&mut self, moves: &[Move], feed: f64) -> Result<(), ProgramError> {
+        let mut end = self.work_position();
+        for m in moves {
+            // `end` is the work position the last move reached; only the plane axes change.
+            match *m {
+                Move::Rapid(p) => {
+                    self.set_plane_point(&mut end, p);
+                    self.emit(&end, MoveKind::Rapid)?
+                }
+                Move::Feed(p) => {
+                    self.set_plane_point(&mut end, p);
+                    self.emit(&end, MoveKind::Feed(feed))?
+                }
+                Move::Arc { to, c, ccw } => {
+                    self.set_plane_point(&mut end, to);
+                    self.emit(
+                        &end,
+                        MoveKind::Arc {
+                            center: c,
+                            ccw,
+                            feed,
+                        },
+                    )?
+                }
+            }
+        }
+        Ok(())
+    }
+
+    // ------------------------------------------------------------------ compensation
+
+    /// Starts radius compensation on `side` with the tool's `radius` and tip direction.
+    pub fn start_comp(
+        &mut self,
+        side: comp::Side,
+        radius: f64,
+        tip: u8,
+        startup: comp::Startup,
+    ) -> Result<(), ProgramError> {
+        let from = self.plane_point(&self.work_position())?;
+        self.comp = Some(RadiusComp::new(side, radius, tip, from, startup));
+        self.comp_cancel = false;
+        Ok(())
+    }
+
+    /// The alarm for a compensation error.
+    pub fn comp_fault(&self, e: CompError) -> ProgramError {
+        let what = self.rules.comp.name;
+        let (fault, text) = match e {
+            CompError::NoIntersection => (
+                Fault::CompNoIntersection,
+                "the offset path has no intersection here",
+            ),
+            CompError::ArcVanishes => (
+                Fault::CompArcVanishes,
+                "arc radius smaller than the tool radius",
+            ),
+            CompError::ArcStartup => (
+                Fault::CompStartNotLine,
+                "it cannot start in an arc: start it in a G00/G01 block",
+            ),
+            CompError::Interference => (
+                Fault::CompInterference,
+                "the tool would cut into the contour here (interference)",
+            ),
+        };
+        self.fault(fault, format!("{what}: {text}"))
+    }
+
+    /// A move while compensation is active: handed to the compensation, which returns the
+    /// moves of the controlled point that are now certain.
+    fn emit_compensated(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        let here = self.work_position();
+        let from = self.plane_point(&here)?;
+        let to = self.plane_point(end)?;
+        let normal = self.plane_normal();
+        let depth = normal.map_or(0.0, |i| end[i]);
+        // Compensation carries the plane and its normal; a rotary axis would be left behind.
+        let (h, v) = self.plane_axes()?;
+        let other = (0..end.len())
+            .find(|&i| i != h && i != v && Some(i) != normal && (end[i] - here[i]).abs() > 1e-9);
+        if let Some(i) = other {
+            return Err(self.fault(
+                Fault::CompInCycle,
+                format!(
+                    "{} cannot move while compensation is active: G40 first",
+                    self.setup.axes[i]
+                ),
+            ));
+        }
+        let (path, ck) = match kind {
+            MoveKind::Rapid if self.rules.comp.refuse_rapid => {
+                return Err(self.fault(
+                    Fault::CompRapid,
+                    "G00 while tool-nose compensation is active: cancel with G40 first",
+                ))
+            }
+            MoveKind::Rapid => (Elem::Line { a: from, b: to }, comp::Kind::Rapid),
+            MoveKind::Feed(f) => (Elem::Line { a: from, b: to }, comp::Kind::Feed(f)),
+            MoveKind::Arc { center, ccw, feed } => (
+                Elem::Arc {
+                    a: from,
+                    b: to,
+                    c: center,
+                    ccw,
+                },
+                comp::Kind::Feed(feed),
+            ),
+            MoveKind::Thread { .. } => {
+                return Err(self.fault(
+                    Fault::CompInCycle,
+                    "thread cutting while tool-nose compensation is active",
+                ))
+            }
+        };
+        let line = self.line;
+        let still = (from.z - to.z).hypot(from.r - to.r) < 1e-9;
+        let outs = if self.comp_cancel {
+            self.comp_cancel = false;
+            match self.comp.take() {
+                Some(mut comp) => comp.cancel(to, depth, ck, line),
+                None => Vec::new(),
+            }
+        } else if still {
+            // No move in the plane: a move along the normal waits for the held element's
+            // end (decision D48); no move at all compensates nothing.
+            match (normal, self.comp.as_mut()) {
+                (Some(i), Some(comp)) if (end[i] - here[i]).abs() > 1e-9 => {
+                    comp.push_still(from, depth, ck, line)
+                }
+                _ => return Ok(()),
+            }
+        } else {
+            let pushed = match self.comp.as_mut() {
+                Some(comp) => comp.push(path, depth, ck, line),
+                None => Ok(Vec::new()),
+            };
+            pushed.map_err(|e| self.comp_fault(e))?
+        };
+        self.emit_outs(outs, end)
+    }
+
+    /// Runs `f`, which queues the moves of an element that was held back (compensation,
+    /// chamfer), and moves what it queued to where the element was in program order: before
+    /// the commands of later blocks queued meanwhile. Returns `f`'s result and the index just
+    /// after the moved commands. The source line is restored afterwards.
+    pub(crate) fn queue_held(
+        &mut self,
+        f: impl FnOnce(&mut Self) -> Result<(), ProgramError>,
+    ) -> (Result<(), ProgramError>, usize) {
+        let before = self.pending.len();
+        let at = self.hold_at.take().unwrap_or(before).min(before);
+        let saved_line = self.line;
+        let result = f(self);
+        self.line = saved_line;
+        let moved: Vec<Canon> = self.pending.drain(before..).collect();
+        let n = moved.len();
+        for (k, c) in moved.into_iter().enumerate() {
+            self.pending.insert(at + k, c);
+        }
+        (result, at + n)
+    }
+
+    /// Queues compensated moves where they belong in program order (before anything queued
+    /// after the element compensation held back), then puts the program's position back on
+    /// the programmed end point: incremental words and the next element start there.
+    pub(crate) fn emit_outs(
+        &mut self,
+        outs: Vec<comp::Out>,
+        programmed_end: &[f64],
+    ) -> Result<(), ProgramError> {
+        self.emitting_comp = true;
+        let (result, held_end) = self.queue_held(|me| {
+            for o in outs {
+                me.line = o.line;
+                let base = me.work_position();
+                let mut end = me.with_point(&base, o.path.end());
+                if let Some(i) = me.plane_normal() {
+                    end[i] = o.depth;
+                }
+                let kind = match (o.path, o.kind) {
+                    (Elem::Arc { c, ccw, .. }, comp::Kind::Feed(feed)) => MoveKind::Arc {
+                        center: c,
+                        ccw,
+                        feed,
+                    },
+                    (_, comp::Kind::Feed(f)) => MoveKind::Feed(f),
+                    (_, comp::Kind::Rapid) => MoveKind::Rapid,
+                };
+                me.emit(&end, kind)?;
+            }
+            Ok(())
+        });
+        self.emitting_comp = false;
+        self.hold_at = self.comp.as_ref().filter(|c| c.holding()).map(|_| held_end);
+        self.pos = self.to_machine(programmed_end);
+        result
+    }
+}

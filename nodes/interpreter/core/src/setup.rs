@@ -1,0 +1,110 @@
+//! What the interpreter needs to know about the machine and its stored data: axes, the
+//! reference points, tool offsets, work offsets, kept macro variables and the switches that
+//! change how a program runs. The shell fills it from the launch config and the data files.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use serde::{Deserialize, Serialize};
+
+/// One row of the tool offset page: geometry plus wear, entered separately and added.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ToolOffset {
+    /// X geometry offset, diameter on a diameter axis, mm.
+    pub x: f64,
+    /// Z geometry offset (a mill's tool length), mm.
+    pub z: f64,
+    /// X wear (added to `x`).
+    pub wear_x: f64,
+    pub wear_z: f64,
+    /// Nose or cutter radius, mm.
+    pub radius: f64,
+    /// Imaginary tool tip direction 0–9 (0: the programmed point is the centre).
+    pub tip: u8,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct Offsets {
+    /// Tool offsets by number.
+    pub tools: BTreeMap<u32, ToolOffset>,
+    /// Work offsets by index (0 = the first work system), per axis letter.
+    pub work: BTreeMap<u8, BTreeMap<char, f64>>,
+}
+
+impl Offsets {
+    pub fn tool(&self, n: u32) -> ToolOffset {
+        self.tools.get(&n).copied().unwrap_or_default()
+    }
+
+    /// Work offset `index` (0 = the first work system) of axis `letter`.
+    pub fn work(&self, index: u8, letter: char) -> f64 {
+        self.work
+            .get(&index)
+            .and_then(|w| w.get(&letter))
+            .copied()
+            .unwrap_or(0.0)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setup {
+    /// Machine axis letters in machine order, e.g. `['X', 'Z']`.
+    pub axes: Vec<char>,
+    /// Axes programmed in diameter (lathe X).
+    pub diameter: Vec<bool>,
+    /// The machine position when the program starts (X as diameter).
+    pub start: Vec<f64>,
+    /// Machine coordinates of the reference point.
+    pub reference: Vec<f64>,
+    /// Machine coordinates of the second reference point (where a mill changes tools).
+    pub second_reference: Vec<f64>,
+    pub offsets: Offsets,
+    /// Kept macro variables, by number.
+    pub kept: BTreeMap<i64, f64>,
+    /// Input bits that are on, as `(byte, bit)` of the X table.
+    pub inputs: BTreeSet<(u32, u8)>,
+    /// Block skip switch: blocks starting with `/` are skipped.
+    pub block_skip: bool,
+    /// Stop where the program would start over (a return in a main program, an endless
+    /// block-range repeat, an end-and-restart code): for checks and simulation, which must
+    /// end.
+    pub single_pass: bool,
+    /// Active work system at start (0 = the first).
+    pub work_system: u8,
+    /// The turret is in front of the spindle axis: compensation sides swap (decision D30).
+    pub front_tool_post: bool,
+    /// A T word calls this program as the tool-change macro (a machine parameter).
+    pub tool_change_macro: Option<u32>,
+}
+
+impl Setup {
+    /// A lathe with X (diameter) and Z at the given start position, no offsets.
+    pub fn lathe(start: [f64; 2]) -> Setup {
+        Setup::new(&['X', 'Z'], &[true, false], &start)
+    }
+
+    pub fn new(axes: &[char], diameter: &[bool], start: &[f64]) -> Setup {
+        let n = axes.len();
+        let start: Vec<f64> = (0..n)
+            .map(|i| start.get(i).copied().unwrap_or(0.0))
+            .collect();
+        Setup {
+            axes: axes.to_vec(),
+            diameter: (0..n)
+                .map(|i| diameter.get(i).copied().unwrap_or(false))
+                .collect(),
+            reference: start.clone(),
+            second_reference: start.clone(),
+            start,
+            offsets: Offsets::default(),
+            kept: BTreeMap::new(),
+            inputs: BTreeSet::new(),
+            block_skip: true,
+            single_pass: true,
+            work_system: 0,
+            front_tool_post: false,
+            tool_change_macro: None,
+        }
+    }
+}

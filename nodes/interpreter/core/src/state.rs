@@ -1,0 +1,386 @@
+//! [`Core`]: the machine as a program sees it while it runs, and the stream of canonical
+//! commands the program has produced so far.
+
+use std::collections::{HashMap, VecDeque};
+use std::sync::Arc;
+
+use crate::canon::{Aux, Canon, Command};
+use crate::chip_break::ChipBreak;
+use crate::comp::RadiusComp;
+use crate::corner::Corner;
+use crate::error::{AlarmTable, Fault, ProgramError};
+use crate::flow::CallLevel;
+use crate::geometry::Pt;
+use crate::setup::Setup;
+use crate::text::{Library, Pos};
+use crate::transform::Frame;
+
+/// The working plane: the axis letters of its horizontal and vertical axes (arcs turn
+/// counter-clockwise from the first toward the second), the axis along its normal, and what
+/// to say when the machine lacks one of them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    pub h: char,
+    pub v: char,
+    /// The axis along the normal (drilling axis, carried along by compensation); `None`
+    /// where the plane has no third axis (a lathe).
+    pub normal: Option<char>,
+    pub missing: (Fault, &'static str),
+}
+
+/// How constant surface speed turns the X position into a spindle speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum CssRule {
+    /// rpm = speed × 1000 / (π × diameter), clamped by the maximum spindle speed, at least 10.
+    SurfaceSpeed,
+    /// The speed programmed is the rpm at X0; from the rpm `rpm0` at diameter `x0` (where
+    /// constant surface speed was given) the speed changes linearly toward it.
+    LinearToCenter { rpm0: f64, x0: f64 },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpindleDir {
+    Stopped,
+    Cw,
+    Ccw,
+}
+
+/// What radius compensation allows and how its alarms name it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CompRules {
+    /// A rapid move while compensation is active is refused (alarm [`Fault::CompRapid`]).
+    pub refuse_rapid: bool,
+    /// "tool-nose compensation" or "cutter compensation".
+    pub name: &'static str,
+}
+
+/// What a front end tells the core about its control.
+#[derive(Debug, Clone, Copy)]
+pub struct Rules {
+    pub alarms: AlarmTable,
+    /// Largest programmable feed per minute, mm/min.
+    pub max_feed: f64,
+    /// Feed at program start, mm/min.
+    pub initial_feed: f64,
+    /// A program that runs off its end without a program end is an alarm with this text.
+    pub needs_end: Option<&'static str>,
+    /// Local variables per call level.
+    pub locals: usize,
+    /// The active work system's offset is part of the transform chain.
+    pub work_offsets: bool,
+    pub plane: Plane,
+    pub comp: CompRules,
+    /// Deepest program call nesting below the main program.
+    pub max_call_depth: usize,
+}
+
+/// Most blocks read without producing a command before the program is judged stuck in a loop
+/// that never moves (a macro jump loop): an alarm instead of a hang.
+pub const MAX_SILENT_BLOCKS: u32 = 1_000_000;
+
+/// The core's state; front ends read and change it through its fields and methods.
+pub struct Core {
+    pub rules: Rules,
+    pub setup: Setup,
+    pub library: Library,
+    /// The main program and the programs it has called, innermost last.
+    pub levels: Vec<CallLevel>,
+    /// Commanded machine position per axis (X as diameter on a diameter axis).
+    pub pos: Vec<f64>,
+    /// Work position at the program start.
+    pub program_start: Vec<f64>,
+    // The transform chain (`transform.rs`).
+    pub work_system: u8,
+    pub shift: Vec<f64>,
+    pub local: Vec<f64>,
+    pub frame: Frame,
+    pub tool_offset: Vec<f64>,
+    pub plane: Plane,
+    // Modal motion state.
+    pub feed: f64,
+    pub feed_per_rev: bool,
+    pub exact_stop_mode: bool,
+    // The spindle.
+    pub spindle: SpindleDir,
+    /// Constant surface speed in force, with its rule.
+    pub css: Option<CssRule>,
+    /// The surface speed (or rpm at X0) constant surface speed keeps.
+    pub css_speed: f64,
+    /// Last programmed spindle speed, rpm.
+    pub rpm: f64,
+    /// Last spindle speed sent, rpm.
+    pub sent_rpm: Option<f64>,
+    /// Maximum spindle speed under constant surface speed.
+    pub max_rpm: Option<f64>,
+    // Path filters (`emit.rs`).
+    pub comp: Option<RadiusComp>,
+    /// Compensation ends with the next move.
+    pub comp_cancel: bool,
+    pub corner: Option<Corner>,
+    pub chip_break: Option<ChipBreak>,
+    /// Set while compensated moves are being queued (they are not compensated again).
+    pub(crate) emitting_comp: bool,
+    /// While a filter holds an element back, commands from this index of `pending` on wait
+    /// for it (they come after it in the program).
+    pub(crate) hold_at: Option<usize>,
+    /// Common variables by number.
+    pub common: HashMap<i64, f64>,
+    // The stream.
+    pub(crate) pending: VecDeque<Canon>,
+    /// The source line of the block being run.
+    pub line: u32,
+    /// Where the line being run starts (a loop comes back to it).
+    pub block_start: Pos,
+    pub(crate) done: bool,
+    pub(crate) error: Option<ProgramError>,
+    pub(crate) silent_blocks: u32,
+    /// A program end has been read.
+    pub saw_end: bool,
+}
+
+impl Core {
+    /// The core for the program `text` on the machine `setup`, with the called programs of
+    /// `library`.
+    pub fn new(rules: Rules, text: &str, setup: Setup, library: Library) -> Core {
+        let n = setup.axes.len();
+        let common = setup.kept.iter().map(|(&k, &v)| (k, v)).collect();
+        let mut core = Core {
+            levels: vec![CallLevel::main(Arc::from(text), rules.locals)],
+            pos: setup.start.clone(),
+            program_start: Vec::new(),
+            work_system: setup.work_system.min(5),
+            shift: vec![0.0; n],
+            local: vec![0.0; n],
+            frame: Frame::identity(n),
+            tool_offset: vec![0.0; n],
+            plane: rules.plane,
+            feed: rules.initial_feed,
+            feed_per_rev: false,
+            exact_stop_mode: false,
+            spindle: SpindleDir::Stopped,
+            css: None,
+            css_speed: 0.0,
+            rpm: 0.0,
+            sent_rpm: None,
+            max_rpm: None,
+            comp: None,
+            comp_cancel: false,
+            corner: None,
+            chip_break: None,
+            emitting_comp: false,
+            hold_at: None,
+            common,
+            pending: VecDeque::new(),
+            line: 0,
+            block_start: Pos::default(),
+            done: false,
+            error: None,
+            silent_blocks: 0,
+            saw_end: false,
+            rules,
+            setup,
+            library,
+        };
+        core.program_start = core.work_position();
+        core
+    }
+
+    // ------------------------------------------------------------------ errors
+
+    /// The alarm of `f` in the front end's table, at the line being run, naming the called
+    /// program it is in.
+    pub fn fault(&self, f: Fault, text: impl Into<String>) -> ProgramError {
+        let mut e = ProgramError::new((self.rules.alarms)(f), self.line, text);
+        if let Some(level) = self.levels.last() {
+            e.program.clone_from(&level.name);
+        }
+        e
+    }
+
+    // ------------------------------------------------------------------ coordinates
+
+    pub fn axis(&self, letter: char) -> Option<usize> {
+        self.setup.axes.iter().position(|&a| a == letter)
+    }
+
+    /// Program zero of axis `i` in machine coordinates, without the frame.
+    pub fn origin(&self, i: usize) -> f64 {
+        let letter = self.setup.axes[i];
+        let work = if self.rules.work_offsets {
+            self.setup.offsets.work(self.work_system, letter)
+        } else {
+            0.0
+        };
+        work + self.shift[i] + self.local[i] + self.tool_offset[i]
+    }
+
+    /// Program zero per axis in machine coordinates (work offset, shifts, tool offset) as it
+    /// stands after the blocks read so far: the HMI's work position is measured from it.
+    pub fn program_origin(&self) -> Vec<f64> {
+        (0..self.pos.len()).map(|i| self.origin(i)).collect()
+    }
+
+    /// Current position in work coordinates (X as diameter).
+    pub fn work_position(&self) -> Vec<f64> {
+        let p: Vec<f64> = (0..self.pos.len())
+            .map(|i| self.pos[i] - self.origin(i))
+            .collect();
+        if self.frame.is_identity() {
+            p
+        } else {
+            self.frame.invert(&p)
+        }
+    }
+
+    pub fn to_machine(&self, work: &[f64]) -> Vec<f64> {
+        if self.frame.is_identity() {
+            (0..work.len()).map(|i| work[i] + self.origin(i)).collect()
+        } else {
+            let f = self.frame.apply(work);
+            (0..f.len()).map(|i| f[i] + self.origin(i)).collect()
+        }
+    }
+
+    /// The X and Z axes' indices (alarm when the machine lacks one).
+    pub fn xz(&self) -> Result<(usize, usize), ProgramError> {
+        match (self.axis('X'), self.axis('Z')) {
+            (Some(x), Some(z)) => Ok((x, z)),
+            _ => Err(self.fault(Fault::AxisAddress, "this function needs the X and Z axes")),
+        }
+    }
+
+    /// The working plane as (horizontal, vertical) axis indices.
+    pub fn plane_axes(&self) -> Result<(usize, usize), ProgramError> {
+        match (self.axis(self.plane.h), self.axis(self.plane.v)) {
+            (Some(h), Some(v)) => Ok((h, v)),
+            _ => Err(self.fault(self.plane.missing.0, self.plane.missing.1)),
+        }
+    }
+
+    /// The axis along the plane's normal, if the plane has one and the machine has it.
+    pub fn plane_normal(&self) -> Option<usize> {
+        self.axis(self.plane.normal?)
+    }
+
+    /// Display units → plane units: a diameter axis counts half.
+    pub fn axis_scale(&self, i: usize) -> f64 {
+        if self.setup.diameter.get(i) == Some(&true) {
+            0.5
+        } else {
+            1.0
+        }
+    }
+
+    /// The scale of the X axis (0.5 when it is programmed in diameter).
+    pub fn x_scale(&self) -> f64 {
+        match self.axis('X') {
+            Some(i) if self.setup.diameter.get(i) == Some(&true) => 0.5,
+            _ => 1.0,
+        }
+    }
+
+    /// Work position as a plane point (`z` horizontal, `r` vertical; X as radius).
+    pub fn plane_point(&self, work: &[f64]) -> Result<Pt, ProgramError> {
+        let (h, v) = self.plane_axes()?;
+        Ok(Pt::new(
+            work[h] * self.axis_scale(h),
+            work[v] * self.axis_scale(v),
+        ))
+    }
+
+    /// Sets the plane axes of work position `w` to the plane point `p`.
+    pub fn set_plane_point(&self, w: &mut [f64], p: Pt) {
+        if let Ok((h, v)) = self.plane_axes() {
+            w[v] = p.r / self.axis_scale(v);
+            w[h] = p.z / self.axis_scale(h);
+        }
+    }
+
+    /// `base` with its plane axes at `p`.
+    pub fn with_point(&self, base: &[f64], p: Pt) -> Vec<f64> {
+        let mut w = base.to_vec();
+        self.set_plane_point(&mut w, p);
+        w
+    }
+
+    // ------------------------------------------------------------------ the stream
+
+    /// Queues a command on the line being run.
+    pub fn push(&mut self, command: Command) {
+        self.pending.push_back(Canon {
+            line: self.line,
+            command,
+        });
+    }
+
+    pub fn aux(&mut self, a: Aux) {
+        self.push(Command::Aux(a));
+    }
+
+    /// How many commands are queued: a front end compares it before and after a block to
+    /// know what the block produced.
+    pub fn queued(&self) -> usize {
+        self.pending.len()
+    }
+
+    /// The block that produced the commands from index `from` of the queue on ends at rest
+    /// (an exact stop for one block): its first motion is preceded by an exact-stop path mode
+    /// and the block is followed by the continuous one.
+    pub fn exact_stop_block(&mut self, from: usize) {
+        let first = self
+            .pending
+            .iter()
+            .skip(from)
+            .position(|c| c.command.end().is_some());
+        if let Some(i) = first {
+            self.pending.insert(
+                from + i,
+                Canon {
+                    line: self.line,
+                    command: Command::PathMode { exact_stop: true },
+                },
+            );
+            self.push(Command::PathMode { exact_stop: false });
+        }
+    }
+
+    /// Sets the spindle speed, sending it when it changed.
+    pub fn set_rpm(&mut self, rpm: f64) {
+        self.rpm = rpm;
+        if self.sent_rpm != Some(rpm) {
+            self.sent_rpm = Some(rpm);
+            self.aux(Aux::S(rpm));
+        }
+    }
+
+    /// Sends the spindle speed for a block ending at work position `end` under constant
+    /// surface speed: the speed at the end point (decision D17).
+    pub fn spindle_for(&mut self, end: &[f64]) {
+        let Some(rule) = self.css else {
+            return;
+        };
+        let x = self.axis('X').map(|i| end[i].abs()).unwrap_or(0.0);
+        let rpm = match rule {
+            CssRule::LinearToCenter { rpm0, x0 } => {
+                if x0 <= 0.0 {
+                    self.css_speed
+                } else {
+                    self.css_speed + (rpm0 - self.css_speed) * (x / x0).min(1.0)
+                }
+            }
+            CssRule::SurfaceSpeed => {
+                let d = x.max(1e-3);
+                let mut rpm = self.css_speed * 1000.0 / (std::f64::consts::PI * d);
+                if let Some(m) = self.max_rpm {
+                    rpm = rpm.min(m);
+                }
+                rpm.max(10.0)
+            }
+        };
+        let rpm = (rpm * 10.0).round() / 10.0;
+        if self.sent_rpm != Some(rpm) {
+            self.sent_rpm = Some(rpm);
+            self.aux(Aux::S(rpm));
+        }
+    }
+}

@@ -1,0 +1,454 @@
+//! The Huaxing WA-N7xx lathe (`000`): FANUC "G-code system A" style (G50 sets coordinates,
+//! G90/G92/G94 are cycles, U/W incremental), single and multiple repetitive cycles, G07 chip
+//! breaking, block-range repeats G21–G27, chamfers in G01, macro variables, and the tool-change
+//! macro.
+
+mod alarms;
+mod compound;
+mod drilling;
+mod flow;
+mod grooving;
+mod threads;
+mod tool;
+
+use cnc_interpreter_core::corner::Chamfer;
+use cnc_interpreter_core::{CompRules, Fault, Plane, ProgramError, Setup};
+
+use crate::fanuc::block::Block;
+use crate::fanuc::codes::{GCode, Rules, G, M};
+use crate::fanuc::expr::{EvalError, Value};
+use crate::fanuc::{Family, Fanuc, ThreadWords};
+
+pub use alarms::alarm;
+pub use tool::ToolMacro;
+
+/// The Huaxing's own G meanings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HuaxingG {
+    /// G05 (`absolute` false: mid point relative to start) / G05.1 (absolute).
+    ThreePointArc {
+        absolute: bool,
+    },
+    /// G50.1: assign work coordinate, remember the difference as local coordinate.
+    AssignCoordinate,
+    /// G50.2: assign work coordinate and clear the local coordinate.
+    AssignClearLocal,
+    /// G50.3: shift the work coordinate by U/W and clear the local coordinate.
+    ShiftCoordinate,
+    /// G52: add to the local shift.
+    LocalCoordinate,
+    TurningCycle,
+    FacingCycle,
+    ThreadCycle,
+    Thread,
+    VariableLeadThread,
+    TappingCycle,
+    MultiThreadCycle,
+    RoughTurning,
+    RoughFacing,
+    PatternRepeat,
+    Finishing,
+    FaceGrooving,
+    RadialGrooving,
+    /// G83 (axial, `radial` false) / G87 (radial) peck drilling (§5.22.7).
+    Drilling {
+        radial: bool,
+    },
+    /// G07 K L: pause K s after every L mm of a G01; plain G07 cancels (§5.6).
+    ChipBreak,
+    /// G21 (`high` false) / G23 (`high` true): input-conditioned range repeat (§5.12).
+    ConditionalRepeat {
+        high: bool,
+    },
+    JumpRange,
+    CallRange,
+    LoopRange,
+}
+
+/// Retained words of a single cycle (G90/G92/G94, §5.21.3).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CycleWords {
+    pub x: Option<f64>,
+    pub z: Option<f64>,
+    pub r: f64,
+}
+
+/// The Huaxing's own modal state.
+pub struct Huaxing {
+    pub thread: ThreadWords,
+    pub cycle: CycleWords,
+    pub compound: compound::CompoundWords,
+    /// G74/G75 retract per peck (GS#43 default 1 mm).
+    pub groove_retract: f64,
+    /// G83/G87 modal words (§5.22.7).
+    pub drill: drilling::DrillWords,
+    /// G92 number of starts (§5.23.5, modal).
+    pub cycle_starts: u32,
+    /// The call depth of a running tool-change macro: T words inside it do not call it again.
+    pub tool_macro_depth: Option<usize>,
+}
+
+/// The lathe's working plane, Z-X.
+pub const LATHE_PLANE: Plane = Plane {
+    h: 'Z',
+    v: 'X',
+    normal: None,
+    missing: (Fault::AxisAddress, "this function needs the X and Z axes"),
+};
+
+/// Tool-nose compensation on a lathe whose G00 may not run under it.
+pub const LATHE_COMP: CompRules = CompRules {
+    refuse_rapid: true,
+    name: "tool-nose compensation",
+};
+
+impl Family for Huaxing {
+    type G = HuaxingG;
+    type M = ToolMacro;
+
+    fn g_code(x10: u32) -> Option<GCode<HuaxingG>> {
+        g_code(x10)
+    }
+    fn m_code(x10: u32) -> Option<M<ToolMacro>> {
+        m_code(x10)
+    }
+    fn alarm(f: Fault) -> u32 {
+        alarm(f)
+    }
+    fn rules() -> Rules<HuaxingG> {
+        Rules {
+            macros: true,
+            // Least input increment 0.0001 mm (§1.2).
+            increment: 0.0001,
+            max_coordinate: 99999.9999,
+            initial_motion: G::Linear,
+        }
+    }
+    fn core_rules() -> cnc_interpreter_core::Rules {
+        cnc_interpreter_core::Rules {
+            alarms: alarm,
+            max_feed: 15000.0,
+            // Power-on feed F 50 (§5.25).
+            initial_feed: 50.0,
+            needs_end: None,
+            locals: 41,
+            work_offsets: true,
+            plane: LATHE_PLANE,
+            comp: LATHE_COMP,
+            // Four levels of subprograms (§4.1.3).
+            max_call_depth: 4,
+        }
+    }
+    fn new(_setup: &Setup) -> Self {
+        Huaxing {
+            thread: ThreadWords::default(),
+            cycle: CycleWords::default(),
+            compound: compound::CompoundWords::default(),
+            groove_retract: 1.0,
+            drill: drilling::DrillWords::default(),
+            cycle_starts: 1,
+            tool_macro_depth: None,
+        }
+    }
+
+    const REFUSE_GROUP00_WITH_01: bool = true;
+    const INCREMENTAL_ADDRESSES: bool = true;
+
+    fn extra_address(c: char) -> bool {
+        c == 'U' || c == 'W'
+    }
+
+    fn read_var(f: &Fanuc<Self>, n: i64) -> Result<Value, EvalError> {
+        f.lathe_read(n)
+    }
+    fn write_var(f: &mut Fanuc<Self>, n: i64, v: Value) -> Result<(), ProgramError> {
+        f.lathe_write(n, v)
+    }
+
+    fn f_is_lead(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
+        let motion = b.group(1).unwrap_or(f.motion);
+        matches!(
+            motion,
+            G::Own(
+                HuaxingG::Thread
+                    | HuaxingG::VariableLeadThread
+                    | HuaxingG::ThreadCycle
+                    | HuaxingG::TappingCycle
+            )
+        ) || b.has_g(G::Own(HuaxingG::MultiThreadCycle))
+    }
+    fn tool_word(f: &mut Fanuc<Self>, t: f64) -> Result<(), ProgramError> {
+        f.huaxing_tool_word(t)
+    }
+    fn m_in_cycle(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
+        // In a G83/G87 block an M word is the spindle clamp code of the cycle (§5.22.7).
+        matches!(
+            b.group(1).unwrap_or(f.motion),
+            G::Own(HuaxingG::Drilling { .. })
+        ) && f.has_axis_words(b)
+    }
+    fn own_m_before(
+        f: &mut Fanuc<Self>,
+        m: ToolMacro,
+        b: &Block<Self>,
+    ) -> Result<(), ProgramError> {
+        f.tool_macro_code(m, b)
+    }
+    fn flow_waits(_f: &Fanuc<Self>, b: &Block<Self>) -> bool {
+        b.has_g(G::Own(HuaxingG::Finishing))
+    }
+    fn start_comp(
+        f: &mut Fanuc<Self>,
+        b: &Block<Self>,
+        g: G<HuaxingG>,
+    ) -> Result<(), ProgramError> {
+        f.lathe_start_comp(b, g)
+    }
+    fn cancel_comp(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
+        f.lathe_cancel_comp(b)
+    }
+    fn ret(f: &mut Fanuc<Self>) -> Result<(), ProgramError> {
+        f.core.return_from_call();
+        if f.d.tool_macro_depth.is_some_and(|d| f.core.depth() < d) {
+            f.d.tool_macro_depth = None;
+        }
+        Ok(())
+    }
+    fn one_shot(
+        f: &mut Fanuc<Self>,
+        g: HuaxingG,
+        b: &Block<Self>,
+    ) -> Option<Result<(), ProgramError>> {
+        use HuaxingG::*;
+        Some(match g {
+            AssignCoordinate | AssignClearLocal => f.set_coordinate(b, g == AssignClearLocal),
+            ShiftCoordinate => f.shift_coordinate(b),
+            LocalCoordinate => {
+                for (i, &a) in f.core.setup.axes.clone().iter().enumerate() {
+                    if let Some(v) = b.get(a) {
+                        f.core.shift[i] += v;
+                    }
+                }
+                Ok(())
+            }
+            ConditionalRepeat { high } => f.conditional_repeat(b, high),
+            JumpRange | CallRange | LoopRange => f.range(b, g),
+            RoughTurning | RoughFacing | PatternRepeat => f.compound_cycle(b, g),
+            Finishing => f.finishing(b),
+            FaceGrooving | RadialGrooving => f.grooving(b, g == RadialGrooving),
+            ChipBreak => f.set_chip_break(b),
+            MultiThreadCycle => f.g76(b),
+            _ => return None,
+        })
+    }
+    fn is_motion(g: HuaxingG) -> bool {
+        use HuaxingG::*;
+        matches!(
+            g,
+            ThreePointArc { .. }
+                | Thread
+                | VariableLeadThread
+                | TappingCycle
+                | TurningCycle
+                | FacingCycle
+                | ThreadCycle
+                | Drilling { .. }
+        )
+    }
+    fn motion_selected(
+        f: &mut Fanuc<Self>,
+        _new: G<HuaxingG>,
+        changed: bool,
+        _b: &Block<Self>,
+    ) -> Option<Result<(), ProgramError>> {
+        if changed {
+            // A new cycle or motion code drops the retained cycle words.
+            f.d.cycle = CycleWords::default();
+        }
+        None
+    }
+    fn motion_words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
+        if let G::Own(HuaxingG::Drilling { .. }) = f.motion {
+            f.drill_words(b)?;
+        }
+        Ok(())
+    }
+    fn motion(f: &mut Fanuc<Self>, g: HuaxingG, b: &Block<Self>) -> Result<(), ProgramError> {
+        use HuaxingG::*;
+        match g {
+            ThreePointArc { absolute } => f.three_point_arc(b, absolute),
+            Drilling { radial } => f.drilling(b, radial),
+            Thread => f.g32(b),
+            VariableLeadThread => f.g34(b),
+            TappingCycle => f.g33(b),
+            TurningCycle | FacingCycle | ThreadCycle => f.single_cycle(b, g),
+            other => Err(f.fault(Fault::UndefinedCode, format!("{other:?} is not a motion"))),
+        }
+    }
+    fn chamfer(f: &Fanuc<Self>, b: &Block<Self>) -> Result<Option<Chamfer>, ProgramError> {
+        f.chamfer_words(b)
+    }
+}
+
+impl Fanuc<Huaxing> {
+    /// G50.3: shift the work coordinates by the block's words.
+    fn shift_coordinate(&mut self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
+        let here = self.core.work_position();
+        let end = self.end_point(b)?;
+        for i in 0..here.len() {
+            self.core.shift[i] -= end[i] - here[i];
+        }
+        Ok(())
+    }
+
+    /// The chamfer or rounding words of a G01 block (§5.11); a value outside 0–1000 is
+    /// ignored, as the manual says.
+    fn chamfer_words(&self, b: &Block<Huaxing>) -> Result<Option<Chamfer>, ProgramError> {
+        let usable = |v: f64| v > 0.0 && v <= 1000.0;
+        match (b.get('L'), b.get('D')) {
+            (Some(_), Some(_)) => Err(self.fault(
+                Fault::Chamfer,
+                "chamfer L and corner rounding D in one block",
+            )),
+            (Some(l), None) if usable(l) => Ok(Some(Chamfer::Line(l))),
+            (None, Some(d)) if usable(d) => Ok(Some(Chamfer::Round(d))),
+            _ => Ok(None),
+        }
+    }
+}
+
+pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
+    use HuaxingG::*;
+    use G::*;
+    let (group, meaning) = match n {
+        0 => (1, Rapid),
+        10 => (1, Linear),
+        20 => (1, ArcCw),
+        30 => (1, ArcCcw),
+        40 => (0, Dwell),
+        50 => (1, G::Own(ThreePointArc { absolute: false })),
+        51 => (1, G::Own(ThreePointArc { absolute: true })),
+        70 => (0, G::Own(ChipBreak)),
+        71 => (
+            0,
+            Unsupported("G07.1 thread chip breaking needs an oscillation superimposed in motion"),
+        ),
+        80..=86 => (
+            1,
+            Unsupported("G08 rotary-axis interpolation needs a rotary axis"),
+        ),
+        90 => (15, ExactStopBlock),
+        121 => (16, Unsupported("G12.1 polar interpolation needs a C axis")),
+        131 => (16, Unsupported("G13.1 polar interpolation needs a C axis")),
+        141..=146 => (
+            1,
+            Unsupported("G14.n live-tool tapping needs a live tool axis"),
+        ),
+        170 => (16, PlaneXy),
+        180 => (16, PlaneZx),
+        190 => (16, PlaneYz),
+        210 => (0, G::Own(ConditionalRepeat { high: false })),
+        230 => (0, G::Own(ConditionalRepeat { high: true })),
+        250 => (0, G::Own(JumpRange)),
+        260 => (0, G::Own(CallRange)),
+        270 => (0, G::Own(LoopRange)),
+        280 => (0, ReferenceReturn),
+        310 => (1, Unsupported("G31 skip needs a skip input in motion")),
+        320 => (1, G::Own(Thread)),
+        330 => (1, G::Own(TappingCycle)),
+        340 => (1, G::Own(VariableLeadThread)),
+        400 => (7, NoseCancel),
+        410 => (7, NoseLeft),
+        420 => (7, NoseRight),
+        430 | 440 | 490 => (
+            8,
+            Unsupported("G43/G44/G49 tool length compensation is milling"),
+        ),
+        500 => (0, SetCoordinate),
+        501 => (0, G::Own(AssignCoordinate)),
+        502 => (0, G::Own(AssignClearLocal)),
+        503 => (0, G::Own(ShiftCoordinate)),
+        520 => (0, G::Own(LocalCoordinate)),
+        540..=590 if n.is_multiple_of(10) => (14, WorkSystem(((n - 540) / 10) as u8)),
+        610 => (15, ExactStopMode),
+        640 => (15, ContinuousMode),
+        650 => (
+            0,
+            Unsupported("G65 macro call: format not documented in the manual"),
+        ),
+        660 => (
+            0,
+            Unsupported("G66 modal macro call: format not documented in the manual"),
+        ),
+        700 => (0, G::Own(Finishing)),
+        710 => (0, G::Own(RoughTurning)),
+        720 => (0, G::Own(RoughFacing)),
+        730 => (0, G::Own(PatternRepeat)),
+        740 => (0, G::Own(FaceGrooving)),
+        750 => (0, G::Own(RadialGrooving)),
+        760 => (0, G::Own(MultiThreadCycle)),
+        770 => (
+            0,
+            Unsupported("G77 clears an absolute encoder's multi-turn count"),
+        ),
+        800 => (
+            1,
+            Unsupported("G80 cancels rigid tapping, which needs a position spindle"),
+        ),
+        830 => (1, G::Own(Drilling { radial: false })),
+        870 => (1, G::Own(Drilling { radial: true })),
+        840 | 880 => (
+            1,
+            Unsupported("G84/G88 rigid tapping needs a position spindle"),
+        ),
+        850 | 860 | 890 => (1, Unsupported("not described in the manual")),
+        900 => (1, G::Own(TurningCycle)),
+        920 => (1, G::Own(ThreadCycle)),
+        921 => (1, Unsupported("G92.1 rigid thread cycle is only listed")),
+        940 => (1, G::Own(FacingCycle)),
+        960 => (2, ConstantSurfaceSpeed),
+        970 => (2, ConstantRpm),
+        980 => (5, FeedPerMinute),
+        990 => (5, FeedPerRevolution),
+        991 => (5, Unsupported("G99.1 needs the encoder Z pulse in motion")),
+        _ => return None,
+    };
+    Some(GCode { group, meaning })
+}
+
+pub fn m_code(n: u32) -> Option<M<ToolMacro>> {
+    use M::*;
+    Some(match n {
+        0 => Stop,
+        10 => OptionalStop,
+        20 | 300 => ProgramEnd,
+        // Codes that start something go out before the block's motion (decision D6).
+        30 | 40 | 60 | 80 | 100 | 120 | 140 | 170 | 180 | 190 | 200 | 220 | 320 | 410 | 420
+        | 430 | 440 | 630 | 640 => AuxBefore,
+        // Codes that stop something go out after it.
+        50 | 90 | 110 | 130 | 150 | 210 | 230 | 330 | 650 => AuxAfter,
+        // M48 counts a part: the PLC does, after the motion.
+        480 => AuxAfter,
+        980 => SubprogramCall,
+        990 => SubprogramReturn,
+        141..=146 => Unsupported("M14.n assigns the spindle angle to a rotary axis"),
+        290 => Unsupported("M29 rigid tapping needs a position spindle"),
+        500 => Unsupported("M50 bar feed drives outputs directly, not through the PLC"),
+        510 => Unsupported("M51 sets the start block in MDI"),
+        520 => Own(ToolMacro::ReadTool),
+        530 | 531 => Own(ToolMacro::SetOffset),
+        540 => Own(ToolMacro::Sync),
+        570 => Own(ToolMacro::ToolToPlc),
+        580 => Own(ToolMacro::RaiseAlarm),
+        // M56 moves the turret toward the change position: the PLC's.
+        560 => AuxBefore,
+        550 => Unsupported("M55 writes PLC F026–F029, which the PLC program does not read"),
+        590 | 600 | 660 | 850 | 860 | 870 | 880 | 890 => {
+            Unsupported("NC-internal M code of multi-channel or live-tool machines")
+        }
+        90000..=99990 if n.is_multiple_of(10) => Unsupported(
+            "M9000–M9999 call programs through an address table the manual does not give",
+        ),
+        _ => return None,
+    })
+}

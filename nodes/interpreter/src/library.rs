@@ -1,0 +1,130 @@
+//! Program libraries of the FANUC family's program numbers: a program is found by the `O`
+//! number on its first line or by a file name like `O2011.nc` (issue 3), and a tape of several
+//! programs is split at its program heads.
+
+use std::path::Path;
+
+use cnc_interpreter_core::{read_line, Library, Pos};
+
+/// The program number a line starts (`O2002`, `O2002 (SUB)`), if it is a program head.
+fn program_head(line: &str) -> Option<u32> {
+    let rest = line.trim_start().strip_prefix(['O', 'o'])?;
+    let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    let after = rest[digits.len()..].chars().next();
+    if digits.is_empty() || digits.len() > 4 || after.is_some_and(|c| c.is_ascii_alphanumeric()) {
+        return None;
+    }
+    digits.parse().ok()
+}
+
+/// A file that holds several programs, as a FANUC tape does (`%`, `O1002` … M30, `O2002` …
+/// M99, `%`): the byte length of the first program (from the top to the next program head)
+/// and each following program as (number, its text). A file of one program gives its whole
+/// length and no others.
+pub fn split_programs(text: &str) -> (usize, Vec<(u32, &str)>) {
+    let mut heads = Vec::new();
+    let mut pos = Pos::default();
+    let mut seen_block = false;
+    while let Some((line, next)) = read_line(text, pos) {
+        let t = line.trim();
+        match program_head(t) {
+            Some(n) if seen_block => heads.push((n, pos.offset)),
+            _ => {}
+        }
+        if !t.is_empty() && t != "%" && !t.starts_with('(') && !t.starts_with(';') {
+            seen_block = true;
+        }
+        pos = next;
+    }
+    let main_end = heads.first().map_or(text.len(), |h| h.1);
+    let others = heads
+        .iter()
+        .enumerate()
+        .map(|(k, &(n, start))| {
+            let end = heads.get(k + 1).map_or(text.len(), |h| h.1);
+            (n, &text[start..end])
+        })
+        .collect();
+    (main_end, others)
+}
+
+/// The program number a text declares: `O1234` on its first non-empty line.
+pub fn declared_number(text: &str) -> Option<u32> {
+    let first = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && *l != "%" && !l.starts_with('(') && !l.starts_with(';'))?;
+    let rest = first.strip_prefix(['O', 'o'])?;
+    let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    digits.parse().ok()
+}
+
+/// The program number a file name gives: `O2011.nc`, `o2011.txt`, `2011.nc`.
+pub fn file_number(path: &Path) -> Option<u32> {
+    let stem = path.file_stem()?.to_str()?;
+    // `O2011.nc`, `2011.nc`, or a descriptive name ending in `_O2011`.
+    let stem = stem.rsplit('_').next().unwrap_or(stem);
+    let stem = stem.strip_prefix(['O', 'o']).unwrap_or(stem);
+    if stem.is_empty() || !stem.chars().all(|c| c.is_ascii_digit()) || stem.len() > 4 {
+        return None;
+    }
+    stem.parse().ok()
+}
+
+/// Reads every program of a folder (the shell's job; the core never touches files).
+/// Unreadable or nameless files are skipped and listed in the second value.
+pub fn load_dir(dir: &Path) -> std::io::Result<(Library, Vec<String>)> {
+    let mut lib = Library::new();
+    let mut skipped = Vec::new();
+    let mut entries: Vec<_> = std::fs::read_dir(dir)?.filter_map(Result::ok).collect();
+    entries.sort_by_key(|e| e.path());
+    for entry in entries {
+        let path = entry.path();
+        if !path.is_file() {
+            continue;
+        }
+        let Ok(bytes) = std::fs::read(&path) else {
+            skipped.push(format!("{}: unreadable", path.display()));
+            continue;
+        };
+        let Ok(text) = String::from_utf8(bytes) else {
+            skipped.push(format!("{}: not UTF-8 text", path.display()));
+            continue;
+        };
+        let number = declared_number(&text).or_else(|| file_number(&path));
+        let name = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("?")
+            .to_string();
+        match number {
+            // The first file wins; a later one with the same number is reported.
+            Some(n) if lib.get(n).is_none() => lib.insert(n, &name, &text),
+            Some(n) => skipped.push(format!("{name}: O{n:04} already taken")),
+            None => {}
+        }
+    }
+    Ok((lib, skipped))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn program_numbers_and_tapes() {
+        assert_eq!(declared_number("\n O0010 ;x\nN1"), Some(10));
+        // A tape: main program, then two subprograms; `%` and the program heads delimit them.
+        let tape = "%\nO1002 (MAIN)\nG0 X1\nM30\nO2002\nX2\nM99\no3 (x)\nX3\nM99\n%\n";
+        let (main, others) = split_programs(tape);
+        assert_eq!(&tape[..main], "%\nO1002 (MAIN)\nG0 X1\nM30\n");
+        assert_eq!(
+            others,
+            vec![(2002, "O2002\nX2\nM99\n"), (3, "o3 (x)\nX3\nM99\n%\n")]
+        );
+        assert_eq!(split_programs("G0 X1\nOR\nO12345\n"), (16, vec![]));
+        assert_eq!(file_number(Path::new("lib/O2011.nc")), Some(2011));
+        assert_eq!(file_number(Path::new("lib/part.nc")), None);
+        assert_eq!(file_number(Path::new("052_sphere_sub_O0010.nc")), Some(10));
+    }
+}
