@@ -32,7 +32,11 @@ impl User {
             std::fs::create_dir_all(d).unwrap();
         }
         let cnc = bin.join("cnc");
-        std::fs::copy(env!("CARGO_BIN_EXE_cnc"), &cnc).unwrap();
+        // A hard link opens no file for writing: a copy's open descriptor, inherited by a
+        // child another test forks meanwhile, would make the binary "text file busy".
+        if std::fs::hard_link(env!("CARGO_BIN_EXE_cnc"), &cnc).is_err() {
+            std::fs::copy(env!("CARGO_BIN_EXE_cnc"), &cnc).unwrap();
+        }
         User { home, work, cnc }
     }
 
@@ -48,13 +52,26 @@ impl User {
     }
 
     fn run(&self, args: &[&str]) -> Output {
-        self.command(args).output().unwrap()
+        busy_retry(|| self.command(args).output())
     }
 
     /// The data folder of the built-in lathe, as the README says.
     fn data(&self) -> PathBuf {
         self.home.join(".local/share/cnc/sim_lathe")
     }
+}
+
+/// Runs `f` again while the binary is "text file busy" (a copied binary, see [`User::new`]).
+fn busy_retry<T>(mut f: impl FnMut() -> std::io::Result<T>) -> T {
+    for _ in 0..100 {
+        match f() {
+            Err(e) if e.raw_os_error() == Some(libc::ETXTBSY) => {
+                std::thread::sleep(Duration::from_millis(20))
+            }
+            other => return other.unwrap(),
+        }
+    }
+    panic!("the binary stayed busy")
 }
 
 fn text(out: &Output) -> String {
@@ -142,13 +159,13 @@ fn an_installed_cnc_runs_a_program_and_keeps_its_files_in_its_data_folder() {
         "#200=12.5\nG00 X100 Z20\nS500 M03\nG01 Z10 F3000\nM05\nM30\n",
     )
     .unwrap();
-    let mut child = user
-        .command(&["run", "--program", "part.nc", "--cycles", "1"])
-        .env("ROS_DOMAIN_ID", "61")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = busy_retry(|| {
+        user.command(&["run", "--program", "part.nc", "--cycles", "1"])
+            .env("ROS_DOMAIN_ID", "61")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+    });
     let lines = read_lines(&mut child, usize::MAX, Duration::from_secs(120));
     let status = finish(&mut child, &lines);
     let all = lines.join("\n");
@@ -192,13 +209,13 @@ fn an_installed_cnc_runs_a_program_and_keeps_its_files_in_its_data_folder() {
 fn the_demo_cell_starts_without_a_warning_from_a_dependency() {
     let _one = CELL.lock().unwrap_or_else(|e| e.into_inner());
     let user = User::new("demo");
-    let mut child = user
-        .command(&[])
-        .env("ROS_DOMAIN_ID", "62")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = busy_retry(|| {
+        user.command(&[])
+            .env("ROS_DOMAIN_ID", "62")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+    });
     // 20 lines: the banner, where files go, and the demo part's progress.
     let lines = read_lines(&mut child, 20, Duration::from_secs(120));
     // SAFETY: a signal to our own child process.
