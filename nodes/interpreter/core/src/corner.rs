@@ -88,7 +88,7 @@ impl Core {
         let feed = MoveKind::Feed(corner.feed);
         let a = self.plane_point(&corner.start)?;
         let p = self.plane_point(&corner.end)?;
-        let plain = |me: &mut Self| me.emit(&corner.end, feed);
+        let plain = |me: &mut Self| me.after_corner(&corner.end, feed);
         let Some(t1) = unit(p.z - a.z, p.r - a.r) else {
             return plain(self);
         };
@@ -131,15 +131,15 @@ impl Core {
                 }
                 let q1 = Pt::new(p.z - d * t1.0, p.r - d * t1.1);
                 let q2 = Pt::new(p.z + d * t2.0, p.r + d * t2.1);
-                self.emit(&self.with_point(&base, q1), feed)?;
+                self.after_corner(&self.with_point(&base, q1), feed)?;
                 match round {
-                    None => self.emit(&self.with_point(&base, q2), feed),
+                    None => self.after_corner(&self.with_point(&base, q2), feed),
                     Some(r) => {
                         // The centre lies on the inside of the turn, r from both lines.
                         let side = cross.signum();
                         let n = (-t1.1 * side, t1.0 * side);
                         let center = Pt::new(q1.z + r * n.0, q1.r + r * n.1);
-                        self.emit(
+                        self.after_corner(
                             &self.with_point(&base, q2),
                             MoveKind::Arc {
                                 center,
@@ -178,8 +178,8 @@ impl Core {
                     center.r + rz * ang.sin() + rr * ang.cos(),
                 );
                 let q1 = Pt::new(p.z - l * t1.0, p.r - l * t1.1);
-                self.emit(&self.with_point(&base, q1), feed)?;
-                self.emit(&self.with_point(&base, q2), feed)
+                self.after_corner(&self.with_point(&base, q1), feed)?;
+                self.after_corner(&self.with_point(&base, q2), feed)
             }
             (Chamfer::Round(_), MoveKind::Arc { .. }) => Err(self.fault(
                 Fault::NotSupported,

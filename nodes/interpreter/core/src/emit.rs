@@ -1,14 +1,19 @@
 //! The emitter: a move in work coordinates becomes a canonical command in machine
-//! coordinates. On its way it passes the path filters in this order:
+//! coordinates. It passes three stages, each handing its moves to the next and none calling
+//! back into an earlier one:
 //!
-//! 1. a chamfered or rounded corner waiting for the move after it ([`crate::corner`]);
-//! 2. radius compensation ([`crate::comp`]), which holds one element back until the next one
-//!    shows how the two meet;
-//! 3. the range check, the feed check, the spindle speed under constant surface speed, the
-//!    transform chain.
+//! 1. [`Core::emit`]: a chamfered or rounded corner waiting for the move after it
+//!    ([`crate::corner`]) is resolved by this move: the held line, cut back, and the chamfer
+//!    or rounding go on to stage 2, then this move does;
+//! 2. [`Core::after_corner`]: radius compensation ([`crate::comp`]) takes the move and gives
+//!    back the moves of the controlled point that are now certain (it holds one element back
+//!    until the next one shows how the two meet);
+//! 3. [`Core::machine`]: the range check, the feed check, the spindle speed under constant
+//!    surface speed, the transform chain, and the command in the queue.
 //!
-//! A filter that holds an element back makes every command queued after it wait behind it
-//! (`hold_at`), so commands leave in program order.
+//! While a stage holds an element back, the queue has a hold point (`hold_at`): commands
+//! queued after it (a block's M codes, say) wait behind it, and the element's moves, once
+//! released, go in at the hold point, so commands leave in program order.
 
 use crate::canon::{Canon, Command};
 use crate::comp::{self, CompError, RadiusComp};
@@ -40,14 +45,25 @@ pub enum MoveKind {
 const MAX_FEED_PER_REV: f64 = 500.0;
 
 impl Core {
-    /// Emits a move to work position `end` and makes it the current position.
+    /// Emits a move to work position `end` and makes it the current position (stage 1).
     pub fn emit(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
         if self.corner.is_some() {
             self.resolve_corner(Some((end, kind)))?;
         }
-        if self.comp.is_some() && !self.emitting_comp {
-            return self.emit_compensated(end, kind);
+        self.after_corner(end, kind)
+    }
+
+    /// Stage 2: radius compensation, when it is active.
+    pub(crate) fn after_corner(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        if self.comp.is_some() {
+            self.emit_compensated(end, kind)
+        } else {
+            self.machine(end, kind)
         }
+    }
+
+    /// Stage 3: the move as a command in machine coordinates.
+    fn machine(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
         for (i, v) in end.iter().enumerate() {
             if !v.is_finite() || v.abs() > 1e6 {
                 return Err(self.fault(
@@ -301,7 +317,6 @@ impl Core {
         outs: Vec<comp::Out>,
         programmed_end: &[f64],
     ) -> Result<(), ProgramError> {
-        self.emitting_comp = true;
         let (result, held_end) = self.queue_held(|me| {
             for o in outs {
                 me.line = o.line;
@@ -319,11 +334,10 @@ impl Core {
                     (_, comp::Kind::Feed(f)) => MoveKind::Feed(f),
                     (_, comp::Kind::Rapid) => MoveKind::Rapid,
                 };
-                me.emit(&end, kind)?;
+                me.machine(&end, kind)?;
             }
             Ok(())
         });
-        self.emitting_comp = false;
         self.hold_at = self.comp.as_ref().filter(|c| c.holding()).map(|_| held_end);
         self.pos = self.to_machine(programmed_end);
         result

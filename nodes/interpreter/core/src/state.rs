@@ -118,8 +118,6 @@ pub struct Core {
     pub comp_cancel: bool,
     pub corner: Option<Corner>,
     pub chip_break: Option<ChipBreak>,
-    /// Set while compensated moves are being queued (they are not compensated again).
-    pub(crate) emitting_comp: bool,
     /// While a filter holds an element back, commands from this index of `pending` on wait
     /// for it (they come after it in the program).
     pub(crate) hold_at: Option<usize>,
@@ -167,7 +165,6 @@ impl Core {
             comp_cancel: false,
             corner: None,
             chip_break: None,
-            emitting_comp: false,
             hold_at: None,
             common,
             pending: VecDeque::new(),
