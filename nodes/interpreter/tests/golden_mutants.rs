@@ -4,7 +4,9 @@
 //! `tests/golden/mutants.txt`. Mutants reach the error paths and odd states that the printed
 //! programs never do, so a reshaped interpreter that behaves differently anywhere shows here.
 //!
-//! `GOLDEN_BLESS=1 cargo test --workspace --test golden_mutants` rewrites the file.
+//! `GOLDEN_BLESS=1 cargo test --workspace --test golden_mutants` rewrites the file;
+//! `GOLDEN_SHOW="mill 36_slot_with_length_change.ngc 6" cargo test … -- --nocapture` prints that
+//! mutant and its trace, to see what a difference is.
 
 use std::fmt::Write;
 use std::path::Path;
@@ -207,11 +209,30 @@ fn corpus() -> String {
             let _ = writeln!(out, "{} {name} 0 {}", set.name, outcome(set.dialect, &text));
             for k in 1..=set.mutants {
                 let m = mutate::mutate(&text, tokens, &mut rng);
+                show(&format!("{} {name} {k}", set.name), set.dialect, &m);
                 let _ = writeln!(out, "{} {name} {k} {}", set.name, outcome(set.dialect, &m));
             }
         }
     }
     out
+}
+
+/// Prints the mutant `id` names (see the module text) and what it gives.
+fn show(id: &str, dialect: Dialect, text: &str) {
+    if std::env::var("GOLDEN_SHOW").ok().as_deref() != Some(id) {
+        return;
+    }
+    let setup = if dialect == Dialect::FanucMill {
+        mill_setup()
+    } else {
+        lathe_setup()
+    };
+    let letters = setup.axes.clone();
+    println!("--- {id}\n{text}---");
+    match check_limited(dialect, text, setup, Library::new(), LIMIT) {
+        Ok(c) => c.iter().for_each(|c| println!("{}", trace::line(&letters, c))),
+        Err(e) => println!("{e}"),
+    }
 }
 
 #[test]

@@ -238,9 +238,11 @@ impl Elem {
             }
         }
     }
+    /// The element from `p` on. A full circle stays one: it now starts and ends at `p`.
     fn with_start(&self, p: Pt) -> Elem {
         match *self {
             Elem::Line { b, .. } => Elem::Line { a: p, b },
+            Elem::Arc { a, b, c, ccw } if len(sub(a, b)) < EPS => Elem::Arc { a: p, b: p, c, ccw },
             Elem::Arc { b, c, ccw, .. } => Elem::Arc { a: p, b, c, ccw },
         }
     }

@@ -262,7 +262,10 @@ impl Core {
             }
         };
         let line = self.line;
-        let still = (from.z - to.z).hypot(from.r - to.r) < 1e-9;
+        // No move in the plane; an arc never is one: ending where it starts it is a full
+        // circle (with a normal move, a helix).
+        let still =
+            !matches!(kind, MoveKind::Arc { .. }) && (from.z - to.z).hypot(from.r - to.r) < 1e-9;
         let outs = if self.comp_cancel {
             self.comp_cancel = false;
             match self.comp.take() {

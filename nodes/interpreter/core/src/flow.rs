@@ -45,7 +45,9 @@ pub struct CallLevel {
     /// Times the program still runs after this pass (a repeat count of the call).
     pub remaining: u32,
     pub repeats: Vec<Repeat>,
-    pub locals: Vec<Value>,
+    /// The level's local variables; `None`: it works with its caller's (a subprogram on
+    /// controls where only a macro call opens a level of locals).
+    pub locals: Option<Vec<Value>>,
     /// Open condition loops: loop number and where the line that opened it starts.
     pub loops: Vec<(u32, Pos)>,
 }
@@ -58,7 +60,7 @@ impl CallLevel {
             pos: Pos::default(),
             remaining: 0,
             repeats: Vec::new(),
-            locals: vec![None; locals],
+            locals: Some(vec![None; locals]),
             loops: Vec::new(),
         }
     }
@@ -80,6 +82,25 @@ impl Core {
     /// Call levels in use (1: the main program).
     pub fn depth(&self) -> usize {
         self.levels.len()
+    }
+
+    /// The local variables the innermost level works with: its own, or those of the nearest
+    /// caller that has its own.
+    pub fn locals(&self) -> &[Value] {
+        self.levels
+            .iter()
+            .rev()
+            .find_map(|l| l.locals.as_deref())
+            .unwrap_or(&[])
+    }
+
+    /// The local variables the innermost level works with, to write.
+    pub fn locals_mut(&mut self) -> &mut [Value] {
+        self.levels
+            .iter_mut()
+            .rev()
+            .find_map(|l| l.locals.as_deref_mut())
+            .unwrap_or(&mut [])
     }
 
     /// Reads the next line of the innermost level: its text and the line's byte range in it.
@@ -196,12 +217,13 @@ impl Core {
     }
 
     /// Runs library program `number` `count` times as a called program with the given
-    /// locals; `what` names the caller in the alarm when the program is missing.
+    /// locals (`None`: the caller's); `what` names the caller in the alarm when the program
+    /// is missing.
     pub fn call_program(
         &mut self,
         number: u32,
         count: u32,
-        locals: Vec<Value>,
+        locals: Option<Vec<Value>>,
         what: &str,
     ) -> Result<(), ProgramError> {
         if self.levels.len() > self.rules.max_call_depth {

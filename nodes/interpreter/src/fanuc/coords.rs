@@ -140,7 +140,8 @@ impl<D: Family> Fanuc<D> {
         if count == 0 || count > 9999 {
             return Err(self.fault(Fault::Call, format!("repeat count {count} out of 1–9999")));
         }
-        self.core
-            .call_program(number, count, vec![None; D::LOCALS], "M98: program")
+        // A subprogram opens a level of local variables where the dialect says so (D51).
+        let locals = D::SUBPROGRAM_LOCALS.then(|| vec![None; D::LOCALS]);
+        self.core.call_program(number, count, locals, "M98: program")
     }
 }

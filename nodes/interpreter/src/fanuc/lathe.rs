@@ -111,10 +111,9 @@ impl<D: Family> Fanuc<D> {
     /// Reads a variable of the lathe map: #1–#40 local, #100–#289 common (#200– kept),
     /// #4001– the offset page, #5000– positions, #5220– work offsets.
     pub fn lathe_read(&self, n: i64) -> Result<Value, EvalError> {
-        let level = self.core.current();
         Ok(match n {
             0 => None,
-            1..=40 => level.locals[n as usize],
+            1..=40 => self.core.locals().get(n as usize).copied().flatten(),
             100..=289 => self.core.common.get(&n).copied(),
             1000..=1033 => {
                 return Err(EvalError(
@@ -162,7 +161,9 @@ impl<D: Family> Fanuc<D> {
     pub fn lathe_write(&mut self, n: i64, v: Value) -> Result<(), ProgramError> {
         match n {
             1..=40 => {
-                self.core.level().locals[n as usize] = v;
+                if let Some(slot) = self.core.locals_mut().get_mut(n as usize) {
+                    *slot = v;
+                }
                 Ok(())
             }
             100..=289 => {

@@ -69,6 +69,9 @@ pub trait Family: Sized + Send + 'static {
     const ARC_I_DIAMETER: bool = false;
     /// Local variables per call level.
     const LOCALS: usize = 41;
+    /// An M98 subprogram gets its own local variables (else it works with its caller's, and
+    /// only a macro call opens a new level; decision D51).
+    const SUBPROGRAM_LOCALS: bool = true;
 
     /// An address letter the dialect has beyond the axes and F S T P Q R I J K L D E.
     fn extra_address(_c: char) -> bool {

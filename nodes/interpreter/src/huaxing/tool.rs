@@ -63,7 +63,7 @@ impl Fanuc<Huaxing> {
             locals[i + 1] = Some(v as f64);
         }
         self.core
-            .call_program(program, 1, locals, "tool-change macro")?;
+            .call_program(program, 1, Some(locals), "tool-change macro")?;
         self.d.tool_macro_depth = Some(self.core.depth());
         Ok(())
     }

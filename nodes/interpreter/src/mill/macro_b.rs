@@ -81,12 +81,12 @@ impl Fanuc<Mill> {
             .and_then(integer_word)
             .filter(|&p| p <= 9999)
             .ok_or_else(|| self.fault(Fault::Call, "G65 needs P (the macro's program number)"))?;
-        self.core.call_program(number, count, locals, "G65: macro")
+        self.core
+            .call_program(number, count, Some(locals), "G65: macro")
     }
 
     /// Reads a variable of the mill's map.
     pub(super) fn fanuc_read(&self, n: i64) -> Result<Value, EvalError> {
-        let frame = self.core.current();
         let axis = |base: i64| {
             usize::try_from(n - base)
                 .ok()
@@ -94,7 +94,7 @@ impl Fanuc<Mill> {
         };
         Ok(match n {
             0 => None,
-            1..=33 => frame.locals[n as usize],
+            1..=33 => self.core.locals().get(n as usize).copied().flatten(),
             100..=199 | 500..=999 => self.core.common.get(&n).copied(),
             2001..=2200 => {
                 let t = self.core.setup.offsets.tool((n - 2000) as u32);
@@ -180,7 +180,11 @@ impl Fanuc<Mill> {
     /// Writes a variable of the mill's map: #3000 = n raises macro alarm 3000 + n.
     pub(super) fn fanuc_write(&mut self, n: i64, v: Value) -> Result<(), ProgramError> {
         match n {
-            1..=33 => self.core.level().locals[n as usize] = v,
+            1..=33 => {
+                if let Some(slot) = self.core.locals_mut().get_mut(n as usize) {
+                    *slot = v;
+                }
+            }
             100..=199 | 500..=999 => {
                 match v {
                     Some(x) => self.core.common.insert(n, x),

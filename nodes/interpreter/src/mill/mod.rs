@@ -162,6 +162,8 @@ impl Family for Mill {
 
     // FANUC's ROUND in an expression rounds to a whole number (A.3).
     const ROUND_DECIMALS: i32 = 0;
+    // Only G65 opens a level of locals; an M98 subprogram works with its caller's (D51).
+    const SUBPROGRAM_LOCALS: bool = false;
 
     fn extra_address(c: char) -> bool {
         c == 'H'

@@ -169,11 +169,14 @@ impl Fanuc<Mill> {
     }
 
     /// What needs the tool's own position, not a compensated one, is refused while G41/G42
-    /// is in force: G28, G53, G92, G52 and canned cycles (decision D48; LinuxCNC refuses the
-    /// same, FANUC ignores compensation in cycles).
+    /// is in force: G27–G30, G53, G92, G52 and canned cycles (decision D48; LinuxCNC refuses
+    /// the same, FANUC ignores compensation in cycles).
     pub(super) fn refuse_under_cutter_comp(&self, b: &Block<Mill>) -> Result<(), ProgramError> {
         let code = b.g.iter().find_map(|&(_, g, _)| match g {
             G::ReferenceReturn => Some("G28"),
+            G::Own(MillG::ReferenceCheck) => Some("G27"),
+            G::Own(MillG::FromReference) => Some("G29"),
+            G::Own(MillG::SecondReference) => Some("G30"),
             G::Own(MillG::MachineCoordinates) => Some("G53"),
             G::SetCoordinate => Some("G92"),
             G::Own(MillG::MillLocal) => Some("G52"),

