@@ -163,3 +163,37 @@ fn reference_point_codes_are_refused_under_cutter_compensation_like_g28() {
         assert!(e.text.contains("G40 first"), "{e}");
     }
 }
+
+// ------------------------------------------------------------------ D55: non-ASCII text
+
+#[test]
+fn a_non_ascii_character_inside_a_block_is_an_alarm_and_chinese_text_behind_it_a_comment() {
+    let lathe = || Setup::lathe([200.0, 100.0]);
+    for (text, what) in [
+        ("G00 X100 Z50\nG00 X6é0 Z-3\nM30\n", "é inside a word"),
+        ("G00 X100 Z50\nG01 X20\u{a0}Z-30 F100\nM30\n", "no-break space"),
+        ("G00 X100 Z50\nＧＧ00 X10\nM30\n", "full-width letters"),
+        ("G00 X100 Z50\nG01 X20 Z-30é F100\nM30\n", "accent after a word"),
+        ("G00 X100 Z50\nG01 X20 é Z-30\nM30\n", "a letter that is no Chinese text"),
+    ] {
+        for dialect in [Dialect::HuaxingLathe, Dialect::Gtc2eLathe] {
+            let e = run(dialect, text, lathe()).unwrap_err();
+            assert_eq!(e.line, 2, "{what}: {e}");
+            assert!(e.text.contains("inside the block"), "{what}: {e}");
+        }
+    }
+    let e = run(
+        Dialect::FanucMill,
+        "G00 X1. Y2.\nG01 X3.é Y4. F100\nM30\n",
+        mill(),
+    )
+    .unwrap_err();
+    assert_eq!((e.number, e.line), (9, 2), "{e}");
+    // As the manuals print it: Chinese text after a space behind the block.
+    let l = lines_of(
+        Dialect::HuaxingLathe,
+        "G00 X100 Z50\nN0020 G01 X80 Z40 F100      每 5mm 停 1 秒\nM30\n",
+        lathe(),
+    );
+    assert!(l.contains(&"LINEAR X80.0000 Z40.0000 F100.0000".to_string()), "{l:?}");
+}

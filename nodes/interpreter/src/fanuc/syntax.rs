@@ -3,9 +3,10 @@
 //! A line is: optional `/` block skip (with an optional level digit), optional `N` sequence
 //! number, then one statement: address words (`G01 X[#1+2] F100`), a macro assignment
 //! (`#1=#1+20`), `GOTO n`, or `IF[cond]` followed by any of these. `;` ends the block and what
-//! follows is a comment; `( … )` is a comment, also in full-width form `（ … ）`. Non-ASCII text
-//! outside parentheses starts a comment to the end of the line: the control's keyboard types only
-//! letters and digits, so such text can only be a comment written on a PC (decision D2).
+//! follows is a comment; `( … )` is a comment, also in full-width form `（ … ）`. Chinese text
+//! after a space, behind the block's words, is a comment to the end of the line, as the manuals
+//! print it (decisions D2, D55); any other non-ASCII character is an alarm: a block is never run
+//! with the rest of its words cut off.
 //! A `%` alone marks the start or end of the program text; `%NN` names a GTC2E program.
 
 use super::expr::{BinOp, Expr, Func, UnOp};
@@ -116,11 +117,28 @@ pub fn code_part(text: &str) -> Result<Cow<'_, str>, SyntaxError> {
                 out.push(' ');
             }
             '\u{3000}' | '\t' | '\r' => out.push(' '),
-            c if !c.is_ascii() => break,
+            // Text in Chinese after a space, as the manuals print it behind a block, is a
+            // comment to the end of the line (decision D55).
+            c if is_cjk(c) && out.ends_with(' ') && !out.trim().is_empty() => break,
+            c if !c.is_ascii() => {
+                return err(
+                    Fault::DataFormat,
+                    format!(
+                        "character {c:?} inside the block: the control reads only letters, \
+                         digits and signs here (text after it would be lost)"
+                    ),
+                )
+            }
             c => out.push(c.to_ascii_uppercase()),
         }
     }
     Ok(Cow::Owned(out))
+}
+
+/// A character of Chinese text (ideographs, radicals, CJK punctuation, kana), not a
+/// full-width letter or digit.
+fn is_cjk(c: char) -> bool {
+    matches!(c, '\u{2E80}'..='\u{9FFF}' | '\u{F900}'..='\u{FAFF}' | '\u{FF0C}' | '\u{FF1A}')
 }
 
 /// 10⁰ … 10¹⁵, each exact in an f64.
