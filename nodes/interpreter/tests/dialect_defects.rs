@@ -171,10 +171,19 @@ fn a_non_ascii_character_inside_a_block_is_an_alarm_and_chinese_text_behind_it_a
     let lathe = || Setup::lathe([200.0, 100.0]);
     for (text, what) in [
         ("G00 X100 Z50\nG00 X6é0 Z-3\nM30\n", "é inside a word"),
-        ("G00 X100 Z50\nG01 X20\u{a0}Z-30 F100\nM30\n", "no-break space"),
+        (
+            "G00 X100 Z50\nG01 X20\u{a0}Z-30 F100\nM30\n",
+            "no-break space",
+        ),
         ("G00 X100 Z50\nＧＧ00 X10\nM30\n", "full-width letters"),
-        ("G00 X100 Z50\nG01 X20 Z-30é F100\nM30\n", "accent after a word"),
-        ("G00 X100 Z50\nG01 X20 é Z-30\nM30\n", "a letter that is no Chinese text"),
+        (
+            "G00 X100 Z50\nG01 X20 Z-30é F100\nM30\n",
+            "accent after a word",
+        ),
+        (
+            "G00 X100 Z50\nG01 X20 é Z-30\nM30\n",
+            "a letter that is no Chinese text",
+        ),
     ] {
         for dialect in [Dialect::HuaxingLathe, Dialect::Gtc2eLathe] {
             let e = run(dialect, text, lathe()).unwrap_err();
@@ -195,5 +204,37 @@ fn a_non_ascii_character_inside_a_block_is_an_alarm_and_chinese_text_behind_it_a
         "G00 X100 Z50\nN0020 G01 X80 Z40 F100      每 5mm 停 1 秒\nM30\n",
         lathe(),
     );
-    assert!(l.contains(&"LINEAR X80.0000 Z40.0000 F100.0000".to_string()), "{l:?}");
+    assert!(
+        l.contains(&"LINEAR X80.0000 Z40.0000 F100.0000".to_string()),
+        "{l:?}"
+    );
+}
+
+// ------------------------------------------------------------------ D54: G71 type I
+
+/// A G71 over a contour whose X goes back from `back_x` after X60 (a pocket when below 60).
+fn g71(ns_z: &str, back_x: &str) -> String {
+    format!(
+        "G00 X100 Z5\nG71 U1 R0.5\nG71 P10 Q20 U0.4 W0.1 F100\nN10 G01 X40{ns_z}\nZ-10\n\
+         X60 Z-20\nX{back_x} Z-30\nX70 Z-40\nN20 X80\nM30\n"
+    )
+}
+
+#[test]
+fn a_g71_type_one_contour_with_a_pocket_is_refused_within_the_contour_tolerance() {
+    let lathe = |tol: f64| {
+        let mut s = Setup::lathe([200.0, 100.0]);
+        s.contour_tolerance = tol;
+        s
+    };
+    // A pocket of 5 mm (radius): alarm 47 on the cycle's line, with the way out named.
+    let e = run(Dialect::HuaxingLathe, &g71("", "50"), lathe(0.05)).unwrap_err();
+    assert_eq!((e.number, e.line), (47, 3), "{e}");
+    assert!(e.text.contains("type II"), "{e}");
+    // The same contour as type II (Z in the ns block) is roughed.
+    assert!(run(Dialect::HuaxingLathe, &g71(" W0", "50"), lathe(0.05)).is_ok());
+    // 0.03 mm back (X59.94 as a diameter) is within GS#33 = 0.05, not within 0.01.
+    assert!(run(Dialect::HuaxingLathe, &g71("", "59.94"), lathe(0.05)).is_ok());
+    let e = run(Dialect::HuaxingLathe, &g71("", "59.94"), lathe(0.01)).unwrap_err();
+    assert_eq!(e.number, 47, "{e}");
 }

@@ -230,7 +230,9 @@ fn show(id: &str, dialect: Dialect, text: &str) {
     let letters = setup.axes.clone();
     println!("--- {id}\n{text}---");
     match check_limited(dialect, text, setup, Library::new(), LIMIT) {
-        Ok(c) => c.iter().for_each(|c| println!("{}", trace::line(&letters, c))),
+        Ok(c) => c
+            .iter()
+            .for_each(|c| println!("{}", trace::line(&letters, c))),
         Err(e) => println!("{e}"),
     }
 }

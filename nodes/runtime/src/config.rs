@@ -95,6 +95,14 @@ pub struct MachineConfig {
     /// parameters cannot be written.
     #[serde(default)]
     pub parameter_file: Option<std::path::PathBuf>,
+    /// How far a lathe roughing contour (G71/G72) may leave its start point or turn back
+    /// before the cycle is refused, mm (Huaxing GS#33).
+    #[serde(default = "default_contour_tolerance")]
+    pub contour_tolerance: f64,
+}
+
+fn default_contour_tolerance() -> f64 {
+    0.05
 }
 
 /// `G54` → 0 … `G59` → 5 (case and surrounding blanks ignored).
@@ -645,6 +653,12 @@ impl LaunchConfig {
             return Err(
                 "recorder: flush_ms, split_mib, split_seconds and max_total_mib must be > 0".into(),
             );
+        }
+        let tol = self.machine.contour_tolerance;
+        if !(0.001..=1.0).contains(&tol) {
+            return Err(format!(
+                "machine.contour_tolerance {tol}: 0.001–1 mm (GS#33)"
+            ));
         }
         let n = self.machine.axes.len();
         if n == 0 || n > cnc_msgs::servo::MAX_AXES {

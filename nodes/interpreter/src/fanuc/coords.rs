@@ -142,6 +142,7 @@ impl<D: Family> Fanuc<D> {
         }
         // A subprogram opens a level of local variables where the dialect says so (D51).
         let locals = D::SUBPROGRAM_LOCALS.then(|| vec![None; D::LOCALS]);
-        self.core.call_program(number, count, locals, "M98: program")
+        self.core
+            .call_program(number, count, locals, "M98: program")
     }
 }

@@ -349,7 +349,9 @@ impl Fanuc<Huaxing> {
                         });
                     (coord(a1) - deepest).signum()
                 };
-                // No contour point beyond the start (`000` alarm 57), within GS#33 = 0.05 mm.
+                // The contour tolerance GS#33 (0.05 mm unless the machine sets it).
+                let tol = self.core.setup.contour_tolerance;
+                // No contour point beyond the start (`000` alarm 57), within the tolerance.
                 for e in &shifted {
                     let (lo, hi) = e.extent(radial);
                     let worst = if sigma > 0.0 {
@@ -357,7 +359,7 @@ impl Fanuc<Huaxing> {
                     } else {
                         coord(a1) - lo
                     };
-                    if worst > 0.05 {
+                    if worst > tol {
                         return Err(self.fault(
                             Fault::ContourBeyondStart,
                             "a contour point lies beyond the cycle's start point",
@@ -379,12 +381,17 @@ impl Fanuc<Huaxing> {
                     } else {
                         hi.max(t) - s
                     };
-                    if (t - s) * zeta < -0.05 || back > 0.05 + (t - s).abs() {
+                    if (t - s) * zeta < -tol || back > tol + (t - s).abs() {
                         return Err(self.fault(
                             Fault::ContourData,
                             "the contour turns back along the cut axis",
                         ));
                     }
+                }
+                // G71 type I: no pockets, X runs one way too after the ns move (§5.22.1,
+                // decision D54).
+                if radial && !type_two {
+                    self.type_one_monotonic(&shifted[1..], tol)?;
                 }
                 // Bound the work a cycle may generate (a tiny depth over a long contour).
                 let span = shifted
@@ -430,6 +437,39 @@ impl Fanuc<Huaxing> {
         // (`000` §5.22.2).
         if contour.first == self.core.level().pos {
             self.core.level().pos = contour.after;
+        }
+        Ok(())
+    }
+
+    /// The depth axis (X) of a G71 type I contour after its ns move runs one way, within
+    /// `tol`: a pocket needs type II (alarm 47, decision D54).
+    fn type_one_monotonic(&self, elems: &[Elem], tol: f64) -> Result<(), ProgramError> {
+        let x = |p: Pt| p.r;
+        let dir = elems
+            .iter()
+            .map(|e| x(e.end()) - x(e.start()))
+            .find(|d| d.abs() > tol)
+            .unwrap_or(0.0)
+            .signum();
+        for e in elems {
+            let (lo, hi) = e.extent(true);
+            let (s, t) = (x(e.start()), x(e.end()));
+            // How far the element goes back against the direction, arcs' bulges included.
+            let back = if dir >= 0.0 {
+                s.min(t) - lo + (s - t).max(0.0)
+            } else {
+                hi - s.max(t) + (t - s).max(0.0)
+            };
+            if back > tol {
+                return Err(self.fault(
+                    Fault::ContourData,
+                    format!(
+                        "G71 type I: the contour turns back along X by {} mm (a pocket): \
+                         program it as type II, with Z(W) in the ns block",
+                        cnc_interpreter_core::show(back)
+                    ),
+                ));
+            }
         }
         Ok(())
     }
