@@ -34,6 +34,10 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
     setup.tool_change_macro = cfg.machine.tool_change_macro;
     setup.contour_tolerance = cfg.machine.contour_tolerance;
+    setup.calculator_decimal_point = cfg
+        .machine
+        .decimal_point
+        .map(|d| d == cnc_runtime::config::DecimalPoint::Calculator);
     for (&n, t) in &cfg.machine.tools {
         setup.offsets.tools.insert(
             n,

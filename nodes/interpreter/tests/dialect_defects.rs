@@ -136,17 +136,18 @@ fn a_full_circle_and_a_helix_under_cutter_compensation_are_cut_in_every_plane() 
         let arcs: Vec<&String> = l.iter().filter(|m| m.starts_with("ARC")).collect();
         assert_eq!(arcs.len(), 2, "{code}: {l:?}");
         for (arc, depth) in arcs.iter().zip([5.0, -3.0]) {
-            // Closed: the arc ends where the move before it ended, on the circle of 25.
+            // The entry ends on the offset circle (radius 25), and the circle runs round to
+            // the offset of its own end point, as FANUC and LinuxCNC cut it (oracle 50–54).
             let k = l.iter().position(|m| m == *arc).unwrap();
             let before = &l[k - 1];
-            for axis in [h, v] {
-                assert!(
-                    (field(arc, axis) - field(before, axis)).abs() < 1e-4,
-                    "{code}: not closed: {before} / {arc}"
-                );
-            }
+            let r0 = field(before, h).hypot(field(before, v));
             let r = field(arc, h).hypot(field(arc, v));
+            assert!(
+                (r0 - 25.0).abs() < 1e-4,
+                "{code}: entry ends at radius {r0}: {before}"
+            );
             assert!((r - 25.0).abs() < 1e-4, "{code}: radius {r} in {arc}");
+            assert!((field(arc, h) - 25.0).abs() < 1e-4, "{code}: {arc}");
             assert!((field(arc, n) - depth).abs() < 1e-4, "{code}: {arc}");
         }
     }
@@ -237,4 +238,114 @@ fn a_g71_type_one_contour_with_a_pocket_is_refused_within_the_contour_tolerance(
     assert!(run(Dialect::HuaxingLathe, &g71("", "59.94"), lathe(0.05)).is_ok());
     let e = run(Dialect::HuaxingLathe, &g71("", "59.94"), lathe(0.01)).unwrap_err();
     assert_eq!(e.number, 47, "{e}");
+}
+
+// ------------------------------------------------------------------ D52: decimal points
+
+#[test]
+fn mill_numbers_without_a_decimal_point_count_thousandths_unless_the_machine_says_calculator() {
+    let text = "G00 X50 Y20. Z0\nG01 X50. F100\nG04 X1500\nG02 X50. Y0 R10. \
+                \nG91 G00 X10\nM30\n";
+    let l = mill_lines(text);
+    assert_eq!(l[0], "RAPID X0.0500 Y20.0000 Z0.0000", "{l:?}");
+    assert_eq!(l[1], "LINEAR X50.0000 Y20.0000 Z0.0000 F100.0000", "{l:?}");
+    // G04 X counts milliseconds; F is a feed as written.
+    assert_eq!(l[2], "DWELL 1.500", "{l:?}");
+    assert_eq!(l[4], "RAPID X50.0100 Y0.0000 Z0.0000", "{l:?}");
+    // The machine parameter (FANUC's DPI): calculator type reads X50 as 50 mm.
+    let mut calc = mill();
+    calc.calculator_decimal_point = Some(true);
+    let l = lines_of(Dialect::FanucMill, "G00 X50 Y20 Z0\nM30\n", calc);
+    assert_eq!(l[0], "RAPID X50.0000 Y20.0000 Z0.0000");
+    // In a canned cycle K counts repeats; in a G18 arc it is a length.
+    let l = moves(&mill_lines(
+        "G00 X0 Y0 Z10.\nG91 G99 G81 X10. Z-5. R-8. K3 F100\nG80 G90\nM30\n",
+    ));
+    assert_eq!(
+        l.iter().filter(|m| m.starts_with("LINEAR")).count(),
+        3,
+        "{l:?}"
+    );
+    // G65 arguments of lengths count thousandths too; a decimal point means mm.
+    let l = moves(&mill_lines(
+        "O1\nG65 P2 X30 Y30.\nM30\nO2\nG00 X#24 Y#25\nM99\n",
+    ));
+    assert_eq!(l[0], "RAPID X0.0300 Y30.0000 Z0.0000", "{l:?}");
+}
+
+// ------------------------------------------------------------------ D53: inch input
+
+/// The canonical stream's numbers, for comparing two programs that should move alike.
+fn numbers(lines: &[String]) -> Vec<(String, Vec<(String, f64)>)> {
+    lines
+        .iter()
+        .map(|l| {
+            let kind = l.split_whitespace().next().unwrap_or("").to_string();
+            (kind, fields(l))
+        })
+        .collect()
+}
+
+#[test]
+fn an_inch_program_moves_the_machine_as_its_metric_twin_within_a_micrometre() {
+    // The same part twice: millimetres, and inches (every length divided by 25.4). Lines,
+    // arcs by R and by I/J, a full circle under cutter compensation (radius in mm from the
+    // offset page), a canned cycle with R and Q, a work offset written by G10 and a local
+    // system by G52, feeds in units per minute, and positions read back by #5001.
+    let metric = "G21 G90 G17 G54\nG10 L2 P1 X25.4 Y-12.7 Z0\nG52 X5.08\nG00 X0 Y0 Z10.\n\
+                  G01 Z-1. F254.\nG41 D1 X50.8 Y0\nG03 X50.8 Y0 I-50.8 J0\nG40 G01 X0 Y0\n\
+                  G02 X25.4 Y25.4 R25.4 F508.\nG00 Z10.\nG99 G83 X12.7 Y12.7 Z-6.35 R2.54 Q1.27 F127.\n\
+                  G80\n#1 = #5001 * 2\nG00 X#1\nM30\n";
+    let inch = "G20 G90 G17 G54\nG10 L2 P1 X1. Y-.5 Z0\nG52 X.2\nG00 X0 Y0 Z.3937008\n\
+                G01 Z-.0393701 F10.\nG41 D1 X2. Y0\nG03 X2. Y0 I-2. J0\nG40 G01 X0 Y0\n\
+                G02 X1. Y1. R1. F20.\nG00 Z.3937008\nG99 G83 X.5 Y.5 Z-.25 R.1 Q.05 F5.\n\
+                G80\n#1 = #5001 * 2\nG00 X#1\nM30\n";
+    let (m, i) = (numbers(&mill_lines(metric)), numbers(&mill_lines(inch)));
+    assert_eq!(m.len(), i.len(), "{m:?}\n{i:?}");
+    for ((km, fm), (ki, fi)) in m.iter().zip(&i) {
+        assert_eq!(km, ki);
+        assert_eq!(fm.len(), fi.len(), "{km}");
+        for ((n, a), (_, b)) in fm.iter().zip(fi) {
+            assert!((a - b).abs() < 1e-3, "{km} {n}: metric {a}, inch {b}");
+        }
+    }
+    // The last move: #5001 read in inches under G20, so the inch program goes to the same
+    // machine point.
+    assert!(m.len() > 20, "{m:?}");
+}
+
+#[test]
+fn variables_read_and_write_offsets_and_positions_in_the_programs_unit() {
+    // Offset 1 is 100 mm long; under G20 #2001 reads 3.937 inches and #5221 writes inches.
+    let l = mill_lines("G20\n#1 = #2001\n#5221 = 1.\nG00 X#1 Y0 Z0\nM30\n");
+    let x = field(&l[0], "X");
+    // X#1 is 3.937 inches in G54, whose X zero is now 1 inch: 25.4 + 100 mm.
+    assert!((x - 125.4).abs() < 1e-6, "{l:?}");
+}
+
+#[test]
+fn a_stop_code_in_a_block_with_motion_acts_after_it() {
+    // D56 (D6): the return, then the spindle stop.
+    let l = mill_lines("G00 X0 Y0 Z0\nS1000 M3\nG30 Z30. M5\nM30\n");
+    let at = |s: &str| l.iter().position(|x| x == s).unwrap_or(usize::MAX);
+    assert!(at("M5") > at("RAPID X0.0000 Y0.0000 Z30.0000"), "{l:?}");
+}
+
+#[test]
+fn a_full_circle_under_tool_nose_compensation_is_cut_on_the_lathe() {
+    // Huaxing G42 (nose radius 0.4, tip 3 on offset 1): a full circle in Z-X by I/K after a
+    // G01 start-up; before the fix it was dropped without a word.
+    let mut setup = Setup::lathe([200.0, 100.0]);
+    setup.offsets.tools.insert(
+        1,
+        cnc_interpreter::setup::ToolOffset {
+            radius: 0.4,
+            tip: 3,
+            ..Default::default()
+        },
+    );
+    let text =
+        "T0101\nG00 X100 Z20\nG42 G01 X80 Z10 F100\nG02 X80 Z10 I-10 K0\nG40 G01 X100 Z20\nM30\n";
+    let l = moves(&lines_of(Dialect::HuaxingLathe, text, setup));
+    assert!(l.iter().any(|m| m.starts_with("ARC")), "{l:?}");
 }

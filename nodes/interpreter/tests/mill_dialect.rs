@@ -41,7 +41,7 @@ fn alarm(text: &str) -> ProgramError {
 
 #[test]
 fn g98_after_g99_moves_over_at_the_r_level_and_returns_to_the_initial_level() {
-    let l = lines("G0 X0 Y0 Z20\nG99 G81 X5 Y5 Z-5 R2 F100\nG98 X15\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z20.\nG99 G81 X5. Y5. Z-5. R2. F100\nG98 X15.\nG80\nM30\n");
     assert_eq!(
         l[1..9],
         [
@@ -60,7 +60,7 @@ fn g98_after_g99_moves_over_at_the_r_level_and_returns_to_the_initial_level() {
 
 #[test]
 fn tapping_reverses_the_spindle_at_the_bottom_and_back_at_r() {
-    let l = lines("G0 X0 Y0 Z10\nS500 M3\nG99 G84 X5 Y5 Z-8 R2 P300 F100\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z10.\nS500 M3\nG99 G84 X5. Y5. Z-8. R2. P300 F100\nG80\nM30\n");
     assert_eq!(
         l[4..11],
         [
@@ -74,7 +74,7 @@ fn tapping_reverses_the_spindle_at_the_bottom_and_back_at_r() {
         ]
     );
     // G74 left-hand: the other way round; G98 returns to the initial level after R.
-    let l = lines("G0 X0 Y0 Z10\nS500 M4\nG98 G74 X5 Y5 Z-8 R2 F100\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z10.\nS500 M4\nG98 G74 X5. Y5. Z-8. R2. F100\nG80\nM30\n");
     assert_eq!(
         l[6..10],
         [
@@ -90,7 +90,7 @@ fn tapping_reverses_the_spindle_at_the_bottom_and_back_at_r() {
 
 #[test]
 fn fine_boring_orients_and_shifts_off_the_wall_before_leaving() {
-    let l = lines("G0 X0 Y0 Z10\nS800 M3\nG98 G76 X5 Y5 Z-8 R2 Q0.4 F80\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z10.\nS800 M3\nG98 G76 X5. Y5. Z-8. R2. Q0.4 F80\nG80\nM30\n");
     assert_eq!(
         l[5..11],
         [
@@ -106,7 +106,7 @@ fn fine_boring_orients_and_shifts_off_the_wall_before_leaving() {
 
 #[test]
 fn back_boring_goes_down_shifted_and_bores_upwards() {
-    let l = lines("G0 X0 Y0 Z10\nS800 M3\nG98 G87 X5 Y5 Z-3 R-12 Q0.5 F60\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z10.\nS800 M3\nG98 G87 X5. Y5. Z-3. R-12. Q0.5 F60\nG80\nM30\n");
     assert_eq!(
         l[3..15],
         [
@@ -124,16 +124,16 @@ fn back_boring_goes_down_shifted_and_bores_upwards() {
             "M3",
         ]
     );
-    let e = alarm("G0 Z10\nG99 G87 X5 Y5 Z-3 R-12 Q0.5 F60\nM30\n");
+    let e = alarm("G0 Z10.\nG99 G87 X5. Y5. Z-3. R-12. Q0.5 F60\nM30\n");
     assert_eq!((e.line, e.text.contains("G98")), (2, true), "{e}");
 }
 
 #[test]
 fn g86_and_g88_stop_the_spindle_and_restart_it_the_way_it_turned() {
-    let l = lines("G0 X0 Y0 Z10\nS800 M4\nG98 G86 X5 Y5 Z-8 R2 F80\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z10.\nS800 M4\nG98 G86 X5. Y5. Z-8. R2. F80\nG80\nM30\n");
     assert_eq!(l[6..9], ["M5", "RAPID X5.0000 Y5.0000 Z10.0000", "M4"]);
     // G88: dwell, stop, a program stop for the manual retract, then out and on again.
-    let l = lines("G0 X0 Y0 Z10\nS800 M3\nG99 G88 X5 Y5 Z-8 R2 P1000 F80\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z10.\nS800 M3\nG99 G88 X5. Y5. Z-8. R2. P1000 F80\nG80\nM30\n");
     assert_eq!(
         l[6..11],
         [
@@ -149,17 +149,17 @@ fn g86_and_g88_stop_the_spindle_and_restart_it_the_way_it_turned() {
 #[test]
 fn hole_data_stay_until_g80_and_l0_only_stores_them() {
     // L0 stores the data without drilling; the next position drills with them.
-    let l = lines("G0 X0 Y0 Z10\nG98 G81 Z-4 R1 F90 L0\nX7\nG85 X9\nG80\nM30\n");
+    let l = lines("G0 X0. Y0. Z10.\nG98 G81 Z-4. R1. F90 L0\nX7.\nG85 X9.\nG80\nM30\n");
     assert_eq!(l[1], "RAPID X7.0000 Y0.0000 Z10.0000", "{l:?}");
     assert!(
         l.contains(&"LINEAR X9.0000 Y0.0000 Z1.0000 F90.0000".to_string()),
         "{l:?}"
     );
     // After G80 the data are gone.
-    let e = alarm("G0 Z10\nG81 X1 Z-4 R1 F90\nG80\nG81 X2\nM30\n");
+    let e = alarm("G0 Z10.\nG81 X1. Z-4. R1. F90\nG80\nG81 X2.\nM30\n");
     assert_eq!((e.number, e.line), (10, 4), "{e}");
     // A group-01 code ends the cycle: this X moves, nothing drills.
-    let l = lines("G0 Z10\nG81 X1 Z-4 R1 F90\nG0 X3\nX4\nM30\n");
+    let l = lines("G0 Z10.\nG81 X1. Z-4. R1. F90\nG0 X3.\nX4.\nM30\n");
     assert_eq!(
         l[l.len() - 3..l.len() - 2],
         ["RAPID X4.0000 Y0.0000 Z10.0000"]
@@ -171,15 +171,15 @@ fn cycle_words_are_checked_with_their_line() {
     // FANUC P/S numbers (decision D49): 010 a code missing what it needs, 003 a value out
     // of its range, 009 a word where it may not be.
     for (text, number, line) in [
-        ("G0 Z10\nG81 X1 Z-4 F90\nM30\n", 10, 2),
-        ("G0 Z10\nG83 X1 Z-4 R1 Q0 F90\nM30\n", 3, 2),
-        ("G0 Z10\nG81 X1 Z-4 R-6 F90\nM30\n", 3, 2),
-        ("G0 Z10\nG81 X1 Z-4 R1 L2 K2 F90\nM30\n", 9, 2),
-        ("G0 Z10\nG81 X1 Z-4 R1 L2.5 F90\nM30\n", 3, 2),
-        ("G0 Z10\nG82 X1 Z-4 R1 P-5 F90\nM30\n", 3, 2),
-        ("G0 Z10\nG73 X1 Z-4 R1 F90\nM30\n", 10, 2),
-        ("G0 Z10\nG83 X1 Z-4 R1 Q0.000001 F90\nM30\n", 3, 2),
-        ("G0 Z10\nG81 X1 Z-4 R1 L1000 F90\nM30\n", 3, 2),
+        ("G0 Z10.\nG81 X1. Z-4. F90\nM30\n", 10, 2),
+        ("G0 Z10.\nG83 X1. Z-4. R1. Q0. F90\nM30\n", 3, 2),
+        ("G0 Z10.\nG81 X1. Z-4. R-6. F90\nM30\n", 3, 2),
+        ("G0 Z10.\nG81 X1. Z-4. R1. L2 K2. F90\nM30\n", 9, 2),
+        ("G0 Z10.\nG81 X1. Z-4. R1. L2.5 F90\nM30\n", 3, 2),
+        ("G0 Z10.\nG82 X1. Z-4. R1. P-5 F90\nM30\n", 3, 2),
+        ("G0 Z10.\nG73 X1. Z-4. R1. F90\nM30\n", 10, 2),
+        ("G0 Z10.\nG83 X1. Z-4. R1. Q0.000001 F90\nM30\n", 3, 2),
+        ("G0 Z10.\nG81 X1. Z-4. R1. L1000 F90\nM30\n", 3, 2),
     ] {
         let e = alarm(text);
         assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
@@ -188,7 +188,7 @@ fn cycle_words_are_checked_with_their_line() {
 
 #[test]
 fn g44_subtracts_the_length_and_h0_or_g49_cancel() {
-    let l = lines("G44 H2 G0 Z10\nH1 Z10\nH0 Z10\nG43 H2 Z10\nG49 Z10\nM30\n");
+    let l = lines("G44 H2 G0 Z10.\nH1 Z10.\nH0 Z10.\nG43 H2 Z10.\nG49 Z10.\nM30\n");
     let z: Vec<&str> = l
         .iter()
         .map(|s| s.rsplit(' ').next().unwrap_or(""))
@@ -197,21 +197,21 @@ fn g44_subtracts_the_length_and_h0_or_g49_cancel() {
         z[..5],
         ["Z-32.5000", "Z-90.0000", "Z10.0000", "Z52.5000", "Z10.0000"]
     );
-    let e = alarm("G43 H201 Z10\nM30\n");
+    let e = alarm("G43 H201 Z10.\nM30\n");
     assert_eq!((e.number, e.line), (30, 1), "{e}");
 }
 
 #[test]
 fn t_only_selects_the_tool_on_the_mill() {
     // No offset comes with T: the Z move is the programmed one.
-    let l = lines("T1 M6\nG0 Z10\nM30\n");
+    let l = lines("T1 M6\nG0 Z10.\nM30\n");
     assert_eq!(l[..3], ["T1", "M6", "RAPID X0.0000 Y0.0000 Z10.0000"]);
     assert_eq!(alarm("T100\nM30\n").number, 30);
 }
 
 #[test]
 fn a_tape_runs_its_first_program_and_calls_the_others() {
-    let tape = "%\nO1\nG0 X0 Y0 Z5\nM98 P2 L2\nM30\nO2\nG91 G1 X10 F100\nM99\n%\n";
+    let tape = "%\nO1\nG0 X0. Y0. Z5.\nM98 P2 L2\nM30\nO2\nG91 G1 X10. F100\nM99\n%\n";
     let l = lines(tape);
     assert_eq!(
         l[..3],
@@ -223,17 +223,17 @@ fn a_tape_runs_its_first_program_and_calls_the_others() {
     );
     // A program of the tape replaces a library program of the same number.
     let mut lib = Library::new();
-    lib.insert(2, "O0002", "G0 X99\nM99\n");
+    lib.insert(2, "O0002", "G0 X99.\nM99\n");
     let cmds = cnc_interpreter::check_with_library(Dialect::FanucMill, tape, mill(), lib).unwrap();
     assert_eq!(cmds[1].command.end(), Some(&[10.0, 0.0, 5.0][..]));
     // An error inside a subprogram names it.
-    let e = alarm("O1\nM98 P3\nM30\nO3\nG1 X1 F-5\nM99\n");
+    let e = alarm("O1\nM98 P3\nM30\nO3\nG1 X1. F-5\nM99\n");
     assert_eq!(e.program, "O0003", "{e}");
 }
 
 #[test]
 fn a_one_shot_code_may_share_its_block_with_a_motion_code() {
-    let l = lines("G0 X5 Y5 Z5\nG53 G1 Z0 F100\nX7\nM30\n");
+    let l = lines("G0 X5. Y5. Z5.\nG53 G1 Z0. F100\nX7.\nM30\n");
     // G53 moves at rapid in machine coordinates; G01 stays modal for the next block.
     assert_eq!(
         l[1..3],
@@ -247,7 +247,7 @@ fn a_one_shot_code_may_share_its_block_with_a_motion_code() {
 #[test]
 fn cutter_compensation_works_in_g19_which_linuxcnc_refuses() {
     // G19: Y across, Z up; G42 keeps the cutter right of a path going +Y at Z0, so below it.
-    let l = lines("G19 G0 X5 Y-10 Z0\nG42 D1 G1 Y0 F100\nY30\nG40 Y40\nM30\n");
+    let l = lines("G19 G0 X5. Y-10. Z0.\nG42 D1 G1 Y0. F100\nY30.\nG40 Y40.\nM30\n");
     assert_eq!(
         l[1..4],
         [
@@ -260,10 +260,10 @@ fn cutter_compensation_works_in_g19_which_linuxcnc_refuses() {
 
 #[test]
 fn d0_compensates_with_no_radius_and_d_is_modal() {
-    let l = lines("G0 X-10 Y0\nG41 D0 G1 X0 F100\nY10\nG40 X-10\nM30\n");
+    let l = lines("G0 X-10. Y0.\nG41 D0 G1 X0. F100\nY10.\nG40 X-10.\nM30\n");
     assert_eq!(l[1], "LINEAR X0.0000 Y0.0000 Z0.0000 F100.0000");
     // D2 given in a block of its own is used by the G41 after it: radius 3.
-    let l = lines("G0 X-10 Y0\nD2\nG41 G1 X0 F100\nX20\nG40 X30\nM30\n");
+    let l = lines("G0 X-10. Y0.\nD2\nG41 G1 X0. F100\nX20.\nG40 X30.\nM30\n");
     assert_eq!(l[1], "LINEAR X0.0000 Y3.0000 Z0.0000 F100.0000");
 }
 
@@ -271,33 +271,33 @@ fn d0_compensates_with_no_radius_and_d_is_modal() {
 fn cutter_compensation_alarms_name_the_block() {
     let cases = [
         // Start-up in an arc block (P/S 034).
-        ("G0 X0 Y0\nG41 D1 G2 X10 Y0 R5 F100\nM30\n", 2, "arc"),
+        ("G0 X0. Y0.\nG41 D1 G2 X10. Y0. R5. F100\nM30\n", 2, "arc"),
         // Cancel in an arc block.
         (
-            "G0 X0 Y0\nG41 D1 G1 X10 F100\nY10\nG40 G3 X0 Y20 R10\nM30\n",
+            "G0 X0. Y0.\nG41 D1 G1 X10. F100\nY10.\nG40 G3 X0. Y20. R10.\nM30\n",
             4,
             "arc",
         ),
         // Plane change under compensation (P/S 037).
-        ("G0 X0 Y0\nG41 D1 G1 X10 F100\nG18\nM30\n", 3, "plane"),
+        ("G0 X0. Y0.\nG41 D1 G1 X10. F100\nG18\nM30\n", 3, "plane"),
         // Reference return, machine coordinates and canned cycles need G40 first.
-        ("G0 X0 Y0\nG41 D1 G1 X10 F100\nG28 Z0\nM30\n", 3, "G28"),
-        ("G0 X0 Y0\nG41 D1 G1 X10 F100\nG53 Z0\nM30\n", 3, "G53"),
+        ("G0 X0. Y0.\nG41 D1 G1 X10. F100\nG28 Z0.\nM30\n", 3, "G28"),
+        ("G0 X0. Y0.\nG41 D1 G1 X10. F100\nG53 Z0.\nM30\n", 3, "G53"),
         (
-            "G0 X0 Y0 Z10\nG41 D1 G1 X10 F100\nG81 X20 Z-5 R2\nM30\n",
+            "G0 X0. Y0. Z10.\nG41 D1 G1 X10. F100\nG81 X20. Z-5. R2.\nM30\n",
             3,
             "canned cycle",
         ),
         // A step smaller than the cutter radius between two inner corners: the offset line
         // would run backwards (interference, P/S 041), seen when block 5 shows the corner.
         (
-            "G0 X-10 Y0\nG41 D1 G1 X0 Y0 F100\nX20\nY4\nX40\nY20\nG40 X50\nM30\n",
+            "G0 X-10. Y0.\nG41 D1 G1 X0. Y0. F100\nX20.\nY4.\nX40.\nY20.\nG40 X50.\nM30\n",
             5,
             "interference",
         ),
         // G41 on top of G41.
         (
-            "G0 X0 Y0\nG41 D1 G1 X10 F100\nG42 X20\nM30\n",
+            "G0 X0. Y0.\nG41 D1 G1 X10. F100\nG42 X20.\nM30\n",
             3,
             "G40 first",
         ),
@@ -315,7 +315,7 @@ fn while_loops_nest_and_a_goto_may_leave_them() {
     let l = lines(
         "#1 = 0\nWHILE [#1 LT 3] DO1\n#2 = 0\nWHILE [#2 LT 2] DO2\n\
          IF [[#1 EQ 2] AND [#2 EQ 1]] GOTO 9\nG1 X#1 Y#2 F100\n#2 = #2 + 1\nEND2\n\
-         #1 = #1 + 1\nEND1\nN9 G0 Z5\nM30\n",
+         #1 = #1 + 1\nEND1\nN9 G0 Z5.\nM30\n",
     );
     let xy: Vec<&str> = l.iter().map(|s| s.as_str()).collect();
     assert_eq!(
@@ -330,7 +330,7 @@ fn while_loops_nest_and_a_goto_may_leave_them() {
         ]
     );
     // A false condition at the start skips the body; DO without WHILE loops until a GOTO.
-    let l = lines("WHILE [1 GT 2] DO1\nG1 X9 F100\nEND1\n#5 = 0\nDO3\n#5 = #5 + 1\nIF [#5 GE 4] GOTO 7\nEND3\nN7 G1 X#5 F100\nM30\n");
+    let l = lines("WHILE [1 GT 2] DO1\nG1 X9. F100\nEND1\n#5 = 0\nDO3\n#5 = #5 + 1\nIF [#5 GE 4] GOTO 7\nEND3\nN7 G1 X#5 F100\nM30\n");
     assert_eq!(l[0], "LINEAR X4.0000 Y0.0000 Z0.0000 F100.0000");
 }
 
@@ -338,7 +338,7 @@ fn while_loops_nest_and_a_goto_may_leave_them() {
 fn g65_passes_arguments_by_the_table_and_repeats_with_l() {
     // A=#1, B=#2, X=#24, Y=#25; locals are the macro's own. L2 runs it twice in one call:
     // the second pass sees what the first left in #24.
-    let text = "%\nO1000\n#1 = 99\nG65 P9010 A2 B-3 X10 Y[4 * 2] L2\nG1 X#1 F100\nM30\n\
+    let text = "%\nO1000\n#1 = 99\nG65 P9010 A2. B-3. X10. Y[4 * 2] L2\nG1 X#1 F100\nM30\n\
                 O9010\nG1 X[#24 + #1] Y[#25 + #2] F200\n#24 = #24 + 1\nM99\n%\n";
     let l = lines(text);
     assert_eq!(
@@ -355,10 +355,10 @@ fn g65_passes_arguments_by_the_table_and_repeats_with_l() {
 #[test]
 fn system_variables_read_positions_offsets_and_modal_state() {
     let l = lines(
-        "G10 L2 P2 X100 Y50 Z-10\nG55 G1 X5 Y6 F300\n\
+        "G10 L2 P2 X100. Y50. Z-10.\nG55 G1 X5. Y6. F300\n\
          #100 = #5001 + #5002\n#101 = #5021\n#102 = #4001 * 100 + #4003\n\
          #103 = #5242 + #2001 + #2202\n#5241 = 200\n#2001 = 7\n\
-         G1 X#100 Y#101 Z#102\nG1 X#103\nG43 H1 Z0\nM30\n",
+         G1 X#100 Y#101 Z#102\nG1 X#103\nG43 H1 Z0.\nM30\n",
     );
     // #5001 + #5002 = 5 + 6 (work), #5021 = 105 (machine X), G01 and G90 give 190, G55's
     // Y zero 50 + H1's length 100 + D2's radius 3 give 153. G55's Z zero is -10.
@@ -397,7 +397,7 @@ fn common_variables_500_to_999_are_kept_for_the_next_program() {
 fn g27_checks_g29_returns_and_g60_approaches_from_one_side() {
     // G28 through X10 Y5 to the reference point (0, 0, 0); G29 back through the same
     // intermediate point to X30 Y20.
-    let l = lines("G0 X10 Y5 Z20\nG28 X10 Y5\nG29 X30 Y20\nG27 X0 Y0\nM30\n");
+    let l = lines("G0 X10. Y5. Z20.\nG28 X10. Y5.\nG29 X30. Y20.\nG27 X0. Y0.\nM30\n");
     assert_eq!(
         l[1..6],
         [
@@ -410,12 +410,12 @@ fn g27_checks_g29_returns_and_g60_approaches_from_one_side() {
         ]
     );
     // G27 to a point that is not the reference point: P/S 092 on its line.
-    let e = alarm("G0 X10\nG27 X5\nM30\n");
+    let e = alarm("G0 X10.\nG27 X5.\nM30\n");
     assert_eq!((e.number, e.line), (92, 2), "{e}");
     // G29 with no G28 before it.
-    assert_eq!(alarm("G29 X5\nM30\n").number, 10);
+    assert_eq!(alarm("G29 X5.\nM30\n").number, 10);
     // G60: each moving axis stops 1 mm short and comes the last millimetre from below.
-    let l = lines("G0 X10 Y10\nG60 X-5 Y10\nM30\n");
+    let l = lines("G0 X10. Y10.\nG60 X-5. Y10.\nM30\n");
     assert_eq!(
         l[1..3],
         [
@@ -434,7 +434,7 @@ fn m06_needs_the_tool_axis_at_the_second_reference_point() {
     let e = run("T2\nM06\nM30\n").unwrap_err();
     assert_eq!((e.number, e.line), (1006, 2), "{e}");
     // G91 G30 Z0 takes Z there (only Z moves); then M06 changes the tool.
-    let c = run("G0 X20 Y10\nG91 G30 Z0\nT2 M06\nM30\n").expect("tool change at G30");
+    let c = run("G0 X20. Y10.\nG91 G30 Z0.\nT2 M06\nM30\n").expect("tool change at G30");
     let text: Vec<String> = c.iter().map(|c| trace::line(&XYZ, c)).collect();
     assert!(
         text.iter()
@@ -443,7 +443,7 @@ fn m06_needs_the_tool_axis_at_the_second_reference_point() {
     );
     assert!(text.iter().any(|l| l.ends_with(" M6")), "{text:?}");
     // A third reference point is not configured.
-    assert_eq!(run("G30 P3 Z0\nM30\n").unwrap_err().number, 3);
+    assert_eq!(run("G30 P3 Z0.\nM30\n").unwrap_err().number, 3);
 }
 
 #[test]
@@ -451,7 +451,7 @@ fn a_rotary_axis_cannot_move_under_cutter_compensation() {
     let setup = Setup::new(&['X', 'Y', 'Z', 'A'], &[false; 4], &[0.0; 4]);
     let e = cnc_interpreter::check(
         Dialect::FanucMill,
-        "G0 X-10 Y0\nG41 D0 G1 X0 F100\nX10 A30\nG40 X20\nM30\n",
+        "G0 X-10. Y0.\nG41 D0 G1 X0. F100\nX10. A30.\nG40 X20.\nM30\n",
         setup,
     )
     .unwrap_err();
@@ -461,9 +461,9 @@ fn a_rotary_axis_cannot_move_under_cutter_compensation() {
 
 #[test]
 fn modal_information_names_the_codes_in_force() {
-    let text = "G0 X0 Y-10 Z20\nG56 G61 G44 H1 Z20\nG42 D1 G1 X5 Y0 F100\n\
-                #500 = #4007 * 100 + #4008\n#501 = #4001\nG40 G1 X10\n\
-                G99 G83 Z-5 R2 Q2 F50 L0\n#502 = #4009 * 100 + #4010\nG80\n\
+    let text = "G0 X0. Y-10. Z20.\nG56 G61 G44 H1 Z20.\nG42 D1 G1 X5. Y0. F100\n\
+                #500 = #4007 * 100 + #4008\n#501 = #4001\nG40 G1 X10.\n\
+                G99 G83 Z-5. R2. Q2. F50 L0\n#502 = #4009 * 100 + #4010\nG80\n\
                 G18 G91\n#503 = #4002 * 100 + #4003\n#504 = #4014 * 100 + #4015\nM30\n";
     let mut it = cnc_interpreter::Interpreter::new(Dialect::FanucMill, text, mill());
     while let Ok(Some(_)) = it.next_command() {}

@@ -99,6 +99,19 @@ pub struct MachineConfig {
     /// before the cycle is refused, mm (Huaxing GS#33).
     #[serde(default = "default_contour_tolerance")]
     pub contour_tolerance: f64,
+    /// How a number without a decimal point reads: `calculator` (X50 is 50 mm) or
+    /// `increment` (X50 is 50 least input increments, 0.050 mm on the mill); absent: as the
+    /// dialect's manual says (decision D52).
+    #[serde(default)]
+    pub decimal_point: Option<DecimalPoint>,
+}
+
+/// How a number without a decimal point reads (FANUC's parameter DPI).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DecimalPoint {
+    Calculator,
+    Increment,
 }
 
 fn default_contour_tolerance() -> f64 {

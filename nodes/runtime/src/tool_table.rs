@@ -1,5 +1,6 @@
-//! The mill's tool table file (issue 7): one tool per line, `number length_mm diameter_mm`,
-//! separated by blanks, `#` starting a comment. Entry n gives H<n> its length and D<n> its
+//! The mill's tool table file (issue 7): one tool per line, `number length diameter`,
+//! separated by blanks, `#` starting a comment; lengths in mm, or in inches after a line
+//! `units inch` (until `units mm`), converted to mm as the table is read (decision D53). Entry n gives H<n> its length and D<n> its
 //! radius (half the diameter), as FANUC 0-M's one offset memory shared by H and D does
 //! (inventory `003` Appendix A.2; decision D47). Read by the launch config
 //! (`machine.tool_table`) and by `cnc check --tools`.
@@ -16,11 +17,25 @@ const MAX_VALUE: f64 = 10_000.0;
 /// The entries of a tool table text, or the first bad line with its number and reason.
 pub fn parse(text: &str) -> Result<BTreeMap<u32, ToolEntry>, String> {
     let mut tools = BTreeMap::new();
+    // Millimetres per unit of the values that follow.
+    let mut unit = 1.0;
     for (k, raw) in text.lines().enumerate() {
         let line = k + 1;
         let body = raw.split('#').next().unwrap_or("");
         let fields: Vec<&str> = body.split_whitespace().collect();
         if fields.is_empty() {
+            continue;
+        }
+        if fields[0] == "units" {
+            unit = match fields[1..] {
+                ["inch"] => 25.4,
+                ["mm"] => 1.0,
+                _ => {
+                    return Err(format!(
+                        "line {line}: `units inch` or `units mm`, found {body:?}"
+                    ))
+                }
+            };
             continue;
         }
         let [number, length, diameter] = fields[..] else {
@@ -44,8 +59,8 @@ pub fn parse(text: &str) -> Result<BTreeMap<u32, ToolEntry>, String> {
                     format!("line {line}: {what} {text:?} is not a number within ±{MAX_VALUE} mm")
                 })
         };
-        let length = value("length", length)?;
-        let diameter = value("diameter", diameter)?;
+        let length = value("length", length)? * unit;
+        let diameter = value("diameter", diameter)? * unit;
         if diameter < 0.0 {
             return Err(format!("line {line}: diameter {diameter} is negative"));
         }
@@ -77,6 +92,11 @@ mod tests {
         assert_eq!(t.len(), 2);
         assert_eq!((t[&1].z, t[&1].radius), (50.5, 5.0));
         assert_eq!((t[&200].z, t[&200].radius), (-3.0, 0.0));
+        // An inch table is read in mm.
+        let t = parse("units inch\n3 2.5 0.5\nunits mm\n4 10 6\n").unwrap();
+        assert_eq!((t[&3].z, t[&3].radius), (63.5, 6.35));
+        assert_eq!((t[&4].z, t[&4].radius), (10.0, 3.0));
+        assert!(parse("units feet\n").is_err());
     }
 
     #[test]

@@ -238,11 +238,11 @@ impl Elem {
             }
         }
     }
-    /// The element from `p` on. A full circle stays one: it now starts and ends at `p`.
+    /// The element from `p` on. A full circle entered at `p` still ends at its own offset end,
+    /// as ISO controls cut it (what lies between is left: a bore wants a lead-in arc).
     fn with_start(&self, p: Pt) -> Elem {
         match *self {
             Elem::Line { b, .. } => Elem::Line { a: p, b },
-            Elem::Arc { a, b, c, ccw } if len(sub(a, b)) < EPS => Elem::Arc { a: p, b: p, c, ccw },
             Elem::Arc { b, c, ccw, .. } => Elem::Arc { a: p, b, c, ccw },
         }
     }

@@ -76,6 +76,9 @@ pub struct Setup {
     pub front_tool_post: bool,
     /// A T word calls this program as the tool-change macro (a machine parameter).
     pub tool_change_macro: Option<u32>,
+    /// Numbers without a decimal point are millimetres (`Some(true)`, calculator type) or
+    /// least input increments (`Some(false)`); `None`: as the control's manual says.
+    pub calculator_decimal_point: Option<bool>,
     /// How far a roughing contour may leave its start or turn back before it is refused,
     /// mm (a machine parameter; 0.05 unless set).
     pub contour_tolerance: f64,
@@ -108,6 +111,7 @@ impl Setup {
             work_system: 0,
             front_tool_post: false,
             tool_change_macro: None,
+            calculator_decimal_point: None,
             contour_tolerance: 0.05,
         }
     }

@@ -3,7 +3,7 @@
 
 use cnc_interpreter_core::{show, Fault, ProgramError};
 
-use super::codes::{G, M};
+use super::codes::{WordUnit, G, M};
 use super::syntax::Word;
 use super::{Family, Fanuc};
 
@@ -51,6 +51,12 @@ impl Words {
     /// Sets the letter's value; returns the value it had.
     pub fn insert(&mut self, c: char, w: (f64, bool)) -> Option<(f64, bool)> {
         Self::slot(c).and_then(|i| self.0[i].replace(w))
+    }
+    /// Sets the value of letter `i` (0 = A), if it was given.
+    fn set(&mut self, i: usize, w: (f64, bool)) {
+        if let Some(slot) = self.0.get_mut(i).filter(|s| s.is_some()) {
+            *slot = Some(w);
+        }
     }
     /// The letters given, in alphabetical order.
     pub fn iter(&self) -> impl Iterator<Item = (char, (f64, bool))> + '_ {
@@ -159,6 +165,7 @@ impl<D: Family> Fanuc<D> {
                 ));
             }
         }
+        self.units(b);
         for (c, (v, _)) in b.words.iter() {
             let axis_word = self.core.setup.axes.contains(&c)
                 || self
@@ -192,6 +199,65 @@ impl<D: Family> Fanuc<D> {
             }
         }
         Ok(())
+    }
+
+    /// Reads the block's words in millimetres, degrees, seconds and mm/min: a number without
+    /// a decimal point counts least input increments where the machine reads numbers so
+    /// (D52), and lengths and feeds are in inches under G20 (D53). The range checks after it
+    /// see millimetres.
+    fn units(&self, b: &mut Block<D>) {
+        let inch = if b.has_g(G::InchInput) {
+            true
+        } else if b.has_g(G::MetricInput) {
+            false
+        } else {
+            self.inch
+        };
+        if self.calculator && !inch {
+            return;
+        }
+        let mut units = [WordUnit::Plain; 26];
+        for (c, _) in b.words.iter() {
+            units[usize::from(c as u8 - b'A')] = D::word_unit(self, b, c);
+        }
+        let increments = !self.calculator;
+        // The least input increment: 0.001 mm, 0.0001 inch, 0.001 degree, 1 ms on the mill.
+        let step = if inch {
+            self.rules.increment / 10.0
+        } else {
+            self.rules.increment
+        };
+        let scale = if inch { 25.4 } else { 1.0 };
+        for (i, unit) in units.into_iter().enumerate() {
+            let Some(&(v, point)) = b.words.get(&char::from(b'A' + i as u8)) else {
+                continue;
+            };
+            let counted = increments && !point;
+            let v = match unit {
+                WordUnit::Plain => continue,
+                WordUnit::Length if counted => v * step * scale,
+                WordUnit::Length | WordUnit::Feed => v * scale,
+                WordUnit::Angle | WordUnit::Time if counted => v * self.rules.increment,
+                WordUnit::Angle | WordUnit::Time => v,
+            };
+            // A counted value is a value in mm now, as one written with a point.
+            b.words.set(i, (v, point || counted));
+        }
+    }
+
+    /// The family's word units: F a feed; I, J, K, R lengths; linear axes (and their
+    /// incremental addresses) lengths, rotary axes angles; X or U of G04 a time.
+    pub fn default_word_unit(&self, b: &Block<D>, c: char) -> WordUnit {
+        let axes = &self.core.setup.axes;
+        let axis = axes.contains(&c) || axes.iter().any(|&a| self.inc_letter(a) == Some(c));
+        match c {
+            'F' => WordUnit::Feed,
+            'I' | 'J' | 'K' | 'R' => WordUnit::Length,
+            'X' | 'U' if axis && b.has_g(G::Dwell) => WordUnit::Time,
+            'A' | 'B' | 'C' if axis => WordUnit::Angle,
+            _ if axis => WordUnit::Length,
+            _ => WordUnit::Plain,
+        }
     }
 
     /// A G or M word's code number (×10) and its meaning in the dialect's table.

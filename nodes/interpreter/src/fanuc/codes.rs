@@ -28,8 +28,10 @@ pub enum G<O> {
     PlaneXy,
     PlaneZx,
     PlaneYz,
-    /// G21: millimetre input (the only input unit here).
+    /// G21: millimetre input.
     MetricInput,
+    /// G20: inch input, converted to millimetres as the block is read (decision D53).
+    InchInput,
     NoseCancel,
     NoseLeft,
     NoseRight,
@@ -77,6 +79,22 @@ pub enum M<O> {
     Unsupported(&'static str),
     /// The dialect's own meaning.
     Own(O),
+}
+
+/// What a word's number is, for the units it is read in (decisions D52, D53).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WordUnit {
+    /// A length: in least input increments without a decimal point (where the machine
+    /// reads numbers so), in inches under G20.
+    Length,
+    /// An angle (a rotary axis): in increments without a decimal point, never in inches.
+    Angle,
+    /// A time in seconds (G04 X): in increments (ms) without a decimal point.
+    Time,
+    /// A feed: in inches per minute or revolution under G20.
+    Feed,
+    /// A number (code, count, offset number, speed): as written.
+    Plain,
 }
 
 /// A dialect without meanings of its own.

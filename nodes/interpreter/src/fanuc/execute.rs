@@ -56,7 +56,8 @@ impl<D: Family> Fanuc<D> {
                 // Keep the machine position; the work coordinates change.
                 G::WorkSystem(n) => self.core.work_system = n,
                 G::PlaneXy | G::PlaneZx | G::PlaneYz => D::plane(self, g)?,
-                G::MetricInput => {}
+                G::MetricInput => self.inch = false,
+                G::InchInput => self.inch = true,
                 G::NoseLeft | G::NoseRight => D::start_comp(self, &b, g)?,
                 G::NoseCancel if self.core.comp.is_some() => {
                     D::cancel_comp(self, &b)?;

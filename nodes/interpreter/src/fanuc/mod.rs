@@ -23,7 +23,7 @@ use cnc_interpreter_core::comp::Side;
 use cnc_interpreter_core::{Core, CssRule, Fault, FrontEnd, Library, ProgramError, Setup};
 
 use self::block::{code_x10, Block};
-use self::codes::{GCode, Rules, G, M};
+use self::codes::{GCode, Rules, WordUnit, G, M};
 use self::expr::{EvalError, Value, Variables};
 use self::syntax::{parse_line, Stmt, Word};
 use crate::library::split_programs;
@@ -63,6 +63,9 @@ pub trait Family: Sized + Send + 'static {
     const INCREMENTAL_ADDRESSES: bool = false;
     /// Decimal places ROUND keeps.
     const ROUND_DECIMALS: i32 = 3;
+    /// A number without a decimal point is millimetres (calculator type) unless the machine
+    /// says otherwise; else least input increments (decision D52).
+    const CALCULATOR_POINT: bool = true;
     /// The modal group of G96/G97.
     const CSS_GROUP: u8 = 2;
     /// The arc's I is a diameter (on a diameter axis).
@@ -76,6 +79,10 @@ pub trait Family: Sized + Send + 'static {
     /// An address letter the dialect has beyond the axes and F S T P Q R I J K L D E.
     fn extra_address(_c: char) -> bool {
         false
+    }
+    /// What letter `c` of block `b` is, for the units it is read in.
+    fn word_unit(f: &Fanuc<Self>, b: &Block<Self>, c: char) -> WordUnit {
+        f.default_word_unit(b, c)
     }
     /// The modal group of an M code, where codes of one group may not share a block.
     fn m_group(_x10: u32) -> u32 {
@@ -228,6 +235,11 @@ pub struct Fanuc<D: Family> {
     pub offset_number: u32,
     /// The sign of the last move along X (a thread's retract goes the other way).
     pub last_x_direction: f64,
+    /// Numbers without a decimal point are millimetres (calculator type), not least input
+    /// increments (decision D52).
+    pub calculator: bool,
+    /// G20: words of length are in inches (decision D53).
+    pub inch: bool,
 }
 
 impl<D: Family> Fanuc<D> {
@@ -244,6 +256,9 @@ impl<D: Family> Fanuc<D> {
         }
         let rules = D::rules();
         let d = D::new(&setup);
+        let calculator = setup
+            .calculator_decimal_point
+            .unwrap_or(D::CALCULATOR_POINT);
         Fanuc {
             core: Core::new(D::core_rules(), text, setup, library),
             d,
@@ -254,6 +269,8 @@ impl<D: Family> Fanuc<D> {
             tool: 0,
             offset_number: 0,
             last_x_direction: -1.0,
+            calculator,
+            inch: false,
         }
     }
 

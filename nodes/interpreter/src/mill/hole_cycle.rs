@@ -8,7 +8,7 @@
 
 use cnc_interpreter_core::{show, Aux, Command, Fault, MoveKind, ProgramError, SpindleDir};
 
-use super::{HoleKind, Mill};
+use super::{HoleKind, Mill, MillG};
 use crate::fanuc::block::Block;
 use crate::fanuc::codes::G;
 use crate::fanuc::Fanuc;
@@ -56,13 +56,23 @@ impl Fanuc<Mill> {
         })
     }
 
-    /// G73/G74/G76/G81–G89: makes the cycle modal, keeping the hole data of one that is
-    /// already modal.
     /// The canned cycle in force, if any.
     pub(super) fn hole_kind(&self) -> Option<HoleKind> {
         self.d.hole.map(|h| h.kind)
     }
 
+    /// The block machines a hole: a cycle code in it, or a cycle in force and no group-01
+    /// code or G80 (its K is then a repeat count).
+    pub(super) fn cycle_block(&self, b: &Block<Mill>) -> bool {
+        match b.group(9) {
+            Some(G::Own(MillG::HoleCycle(_))) => true,
+            Some(_) => false,
+            None => self.d.hole.is_some() && b.group(1).is_none(),
+        }
+    }
+
+    /// G73/G74/G76/G81–G89: makes the cycle modal, keeping the hole data of one that is
+    /// already modal.
     pub(super) fn select_hole_cycle(&mut self, kind: HoleKind) -> Result<(), ProgramError> {
         let d = self.drill_axis()?;
         let initial = self.core.work_position()[d];

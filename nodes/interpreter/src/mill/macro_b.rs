@@ -73,7 +73,15 @@ impl Fanuc<Mill> {
                             format!("G65: argument {letter} given twice"),
                         ));
                     }
-                    locals[n] = v;
+                    // A number without a decimal point counts least input increments for
+                    // the addresses that take lengths and angles (D52); the macro gets it in
+                    // program units (inches under G20), as it computes in them.
+                    let counted = !self.calculator && !w.value.has_point();
+                    let scaled = matches!(letter, 'A'..='C' | 'I'..='K' | 'Q' | 'R' | 'U'..='Z');
+                    locals[n] = match v {
+                        Some(x) if counted && scaled => Some(x * self.step()),
+                        other => other,
+                    };
                 }
             }
         }
@@ -85,7 +93,34 @@ impl Fanuc<Mill> {
             .call_program(number, count, Some(locals), "G65: macro")
     }
 
-    /// Reads a variable of the mill's map.
+    /// The least input increment in program units: 0.001 mm, or 0.0001 inch under G20.
+    fn step(&self) -> f64 {
+        if self.inch {
+            self.rules.increment / 10.0
+        } else {
+            self.rules.increment
+        }
+    }
+
+    /// A length in program units (inches under G20) of a length in mm.
+    fn mm_to_program(&self, mm: f64) -> f64 {
+        if self.inch {
+            mm / 25.4
+        } else {
+            mm
+        }
+    }
+
+    /// A length in mm of a length in program units.
+    fn program_to_mm(&self, v: f64) -> f64 {
+        if self.inch {
+            v * 25.4
+        } else {
+            v
+        }
+    }
+
+    /// Reads a variable of the mill's map; offsets and positions in program units.
     pub(super) fn fanuc_read(&self, n: i64) -> Result<Value, EvalError> {
         let axis = |base: i64| {
             usize::try_from(n - base)
@@ -98,18 +133,22 @@ impl Fanuc<Mill> {
             100..=199 | 500..=999 => self.core.common.get(&n).copied(),
             2001..=2200 => {
                 let t = self.core.setup.offsets.tool((n - 2000) as u32);
-                Some(t.z + t.wear_z)
+                Some(self.mm_to_program(t.z + t.wear_z))
             }
-            2201..=2400 => Some(self.core.setup.offsets.tool((n - 2200) as u32).radius),
+            2201..=2400 => {
+                Some(self.mm_to_program(self.core.setup.offsets.tool((n - 2200) as u32).radius))
+            }
             4001..=4022 | 4107 | 4109 | 4111 | 4119 | 4120 => self.modal_information(n),
             5001..=5020 | 5041..=5060 => {
                 let i = axis(if n < 5041 { 5001 } else { 5041 });
-                i.map(|i| self.core.work_position()[i])
+                i.map(|i| self.mm_to_program(self.core.work_position()[i]))
             }
-            5021..=5040 => axis(5021).map(|i| self.core.pos[i]),
-            5081..=5100 => axis(5081).map(|i| self.core.tool_offset[i]),
+            5021..=5040 => axis(5021).map(|i| self.mm_to_program(self.core.pos[i])),
+            5081..=5100 => axis(5081).map(|i| self.mm_to_program(self.core.tool_offset[i])),
             5221..=5340 => match self.work_offset_slot(n) {
-                Some((system, a)) => Some(self.core.setup.offsets.work(system, a)),
+                Some((system, a)) => {
+                    Some(self.mm_to_program(self.core.setup.offsets.work(system, a)))
+                }
                 None => return Err(no_variable(n)),
             },
             _ => return Err(no_variable(n)),
@@ -141,7 +180,7 @@ impl Fanuc<Mill> {
                 G::FeedPerRevolution,
                 G::FeedPerMinute,
             ),
-            4006 => G::MetricInput,
+            4006 => pick(self.inch, G::InchInput, G::MetricInput),
             4007 => match self.core.comp.as_ref().map(|c| c.side()) {
                 None => G::NoseCancel,
                 Some(Side::Left) => G::NoseLeft,
@@ -165,7 +204,7 @@ impl Fanuc<Mill> {
                 G::ContinuousMode,
             ),
             4107 => return Some(f64::from(self.d.radius_offset)),
-            4109 => return Some(self.core.feed),
+            4109 => return Some(self.mm_to_program(self.core.feed)),
             4111 => return Some(f64::from(self.d.length_offset)),
             4119 => return Some(self.core.sent_rpm.unwrap_or(0.0)),
             4120 => return Some(f64::from(self.tool)),
@@ -192,7 +231,7 @@ impl Fanuc<Mill> {
                 };
             }
             2001..=2400 => {
-                let x = v.unwrap_or(0.0);
+                let x = self.program_to_mm(v.unwrap_or(0.0));
                 if !x.is_finite() || x.abs() > 9999.0 {
                     return Err(self.fault(Fault::CompRadiusZero, format!("#{n}: {x} mm")));
                 }
@@ -221,6 +260,7 @@ impl Fanuc<Mill> {
                 let (system, letter) = self
                     .work_offset_slot(n)
                     .ok_or_else(|| self.fault(Fault::MacroVariable, no_variable(n).0))?;
+                let v = v.map(|x| self.program_to_mm(x));
                 return self.write_work_offset(n, system, letter, v, Fault::OutOfRange);
             }
             _ if self.fanuc_read(n).is_ok() => {

@@ -11,7 +11,7 @@ use cnc_interpreter_core::comp::Startup;
 use cnc_interpreter_core::{CompRules, Fault, Plane, ProgramError, Setup, SpindleDir};
 
 use crate::fanuc::block::Block;
-use crate::fanuc::codes::{GCode, Nothing, Rules, G, M};
+use crate::fanuc::codes::{GCode, Nothing, Rules, WordUnit, G, M};
 use crate::fanuc::expr::{EvalError, Value};
 use crate::fanuc::syntax::Word;
 use crate::fanuc::{Family, Fanuc};
@@ -165,8 +165,19 @@ impl Family for Mill {
     // Only G65 opens a level of locals; an M98 subprogram works with its caller's (D51).
     const SUBPROGRAM_LOCALS: bool = false;
 
+    // Numbers without a decimal point count 0.001 mm (§7.2.1; decision D52).
+    const CALCULATOR_POINT: bool = false;
+
     fn extra_address(c: char) -> bool {
         c == 'H'
+    }
+    /// Q (peck depth, shift) is a length; K is a repeat count in a canned-cycle block.
+    fn word_unit(f: &Fanuc<Self>, b: &Block<Self>, c: char) -> WordUnit {
+        match c {
+            'Q' => WordUnit::Length,
+            'K' if f.cycle_block(b) => WordUnit::Plain,
+            _ => f.default_word_unit(b, c),
+        }
     }
     fn words_statement(f: &mut Fanuc<Self>, words: &[Word]) -> Option<Result<(), ProgramError>> {
         use crate::fanuc::expr::Expr;
@@ -301,10 +312,7 @@ fn g_code(n: u32) -> Option<GCode<MillG>> {
         170 => (2, PlaneXy),
         180 => (2, PlaneZx),
         190 => (2, PlaneYz),
-        200 => (
-            6,
-            Unsupported("G20 inch input: this controller works in millimetres"),
-        ),
+        200 => (6, InchInput),
         210 => (6, MetricInput),
         100 => (0, G::Own(SetOffsetData)),
         270 => (0, G::Own(ReferenceCheck)),
