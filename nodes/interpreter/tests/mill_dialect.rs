@@ -379,6 +379,17 @@ fn system_variables_read_positions_offsets_and_modal_state() {
 }
 
 #[test]
+fn g91_g10_l2_adds_to_the_work_offset_that_g90_replaces() {
+    // FANUC 0-M: G10 in G91 is an increment to the stored offset; LinuxCNC always replaces.
+    let l = lines(
+        "G10 L2 P1 X37.5 Y-12.25 Z7.5\nG91 G10 L2 P1 X2.5 Y-0.75\n\
+         G90 G54 G0 X0. Y0. Z0.\nG10 L2 P1 X1. Y2. Z3.\nG0 X0. Y0. Z0.\nM30\n",
+    );
+    assert_eq!(l[0], "RAPID X40.0000 Y-13.0000 Z7.5000", "{l:?}");
+    assert_eq!(l[1], "RAPID X1.0000 Y2.0000 Z3.0000", "{l:?}");
+}
+
+#[test]
 fn common_variables_500_to_999_are_kept_for_the_next_program() {
     let mut it = cnc_interpreter::Interpreter::new(
         Dialect::FanucMill,
