@@ -315,6 +315,20 @@ fn an_inch_program_moves_the_machine_as_its_metric_twin_within_a_micrometre() {
 }
 
 #[test]
+fn the_lathe_manuals_have_no_inch_input_so_g20_is_their_undefined_code_alarm() {
+    // D53: Huaxing's G21 is a conditional jump, GTC2E knows inches only as threads per inch.
+    for (dialect, number) in [(Dialect::HuaxingLathe, 7), (Dialect::Gtc2eLathe, 15)] {
+        let e = run(
+            dialect,
+            "G00 X50 Z5\nG20\nG00 X10\nM30\n",
+            Setup::lathe([200.0, 100.0]),
+        )
+        .unwrap_err();
+        assert_eq!((e.number, e.line), (number, 2), "{dialect:?}: {e}");
+    }
+}
+
+#[test]
 fn variables_read_and_write_offsets_and_positions_in_the_programs_unit() {
     // Offset 1 is 100 mm long; under G20 #2001 reads 3.937 inches and #5221 writes inches.
     let l = mill_lines("G20\n#1 = #2001\n#5221 = 1.\nG00 X#1 Y0 Z0\nM30\n");
