@@ -76,15 +76,15 @@ impl CellClient {
             overrides: client::<SetOverrides>(&mut ros, mapping, ns, "set_overrides")?,
             // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
             // within a millisecond, and a depth-1 reader would see only STOPPED.
-            machine: ros.subscription_with_qos(
+            machine: ros.dds_subscription_with_qos(
                 &topics::MACHINE_STATE,
                 qos::state().history(History::KeepLast { depth: 64 }),
             )?,
-            spindle_sub: ros.subscription(&topics::SPINDLE)?,
-            parts: ros.subscription(&topics::PART_COUNT)?,
-            alarms_sub: ros.subscription(&topics::ALARMS)?,
-            axes_sub: ros.subscription(&topics::AXES)?,
-            stats_sub: ros.subscription(&topics::SERVO_STATS)?,
+            spindle_sub: ros.dds_subscription(&topics::SPINDLE)?,
+            parts: ros.dds_subscription(&topics::PART_COUNT)?,
+            alarms_sub: ros.dds_subscription(&topics::ALARMS)?,
+            axes_sub: ros.dds_subscription(&topics::AXES)?,
+            stats_sub: ros.dds_subscription(&topics::SERVO_STATS)?,
             ros,
             mapping,
             namespace: ns.into(),

@@ -25,7 +25,7 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     let cell = Cell::start(&cfg).unwrap();
     let mut auditor = RosNode::new(&cfg.network, "lathe1", "auditor").unwrap();
     let events = auditor
-        .subscription_with_qos::<CommandEvent>(
+        .dds_subscription_with_qos::<CommandEvent>(
             &topics::COMMAND_EVENTS,
             topics::COMMAND_EVENTS
                 .qos()
@@ -59,9 +59,26 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     good.poll();
     assert_eq!(good.state.as_ref().unwrap().execution, MachineState::READY);
 
+    // Program memory is guarded: an intruder cannot overwrite or delete what the robot starts
+    // next; reading stays open.
+    let r = bad.load_program("p.nc", "O0001\nG00 X-500\nM30\n").unwrap();
+    assert!(
+        !r.accepted && r.message.contains("may not move"),
+        "{}",
+        r.message
+    );
+    let r = bad.delete_program("p.nc").unwrap();
+    assert!(
+        !r.accepted && r.message.contains("may not move"),
+        "{}",
+        r.message
+    );
+    let listed = bad.list_programs().unwrap();
+    assert!(listed.names.iter().any(|n| n == "p.nc"), "{listed:?}");
+
     // Malformed requests: clear errors, nothing changed.
     let huge = "G01 X1\n".repeat(cnc_runtime::MAX_PROGRAM_BYTES / 7 + 1);
-    let r = bad.load_program("huge.nc", &huge).unwrap();
+    let r = good.load_program("huge.nc", &huge).unwrap();
     assert!(
         !r.accepted && r.message.contains("too large"),
         "{}",

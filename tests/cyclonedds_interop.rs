@@ -3,9 +3,6 @@
 //! calls the services with the rmw_cyclonedds mapping. `scripts/test.sh` creates the Python
 //! environment (`target/venv`); without it this test fails, it does not skip.
 
-use std::path::PathBuf;
-use std::process::Command;
-
 mod common;
 
 use cnc::cell::Cell;
@@ -13,24 +10,9 @@ use cnc::cell::Cell;
 /// Runs `tests/interop/<script>` with the venv's Python against a cell in `domain`; returns
 /// its output after checking it passed.
 fn run_peer(script: &str, domain: u16) -> String {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let python = std::env::var("CNC_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| root.join("target/venv/bin/python"));
-    assert!(
-        python.exists(),
-        "{} missing: run scripts/test.sh, which creates the venv with cyclonedds",
-        python.display()
-    );
     let cfg = common::sim_lathe(domain);
     let cell = Cell::start(&cfg).unwrap();
-    let out = Command::new(&python)
-        .arg(root.join("tests/interop").join(script))
-        .args(["--domain", &domain.to_string()])
-        // Cyclone on loopback only, like the cell.
-        .env("CYCLONEDDS_URI", "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>")
-        .output()
-        .unwrap();
+    let out = common::cyclone_peer(script, domain);
     let (_, errors) = cell.stop();
     let stdout = String::from_utf8_lossy(&out.stdout).to_string();
     println!("{stdout}");

@@ -156,7 +156,7 @@ fn a_recorded_cycle_reads_back_in_rosbags_and_mcap_with_every_message_published(
     let r = client.set_overrides(100, 100, 100).unwrap();
     assert!(r.accepted, "{}", r.message);
     let mut panel = RosNode::new(&cfg.network, "lathe1", "panel_test").unwrap();
-    let input = panel.publisher::<SimInput>(&topics::SIM_INPUT).unwrap();
+    let input = panel.dds_publisher::<SimInput>(&topics::SIM_INPUT).unwrap();
     std::thread::sleep(Duration::from_millis(500)); // discovery of the new writer
     let press = |value| {
         input
@@ -205,7 +205,7 @@ fn a_recorded_cycle_reads_back_in_rosbags_and_mcap_with_every_message_published(
     // `cnc replay`: the axes again, under /lathe1_replay, spread over the recorded time.
     let mut viewer = RosNode::new(&cfg.network, "lathe1_replay", "viewer_test").unwrap();
     let axes = viewer
-        .subscription_with_qos::<cnc_msgs::msg::AxisState>(
+        .dds_subscription_with_qos::<cnc_msgs::msg::AxisState>(
             &topics::AXES,
             topics::AXES
                 .qos()

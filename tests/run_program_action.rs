@@ -109,7 +109,7 @@ fn run_program_reports_every_block_and_a_cancel_stops_the_machine_ready_for_the_
     // The program events a line-side display would follow.
     let mut watcher = RosNode::new(&cfg.network, "lathe1", "event_watch").unwrap();
     let program_events = watcher
-        .subscription_with_qos::<ProgramEvent>(
+        .dds_subscription_with_qos::<ProgramEvent>(
             &topics::PROGRAM_EVENTS,
             topics::PROGRAM_EVENTS
                 .qos()

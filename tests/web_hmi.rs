@@ -37,7 +37,7 @@ fn the_operator_runs_a_program_from_the_web_hmi_in_chromium() {
     let cell = Cell::start(&cfg).expect("cell starts");
     let mut ros = RosNode::new(&cfg.network, "lathe1", "web_hmi_test").expect("node");
     let events = ros
-        .subscription::<CommandEvent>(&topics::COMMAND_EVENTS)
+        .dds_subscription::<CommandEvent>(&topics::COMMAND_EVENTS)
         .expect("events");
 
     // The page is served once the bridge runs.

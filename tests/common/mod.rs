@@ -17,3 +17,25 @@ pub fn sim_lathe(domain: u16) -> LaunchConfig {
     cfg.hmi.web_address = String::new();
     cfg
 }
+
+/// Runs `tests/interop/<script>` with the venv's Python (PyPI `cyclonedds`) as a participant in
+/// `domain`, on loopback only like the cell. `scripts/test.sh` creates the venv; without it the
+/// calling test fails, it does not skip.
+#[allow(dead_code)]
+pub fn cyclone_peer(script: &str, domain: u16) -> std::process::Output {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let python = std::env::var("CNC_PYTHON")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|_| root.join("target/venv/bin/python"));
+    assert!(
+        python.exists(),
+        "{} missing: run scripts/test.sh, which creates the venv with cyclonedds",
+        python.display()
+    );
+    std::process::Command::new(&python)
+        .arg(root.join("tests/interop").join(script))
+        .args(["--domain", &domain.to_string()])
+        .env("CYCLONEDDS_URI", "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>")
+        .output()
+        .expect("python runs")
+}

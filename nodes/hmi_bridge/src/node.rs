@@ -20,7 +20,6 @@ use cnc_runtime::{MAX_PROGRAM_BYTES, MDI_PROGRAM};
 use ros2_client::dds::rustdds;
 use ros2_client::dds::rustdds::QosPolicies;
 use ros2_client::entities_info::ParticipantEntitiesInfo;
-use ros2_client::qos::History;
 
 use crate::access::{self, may_move, Clients, Who};
 use crate::action_server::{CommandPath, RunProgramServer};
@@ -41,7 +40,7 @@ const COMMAND_REPEAT: Duration = Duration::from_millis(250);
 
 struct Commands {
     publisher: cnc_runtime::dds::Publisher<ProgramCommand>,
-    results: ros2_client::dds::Subscription<CommandResult>,
+    results: cnc_runtime::bus::Subscription<CommandResult>,
     next_id: u64,
 }
 
@@ -65,7 +64,7 @@ impl CommandPath for Commands {
                 }
                 last_sent = Some(Instant::now());
             }
-            while let Ok(Some((r, _))) = self.results.take() {
+            while let Ok(Some(r)) = self.results.take() {
                 if r.id == id {
                     return (r.accepted, r.message);
                 }
@@ -130,6 +129,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             .refusing(RobotRequestResponse::refused);
     let mut run_program = RunProgramServer::new(&participant, &ns, sq)?;
     let robot_signals = ros.publisher::<SimInput>(&topics::ROBOT_SIGNALS)?;
+    // Only a simulated machine has inputs a client may set (`sim.client_inputs`).
+    let sim_inputs = match cfg.sim.client_inputs {
+        true => Some(ros.dds_subscription::<SimInput>(&topics::SIM_INPUT)?),
+        false => None,
+    };
+    let sim_forward = ros.publisher::<SimInput>(&topics::SIM_INPUT_CHECKED)?;
     let handshake_sub = ros.subscription::<RobotHandshake>(&topics::ROBOT_HANDSHAKE)?;
     let mut handshake: Option<RobotHandshake> = None;
     let mut pending: Option<PendingRobot> = None;
@@ -142,13 +147,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let discovery = discovery_reader(&participant)?;
     let mut clients = Clients::default();
     let allowed = cfg.hmi.allowed_clients.clone();
-    // Every state change, in order: the action follows the machine through them.
-    let state_sub = ros.subscription_with_qos::<MachineState>(
-        &topics::MACHINE_STATE,
-        topics::MACHINE_STATE
-            .qos()
-            .history(History::KeepLast { depth: 64 }),
-    )?;
+    // Every state change, in order (the bus keeps 64 per subscriber): the action follows the
+    // machine through them.
+    let state_sub = ros.subscription::<MachineState>(&topics::MACHINE_STATE)?;
     let motion_sub = ros.subscription::<MotionStatus>(&topics::MOTION_STATUS)?;
     let parts_sub = ros.subscription::<PartCount>(&topics::PART_COUNT)?;
     let mut machine: Option<MachineState> = None;
@@ -184,6 +185,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     };
     publish_alarms(&active);
     while !shutdown.requested() {
+        ros.refresh();
         let mut busy = false;
         let mut changed = false;
         discovery.drain_read_notifications();
@@ -228,7 +230,22 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 log::warn!("hmi_bridge: command event not published: {e}");
             }
         };
-        while let Ok(Some((e, _))) = alarm_events.take() {
+        // The simulated machine's inputs (emergency stop, forced door, keys) from the network:
+        // an allowed client's go on to io, anyone else's are refused; both are command events.
+        while let Some(Ok(Some((input, info)))) = sim_inputs.as_ref().map(|s| s.take()) {
+            busy = true;
+            let who = Who::Dds(info.publisher_gid().to_bytes16());
+            let detail = format!("input {} = {}", input.input, input.value);
+            let (accepted, message) = match may_move_who(&who) {
+                Ok(()) => match sim_forward.publish(input) {
+                    Ok(()) => (true, "passed to the simulated machine".to_string()),
+                    Err(e) => (false, format!("not delivered: {e}")),
+                },
+                Err(why) => (false, why),
+            };
+            record("sim_input", &detail, &who, accepted, &message);
+        }
+        while let Ok(Some(e)) = alarm_events.take() {
             if let Some(w) = web.as_mut() {
                 w.view.on_alarm_event(&e);
             }
@@ -240,13 +257,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 w.view.set_active_alarms(active.alarms());
             }
         }
-        while let Ok(Some((m, _))) = motion_sub.take() {
+        while let Ok(Some(m)) = motion_sub.take() {
             motion_run = (m.run_id, m.done_seq);
             if let Some(w) = web.as_mut() {
                 w.view.on_motion_status(m);
             }
         }
-        while let Ok(Some((p, _))) = parts_sub.take() {
+        while let Ok(Some(p)) = parts_sub.take() {
             if let Some(w) = web.as_mut() {
                 w.view.on_parts(p.clone());
             }
@@ -255,7 +272,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         let alarm_list: Vec<cnc_msgs::msg::Alarm> = active.alarms();
         // Each state in turn, so the action sees every transition (a short cycle's end too).
         let mut states = Vec::new();
-        while let Ok(Some((m, _))) = state_sub.take() {
+        while let Ok(Some(m)) = state_sub.take() {
             if let Some(w) = web.as_mut() {
                 w.view.on_machine_state(m.clone());
             }
@@ -482,7 +499,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 web.answer(pending, accepted, message);
             }
         }
-        while let Ok(Some((h, _))) = handshake_sub.take() {
+        while let Ok(Some(h)) = handshake_sub.take() {
             handshake = Some(h);
         }
         let robot_request = robot_srv.receive();
@@ -693,13 +710,13 @@ fn discovery_reader(participant: &rustdds::DomainParticipant) -> Result<Discover
 
 /// The topics only the web panel shows.
 struct PanelFeeds {
-    axes: ros2_client::dds::Subscription<AxisState>,
-    spindle: ros2_client::dds::Subscription<SpindleState>,
-    blocks: ros2_client::dds::Subscription<MotionBlock>,
-    signals: ros2_client::dds::Subscription<PlcSignals>,
-    ladder: ros2_client::dds::Subscription<PlcProgram>,
-    commands: ros2_client::dds::Subscription<CommandEvent>,
-    overrides: ros2_client::dds::Subscription<Overrides>,
+    axes: cnc_runtime::bus::Subscription<AxisState>,
+    spindle: cnc_runtime::bus::Subscription<SpindleState>,
+    blocks: cnc_runtime::bus::Subscription<MotionBlock>,
+    signals: cnc_runtime::bus::Subscription<PlcSignals>,
+    ladder: cnc_runtime::bus::Subscription<PlcProgram>,
+    commands: cnc_runtime::bus::Subscription<CommandEvent>,
+    overrides: cnc_runtime::bus::Subscription<Overrides>,
 }
 
 impl PanelFeeds {
@@ -717,25 +734,25 @@ impl PanelFeeds {
 
     /// Hands everything that arrived to the panel.
     fn feed(&self, w: &mut WebHmi) {
-        while let Ok(Some((a, _))) = self.axes.take() {
+        while let Ok(Some(a)) = self.axes.take() {
             w.view.on_axes(a);
         }
-        while let Ok(Some((s, _))) = self.spindle.take() {
+        while let Ok(Some(s)) = self.spindle.take() {
             w.view.on_spindle(s);
         }
-        while let Ok(Some((b, _))) = self.blocks.take() {
+        while let Ok(Some(b)) = self.blocks.take() {
             w.view.on_block(b);
         }
-        while let Ok(Some((s, _))) = self.signals.take() {
+        while let Ok(Some(s)) = self.signals.take() {
             w.view.on_plc_signals(s);
         }
-        while let Ok(Some((p, _))) = self.ladder.take() {
+        while let Ok(Some(p)) = self.ladder.take() {
             w.set_ladder(&p);
         }
-        while let Ok(Some((e, _))) = self.commands.take() {
+        while let Ok(Some(e)) = self.commands.take() {
             w.view.on_command_event(&e);
         }
-        while let Ok(Some((o, _))) = self.overrides.take() {
+        while let Ok(Some(o)) = self.overrides.take() {
             w.view.on_overrides(o);
         }
     }

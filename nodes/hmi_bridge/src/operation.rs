@@ -107,12 +107,15 @@ impl Operation {
     }
 
     /// Whether only allowed clients may give it (`hmi.allowed_clients`): whatever starts
-    /// motion or changes how the next cut comes out. Stopping is never refused; reading and
-    /// program memory are open to the cell.
+    /// motion or changes how the next cut comes out, loading and deleting programs included
+    /// (a program overwritten is the next part cut wrong). Stopping is never refused; reading
+    /// (the program list and texts too) is open to the cell.
     pub fn moves(&self) -> bool {
         matches!(
             self,
             Operation::Start { .. }
+                | Operation::Load { .. }
+                | Operation::Delete { .. }
                 | Operation::Overrides(_)
                 | Operation::Mode { .. }
                 | Operation::Mdi { .. }
@@ -167,6 +170,15 @@ mod tests {
         assert!(!Operation::Reset.moves());
         assert!(!Operation::Offsets.moves());
         assert!(Operation::Start { name: "O1".into() }.moves());
+        // Program memory is guarded: a program overwritten is the next part cut wrong.
+        assert!(Operation::Load {
+            name: "O1".into(),
+            text: String::new()
+        }
+        .moves());
+        assert!(Operation::Delete { name: "O1".into() }.moves());
+        assert!(!Operation::List.moves());
+        assert!(!Operation::Read { name: "O1".into() }.moves());
         assert!(Operation::Mdi {
             text: "G0X1".into()
         }

@@ -153,19 +153,20 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     };
 
     while !shutdown.requested() {
+        ros.refresh();
         let mut busy = false;
-        while let Ok(Some((s, _))) = status_sub.take() {
+        while let Ok(Some(s)) = status_sub.take() {
             core.motion_status(s);
         }
-        while let Ok(Some((a, _))) = axes_sub.take() {
+        while let Ok(Some(a)) = axes_sub.take() {
             let commanded: Vec<f64> = a.axes.iter().map(|x| x.commanded_position).collect();
             core.axes(&commanded);
         }
-        while let Ok(Some((e, _))) = alarm_sub.take() {
+        while let Ok(Some(e)) = alarm_sub.take() {
             core.alarm_event(&e);
         }
         carry_out(&mut core);
-        while let Ok(Some((c, _))) = commands.take() {
+        while let Ok(Some(c)) = commands.take() {
             busy = true;
             let result = core.command(c);
             carry_out(&mut core);

@@ -88,7 +88,7 @@ pub fn is_robot_signal(input: u8) -> bool {
 /// Runs the io node until shutdown (blocking).
 pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "io")?;
-    let inputs = ros.subscription::<SimInput>(&topics::SIM_INPUT)?;
+    let inputs = ros.subscription::<SimInput>(&topics::SIM_INPUT_CHECKED)?;
     let robot = ros.subscription::<SimInput>(&topics::ROBOT_SIGNALS)?;
     let panel = ros.subscription::<Overrides>(&topics::PANEL_OVERRIDES)?;
     let shm = ShmNode::new(&instance, "io")?;
@@ -103,7 +103,8 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let idle = ServoSetpoint::default();
     feedback.send(sim.step(&idle, &y, 0.0))?;
     while !shutdown.requested() {
-        while let Ok(Some((input, _))) = inputs.take() {
+        ros.refresh();
+        while let Ok(Some(input)) = inputs.take() {
             if apply_input(&mut sim, &input) {
                 log::info!("simulated input {} = {}", input.input, input.value);
             } else {
@@ -111,11 +112,11 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             }
         }
         // The panel's override switches set over the network (hmi_bridge checks the values).
-        while let Ok(Some((o, _))) = panel.take() {
+        while let Ok(Some(o)) = panel.take() {
             set_override_switches(&mut sim.devices.inputs, &o);
         }
         // The robot interface block (X8) set over the network: robot signals only.
-        while let Ok(Some((input, _))) = robot.take() {
+        while let Ok(Some(input)) = robot.take() {
             if is_robot_signal(input.input) {
                 apply_input(&mut sim, &input);
             } else {

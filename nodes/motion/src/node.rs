@@ -78,8 +78,9 @@ fn dds_loop(
     // the reset.
     let mut raised = std::collections::BTreeSet::new();
     while !shutdown.requested() {
+        ros.refresh();
         let mut idle = true;
-        while let Ok(Some((m, _))) = blocks.take() {
+        while let Ok(Some(m)) = blocks.take() {
             idle = false;
             match from_motion_block(&m) {
                 Ok(kind) => {
@@ -103,7 +104,7 @@ fn dds_loop(
                 }
             }
         }
-        while let Ok(Some((c, _))) = commands.take() {
+        while let Ok(Some(c)) = commands.take() {
             idle = false;
             if c.command == ProgramCommand::RESET {
                 for number in std::mem::take(&mut raised) {

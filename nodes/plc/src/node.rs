@@ -96,6 +96,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut parts = PartCounter::default();
     let mut last_spindle = None;
     while !shutdown.requested() {
+        ros.refresh();
         next += period;
         sleep_until_ns(next);
         if monotonic_ns() > next + 10 * period {

@@ -1,24 +1,20 @@
-//! recorder node shell: one undecoded DDS reader per recorded topic, each sample written as it
-//! came off the wire (encapsulation header and CDR) into the bag under
-//! `recorder.directory/<namespace>_<UTC start time>/`.
+//! recorder node shell: one undecoded subscriber per recorded topic on the machine bus, each
+//! sample written as the node published it (encapsulation header and CDR, what DDS carries)
+//! into the bag under `recorder.directory/<namespace>_<UTC start time>/`. The bag holds what
+//! the machine's nodes published, never what a foreign participant wrote on a topic of the
+//! same name (the bus is not on the network).
 
 use std::path::PathBuf;
 use std::time::Duration;
 
+use cnc_runtime::bus::RawSubscription;
 use cnc_runtime::clock::wall_ns;
 use cnc_runtime::dds::RosNode;
-use cnc_runtime::raw::{Raw, RawAdapter};
 use cnc_runtime::topics::{self, Topic};
 use cnc_runtime::{LaunchConfig, Shutdown};
-use ros2_client::dds::rustdds::{no_key::SimpleDataReader, QosPolicies};
-use ros2_client::qos::History;
 
 use crate::bag::{offered_qos, rotate, Bag, BagOptions, BagTopic};
 use crate::mcap::Compression;
-
-/// Samples a reader keeps for the recorder between two takes; the loop takes every few ms, so
-/// this only matters when the disk stalls.
-const READER_DEPTH: usize = 10_000;
 
 /// The topics of `cfg` the recorder records.
 pub fn recorded_topics(cfg: &LaunchConfig) -> Vec<Topic> {
@@ -64,24 +60,12 @@ pub fn utc_stamp(ns: u64) -> String {
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<PathBuf, String> {
     let rc = &cfg.recorder;
     let ns = cfg.machine.namespace.clone();
-    let mut ros = RosNode::new(&cfg.network, &ns, "recorder")?;
-    let participant = ros.participant();
+    let ros = RosNode::new(&cfg.network, &ns, "recorder")?;
     let recorded = recorded_topics(&cfg);
-    let mut readers: Vec<SimpleDataReader<Raw, RawAdapter>> = Vec::new();
+    let mut readers: Vec<RawSubscription> = Vec::new();
     let mut bag_topics = Vec::new();
     for t in &recorded {
-        let dds_topic = ros.dds_topic(t)?;
-        let qos: QosPolicies = (&t.qos().history(History::KeepLast {
-            depth: READER_DEPTH,
-        }))
-            .into();
-        let subscriber = participant
-            .create_subscriber(&qos)
-            .map_err(|e| format!("recorder {}: {e:?}", t.path))?;
-        let reader = subscriber
-            .create_simple_datareader_no_key::<Raw, RawAdapter>(&dds_topic, Some(qos))
-            .map_err(|e| format!("recorder {}: {e:?}", t.path))?;
-        readers.push(reader);
+        readers.push(ros.bus().raw_subscription(t)?);
         bag_topics.push(BagTopic {
             name: format!("/{ns}/{}", t.path),
             type_name: t.type_name.into(),
@@ -120,17 +104,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<PathBuf, String> {
         let stopping = shutdown.requested();
         let mut took = 0;
         for (i, reader) in readers.iter().enumerate() {
-            reader.drain_read_notifications();
-            while let Ok(Some(sample)) = reader.try_take_one() {
+            while let Ok(Some((data, published))) = reader.take() {
                 took += 1;
-                let now = wall_ns();
-                let published = sample
-                    .write_options
-                    .source_timestamp()
-                    .map(|t| ((u128::from(t.to_ticks()) * 1_000_000_000) >> 32) as u64)
-                    .unwrap_or(now);
-                let data = sample.into_value().serialized();
-                if let Err(e) = bag.record(i, now, published, &data) {
+                if let Err(e) = bag.record(i, wall_ns(), published, &data) {
                     if e != last_error {
                         log::error!("recorder: {e}");
                         last_error = e;

@@ -378,6 +378,15 @@ pub struct SimConfig {
     /// Stations of the electric turret (4, 6 or 8).
     #[serde(default = "default_turret_stations")]
     pub turret_stations: u8,
+    /// Whether allowed clients may set the simulated machine's inputs (`sim/input`: emergency
+    /// stop, forced door, stuck turret, keys). A machine whose io is real hardware has no such
+    /// topic: set false, and the bridge does not even subscribe to it.
+    #[serde(default = "default_true")]
+    pub client_inputs: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 fn default_turret_stations() -> u8 {
@@ -401,6 +410,7 @@ impl Default for SimConfig {
             at_speed_tolerance: default_at_speed(),
             coolant_delay: default_coolant_delay(),
             turret_stations: default_turret_stations(),
+            client_inputs: true,
         }
     }
 }

@@ -1,7 +1,13 @@
 //! DDS: participants on the configured interfaces and domain, the QoS profiles of DESIGN.md,
 //! and small helpers for publishers and subscriptions under the machine's namespace.
+//!
+//! A node of the machine publishes each topic on the machine bus ([`crate::bus`]) and, when the
+//! topic is public, on DDS too; it subscribes only on the bus. DDS subscriptions
+//! ([`RosNode::dds_subscription`]) are for clients outside the machine: the `cnc` client,
+//! tests, tools.
 
 use std::collections::BTreeMap;
+use std::rc::{Rc, Weak};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Duration;
@@ -13,15 +19,19 @@ use ros2_client::dds::{Context, Node};
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{Message, MessageTypeName, Name, NodeName, NodeOptions, QosProfile};
 
+use crate::bus::{self, Bus, RawPublisher};
 use crate::config::NetworkConfig;
 use crate::topics::Topic;
 
-/// A ROS 2 node of the controller with its own DDS participant.
+/// A ROS 2 node of the controller with its own DDS participant and its port on the machine bus.
 pub struct RosNode {
     pub node: Node,
     pub namespace: String,
     context: Context,
     domain: u16,
+    bus: Bus,
+    /// This node's state publishers on the bus, for [`RosNode::refresh`].
+    states: Vec<Weak<RawPublisher>>,
 }
 
 /// Creates a participant in the configured domain that uses only the configured interfaces.
@@ -54,11 +64,14 @@ impl RosNode {
             }
             Err(e) => log::warn!("{name}: no spinner: {e:?}"),
         }
+        let domain = net.effective_domain_id()?;
         Ok(RosNode {
             node,
             namespace: namespace.to_string(),
             context,
-            domain: net.effective_domain_id()?,
+            domain,
+            bus: Bus::new(&crate::shm::instance(namespace, domain), name)?,
+            states: Vec::new(),
         })
     }
 
@@ -80,9 +93,39 @@ impl RosNode {
             .map_err(|e| format!("topic {topic}: {e:?}"))
     }
 
-    /// Publisher on `/<namespace>/<topic>`; every sample it sends is counted
-    /// ([`published_count`]).
+    /// Publisher on `/<namespace>/<topic>`: on the machine bus, and on DDS when the topic is
+    /// public. Every sample it sends is counted ([`published_count`]).
     pub fn publisher<M: Message + RosMessage>(
+        &mut self,
+        topic: &Topic,
+    ) -> Result<Publisher<M>, String> {
+        let dds = match topic.internal() {
+            true => None,
+            false => self.dds_publisher(topic)?.dds,
+        };
+        let bus = Rc::new(self.bus.raw_publisher(topic)?);
+        if topic.delivery == crate::topics::Delivery::State {
+            self.states.push(Rc::downgrade(&bus));
+        }
+        Ok(Publisher {
+            dds,
+            bus: Some(bus),
+            count: counter(self.domain, &self.namespace, topic.path),
+        })
+    }
+
+    /// Hands each state this node published to bus subscribers that arrived since: a node
+    /// that starts later has every state at once, as DDS's transient-local delivery gives it.
+    /// Cheap when nobody arrived; node loops call it every turn.
+    pub fn refresh(&self) {
+        for p in self.states.iter().filter_map(Weak::upgrade) {
+            p.refresh();
+        }
+    }
+
+    /// Publisher on DDS only, for a client outside the machine (a test playing a foreign
+    /// participant, replay): the machine's nodes do not act on it.
+    pub fn dds_publisher<M: Message + RosMessage>(
         &mut self,
         topic: &Topic,
     ) -> Result<Publisher<M>, String> {
@@ -94,20 +137,36 @@ impl RosNode {
             .create_publisher::<M>(&t, Some(qos))
             .map_err(|e| format!("publisher {}: {e:?}", topic.path))?;
         Ok(Publisher {
-            inner,
+            dds: Some(inner),
+            bus: None,
             count: counter(self.domain, &self.namespace, topic.path),
         })
     }
 
+    /// What the machine's nodes publish on `topic`, from the machine bus.
     pub fn subscription<M: Message + RosMessage + 'static>(
         &mut self,
         topic: &Topic,
-    ) -> Result<ros2_client::dds::Subscription<M>, String> {
-        self.subscription_with_qos(topic, topic.qos())
+    ) -> Result<bus::Subscription<M>, String> {
+        check_type::<M>(topic)?;
+        self.bus.subscription(topic)
     }
 
-    /// A subscription with its own QoS, e.g. a deeper history than the topic's writers keep.
-    pub fn subscription_with_qos<M: Message + RosMessage + 'static>(
+    /// The machine bus of this node, for raw ports (the recorder).
+    pub fn bus(&self) -> &Bus {
+        &self.bus
+    }
+
+    /// A DDS subscription, for a client outside the machine.
+    pub fn dds_subscription<M: Message + RosMessage + 'static>(
+        &mut self,
+        topic: &Topic,
+    ) -> Result<ros2_client::dds::Subscription<M>, String> {
+        self.dds_subscription_with_qos(topic, topic.qos())
+    }
+
+    /// A DDS subscription with its own QoS, e.g. a deeper history than the topic's writers keep.
+    pub fn dds_subscription_with_qos<M: Message + RosMessage + 'static>(
         &mut self,
         topic: &Topic,
         qos: QosProfile,
@@ -146,19 +205,25 @@ fn check_type<M: RosMessage>(topic: &Topic) -> Result<(), String> {
 /// A publisher that counts what it sends, so a test can compare a recording with what the
 /// nodes published.
 pub struct Publisher<M: Message> {
-    inner: ros2_client::dds::Publisher<M>,
+    dds: Option<ros2_client::dds::Publisher<M>>,
+    bus: Option<Rc<RawPublisher>>,
     count: Arc<AtomicU64>,
 }
 
 impl<M: Message> Publisher<M> {
+    /// Sends `message` on the bus and on DDS; an error on one does not keep it from the other.
     pub fn publish(&self, message: M) -> Result<(), String> {
-        match self.inner.publish(message) {
-            Ok(()) => {
-                self.count.fetch_add(1, Ordering::Relaxed);
-                Ok(())
-            }
-            Err(e) => Err(e.to_string()),
-        }
+        let on_bus = match &self.bus {
+            Some(b) => bus::encode(&message).and_then(|d| b.send(&d, crate::clock::wall_ns())),
+            None => Ok(()),
+        };
+        let on_dds = match &self.dds {
+            Some(d) => d.publish(message).map_err(|e| e.to_string()),
+            None => Ok(()),
+        };
+        on_bus.and(on_dds)?;
+        self.count.fetch_add(1, Ordering::Relaxed);
+        Ok(())
     }
 }
 

@@ -2,6 +2,7 @@
 //! lifecycle, and the alarm reporting helper.
 
 pub mod alarms;
+pub mod bus;
 pub mod clock;
 pub mod config;
 pub mod dds;

@@ -40,7 +40,7 @@ fn err(what: &str, e: impl Debug) -> String {
 /// `iceoryx2.toml` (the usual case; its defaults are what the cell is built for) the lookup
 /// warns "No config file was loaded" on every start, which tells a user nothing. After the
 /// lookup the log level is `IOX2_LOG_LEVEL`, else iceoryx2's default (info).
-fn quiet_global_config() -> &'static iceoryx2::config::Config {
+pub(crate) fn quiet_global_config() -> &'static iceoryx2::config::Config {
     static CONFIG: std::sync::OnceLock<&'static iceoryx2::config::Config> =
         std::sync::OnceLock::new();
     CONFIG.get_or_init(|| {

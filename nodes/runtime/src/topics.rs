@@ -99,7 +99,15 @@ pub const PROGRAM_EVENTS: Topic = topic(
     "cnc_msgs/msg/ProgramEvent",
     Delivery::Events(100),
 );
+/// Inputs to the simulated machine from clients (only when the machine is simulated); the
+/// bridge checks who sent them and passes an allowed client's on [`SIM_INPUT_CHECKED`].
 pub const SIM_INPUT: Topic = topic("sim/input", "cnc_msgs/msg/SimInput", Delivery::Events(10));
+/// The simulated machine's inputs as the bridge passed them on, for the io node.
+pub const SIM_INPUT_CHECKED: Topic = topic(
+    "_internal/sim_input",
+    "cnc_msgs/msg/SimInput",
+    Delivery::Events(10),
+);
 pub const PROGRAM_COMMAND: Topic = topic(
     "_internal/program_command",
     "cnc_msgs/msg/ProgramCommand",
@@ -136,7 +144,7 @@ pub const ALL: &[Topic] = &[
     COMMAND_EVENTS,
     PROGRAM_EVENTS,
     ROBOT_HANDSHAKE,
-    SIM_INPUT,
+    SIM_INPUT_CHECKED,
     ROBOT_SIGNALS,
     PROGRAM_COMMAND,
     COMMAND_RESULT,
