@@ -19,6 +19,8 @@ const RECORDER_GRACE: std::time::Duration = std::time::Duration::from_millis(300
 
 impl Cell {
     pub fn start(cfg: &LaunchConfig) -> Result<Cell, String> {
+        // Not the panel on the network without logins: refused before anything runs.
+        cnc_hmi_bridge::web::check(&cfg.hmi)?;
         let domain = cfg.network.effective_domain_id()?;
         let inst = instance(&cfg.machine.namespace, domain);
         let shutdown = Shutdown::default();

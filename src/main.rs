@@ -94,6 +94,16 @@ enum Verb {
         #[command(subcommand)]
         action: RecordVerb,
     },
+    /// Operators who may log in to the web panel (`hmi.operators_file`, default
+    /// `operators.yaml` beside the launch config).
+    Operator {
+        #[command(subcommand)]
+        action: OperatorVerb,
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill); default:
+        /// the built-in sim_lathe.
+        #[arg(long, global = true)]
+        config: Option<PathBuf>,
+    },
     /// Tamper evidence of recordings.
     Audit {
         #[command(subcommand)]
@@ -123,6 +133,17 @@ enum RecordVerb {
     /// Repair a bag (or one .mcap file) cut off by a crash: keeps everything up to the last
     /// flushed chunk, adds the index and rewrites metadata.yaml.
     Recover { bag: PathBuf },
+}
+
+#[derive(Subcommand)]
+enum OperatorVerb {
+    /// Add an operator or change their password: the password is read from the first line of
+    /// standard input; only its salted hash is stored.
+    Set { name: String },
+    /// Remove an operator.
+    Remove { name: String },
+    /// List the operators.
+    List,
 }
 
 #[derive(Subcommand)]
@@ -250,6 +271,7 @@ fn main() -> ExitCode {
         Some(Verb::Audit {
             action: AuditVerb::Verify { bag },
         }) => audit_verify(&bag),
+        Some(Verb::Operator { action, config }) => operator(action, config.as_deref()),
         Some(Verb::Replay {
             bag,
             config,
@@ -636,4 +658,58 @@ fn print_progress(c: &CellClient, done: u32) {
         c.part_count.as_ref().map(|p| p.count).unwrap_or(0),
         done
     );
+}
+
+/// `cnc operator …`: edits the operators file of the config's web panel.
+fn operator(action: OperatorVerb, config: Option<&Path>) -> Result<(), String> {
+    use cnc_hmi_bridge::web::login::{self, OperatorsFile};
+    let (cfg, _) = machines::load(config, None)?;
+    let path = cfg
+        .hmi
+        .operators_file
+        .clone()
+        .ok_or("the launch config names no hmi.operators_file")?;
+    let mut file = match path.exists() {
+        true => OperatorsFile::load(&path)?,
+        false => OperatorsFile::default(),
+    };
+    match action {
+        OperatorVerb::List => {
+            for name in file.operators.keys() {
+                println!("{name}");
+            }
+            return Ok(());
+        }
+        OperatorVerb::Remove { name } => {
+            if file.operators.remove(&name).is_none() {
+                return Err(format!("no operator {name:?} in {}", path.display()));
+            }
+        }
+        OperatorVerb::Set { name } => {
+            if !OperatorsFile::valid_name(&name) {
+                return Err(format!(
+                    "operator name {name:?}: 1 to 32 letters, digits, '_', '-' or '.'"
+                ));
+            }
+            let mut password = String::new();
+            std::io::stdin()
+                .read_line(&mut password)
+                .map_err(|e| format!("password from standard input: {e}"))?;
+            let password = password.trim_end_matches(['\r', '\n']);
+            if password.chars().count() < 8 {
+                return Err("the password needs at least 8 characters".into());
+            }
+            let salt = login::random(16)?;
+            let hash = login::hash_password(password, &salt, login::ITERATIONS);
+            file.operators.insert(name, hash);
+        }
+    }
+    let text = serde_yaml::to_string(&file).map_err(|e| e.to_string())?;
+    cnc_runtime::persist::write_atomic(&path, &text)?;
+    // Hashes are not secrets, but nobody else needs to read them.
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600))
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("operators in {}: {}", path.display(), file.operators.len());
+    Ok(())
 }

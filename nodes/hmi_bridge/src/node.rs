@@ -76,6 +76,7 @@ impl CommandPath for Commands {
 }
 
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
+    crate::web::check(&cfg.hmi)?;
     let ns = cfg.machine.namespace.clone();
     let mut ros = RosNode::new(&cfg.network, &ns, "hmi_bridge")?;
     let mut commands = Commands {
@@ -147,6 +148,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let discovery = discovery_reader(&participant)?;
     let mut clients = Clients::default();
     let allowed = cfg.hmi.allowed_clients.clone();
+    if !allowed.iter().any(|p| p == "*") {
+        log::warn!(
+            "hmi_bridge: hmi.allowed_clients {allowed:?} are node names that clients announce \
+             on ros_discovery_info: claims, not proof (no DDS Security); keep DDS on a network \
+             only the cell reaches"
+        );
+    }
     // Every state change, in order (the bus keeps 64 per subscriber): the action follows the
     // machine through them.
     let state_sub = ros.subscription::<MachineState>(&topics::MACHINE_STATE)?;
@@ -162,7 +170,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         None
     } else {
         let axes = cfg.machine.axes.iter().map(|a| a.name.clone()).collect();
-        match WebHmi::start(&cfg.hmi.web_address, axes, cfg.diameter_axes()) {
+        match WebHmi::start(&cfg.hmi, axes, cfg.diameter_axes()) {
             Ok(w) => Some(w),
             Err(e) => {
                 log::error!("hmi_bridge: {e}; the web HMI is not served");
@@ -497,6 +505,15 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             for (who, op, pending) in web.take_operations() {
                 let (accepted, message) = perform(op, &who);
                 web.answer(pending, accepted, message);
+            }
+            for (client, operator, accepted, message) in web.take_logins() {
+                record(
+                    "web_login",
+                    &operator,
+                    &Who::Web(client),
+                    accepted,
+                    &message,
+                );
             }
         }
         while let Ok(Some(h)) = handshake_sub.take() {

@@ -38,7 +38,8 @@ function connect() {
   ws.onclose = () => {
     $("link").textContent = "offline";
     $("link").className = "off";
-    setTimeout(connect, 1000);
+    // A closed panel on the network may mean an expired session: ask again before retrying.
+    setTimeout(start, 1000);
   };
   ws.onmessage = (e) => {
     let m;
@@ -254,4 +255,36 @@ $("ladder_filter").oninput = drawLadder;
 $("acknowledge").onclick = () => send({ op: "acknowledge" });
 $("param_set").onclick = () => send({ op: "set_parameter", name: $("param_name").value, value: $("param_value").value });
 $("param_filter").oninput = showParameters;
-connect();
+
+// On the network the panel needs a login (the server says so at /session); on the machine's
+// own screen (loopback) it does not.
+async function start() {
+  let session = { required: false, operator: null };
+  try { session = await (await fetch("/session")).json(); } catch (_) { setTimeout(start, 1000); return; }
+  $("operator").hidden = !session.operator;
+  $("operator_name").textContent = session.operator || "";
+  if (session.required && !session.operator) {
+    $("login").hidden = false;
+    document.querySelector("main").hidden = true;
+    return;
+  }
+  $("login").hidden = true;
+  document.querySelector("main").hidden = false;
+  connect();
+}
+$("login").onsubmit = async (e) => {
+  e.preventDefault();
+  const r = await fetch("/login", {
+    method: "POST",
+    headers: { "Content-Type": "application/json" },
+    body: JSON.stringify({ name: $("login_name").value, password: $("login_password").value }),
+  });
+  $("login_password").value = "";
+  if (r.ok) start();
+  else $("login_message").textContent = `refused: ${await r.text()}`;
+};
+$("logout").onclick = async () => {
+  await fetch("/logout", { method: "POST" });
+  if (ws) ws.close();
+};
+start();

@@ -37,6 +37,28 @@ pub struct HmiConfig {
     /// `127.0.0.1:8080`: the machine's own panel PC, nothing off the machine.
     #[serde(default = "default_web_address")]
     pub web_address: String,
+    /// The operators who may log in to the web HMI (`cnc operator set <name>` writes it: names
+    /// and salted password hashes); default `operators.yaml` beside the config, absent means
+    /// none. Needed when `web_address` is not a loopback address: the cell refuses to serve
+    /// the panel to the network without logins.
+    #[serde(default = "default_operators_file")]
+    pub operators_file: Option<std::path::PathBuf>,
+    /// How long a web HMI login lasts, seconds (default 8 h, a shift).
+    #[serde(default = "default_session_seconds")]
+    pub session_seconds: u64,
+    /// Page origins allowed to open the panel's WebSocket and log in (`http://panel.cell:8080`).
+    /// Empty: the address the panel listens on (and `localhost` for a loopback address). A
+    /// panel on an unspecified address (`0.0.0.0`) must name them.
+    #[serde(default)]
+    pub web_origins: Vec<String>,
+}
+
+fn default_operators_file() -> Option<std::path::PathBuf> {
+    Some("operators.yaml".into())
+}
+
+fn default_session_seconds() -> u64 {
+    8 * 3600
 }
 
 fn default_web_address() -> String {
@@ -52,6 +74,9 @@ impl Default for HmiConfig {
         HmiConfig {
             allowed_clients: default_allowed(),
             web_address: default_web_address(),
+            operators_file: default_operators_file(),
+            session_seconds: default_session_seconds(),
+            web_origins: Vec::new(),
         }
     }
 }
@@ -590,6 +615,7 @@ impl LaunchConfig {
             &mut m.parameter_file,
             &mut self.plc.program,
             &mut self.plc.memory_file,
+            &mut self.hmi.operators_file,
         ];
         for file in files.into_iter().flatten() {
             if file.is_relative() {

@@ -129,7 +129,12 @@ pub const MOTION_STATUS: Topic = topic(
     Delivery::State,
 );
 
-/// Every topic of a machine.
+/// Topics the machine reads from clients on DDS (checked by the bridge, never by a node
+/// directly); the machine itself publishes nothing on them.
+pub const INPUTS: &[Topic] = &[SIM_INPUT];
+
+/// Every topic the machine's nodes publish (on the machine bus, and the public ones on DDS):
+/// what the recorder records.
 pub const ALL: &[Topic] = &[
     MACHINE_STATE,
     SPINDLE,
@@ -193,7 +198,7 @@ mod tests {
             .filter_map(|l| l.strip_prefix("pub const "))
             .filter_map(|l| l.split_once(": Topic =").map(|(name, _)| name))
             .collect();
-        assert_eq!(declared.len(), ALL.len(), "{declared:?}");
+        assert_eq!(declared.len(), ALL.len() + INPUTS.len(), "{declared:?}");
     }
 
     #[test]

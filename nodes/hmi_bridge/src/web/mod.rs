@@ -3,6 +3,7 @@
 //! keeps what the page shows. [`WebHmi`] joins them for the bridge's loop.
 
 pub mod assets;
+pub mod login;
 pub mod protocol;
 pub mod server;
 pub mod view;
@@ -27,8 +28,24 @@ pub struct Pending {
     op: Operation,
 }
 
+/// Whether the panel of `hmi` may be served as configured (see [`login::exposure`]): the cell
+/// refuses to start rather than serve the panel to the network without logins.
+pub fn check(hmi: &cnc_runtime::config::HmiConfig) -> Result<(), String> {
+    if hmi.web_address.is_empty() {
+        return Ok(());
+    }
+    let operators = match &hmi.operators_file {
+        Some(path) => login::OperatorsFile::load(path)?.operators.len(),
+        None => 0,
+    };
+    login::exposure(&hmi.web_address, operators, &hmi.web_origins)
+}
+
 pub struct WebHmi {
     server: WebServer,
+    /// Logins at the panel since the last [`WebHmi::take_logins`]: client, operator,
+    /// accepted, message.
+    logins: Vec<(String, String, bool, String)>,
     pages: BTreeMap<u64, Outbox>,
     pub view: View,
     /// Sent once to every page, and again when it changes.
@@ -37,11 +54,25 @@ pub struct WebHmi {
 }
 
 impl WebHmi {
-    pub fn start(address: &str, axes: Vec<String>, diameter: Vec<bool>) -> Result<WebHmi, String> {
-        let server = WebServer::start(address)?;
+    pub fn start(
+        hmi: &cnc_runtime::config::HmiConfig,
+        axes: Vec<String>,
+        diameter: Vec<bool>,
+    ) -> Result<WebHmi, String> {
+        let operators = match &hmi.operators_file {
+            Some(path) => login::OperatorsFile::load(path)?.operators,
+            None => BTreeMap::new(),
+        };
+        login::exposure(&hmi.web_address, operators.len(), &hmi.web_origins)?;
+        let lifetime = Duration::from_secs(hmi.session_seconds.max(1));
+        let origins = hmi.web_origins.clone();
+        let server = WebServer::start(&hmi.web_address, move |bound| {
+            login::Gate::new(bound, operators, origins, lifetime)
+        })?;
         log::info!("web HMI on http://{}/", server.address);
         Ok(WebHmi {
             server,
+            logins: Vec::new(),
             pages: BTreeMap::new(),
             view: View::new(axes, diameter),
             ladder: None,
@@ -97,6 +128,12 @@ impl WebHmi {
                 WebEvent::Closed { id } => {
                     self.pages.remove(&id);
                 }
+                WebEvent::Login {
+                    client,
+                    operator,
+                    accepted,
+                    message,
+                } => self.logins.push((client, operator, accepted, message)),
                 WebEvent::Request { id, client, text } => match protocol::parse(&text) {
                     (request, Ok(op)) => out.push((
                         Who::Web(client),
@@ -115,6 +152,11 @@ impl WebHmi {
             }
         }
         out
+    }
+
+    /// Logins since the last call (for the command events).
+    pub fn take_logins(&mut self) -> Vec<(String, String, bool, String)> {
+        std::mem::take(&mut self.logins)
     }
 
     /// Answers a page's request; reads bring their data in a frame of their own.
