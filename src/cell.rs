@@ -33,10 +33,18 @@ impl Cell {
         if cfg.recorder.enabled {
             let (c, s) = (cfg.clone(), Shutdown::default());
             let stop = s.clone();
+            let (tx, rx) = std::sync::mpsc::channel();
             let h = std::thread::Builder::new()
                 .name("recorder".into())
-                .spawn(move || cnc_recorder::node::run(c, s))
+                .spawn(move || {
+                    cnc_recorder::node::run_then(c, s, move || {
+                        let _ = tx.send(());
+                    })
+                })
                 .map_err(|e| format!("recorder: {e}"))?;
+            // The other nodes start once the recorder listens (or has failed: its error is
+            // reported by `failed_node`).
+            let _ = rx.recv_timeout(std::time::Duration::from_secs(10));
             cell.recorder = Some((stop, h));
         }
         let spawn = |name: &'static str, f: Box<dyn FnOnce() -> Result<String, String> + Send>| {

@@ -182,6 +182,11 @@ ros_message! {
         round_trip_p50_us: f64,
         round_trip_p99_us: f64,
         round_trip_max_us: f64,
+        realtime: bool,
+        wake_late_max_us: f64,
+        interpolation_max_us: f64,
+        exchange_max_us: f64,
+        worst_phase: String,
     }
 }
 

@@ -102,6 +102,15 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     // Report the power-on position before motion starts.
     let idle = ServoSetpoint::default();
     feedback.send(sim.step(&idle, &y, 0.0))?;
+    // The drives answer the servo loop every tick: real time too, just below it, once the
+    // DDS participant's threads (which must not inherit it) exist.
+    let rt = &cfg.realtime;
+    cnc_runtime::realtime::enter(
+        "io drive loop",
+        rt.io_priority,
+        rt.servo_cpu,
+        rt.lock_memory,
+    );
     while !shutdown.requested() {
         ros.refresh();
         while let Ok(Some(input)) = inputs.take() {

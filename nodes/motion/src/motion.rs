@@ -37,6 +37,12 @@ pub mod alarm {
     pub const THREAD_RUN_IN: u32 = 52;
     /// The PLC stopped sending its G image (the PLC's own alarms are 1000–1091).
     pub const PLC_SILENT: u32 = 1092;
+    /// The servo loop missed its period again and again (`servo.late_alarm_ticks` late ticks
+    /// within a second): the drive bus's cycle is not kept (`000` alarm 54, "bus
+    /// communication … timeout", inventory §11.3; decisions D57). The machine stops.
+    pub const SERVO_OVERRUN: u32 = 54;
+    /// One servo tick later than `servo.late_warning_ms`: a warning (not in the manual: D57).
+    pub const SERVO_LATE: u32 = 1093;
 }
 
 /// Something the shell must publish.
@@ -618,6 +624,12 @@ impl Motion {
 
     /// A drive fault: servo off, the run dropped, the setpoints held where the slides are
     /// (`000` §11.2: servo alarms switch the servo off).
+    /// The servo loop cannot keep its period: the servo alarm, the axes stop where they are
+    /// and the servo is switched off, as for a drive fault (D57).
+    pub fn servo_overrun(&mut self, text: String) {
+        self.drive_fault(alarm::SERVO_OVERRUN, text);
+    }
+
     fn drive_fault(&mut self, number: u32, text: String) {
         let line = self.line;
         self.raise(number, text, line);

@@ -21,7 +21,7 @@ use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::motion::alarm;
-use crate::servo::ServoStatistics;
+use crate::servo::{LateWatch, Lateness, ServoStatistics};
 use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 
 /// The PLC must answer within this time, else motion takes it as an emergency stop.
@@ -34,6 +34,8 @@ enum Input {
 
 enum Report {
     Status(MotionStatus),
+    /// A tick later than the warning limit (its interval, µs), or the warning cleared.
+    Late(Option<f64>),
     /// Commanded and actual slide positions.
     Axes([f64; MAX_AXES], [f64; MAX_AXES]),
     Alarm(u32, String, u32),
@@ -46,9 +48,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<St
     let (out_tx, out_rx) = mpsc::<Report>();
     let mcfg = MotionConfig::from_launch(&cfg);
     let servo_shutdown = shutdown.clone();
+    let timing = Timing::from_launch(&cfg);
     let servo = std::thread::Builder::new()
         .name("servo".into())
-        .spawn(move || servo_loop(mcfg, instance, in_rx, out_tx, servo_shutdown))
+        .spawn(move || servo_loop(mcfg, timing, instance, in_rx, out_tx, servo_shutdown))
         .map_err(|e| format!("servo thread: {e}"))?;
     let dds_result = dds_loop(&cfg, in_tx, out_rx, &shutdown);
     shutdown.request();
@@ -57,6 +60,25 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<St
         .map_err(|_| "servo thread panicked".to_string())?;
     dds_result?;
     servo_result
+}
+
+/// What the servo thread needs of the launch config for its timing.
+struct Timing {
+    realtime: cnc_runtime::config::RealtimeConfig,
+    /// A tick this long after the last is a warning, ns.
+    warning_ns: u64,
+    alarm_ticks: usize,
+}
+
+impl Timing {
+    fn from_launch(cfg: &LaunchConfig) -> Timing {
+        let period_ms = cfg.servo.period_ms;
+        Timing {
+            realtime: cfg.realtime.clone(),
+            warning_ns: (cfg.servo.late_warning_ms.unwrap_or(3.0 * period_ms) * 1e6) as u64,
+            alarm_ticks: cfg.servo.late_alarm_ticks as usize,
+        }
+    }
 }
 
 fn dds_loop(
@@ -116,6 +138,17 @@ fn dds_loop(
         loop {
             match from_servo.try_recv() {
                 Ok(Report::Status(s)) => publish(&status_pub, s),
+                Ok(Report::Late(Some(us))) => alarms.raise(alarms.alarm(
+                    alarm::SERVO_LATE,
+                    Alarm::SEVERITY_WARNING,
+                    &format!(
+                        "servo tick {us:.0} us after the last (period {:.0} us)",
+                        cfg.servo.period_ms * 1000.0
+                    ),
+                    "",
+                    0,
+                )),
+                Ok(Report::Late(None)) => alarms.clear(alarm::SERVO_LATE),
                 Ok(Report::Axes(commanded, actual)) => {
                     let axes = axes
                         .iter()
@@ -184,6 +217,7 @@ fn publish<M: ros2_client::Message + std::fmt::Debug>(p: &cnc_runtime::dds::Publ
 
 fn servo_loop(
     mcfg: MotionConfig,
+    timing: Timing,
     instance: String,
     inputs: Receiver<Input>,
     reports: Sender<Report>,
@@ -194,6 +228,14 @@ fn servo_loop(
     let feedback = shm.receiver::<ServoFeedback>(channel::FEEDBACK, true)?;
     let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
     let f_out = shm.sender::<FImage>(channel::F_IMAGE, false)?;
+    // After the setup, so no helper thread inherits the priority.
+    let rt = &timing.realtime;
+    let granted = cnc_runtime::realtime::enter(
+        "servo loop",
+        rt.servo_priority,
+        rt.servo_cpu,
+        rt.lock_memory,
+    );
     let n = mcfg.axes.len();
     let period_ns = (mcfg.period * 1e9) as u64;
     // Start from where the drives are. Drives (io) may come up after motion, and a loaded
@@ -215,7 +257,18 @@ fn servo_loop(
     // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
     let mut g = GImage::default();
     let mut plc = PlcLink::default();
-    let mut stats = ServoStatistics::default();
+    let mut stats = ServoStatistics {
+        realtime: granted.is_realtime(),
+        ..Default::default()
+    };
+    // One second of ticks is the window of the overrun alarm; five clear a warning.
+    let ticks_per_second = (1.0 / mcfg.period).round().max(1.0) as u64;
+    let mut watch = LateWatch::new(
+        timing.warning_ns,
+        timing.alarm_ticks,
+        ticks_per_second,
+        5 * ticks_per_second,
+    );
     let mut seq = 0u64;
     let mut last_status = None;
     let mut last_tick: Option<u64> = None;
@@ -224,12 +277,32 @@ fn servo_loop(
     while !shutdown.requested() {
         sleep_until_ns(next);
         let now = monotonic_ns();
+        let late = now > next + period_ns / 2;
+        let wake_late_us = now.saturating_sub(next) as f64 / 1000.0;
         if let Some(prev) = last_tick {
-            stats.interval.record((now - prev) as f64 / 1000.0);
+            let interval = now - prev;
+            stats.interval.record(interval as f64 / 1000.0);
+            match watch.tick(stats.ticks, interval, late) {
+                Lateness::OnTime => {}
+                Lateness::Warning(us) => {
+                    let _ = reports.send(Report::Late(Some(us)));
+                }
+                Lateness::Clear => {
+                    let _ = reports.send(Report::Late(None));
+                }
+                Lateness::Overrun(n) => motion.servo_overrun(format!(
+                    "servo loop overrun: {n} late ticks within a second ({})",
+                    if stats.realtime {
+                        "SCHED_FIFO"
+                    } else {
+                        "not real-time"
+                    }
+                )),
+            }
         }
         last_tick = Some(now);
         stats.ticks += 1;
-        if now > next + period_ns / 2 {
+        if late {
             stats.late_ticks += 1;
         }
         next += period_ns;
@@ -243,6 +316,7 @@ fn servo_loop(
                 Input::Command(ProgramCommand::CYCLE_STOP) => motion.cycle_stop(),
                 Input::Command(ProgramCommand::RESET) => {
                     motion.reset();
+                    watch.reset();
                     // A PLC still silent is reported again (its alarm was cleared by reset).
                     plc.reported = false;
                 }
@@ -275,6 +349,7 @@ fn servo_loop(
         fi.seq = seq + 1;
         f_out.send(fi)?;
         seq += 1;
+        let computed = monotonic_ns();
         setpoints.send(ServoSetpoint {
             seq,
             sent_ns: monotonic_ns(),
@@ -299,6 +374,12 @@ fn servo_loop(
                 break;
             }
         }
+        let exchanged = monotonic_ns();
+        stats.phases(
+            wake_late_us,
+            computed.saturating_sub(now) as f64 / 1000.0,
+            exchanged.saturating_sub(computed) as f64 / 1000.0,
+        );
         for e in motion.take_events() {
             let MotionEvent::Alarm { number, text, line } = e;
             let _ = reports.send(Report::Alarm(number, text, line));

@@ -81,6 +81,115 @@ pub struct ServoStatistics {
     pub round_trip: Histogram,
     pub ticks: u64,
     pub late_ticks: u64,
+    /// Whether the servo thread got `SCHED_FIFO`.
+    pub realtime: bool,
+    /// The worst of each phase, µs: waking after the deadline, interpolation, exchange.
+    pub phase_max_us: [f64; 3],
+}
+
+/// The phases of a servo tick, in [`ServoStatistics::phase_max_us`] order.
+pub const PHASES: [&str; 3] = ["wake", "interpolation", "exchange"];
+
+impl ServoStatistics {
+    /// Records one tick's phases, µs.
+    pub fn phases(&mut self, wake_late: f64, interpolation: f64, exchange: f64) {
+        for (m, v) in self
+            .phase_max_us
+            .iter_mut()
+            .zip([wake_late, interpolation, exchange])
+        {
+            *m = m.max(v);
+        }
+    }
+
+    /// The phase whose worst took the most time.
+    pub fn worst_phase(&self) -> &'static str {
+        let mut worst = 0;
+        for (i, v) in self.phase_max_us.iter().enumerate() {
+            if *v > self.phase_max_us[worst] {
+                worst = i;
+            }
+        }
+        PHASES[worst]
+    }
+}
+
+/// What the lateness watch says about a tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Lateness {
+    OnTime,
+    /// The interval before this tick exceeded the warning limit (µs): a warning alarm.
+    Warning(f64),
+    /// No tick over the limit for the clearing time: the warning goes.
+    Clear,
+    /// Too many late ticks within the window: the servo alarm, and the machine stops.
+    Overrun(usize),
+}
+
+/// Watches the tick intervals (pure: the shell passes them in). A tick is late when it comes
+/// more than half a period after its deadline; `alarm_ticks` late ticks within `window` ticks
+/// is an overrun. An interval over `warning_ns` is a warning, cleared after `clear_ticks`
+/// ticks without one.
+pub struct LateWatch {
+    warning_ns: u64,
+    alarm_ticks: usize,
+    window: u64,
+    clear_ticks: u64,
+    /// Tick numbers of the late ticks within the window (capacity `alarm_ticks`).
+    recent: std::collections::VecDeque<u64>,
+    warned_at: Option<u64>,
+    overrun: bool,
+}
+
+impl LateWatch {
+    pub fn new(warning_ns: u64, alarm_ticks: usize, window: u64, clear_ticks: u64) -> LateWatch {
+        LateWatch {
+            warning_ns,
+            alarm_ticks: alarm_ticks.max(1),
+            window,
+            clear_ticks,
+            recent: std::collections::VecDeque::with_capacity(alarm_ticks.max(1)),
+            warned_at: None,
+            overrun: false,
+        }
+    }
+
+    /// Tick number `tick`, `interval_ns` after the last, `late` when past its deadline by
+    /// more than half a period.
+    pub fn tick(&mut self, tick: u64, interval_ns: u64, late: bool) -> Lateness {
+        while self
+            .recent
+            .front()
+            .is_some_and(|t| tick.saturating_sub(*t) >= self.window)
+        {
+            self.recent.pop_front();
+        }
+        if late && !self.overrun {
+            self.recent.push_back(tick);
+            if self.recent.len() >= self.alarm_ticks {
+                // Once per reset: the alarm stops the machine; counting again starts after.
+                self.overrun = true;
+                return Lateness::Overrun(self.recent.len());
+            }
+        }
+        if interval_ns > self.warning_ns {
+            self.warned_at = Some(tick);
+            return Lateness::Warning(interval_ns as f64 / 1000.0);
+        }
+        match self.warned_at {
+            Some(t) if tick.saturating_sub(t) >= self.clear_ticks => {
+                self.warned_at = None;
+                Lateness::Clear
+            }
+            _ => Lateness::OnTime,
+        }
+    }
+
+    /// After a reset the overrun may be raised again.
+    pub fn reset(&mut self) {
+        self.overrun = false;
+        self.recent.clear();
+    }
 }
 
 impl ServoStatistics {
@@ -100,6 +209,11 @@ impl ServoStatistics {
             round_trip_p50_us: self.round_trip.quantile(0.5),
             round_trip_p99_us: self.round_trip.quantile(0.99),
             round_trip_max_us: self.round_trip.max(),
+            realtime: self.realtime,
+            wake_late_max_us: self.phase_max_us[0],
+            interpolation_max_us: self.phase_max_us[1],
+            exchange_max_us: self.phase_max_us[2],
+            worst_phase: self.worst_phase().into(),
         }
     }
 
@@ -127,7 +241,8 @@ impl ServoStatistics {
 
     pub fn summary(&self, period_us: f64) -> String {
         format!(
-            "servo loop: {} ticks of {:.0} us, {} late; interval us min/p50/p99/max {:.0}/{:.0}/{:.0}/{:.0}; iceoryx2 round trip us min/p50/p99/max {:.1}/{:.0}/{:.0}/{:.0} ({} samples)",
+            "servo loop ({}): {} ticks of {:.0} us, {} late; interval us min/p50/p99/max {:.0}/{:.0}/{:.0}/{:.0}; iceoryx2 round trip us min/p50/p99/max {:.1}/{:.0}/{:.0}/{:.0} ({} samples); worst phase us wake/interpolation/exchange {:.0}/{:.0}/{:.0} ({})",
+            if self.realtime { "SCHED_FIFO" } else { "ordinary thread" },
             self.ticks,
             period_us,
             self.late_ticks,
@@ -139,7 +254,11 @@ impl ServoStatistics {
             self.round_trip.quantile(0.5),
             self.round_trip.quantile(0.99),
             self.round_trip.max(),
-            self.round_trip.count()
+            self.round_trip.count(),
+            self.phase_max_us[0],
+            self.phase_max_us[1],
+            self.phase_max_us[2],
+            self.worst_phase()
         )
     }
 }
@@ -147,6 +266,29 @@ impl ServoStatistics {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_long_interval_warns_and_repeated_lateness_is_an_overrun() {
+        // 4 ms ticks: warn above 12 ms, overrun at 3 late ticks within 250, clear after 10.
+        let mut w = LateWatch::new(12_000_000, 3, 250, 10);
+        assert_eq!(w.tick(1, 4_000_000, false), Lateness::OnTime);
+        assert_eq!(w.tick(2, 13_000_000, true), Lateness::Warning(13_000.0));
+        for t in 3..12 {
+            assert_eq!(w.tick(t, 4_000_000, false), Lateness::OnTime, "tick {t}");
+        }
+        assert_eq!(w.tick(12, 4_000_000, false), Lateness::Clear);
+        assert_eq!(w.tick(13, 4_000_000, false), Lateness::OnTime);
+        // Late ticks far apart never add up; close together they do.
+        assert_eq!(w.tick(400, 7_000_000, true), Lateness::OnTime);
+        assert_eq!(w.tick(500, 7_000_000, true), Lateness::OnTime);
+        assert_eq!(w.tick(800, 7_000_000, true), Lateness::OnTime);
+        assert_eq!(w.tick(801, 7_000_000, true), Lateness::OnTime);
+        assert_eq!(w.tick(802, 7_000_000, true), Lateness::Overrun(3));
+        // Raised once until reset.
+        assert_eq!(w.tick(803, 7_000_000, true), Lateness::OnTime);
+        w.reset();
+        assert_eq!(w.tick(804, 7_000_000, true), Lateness::OnTime);
+    }
 
     #[test]
     fn the_histogram_counts_every_interval_once() {

@@ -95,6 +95,9 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut scan_times = ScanTimes::default();
     let mut parts = PartCounter::default();
     let mut last_spindle = None;
+    // The scan keeps the machine's I/O in time: real time below the servo and drive loops.
+    let rt = &cfg.realtime;
+    cnc_runtime::realtime::enter("PLC scan", rt.plc_priority, None, rt.lock_memory);
     while !shutdown.requested() {
         ros.refresh();
         next += period;

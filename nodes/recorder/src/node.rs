@@ -58,6 +58,17 @@ pub fn utc_stamp(ns: u64) -> String {
 
 /// Runs the recorder until shutdown; returns the bag folder it wrote.
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<PathBuf, String> {
+    run_then(cfg, shutdown, || {})
+}
+
+/// [`run`], calling `subscribed` once every topic has its subscriber on the machine bus: a
+/// node started after that loses none of its samples to the recording (the bus keeps no
+/// history for late subscribers beyond a state's last value).
+pub fn run_then(
+    cfg: LaunchConfig,
+    shutdown: Shutdown,
+    subscribed: impl FnOnce(),
+) -> Result<PathBuf, String> {
     let rc = &cfg.recorder;
     let ns = cfg.machine.namespace.clone();
     let ros = RosNode::new(&cfg.network, &ns, "recorder")?;
@@ -72,6 +83,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<PathBuf, String> {
             qos: offered_qos(t.delivery),
         });
     }
+    subscribed();
     let options = BagOptions {
         compression: compression(&rc.compression)?,
         flush_ns: rc.flush_ms * 1_000_000,

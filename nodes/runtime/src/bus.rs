@@ -22,7 +22,7 @@ use iceoryx2::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
-use crate::topics::{Delivery, Topic, MOTION_BLOCKS};
+use crate::topics::{Delivery, Topic, MOTION_BLOCKS, PROGRAM_COMMAND};
 
 /// Ports of one service: the nodes of a machine and the recorder, with room for a node that
 /// restarts before its old ports are cleaned up.
@@ -43,8 +43,20 @@ pub fn depth(topic: &Topic) -> usize {
         Delivery::State => 64,
         Delivery::Events(n) => n.max(16),
         Delivery::Commands if topic.path == MOTION_BLOCKS.path => 1024,
-        // Program texts travel here (up to 4 MiB): few, to bound the shared memory.
+        // Program texts travel here (up to 4 MiB; the bridge repeats a command until it is
+        // answered): few, since every sample slot of a publisher grows to the largest sample.
+        Delivery::Commands if topic.path == PROGRAM_COMMAND.path => 4,
         Delivery::Commands => 16,
+    }
+}
+
+/// Ports of `topic`'s service: the program command stream has two writers (bridge,
+/// interpreter) and three readers (interpreter, motion, recorder), and few ports keep its
+/// shared memory small when a large program passes.
+fn ports(topic: &Topic) -> usize {
+    match topic.path == PROGRAM_COMMAND.path {
+        true => 4,
+        false => MAX_PORTS,
     }
 }
 
@@ -92,9 +104,9 @@ impl Bus {
             .user_header::<u64>()
             .subscriber_max_buffer_size(depth(topic))
             .history_size(history)
-            .max_publishers(MAX_PORTS)
-            .max_subscribers(MAX_PORTS)
-            .max_nodes(2 * MAX_PORTS)
+            .max_publishers(ports(topic))
+            .max_subscribers(ports(topic))
+            .max_nodes(2 * ports(topic))
             .open_or_create()
             .map_err(|e| err(topic.path, e))
     }

@@ -22,6 +22,51 @@ pub struct LaunchConfig {
     pub recorder: RecorderConfig,
     #[serde(default)]
     pub hmi: HmiConfig,
+    #[serde(default)]
+    pub realtime: RealtimeConfig,
+}
+
+/// Real-time treatment of the loops that keep the machine's time ([`crate::realtime`]).
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RealtimeConfig {
+    /// `SCHED_FIFO` priority of the servo loop (1–99; 0: an ordinary thread). Default 80.
+    #[serde(default = "default_servo_priority")]
+    pub servo_priority: i32,
+    /// Of the io node's drive loop, which answers the servo loop each tick. Default 79.
+    #[serde(default = "default_io_priority")]
+    pub io_priority: i32,
+    /// Of the PLC scan. Default 70.
+    #[serde(default = "default_plc_priority")]
+    pub plc_priority: i32,
+    /// Lock the process's memory (`mlockall`) so no page fault stalls a tick. Default true.
+    #[serde(default = "default_true")]
+    pub lock_memory: bool,
+    /// CPU for the servo and io loops (an isolated core: `isolcpus=`); default: any.
+    #[serde(default)]
+    pub servo_cpu: Option<usize>,
+}
+
+fn default_servo_priority() -> i32 {
+    80
+}
+fn default_io_priority() -> i32 {
+    79
+}
+fn default_plc_priority() -> i32 {
+    70
+}
+
+impl Default for RealtimeConfig {
+    fn default() -> Self {
+        RealtimeConfig {
+            servo_priority: default_servo_priority(),
+            io_priority: default_io_priority(),
+            plc_priority: default_plc_priority(),
+            lock_memory: true,
+            servo_cpu: None,
+        }
+    }
 }
 
 /// Who may command the machine from outside.
@@ -344,6 +389,17 @@ pub struct ServoConfig {
     /// Feed of every feed move under dry run, mm/min (`000` S#45, default 1000).
     #[serde(default = "default_dry_run_feed")]
     pub dry_run_feed: f64,
+    /// A servo tick this long after the last (ms) is a warning alarm. Default 3 periods.
+    #[serde(default)]
+    pub late_warning_ms: Option<f64>,
+    /// This many late ticks (more than half a period late) within one second is the servo
+    /// alarm, and the machine stops (decisions D57). Default 50.
+    #[serde(default = "default_late_alarm_ticks")]
+    pub late_alarm_ticks: u32,
+}
+
+fn default_late_alarm_ticks() -> u32 {
+    50
 }
 
 fn default_feedback_lost() -> u32 {
@@ -387,6 +443,8 @@ impl Default for ServoConfig {
             profile: ProfileShape::default(),
             feedback_lost_ticks: default_feedback_lost(),
             dry_run_feed: default_dry_run_feed(),
+            late_warning_ms: None,
+            late_alarm_ticks: default_late_alarm_ticks(),
         }
     }
 }
@@ -690,6 +748,24 @@ impl LaunchConfig {
             return Err(format!(
                 "machine.namespace {ns:?}: letters, digits and _ only, not starting with a digit"
             ));
+        }
+        let rt = &self.realtime;
+        for (name, p) in [
+            ("servo_priority", rt.servo_priority),
+            ("io_priority", rt.io_priority),
+            ("plc_priority", rt.plc_priority),
+        ] {
+            if !(0..=99).contains(&p) {
+                return Err(format!("realtime.{name} {p}: 0 (off) to 99"));
+            }
+        }
+        if self.servo.late_alarm_ticks == 0 {
+            return Err("servo.late_alarm_ticks must be at least 1".into());
+        }
+        if let Some(w) = self.servo.late_warning_ms {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(format!("servo.late_warning_ms {w}: a time above 0"));
+            }
         }
         let r = &self.recorder;
         if !["zstd", "lz4", "none"].contains(&r.compression.as_str()) {

@@ -10,6 +10,7 @@ pub mod lifecycle;
 pub mod parameters;
 pub mod persist;
 pub mod raw;
+pub mod realtime;
 pub mod shm;
 pub mod tool_table;
 pub mod topics;
