@@ -71,7 +71,7 @@ fn run_exits_zero_after_its_cycles() {
     );
     assert!(out.contains("cycles done 2"), "{out}");
     assert!(
-        out.contains("servo loop:") && out.contains("round trip"),
+        out.contains("servo loop (") && out.contains("round trip"),
         "no servo statistics at exit:\n{out}"
     );
 }

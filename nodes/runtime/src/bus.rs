@@ -2,7 +2,8 @@
 //! never over DDS. DDS carries only what the machine shows and offers the cell (the public
 //! topics, services and action); what a node *acts on* comes from the bus or from a service
 //! that checked who asked. So a participant on the domain can read the machine's state but
-//! cannot feed a node a block, a command, an override, an alarm or a position (issue 25).
+//! cannot feed a node a block, a command, an override, an alarm or a position (issue 25,
+//! decisions D58).
 //!
 //! A sample is the message's CDR bytes with the 4-byte encapsulation header, exactly what
 //! DDS would carry, so the recorder writes bus samples into the bag unchanged. The user header

@@ -393,7 +393,7 @@ pub struct ServoConfig {
     #[serde(default)]
     pub late_warning_ms: Option<f64>,
     /// This many late ticks (more than half a period late) within one second is the servo
-    /// alarm, and the machine stops (decisions D57). Default 50.
+    /// alarm, and the machine stops ([D57](docs/decisions.md)). Default 50.
     #[serde(default = "default_late_alarm_ticks")]
     pub late_alarm_ticks: u32,
 }
