@@ -2,7 +2,9 @@
 //! with them, no WebSocket without a session, wrong passwords are refused and recorded, a
 //! foreign Origin is refused (also one whose Host header agrees with it: DNS rebinding),
 //! commands carry the operator's name into the command events, sessions expire, and 40 slow
-//! clients on another host do not lock the operator out.
+//! clients on another host do not lock the operator out. The login is also done in headless
+//! chromium (`tests/hmi/login.cjs`): a login form first, then the panel under the operator's
+//! name.
 //!
 //! Runs inside the network namespace of `scripts/test.sh` (it refuses to run outside one), to
 //! which it adds two addresses on `lo`: 10.99.25.1 (the panel, and the operator's side) and
@@ -131,7 +133,7 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
     let mut cfg = common::sim_lathe(62);
     cfg.hmi.web_address = PANEL.into();
     cfg.hmi.operators_file = Some(operators.clone());
-    cfg.hmi.session_seconds = 4;
+    cfg.hmi.session_seconds = 8;
     cfg.hmi.allowed_clients = vec!["web:anna@*".into()];
 
     // 1. No operators: the cell does not start.
@@ -237,7 +239,24 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
         "{session}"
     );
 
-    // 4. No WebSocket without a session; logins checked; origins are the panel's own.
+    // 4. The same in a real browser: a login form, then the panel under the operator's name.
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let playwright = root.join("target/npm/node_modules/playwright-core");
+    let out = std::process::Command::new("node")
+        .arg(root.join("tests/hmi/login.cjs"))
+        .args([&format!("{ORIGIN}/"), "anna", PASSWORD])
+        .env("PLAYWRIGHT_CORE", &playwright)
+        .output()
+        .expect("node runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}");
+    assert!(
+        out.status.success(),
+        "browser login failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    // 5. No WebSocket without a session; logins checked; origins are the panel's own.
     assert!(upgrade(None, ORIGIN).starts_with("HTTP/1.1 401"));
     assert!(upgrade(Some("forged"), ORIGIN).starts_with("HTTP/1.1 401"));
     let wrong = login("anna", "wrong password", ORIGIN);
@@ -253,7 +272,7 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
         .to_string();
     assert!(upgrade(Some(&token), "http://evil.example:18125").starts_with("HTTP/1.1 403"));
 
-    // 5. A command carries the operator's name.
+    // 6. A command carries the operator's name.
     let mut ws = open_ws(&token);
     let request =
         serde_json::json!({"id": 1, "op": "overrides", "feed": 100, "spindle": 100, "rapid": 100});
@@ -262,9 +281,9 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
     let reply = next_of(&mut ws, "reply", Instant::now() + Duration::from_secs(10)).expect("reply");
     assert_eq!(reply["accepted"], true, "{reply}");
 
-    // 6. The session expires (4 s here): the panel closes the socket, and the cookie opens no
+    // 7. The session expires (8 s here): the panel closes the socket, and the cookie opens no
     // other.
-    let closed = next_of(&mut ws, "never", Instant::now() + Duration::from_secs(15));
+    let closed = next_of(&mut ws, "never", Instant::now() + Duration::from_secs(20));
     assert!(closed.is_none());
     assert!(upgrade(Some(&token), ORIGIN).starts_with("HTTP/1.1 401"));
     for h in slow {
@@ -284,6 +303,12 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
     assert!(has("web_login", "web@10.99.25.1", true), "{seen:?}");
     assert!(
         has("set_overrides", "web:anna@10.99.25.1", true),
+        "{seen:?}"
+    );
+    // The browser's button press, under the operator's name.
+    assert!(
+        seen.iter()
+            .any(|(c, _, who, _)| c == "stop" && who == "web:anna@10.99.25.1"),
         "{seen:?}"
     );
     let (_, errors) = cell.stop();

@@ -264,8 +264,8 @@ async function start() {
   $("operator").hidden = !session.operator;
   $("operator_name").textContent = session.operator || "";
   if (session.required && !session.operator) {
-    $("login").hidden = false;
     document.querySelector("main").hidden = true;
+    $("login").hidden = false;
     return;
   }
   $("login").hidden = true;

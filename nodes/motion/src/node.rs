@@ -209,7 +209,10 @@ impl PlcLink {
     }
 }
 
-fn publish<M: ros2_client::Message + std::fmt::Debug>(p: &cnc_runtime::dds::Publisher<M>, m: M) {
+fn publish<M: ros2_client::Message + std::fmt::Debug + Send + Sync + 'static>(
+    p: &cnc_runtime::dds::Publisher<M>,
+    m: M,
+) {
     if let Err(e) = p.publish(m) {
         log::warn!("motion: publish failed: {e:?}");
     }

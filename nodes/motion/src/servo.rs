@@ -173,8 +173,13 @@ impl LateWatch {
             }
         }
         if interval_ns > self.warning_ns {
+            // Raised once; later long intervals keep it up.
+            let first = self.warned_at.is_none();
             self.warned_at = Some(tick);
-            return Lateness::Warning(interval_ns as f64 / 1000.0);
+            return match first {
+                true => Lateness::Warning(interval_ns as f64 / 1000.0),
+                false => Lateness::OnTime,
+            };
         }
         match self.warned_at {
             Some(t) if tick.saturating_sub(t) >= self.clear_ticks => {
@@ -273,11 +278,13 @@ mod tests {
         let mut w = LateWatch::new(12_000_000, 3, 250, 10);
         assert_eq!(w.tick(1, 4_000_000, false), Lateness::OnTime);
         assert_eq!(w.tick(2, 13_000_000, true), Lateness::Warning(13_000.0));
-        for t in 3..12 {
+        // Another long interval keeps the warning up without raising it again.
+        assert_eq!(w.tick(3, 14_000_000, true), Lateness::OnTime);
+        for t in 4..13 {
             assert_eq!(w.tick(t, 4_000_000, false), Lateness::OnTime, "tick {t}");
         }
-        assert_eq!(w.tick(12, 4_000_000, false), Lateness::Clear);
-        assert_eq!(w.tick(13, 4_000_000, false), Lateness::OnTime);
+        assert_eq!(w.tick(13, 4_000_000, false), Lateness::Clear);
+        assert_eq!(w.tick(14, 4_000_000, false), Lateness::OnTime);
         // Late ticks far apart never add up; close together they do.
         assert_eq!(w.tick(400, 7_000_000, true), Lateness::OnTime);
         assert_eq!(w.tick(500, 7_000_000, true), Lateness::OnTime);

@@ -71,6 +71,8 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut program_mtime = program_path.as_deref().and_then(modified);
 
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "plc")?;
+    // The scan runs in real time: its DDS writes go through a relay thread.
+    ros.relay_dds("plc")?;
     let spindle_pub = ros.publisher::<SpindleState>(&topics::SPINDLE)?;
     let parts_pub = ros.publisher::<PartCount>(&topics::PART_COUNT)?;
     let status_pub = ros.publisher::<PlcStatus>(&topics::PLC_STATUS)?;

@@ -9,6 +9,7 @@
 use std::collections::BTreeMap;
 use std::rc::{Rc, Weak};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::Sender;
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Duration;
 
@@ -32,7 +33,12 @@ pub struct RosNode {
     bus: Bus,
     /// This node's state publishers on the bus, for [`RosNode::refresh`].
     states: Vec<Weak<RawPublisher>>,
+    /// Where DDS writes go when a real-time loop publishes ([`RosNode::relay_dds`]).
+    relay: Option<Sender<Job>>,
 }
+
+/// A DDS write handed to the relay thread.
+type Job = Box<dyn FnOnce() + Send>;
 
 /// Creates a participant in the configured domain that uses only the configured interfaces.
 /// ros2-client's `Context::new()` would always join domain 0 on every interface.
@@ -72,6 +78,7 @@ impl RosNode {
             domain,
             bus: Bus::new(&crate::shm::instance(namespace, domain), name)?,
             states: Vec::new(),
+            relay: None,
         })
     }
 
@@ -103,15 +110,35 @@ impl RosNode {
             true => None,
             false => self.dds_publisher(topic)?.dds,
         };
+        let relay = self.relay.clone();
         let bus = Rc::new(self.bus.raw_publisher(topic)?);
         if topic.delivery == crate::topics::Delivery::State {
             self.states.push(Rc::downgrade(&bus));
         }
         Ok(Publisher {
             dds,
+            relay,
             bus: Some(bus),
             count: counter(self.domain, &self.namespace, topic.path),
         })
+    }
+
+    /// From now on, publishers made by this node hand their DDS writes to a thread of their
+    /// own (started here, so before the caller raises its priority): a real-time loop (the PLC
+    /// scan) then never waits on DDS's locks, which DDS's ordinary threads hold. The bus
+    /// sample still goes out at once, and DDS writes keep their order.
+    pub fn relay_dds(&mut self, name: &str) -> Result<(), String> {
+        let (tx, rx) = std::sync::mpsc::channel::<Job>();
+        std::thread::Builder::new()
+            .name(format!("{name}-dds"))
+            .spawn(move || {
+                while let Ok(job) = rx.recv() {
+                    job();
+                }
+            })
+            .map_err(|e| format!("{name}: DDS relay thread: {e}"))?;
+        self.relay = Some(tx);
+        Ok(())
     }
 
     /// Hands each state this node published to bus subscribers that arrived since: a node
@@ -137,7 +164,8 @@ impl RosNode {
             .create_publisher::<M>(&t, Some(qos))
             .map_err(|e| format!("publisher {}: {e:?}", topic.path))?;
         Ok(Publisher {
-            dds: Some(inner),
+            dds: Some(Arc::new(inner)),
+            relay: None,
             bus: None,
             count: counter(self.domain, &self.namespace, topic.path),
         })
@@ -205,21 +233,32 @@ fn check_type<M: RosMessage>(topic: &Topic) -> Result<(), String> {
 /// A publisher that counts what it sends, so a test can compare a recording with what the
 /// nodes published.
 pub struct Publisher<M: Message> {
-    dds: Option<ros2_client::dds::Publisher<M>>,
+    dds: Option<Arc<ros2_client::dds::Publisher<M>>>,
+    relay: Option<Sender<Job>>,
     bus: Option<Rc<RawPublisher>>,
     count: Arc<AtomicU64>,
 }
 
-impl<M: Message> Publisher<M> {
+impl<M: Message + Send + Sync + 'static> Publisher<M> {
     /// Sends `message` on the bus and on DDS; an error on one does not keep it from the other.
     pub fn publish(&self, message: M) -> Result<(), String> {
         let on_bus = match &self.bus {
             Some(b) => bus::encode(&message).and_then(|d| b.send(&d, crate::clock::wall_ns())),
             None => Ok(()),
         };
-        let on_dds = match &self.dds {
-            Some(d) => d.publish(message).map_err(|e| e.to_string()),
-            None => Ok(()),
+        let on_dds = match (&self.dds, &self.relay) {
+            (Some(d), Some(relay)) => {
+                let d = d.clone();
+                relay
+                    .send(Box::new(move || {
+                        if let Err(e) = d.publish(message) {
+                            log::warn!("DDS write: {e}");
+                        }
+                    }))
+                    .map_err(|_| "DDS relay thread gone".to_string())
+            }
+            (Some(d), None) => d.publish(message).map_err(|e| e.to_string()),
+            (None, _) => Ok(()),
         };
         on_bus.and(on_dds)?;
         self.count.fetch_add(1, Ordering::Relaxed);
