@@ -1,8 +1,8 @@
 //! io node shell: steps the simulated lathe once per servo setpoint and answers with feedback.
 //!
 //! The simulated machine's time advances one servo period per setpoint, so it runs exactly as
-//! fast as motion drives it. Emergency stop, robot signals, panel keys and faults come from
-//! DDS (`/<ns>/sim/input`).
+//! fast as motion drives it. Emergency stop, robot signals, panel keys and faults come over the
+//! machine bus, from the bridge, which took them from allowed clients on `/<ns>/sim/input`.
 
 use std::time::Duration;
 
