@@ -4,7 +4,7 @@ use cnc_runtime::LaunchConfig;
 
 /// `launch_configs/sim_lathe.yaml` in DDS `domain` (one per test, so tests never hear each
 /// other), with no kept memory (part count and variables start empty) and no parameter file and no recorder
-/// (`tests/recording.rs` tests that).
+/// (`tests/recording.rs` tests that), and no alarms for servo lateness.
 pub fn sim_lathe(domain: u16) -> LaunchConfig {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/launch_configs/sim_lathe.yaml");
     let text = std::fs::read_to_string(path).expect("sim_lathe.yaml");
@@ -15,6 +15,11 @@ pub fn sim_lathe(domain: u16) -> LaunchConfig {
     cfg.machine.parameter_file = None;
     cfg.recorder.enabled = false;
     cfg.hmi.web_address = String::new();
+    // Timing is not what the cell tests test: on a busy machine a late servo tick must not
+    // raise the lateness warning or the overrun alarm (`tests/realtime.rs` and the unit
+    // tests of `LateWatch` test those).
+    cfg.servo.late_warning_ms = Some(60_000.0);
+    cfg.servo.late_alarm_ticks = u32::MAX;
     cfg
 }
 

@@ -148,7 +148,10 @@ impl LateWatch {
             alarm_ticks: alarm_ticks.max(1),
             window,
             clear_ticks,
-            recent: std::collections::VecDeque::with_capacity(alarm_ticks.max(1)),
+            // No more late ticks than ticks fit in the window.
+            recent: std::collections::VecDeque::with_capacity(
+                alarm_ticks.max(1).min(window.max(1) as usize),
+            ),
             warned_at: None,
             overrun: false,
         }

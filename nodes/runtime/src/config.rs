@@ -393,13 +393,14 @@ pub struct ServoConfig {
     #[serde(default)]
     pub late_warning_ms: Option<f64>,
     /// This many late ticks (more than half a period late) within one second is the servo
-    /// alarm, and the machine stops ([D57](docs/decisions.md)). Default 50.
+    /// alarm, and the machine stops ([D57](docs/decisions.md)). Default 125: half the ticks
+    /// of a second.
     #[serde(default = "default_late_alarm_ticks")]
     pub late_alarm_ticks: u32,
 }
 
 fn default_late_alarm_ticks() -> u32 {
-    50
+    125
 }
 
 fn default_feedback_lost() -> u32 {
