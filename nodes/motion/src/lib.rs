@@ -3,11 +3,14 @@
 //! A block's path: [`block`] (what arrives) → [`motion`] (queue, limits, handshake) →
 //! [`planner`] (look-ahead window, corner blends) → [`profile`] (speed this tick) →
 //! [`path`] (the point on the path) → setpoint; threads go through [`thread`], locked to the
-//! spindle encoder instead. [`servo`] measures the loop;
+//! spindle encoder ([`encoder`]) instead; [`alarm`] is motion's alarm table. [`servo`]
+//! measures the loop;
 //! [`node`] runs it on its own thread against iceoryx2.
 
+pub mod alarm;
 pub mod block;
 pub mod config;
+mod encoder;
 pub mod motion;
 pub mod node;
 pub mod path;

@@ -12,38 +12,13 @@ use cnc_msgs::signals::{f, g, FImage, GImage, SignalTable};
 
 use crate::block::{Aux, Block, Command};
 use crate::config::MotionConfig;
+use crate::encoder::Encoder;
 use crate::path::{self, Point, Segment, MAX_AXES};
 use crate::planner::{Done, Planner};
 use crate::profile::{Ahead, Limits, Mover};
 use crate::thread::{Piece, ThreadChain};
 
-/// Alarm numbers raised by motion (`000` Appendix 1, inventory §11.2).
-pub mod alarm {
-    pub const SOFT_LIMIT: u32 = 38;
-    /// The block stream from the interpreter is out of step: queue overflow, a block with the
-    /// wrong number of axes, or one that could not run (`000` alarm 111, pre-read/execution sync).
-    pub const BAD_BLOCK: u32 = 111;
-    /// Feed per revolution or threading with the spindle stopped (`000` alarm 36).
-    pub const SPINDLE_NOT_TURNING: u32 = 36;
-    /// A slide lags its setpoint by more than its following-error limit: the servo alarm of
-    /// that axis (`000` alarm 69, "bus servo alarm on physical axis #", inventory §11.3).
-    pub const FOLLOWING_ERROR: u32 = 69;
-    /// No feedback from the drives for `servo.feedback_lost_ticks` ticks: the drive link
-    /// is down (`000` alarm 68, "bus communication line error", inventory §11.3).
-    pub const FEEDBACK_LOST: u32 = 68;
-    /// A thread the axes cannot follow at the spindle's speed: too short for the run-in and
-    /// run-out, or faster than an axis may move (`000` alarm 52, "thread acceleration length
-    /// insufficient").
-    pub const THREAD_RUN_IN: u32 = 52;
-    /// The PLC stopped sending its G image (the PLC's own alarms are 1000–1091).
-    pub const PLC_SILENT: u32 = 1092;
-    /// The servo loop missed its period again and again (`servo.late_alarm_ticks` late ticks
-    /// within a second): the drive bus's cycle is not kept (`000` alarm 54, "bus
-    /// communication … timeout", inventory §11.3; decisions D57). The machine stops.
-    pub const SERVO_OVERRUN: u32 = 54;
-    /// One servo tick later than `servo.late_warning_ms`: a warning (not in the manual: D57).
-    pub const SERVO_LATE: u32 = 1093;
-}
+pub use crate::alarm;
 
 /// Something the shell must publish.
 #[derive(Debug, Clone, PartialEq)]
@@ -206,46 +181,6 @@ struct Merged {
     blocks: usize,
     /// Largest distance of a programmed point from the chord, mm.
     deviation: f64,
-}
-
-/// The spindle as its encoder reports it.
-#[derive(Debug, Clone, Copy, Default)]
-struct Encoder {
-    rpm: f64,
-    /// Degrees after the index pulse, counted in the direction of rotation.
-    angle: f64,
-    /// Revolutions turned since start-up, in either direction.
-    revs: f64,
-    /// Last raw angle and direction (+1 CW, −1 CCW).
-    raw: Option<f64>,
-    direction: f64,
-}
-
-impl Encoder {
-    /// Takes in one reading. Between two readings the spindle turns less than half a
-    /// revolution (7500 rpm at 4 ms).
-    fn read(&mut self, rpm: f64, raw_angle: f64) {
-        if !rpm.is_finite() || !raw_angle.is_finite() {
-            return;
-        }
-        if rpm != 0.0 {
-            self.direction = rpm.signum();
-        } else if self.direction == 0.0 {
-            self.direction = 1.0;
-        }
-        if let Some(prev) = self.raw {
-            let delta = (raw_angle - prev + 180.0).rem_euclid(360.0) - 180.0;
-            self.revs += delta * self.direction / 360.0;
-        }
-        self.raw = Some(raw_angle);
-        self.rpm = rpm;
-        self.angle = (raw_angle * self.direction).rem_euclid(360.0);
-    }
-
-    /// Revolutions per second, whatever the direction.
-    fn omega(&self) -> f64 {
-        self.rpm.abs() / 60.0
-    }
 }
 
 impl Motion {

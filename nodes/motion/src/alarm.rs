@@ -1,0 +1,27 @@
+//! Alarm numbers raised by motion (`000` Appendix 1, inventory §11.2): one table, so a number
+//! is chosen once and the shell and the core raise the same.
+
+pub const SOFT_LIMIT: u32 = 38;
+/// The block stream from the interpreter is out of step: queue overflow, a block with the
+/// wrong number of axes, or one that could not run (`000` alarm 111, pre-read/execution sync).
+pub const BAD_BLOCK: u32 = 111;
+/// Feed per revolution or threading with the spindle stopped (`000` alarm 36).
+pub const SPINDLE_NOT_TURNING: u32 = 36;
+/// A slide lags its setpoint by more than its following-error limit: the servo alarm of
+/// that axis (`000` alarm 69, "bus servo alarm on physical axis #", inventory §11.3).
+pub const FOLLOWING_ERROR: u32 = 69;
+/// No feedback from the drives for `servo.feedback_lost_ticks` ticks: the drive link
+/// is down (`000` alarm 68, "bus communication line error", inventory §11.3).
+pub const FEEDBACK_LOST: u32 = 68;
+/// A thread the axes cannot follow at the spindle's speed: too short for the run-in and
+/// run-out, or faster than an axis may move (`000` alarm 52, "thread acceleration length
+/// insufficient").
+pub const THREAD_RUN_IN: u32 = 52;
+/// The PLC stopped sending its G image (the PLC's own alarms are 1000–1091).
+pub const PLC_SILENT: u32 = 1092;
+/// The servo loop missed its period again and again (`servo.late_alarm_ticks` late ticks
+/// within a second): the drive bus's cycle is not kept (`000` alarm 54, "bus
+/// communication … timeout", inventory §11.3; decisions D57). The machine stops.
+pub const SERVO_OVERRUN: u32 = 54;
+/// One servo tick later than `servo.late_warning_ms`: a warning (not in the manual: D57).
+pub const SERVO_LATE: u32 = 1093;
