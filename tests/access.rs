@@ -12,8 +12,6 @@ use cnc_msgs::msg::{CommandEvent, MachineState};
 use cnc_msgs::srv::StartProgramResponse;
 use cnc_runtime::dds::RosNode;
 use cnc_runtime::raw::{Raw, RawAdapter};
-use cnc_runtime::topics;
-use ros2_client::qos::History;
 use ros2_client::ServiceMapping;
 
 const PROGRAM: &str = "O0001\nG00 X60 Z5\nG01 X50 Z0 F900\nM30\n";
@@ -23,15 +21,7 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     let mut cfg = common::sim_lathe(52);
     cfg.hmi.allowed_clients = vec!["/lathe1/supervisor_ok".into()];
     let cell = Cell::start(&cfg).unwrap();
-    let mut auditor = RosNode::new(&cfg.network, "lathe1", "auditor").unwrap();
-    let events = auditor
-        .dds_subscription_with_qos::<CommandEvent>(
-            &topics::COMMAND_EVENTS,
-            topics::COMMAND_EVENTS
-                .qos()
-                .history(History::KeepLast { depth: 100 }),
-        )
-        .unwrap();
+    let mut auditor = common::Auditor::new(&cfg);
     let mut good = CellClient::new(
         &cfg.network,
         "lathe1",
@@ -102,7 +92,7 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
         "{}",
         r.message
     );
-    let r = start_with_raw_bytes(&mut auditor, &[4, 0, 0, 0, 0xff, 0xfe, b'A', 0]);
+    let r = start_with_raw_bytes(&mut auditor.node, &[4, 0, 0, 0, 0xff, 0xfe, b'A', 0]);
     assert!(
         !r.accepted && r.message.contains("malformed"),
         "{}",
@@ -182,10 +172,7 @@ fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     );
 
     std::thread::sleep(Duration::from_millis(300));
-    let mut seen: Vec<CommandEvent> = Vec::new();
-    while let Ok(Some((e, _))) = events.take() {
-        seen.push(e);
-    }
+    let seen: Vec<CommandEvent> = auditor.events();
     let find = |command: &str, client: &str, accepted: bool| {
         seen.iter()
             .any(|e| e.command == command && e.client == client && e.accepted == accepted)

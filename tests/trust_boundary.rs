@@ -14,10 +14,7 @@ use std::time::{Duration, Instant};
 
 use cnc::cell::Cell;
 use cnc::client::CellClient;
-use cnc_msgs::msg::{CommandEvent, MachineState};
-use cnc_runtime::dds::RosNode;
-use cnc_runtime::topics;
-use ros2_client::qos::History;
+use cnc_msgs::msg::MachineState;
 use ros2_client::ServiceMapping;
 
 const PART: &str = "O0001\nG00 X60 Z5\nS800 M03\nG01 X50 Z0 F900\nZ-10\nG00 X60\nM05\nM30\n";
@@ -28,15 +25,7 @@ fn a_foreign_participant_neither_runs_nor_moves_the_machine() {
     let mut cfg = common::sim_lathe(domain);
     cfg.hmi.allowed_clients = vec!["/lathe1/supervisor".into()];
     let cell = Cell::start(&cfg).unwrap();
-    let mut auditor = RosNode::new(&cfg.network, "lathe1", "auditor").unwrap();
-    let events = auditor
-        .dds_subscription_with_qos::<CommandEvent>(
-            &topics::COMMAND_EVENTS,
-            topics::COMMAND_EVENTS
-                .qos()
-                .history(History::KeepLast { depth: 1000 }),
-        )
-        .unwrap();
+    let auditor = common::Auditor::new(&cfg);
     let mut supervisor = CellClient::new(
         &cfg.network,
         "lathe1",
@@ -98,10 +87,7 @@ fn a_foreign_participant_neither_runs_nor_moves_the_machine() {
 
     // Every refusal is a command event naming the intruder by its GUID.
     std::thread::sleep(Duration::from_millis(500));
-    let mut seen = Vec::new();
-    while let Ok(Some((e, _))) = events.take() {
-        seen.push(e);
-    }
+    let seen = auditor.events();
     let refused = |command: &str| {
         seen.iter()
             .filter(|e| e.command == command && !e.accepted && e.client.starts_with("guid:"))

@@ -17,10 +17,6 @@ use std::net::{SocketAddr, TcpStream};
 use std::time::{Duration, Instant};
 
 use cnc::cell::Cell;
-use cnc_msgs::msg::CommandEvent;
-use cnc_runtime::dds::RosNode;
-use cnc_runtime::topics;
-use ros2_client::qos::History;
 use tungstenite::client::IntoClientRequest;
 
 const PANEL: &str = "10.99.25.1:18125";
@@ -186,15 +182,7 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
     );
 
     let cell = Cell::start(&cfg).unwrap();
-    let mut auditor = RosNode::new(&cfg.network, "lathe1", "auditor").unwrap();
-    let events = auditor
-        .dds_subscription_with_qos::<CommandEvent>(
-            &topics::COMMAND_EVENTS,
-            topics::COMMAND_EVENTS
-                .qos()
-                .history(History::KeepLast { depth: 100 }),
-        )
-        .unwrap();
+    let auditor = common::Auditor::new(&cfg);
     let t0 = Instant::now();
     while try_connect_from("10.99.25.1").is_err() {
         assert!(t0.elapsed() < Duration::from_secs(30), "panel never up");
@@ -291,10 +279,11 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
     }
 
     std::thread::sleep(Duration::from_millis(500));
-    let mut seen = Vec::new();
-    while let Ok(Some((e, _))) = events.take() {
-        seen.push((e.command, e.detail, e.client, e.accepted));
-    }
+    let seen: Vec<_> = auditor
+        .events()
+        .into_iter()
+        .map(|e| (e.command, e.detail, e.client, e.accepted))
+        .collect();
     let has = |command: &str, client: &str, accepted: bool| {
         seen.iter()
             .any(|(c, _, who, a)| c == command && who == client && *a == accepted)

@@ -44,3 +44,35 @@ pub fn cyclone_peer(script: &str, domain: u16) -> std::process::Output {
         .output()
         .expect("python runs")
 }
+
+/// A node outside the machine that follows `/lathe1/command_events`, as an auditor would.
+#[allow(dead_code)]
+pub struct Auditor {
+    pub node: cnc_runtime::dds::RosNode,
+    events: ros2_client::dds::Subscription<cnc_msgs::msg::CommandEvent>,
+}
+
+#[allow(dead_code)]
+impl Auditor {
+    pub fn new(cfg: &LaunchConfig) -> Auditor {
+        use cnc_runtime::topics::COMMAND_EVENTS;
+        let mut node = cnc_runtime::dds::RosNode::new(&cfg.network, "lathe1", "auditor")
+            .expect("auditor node");
+        let qos = COMMAND_EVENTS
+            .qos()
+            .history(ros2_client::qos::History::KeepLast { depth: 1000 });
+        let events = node
+            .dds_subscription_with_qos(&COMMAND_EVENTS, qos)
+            .expect("command events");
+        Auditor { node, events }
+    }
+
+    /// The command events that arrived since the last call.
+    pub fn events(&self) -> Vec<cnc_msgs::msg::CommandEvent> {
+        let mut seen = Vec::new();
+        while let Ok(Some((e, _))) = self.events.take() {
+            seen.push(e);
+        }
+        seen
+    }
+}

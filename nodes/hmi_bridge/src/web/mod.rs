@@ -59,11 +59,11 @@ impl WebHmi {
         axes: Vec<String>,
         diameter: Vec<bool>,
     ) -> Result<WebHmi, String> {
+        // Whether it may be served at all was [`check`]ed when the bridge started.
         let operators = match &hmi.operators_file {
             Some(path) => login::OperatorsFile::load(path)?.operators,
             None => BTreeMap::new(),
         };
-        login::exposure(&hmi.web_address, operators.len(), &hmi.web_origins)?;
         let lifetime = Duration::from_secs(hmi.session_seconds.max(1));
         let origins = hmi.web_origins.clone();
         let server = WebServer::start(&hmi.web_address, move |bound| {

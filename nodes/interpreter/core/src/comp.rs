@@ -375,15 +375,16 @@ impl RadiusComp {
             Elem::Arc { .. } => None,
         };
         let mut out = Vec::new();
+        // What this element leaves held: its offset path (or what joining made of it).
+        let hold = |path, from| Held {
+            path,
+            from,
+            course,
+            depth,
+            kind,
+            line,
+        };
         if let Start::Pending(startup, from) = self.start {
-            let held = |from| Held {
-                path: off,
-                from,
-                course,
-                depth,
-                kind,
-                line,
-            };
             match startup {
                 Startup::ToNextElement => {
                     // The start-up element waits for the element after it.
@@ -399,13 +400,13 @@ impl RadiusComp {
                         kind,
                         line,
                     });
-                    self.held = Some(held(None));
+                    self.held = Some(hold(off, None));
                 }
                 Startup::AlongEntry => {
                     if matches!(path, Elem::Arc { .. }) {
                         return Err(CompError::ArcStartup);
                     }
-                    self.held = Some(held(Some(sub(from, self.tip))));
+                    self.held = Some(hold(off, Some(sub(from, self.tip))));
                 }
             }
             self.start = Start::Running;
@@ -423,36 +424,15 @@ impl RadiusComp {
                 line: s_line,
             });
             self.release_stills(add(off.start(), self.tip), &mut out);
-            self.held = Some(Held {
-                path: off,
-                from: None,
-                course,
-                depth,
-                kind,
-                line,
-            });
+            self.held = Some(hold(off, None));
             return Ok(out);
         }
         let Some(held) = self.held.take() else {
-            self.held = Some(Held {
-                path: off,
-                from: None,
-                course,
-                depth,
-                kind,
-                line,
-            });
+            self.held = Some(hold(off, None));
             return Ok(out);
         };
         let next = self.join(held, path, off, kind, line, &mut out)?;
-        self.held = Some(Held {
-            path: next,
-            from: None,
-            course,
-            depth,
-            kind,
-            line,
-        });
+        self.held = Some(hold(next, None));
         Ok(out)
     }
 
