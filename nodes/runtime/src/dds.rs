@@ -167,7 +167,8 @@ impl RosNode {
             dds: Some(Arc::new(inner)),
             relay: None,
             bus: None,
-            count: counter(self.domain, &self.namespace, topic.path),
+            // Not the machine's: its samples are not counted as published by the machine.
+            count: Arc::default(),
         })
     }
 
