@@ -8,7 +8,7 @@ pub mod mapping;
 pub mod node;
 pub mod offsets;
 pub mod operation;
-pub mod overrides;
+pub use cnc_runtime::overrides;
 pub mod parameters;
 pub mod program_events;
 pub mod robot;

@@ -830,12 +830,12 @@ fn execute(op: &Operation, desk: &mut Desk) -> (bool, String) {
             (accepted, message)
         }
         Operation::Overrides(o) => {
-            let request = SetOverridesRequest {
+            let request = Overrides {
                 feed_percent: o.feed_percent,
                 spindle_percent: o.spindle_percent,
                 rapid_percent: o.rapid_percent,
             };
-            match crate::overrides::check(&request)
+            match cnc_runtime::overrides::check(&request)
                 .and_then(|o| desk.panel.publish(o).map_err(|e| format!("not sent: {e}")))
             {
                 Ok(()) => (true, format!("overrides set: {}", op.detail())),

@@ -122,7 +122,11 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         }
         // The panel's override switches set over the network (hmi_bridge checks the values).
         while let Ok(Some(o)) = panel.take() {
-            set_override_switches(&mut sim.devices.inputs, &o);
+            // Only the switch positions reach the PLC, whoever sent the message.
+            match cnc_runtime::overrides::check(&o) {
+                Ok(o) => set_override_switches(&mut sim.devices.inputs, &o),
+                Err(why) => log::error!("io: panel overrides refused: {why}"),
+            }
         }
         // The robot interface block (X8) set over the network: robot signals only.
         while let Ok(Some(input)) = robot.take() {

@@ -232,13 +232,25 @@ impl Motion {
         }
     }
 
-    /// Takes a block into the queue. Blocks of an older run are dropped; a newer run replaces
-    /// whatever is queued.
+    /// Takes a block into the queue. A run begins with its block 1 (a new run replaces
+    /// whatever is queued) and goes on block by block; blocks of a run a reset or an
+    /// emergency stop dropped are let go. Any other block (another run's, a gap, a run that
+    /// does not begin at 1) is refused with an alarm and changes nothing else: no run id,
+    /// sequence number or queue of it stays behind (decisions D62).
     pub fn push(&mut self, block: Block) {
-        if block.run_id < self.run_id {
+        if block.run_id == self.dead_run && self.dead_run != 0 {
             return;
         }
-        if block.run_id > self.run_id {
+        if block.run_id != self.run_id {
+            if block.seq != 1 {
+                let text = format!(
+                    "block {} of run {} refused: it does not belong to the current run {} \
+                     and does not begin a run",
+                    block.seq, block.run_id, self.run_id
+                );
+                self.raise(alarm::BAD_BLOCK, text, block.line);
+                return;
+            }
             self.run_id = block.run_id;
             self.queue.clear();
             self.active = None;
@@ -253,8 +265,18 @@ impl Motion {
             self.clear_strobe();
         }
         // Blocks of a run started during an emergency stop (before the PLC's first scan at
-        // power-on) wait in the queue; those of the run the stop dropped are refused.
-        if self.alarm || block.run_id <= self.dead_run || block.seq <= self.accepted_seq {
+        // power-on) wait in the queue.
+        if self.alarm || block.seq <= self.accepted_seq {
+            return;
+        }
+        if block.seq != self.accepted_seq + 1 {
+            let text = format!(
+                "block {} of run {} refused: block {} expected",
+                block.seq,
+                block.run_id,
+                self.accepted_seq + 1
+            );
+            self.raise(alarm::BAD_BLOCK, text, block.line);
             return;
         }
         if self.queue.len() >= self.cfg.queue_capacity {
@@ -331,8 +353,10 @@ impl Motion {
         self.cycle_stop = true;
     }
 
-    /// Reset: clears the alarm state and the queue; the axes stop where they are.
+    /// Reset: clears the alarm state and the queue; the axes stop where they are. The run
+    /// is dropped: its blocks still on their way are let go.
     pub fn reset(&mut self) {
+        self.dead_run = self.run_id;
         self.reset_ticks = RESET_SIGNAL_TICKS;
         self.alarm = false;
         self.servo_off = false;

@@ -237,27 +237,54 @@ fn emergency_stop_drops_the_run_and_holds_position() {
     assert_eq!(m.state(), RunState::Alarm);
 }
 
+fn rapid(run_id: u64, seq: u64, x: f64) -> Block {
+    Block {
+        run_id,
+        seq,
+        line: 1,
+        kind: Command::Rapid { end: vec![x, 0.0] },
+    }
+}
+
+/// Issue 26: one block with `run_id = 2^64-1` once disabled motion until a restart. A block
+/// that neither continues the current run nor begins one is refused with an alarm, and
+/// leaves no run id or sequence number behind: after reset the next run moves.
 #[test]
-fn blocks_of_an_old_run_are_ignored() {
+fn a_block_of_no_run_is_refused_with_an_alarm_and_leaves_nothing_behind() {
     let mut m = Motion::new(lathe(), &[0.0, 0.0]);
-    m.push(Block {
-        run_id: 2,
-        seq: 1,
-        line: 1,
-        kind: Command::Rapid {
-            end: vec![10.0, 0.0],
-        },
-    });
-    m.push(Block {
-        run_id: 1,
-        seq: 2,
-        line: 1,
-        kind: Command::Rapid {
-            end: vec![99.0, 0.0],
-        },
-    });
+    m.push(rapid(2, 1, 10.0));
+    run(&mut m, 10_000);
+    m.push(rapid(1, 2, 99.0));
     run(&mut m, 10_000);
     assert_eq!(m.commanded_display(), vec![10.0, 0.0]);
+    assert_eq!(m.state(), RunState::Alarm);
+    assert_eq!((m.run_id(), m.accepted_seq()), (2, 1));
+    m.reset();
+    m.push(rapid(u64::MAX, 7, 50.0));
+    assert_eq!(
+        (m.run_id(), m.accepted_seq()),
+        (2, 1),
+        "nothing of it stays"
+    );
+    m.reset();
+    // A gap in the current run is refused the same way.
+    m.push(rapid(3, 1, 20.0));
+    run(&mut m, 10_000);
+    m.push(rapid(3, 3, 30.0));
+    run(&mut m, 10_000);
+    assert_eq!(m.commanded_display(), vec![20.0, 0.0]);
+    assert_eq!(m.state(), RunState::Alarm);
+    m.reset();
+    // Blocks of the run the reset dropped, still on their way, are let go quietly.
+    m.push(rapid(3, 2, 25.0));
+    assert_ne!(m.state(), RunState::Alarm);
+    // Even a run with the largest id does not shut out the runs after it.
+    m.push(rapid(u64::MAX, 1, 40.0));
+    run(&mut m, 10_000);
+    m.push(rapid(4, 1, 5.0));
+    run(&mut m, 10_000);
+    assert_eq!(m.commanded_display(), vec![5.0, 0.0]);
+    assert_eq!(m.run_id(), 4);
 }
 
 #[test]

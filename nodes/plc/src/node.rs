@@ -68,6 +68,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let memory_file = cfg.plc.memory_file.clone();
     let mut saved = load_retained(memory_file.as_deref());
     let mut plc = Plc::new(program, saved.as_ref(), cfg.plc.level2_divisions as usize);
+    plc.set_spindle_limit(cfg.limits.spindle_max_rpm);
     let mut program_mtime = program_path.as_deref().and_then(modified);
 
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "plc")?;
@@ -96,6 +97,12 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut next = t0;
     let mut scan_times = ScanTimes::default();
     let mut parts = PartCounter::default();
+    // The retained memory is kept at every change, the part count published once its count
+    // is on the disk: a part the cell was told of is never lost (decisions D59).
+    let mut keeper = memory_file
+        .clone()
+        .map(|p| cnc_runtime::persist::Keeper::new(p, "PLC memory"));
+    let mut held_parts: Option<(PartCount, u64)> = None;
     let mut last_spindle = None;
     // The scan keeps the machine's I/O in time: real time below the servo and drive loops.
     let rt = &cfg.realtime;
@@ -160,7 +167,24 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         }
         let scans = plc.scans();
         let now_s = (monotonic_ns() - t0) as f64 * 1e-9;
+        let kept_version = match keeper.as_mut() {
+            Some(k) => {
+                let now = plc.retained();
+                if saved.as_ref() != Some(&now) {
+                    if let Ok(text) = serde_yaml::to_string(&now) {
+                        k.keep(text.into_bytes());
+                    }
+                    saved = Some(now);
+                }
+                k.given()
+            }
+            None => 0,
+        };
         if let Some(msg) = parts.update(&plc, &fi, now_s, scans.is_multiple_of(500)) {
+            held_parts = Some((msg, kept_version));
+        }
+        let durable = keeper.as_ref().map_or(0, |k| k.durable());
+        if let Some((msg, _)) = held_parts.take_if(|(_, v)| *v <= durable) {
             let _ = parts_pub.publish(msg);
         }
         publish_spindle(
@@ -206,18 +230,6 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                     program_mtime = m;
                     if reload(&mut plc, p, &alarms) {
                         publish_program(&program_pub, &plc, &source);
-                    }
-                }
-            }
-            if let Some(path) = memory_file.as_deref() {
-                let now = plc.retained();
-                if saved.as_ref() != Some(&now) {
-                    match serde_yaml::to_string(&now)
-                        .map_err(|e| e.to_string())
-                        .and_then(|t| cnc_runtime::persist::write_atomic(path, &t))
-                    {
-                        Ok(()) => saved = Some(now),
-                        Err(e) => log::warn!("PLC memory not saved: {e}"),
                     }
                 }
             }

@@ -60,6 +60,9 @@ pub struct Plc {
     /// the NC sees `*ESP`, whatever the program does.
     estop_input: Option<BitAddr>,
     spindle_command: f64,
+    /// The spindle drive's rating (`limits.spindle_max_rpm`): no program, override or ladder
+    /// arithmetic commands more.
+    spindle_max_rpm: f64,
     y: YImage,
     g: GImage,
     /// A table at the end of the last scan, for message events.
@@ -95,6 +98,7 @@ impl Plc {
             level2_divisions: level2_divisions.max(1),
             estop_input: Some(estop),
             spindle_command: 0.0,
+            spindle_max_rpm: f64::INFINITY,
             y: YImage::default(),
             g: GImage::default(),
             messages: [0; MESSAGE_BYTES],
@@ -104,6 +108,11 @@ impl Plc {
             last_now: 0,
             emergency_stop: false,
         }
+    }
+
+    /// Sets the spindle drive's top speed, rpm; every command is clamped to it.
+    pub fn set_spindle_limit(&mut self, rpm: f64) {
+        self.spindle_max_rpm = rpm;
     }
 
     /// Parses `text` and, if it is a valid program, runs it from the next scan on; otherwise
@@ -247,7 +256,11 @@ impl Plc {
             }
         }
         self.y.bytes.copy_from_slice(self.mem.table(Space::Y));
-        self.y.spindle_rpm = self.spindle_command;
+        self.y.spindle_rpm = if self.spindle_command.is_finite() {
+            self.spindle_command.clamp(0.0, self.spindle_max_rpm)
+        } else {
+            0.0
+        };
         self.g.bytes.copy_from_slice(self.mem.table(Space::G));
         let estop = self.estop_input.is_some_and(|b| !self.mem.bit(b));
         if estop || self.fault.is_some() {

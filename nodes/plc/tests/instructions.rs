@@ -419,6 +419,16 @@ fn spindle_control_scales_the_s_code_by_the_override() {
     assert_eq!(p.outputs().spindle_rpm, 0.0);
 }
 
+/// Issue 26: an override byte of 255 % once ran 800 rpm at 2040; the drive's rating clamps
+/// whatever the ladder computes.
+#[test]
+fn the_spindle_command_never_exceeds_the_drives_rating() {
+    let mut p = plc("INIT D0 4 800\nINIT D4 1 255\nRD X0.0\nSPLCNT D0, D4");
+    p.set_spindle_limit(1500.0);
+    scan(&mut p, &["X0.0"], 0);
+    assert_eq!(p.outputs().spindle_rpm, 1500.0);
+}
+
 #[test]
 fn level_two_is_split_over_scans_and_level_one_runs_every_scan() {
     let program = Program::parse(

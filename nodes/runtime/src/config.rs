@@ -24,6 +24,10 @@ pub struct LaunchConfig {
     pub hmi: HmiConfig,
     #[serde(default)]
     pub realtime: RealtimeConfig,
+    /// The machine builder's ratings (travel, drives, spindle): set by this file only,
+    /// never a parameter ([`crate::limits`]).
+    #[serde(default)]
+    pub limits: crate::limits::MachineLimits,
 }
 
 /// Real-time treatment of the loops that keep the machine's time ([`crate::realtime`]).
@@ -156,6 +160,13 @@ pub struct MachineConfig {
     /// cell only.
     #[serde(default)]
     pub memory_file: Option<std::path::PathBuf>,
+    /// Program memory: a folder of plain program files, relative to the config file's
+    /// folder ([`crate::program_store`]); absent: programs are kept for this run only.
+    #[serde(default)]
+    pub program_directory: Option<std::path::PathBuf>,
+    /// The program memory's capacity in KiB (all programs together; alarm 70 when full).
+    #[serde(default = "default_program_capacity")]
+    pub program_capacity_kib: u64,
     /// Huaxing S#170: a T word calls this program (O number, 1–9999) as the tool-change
     /// macro; absent: T goes to the PLC.
     #[serde(default)]
@@ -182,6 +193,10 @@ pub struct MachineConfig {
 pub enum DecimalPoint {
     Calculator,
     Increment,
+}
+
+fn default_program_capacity() -> u64 {
+    64 * 1024
 }
 
 fn default_contour_tolerance() -> f64 {
@@ -623,8 +638,10 @@ impl RecorderConfig {
 
 impl LaunchConfig {
     pub fn from_yaml(text: &str) -> Result<Self, String> {
-        let cfg: LaunchConfig =
+        let mut cfg: LaunchConfig =
             serde_yaml::from_str(text).map_err(|e| format!("launch config: {e}"))?;
+        // The machine's own file rates the axes it does not rate explicitly at its values.
+        cfg.limits.complete(&cfg.machine.axes);
         cfg.validate()?;
         Ok(cfg)
     }
@@ -671,6 +688,7 @@ impl LaunchConfig {
         let files = [
             &mut m.tool_table,
             &mut m.memory_file,
+            &mut m.program_directory,
             &mut m.parameter_file,
             &mut self.plc.program,
             &mut self.plc.memory_file,
@@ -692,6 +710,9 @@ impl LaunchConfig {
         let m = &self.machine;
         if let Some(f) = &m.memory_file {
             out.push(("kept variables and offsets", f.as_path()));
+        }
+        if let Some(f) = &m.program_directory {
+            out.push(("program memory", f.as_path()));
         }
         if let Some(f) = &m.parameter_file {
             out.push(("parameters", f.as_path()));
@@ -817,6 +838,27 @@ impl LaunchConfig {
                 return Err(format!(
                     "axis {}: second_reference {r} lies outside min..max",
                     a.name
+                ));
+            }
+        }
+        self.limits.check(&self.machine.axes)?;
+        let cap = self.machine.program_capacity_kib;
+        if !(1..=1024 * 1024).contains(&cap) {
+            return Err(format!(
+                "machine.program_capacity_kib {cap}: 1..1048576 (1 GiB)"
+            ));
+        }
+        let sim = &self.sim;
+        for (name, v, range) in [
+            ("spindle_acceleration", sim.spindle_acceleration, 10.0..=1e6),
+            ("at_speed_tolerance", sim.at_speed_tolerance, 0.001..=0.5),
+            ("coolant_delay", sim.coolant_delay, 0.0..=10.0),
+        ] {
+            if !range.contains(&v) {
+                return Err(format!(
+                    "sim.{name} {v}: {}..{}",
+                    range.start(),
+                    range.end()
                 ));
             }
         }

@@ -18,9 +18,11 @@ const SECTIONS: [&str; 4] = ["machine", "servo", "plc", "sim"];
 
 /// Settings that are not parameters: identity, file paths, and the offset pages (written
 /// through the offset services).
-const NOT_PARAMETERS: [&str; 9] = [
+const NOT_PARAMETERS: [&str; 11] = [
     "machine.namespace",
     "machine.memory_file",
+    "machine.program_directory",
+    "machine.program_capacity_kib",
     "machine.parameter_file",
     "machine.tool_table",
     "machine.tools",
@@ -123,7 +125,12 @@ pub fn set(cfg: &LaunchConfig, name: &str, value: &str) -> Result<LaunchConfig, 
     if value.len() > 256 || value.chars().any(char::is_control) {
         return Err(format!("{name}: a value is one line of at most 256 bytes"));
     }
-    let new: Value = serde_yaml::from_str(value)
+    let scalar: serde_yaml::Value = serde_yaml::from_str(value)
+        .map_err(|e| format!("{name}: {value:?} is not a value: {e}"))?;
+    if scalar.as_f64().is_some_and(|v| !v.is_finite()) {
+        return Err(format!("{name} = {value}: not a finite number"));
+    }
+    let new: Value = serde_json::to_value(&scalar)
         .map_err(|e| format!("{name}: {value:?} is not a value: {e}"))?;
     if matches!(new, Value::Array(_) | Value::Object(_)) {
         return Err(format!("{name}: give one value, not a list or map"));
@@ -260,5 +267,90 @@ mod tests {
         std::fs::write(&path, "servo.lookahead: [").unwrap();
         assert!(load_file(&path).unwrap_err().contains("parameter file"));
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Issue 26's findings: a written value may not widen what the machine is rated for, nor
+    /// be non-finite, nor make a move that never ends.
+    #[test]
+    fn a_parameter_may_not_widen_the_machines_ratings() {
+        let cfg = lathe();
+        for (name, value, says) in [
+            ("machine.axes.X.max", "1e308", "rated travel -2..300"),
+            ("machine.axes.X.min", "-1e308", "rated travel -2..300"),
+            ("machine.axes.X.max_velocity", "1e308", "rated 60..6000"),
+            (
+                "machine.axes.X.max_acceleration",
+                "1e-300",
+                "rated 15..1500",
+            ),
+            ("machine.axes.Z.max_jerk", "1e300", "max_jerk"),
+            ("machine.axes.X.max_velocity", ".inf", "not a finite number"),
+            ("machine.axes.X.max_velocity", ".nan", "not a finite number"),
+            (
+                "sim.spindle_acceleration",
+                "1e-300",
+                "sim.spindle_acceleration",
+            ),
+            ("servo.dry_run_feed", "-.inf", "not a finite number"),
+        ] {
+            let e = set(&cfg, name, value).expect_err(name);
+            assert!(
+                e.contains(name) && e.contains(says),
+                "{name} = {value}: {e}"
+            );
+        }
+        // Lowering a rating is a parameter change like any other.
+        let slower = set(&cfg, "machine.axes.X.max_velocity", "3000").expect("lower");
+        assert_eq!(slower.machine.axes[0].max_velocity, 3000.0);
+        let shorter = set(&cfg, "machine.axes.X.max", "250").expect("shorter travel");
+        // … and the ratings themselves are no parameter.
+        assert!(list(&shorter).iter().all(|(n, _)| !n.starts_with("limits")));
+        assert!(set(&cfg, "limits.spindle_max_rpm", "99999").is_err());
+    }
+
+    /// Every parameter with random, extreme and non-finite values: each write is refused with
+    /// the parameter's name, or gives a config within the machine's ratings.
+    #[test]
+    fn every_parameter_under_extreme_values_is_refused_by_name_or_stays_rated() {
+        let cfg = lathe();
+        let values = [
+            "0",
+            "-1",
+            "1e308",
+            "-1e308",
+            "1e-300",
+            ".inf",
+            "-.inf",
+            ".nan",
+            "18446744073709551615",
+            "-9223372036854775809",
+            "4294967296",
+            "255",
+            "true",
+            "''",
+            "~",
+            "x",
+            "1.5",
+        ];
+        let mut refused = 0;
+        for (name, _) in list(&cfg) {
+            for v in values {
+                match set(&cfg, &name, v) {
+                    Err(e) => {
+                        refused += 1;
+                        assert!(e.contains(&name), "{name} = {v}: {e}");
+                    }
+                    Ok(changed) => {
+                        changed.validate().expect("a taken write is valid");
+                        for (a, l) in changed.machine.axes.iter().zip(cfg.machine.axes.iter()) {
+                            assert!(a.min >= l.min && a.max <= l.max, "{name} = {v}");
+                            assert!(a.max_velocity <= l.max_velocity, "{name} = {v}");
+                            assert!(a.max_acceleration >= 0.01 * l.max_acceleration);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(refused > list(&cfg).len() * 5, "{refused}");
     }
 }

@@ -1,7 +1,8 @@
-//! Override switch positions a client may set: the steps of the standard PLC (`000` §7.3).
+//! Override switch positions: the steps of the standard PLC (`000` §7.3). The bridge checks
+//! a client's request with them, and the io node checks again what reaches the switch bytes,
+//! so no other value gets to the PLC whatever the message's path (issue 26).
 
 use cnc_msgs::msg::Overrides;
-use cnc_msgs::srv::SetOverridesRequest;
 
 /// Feed and spindle override steps of the standard PLC, percent.
 pub const STEPS: [u8; 16] = [
@@ -11,7 +12,7 @@ pub const STEPS: [u8; 16] = [
 pub const RAPID: [u8; 4] = [0, 25, 50, 100];
 
 /// The switch positions, or which value is out of range and what is allowed.
-pub fn check(r: &SetOverridesRequest) -> Result<Overrides, String> {
+pub fn check(r: &Overrides) -> Result<Overrides, String> {
     let steps = || {
         STEPS
             .iter()
@@ -50,8 +51,8 @@ pub fn check(r: &SetOverridesRequest) -> Result<Overrides, String> {
 mod tests {
     use super::*;
 
-    fn req(feed: u8, spindle: u8, rapid: u8) -> SetOverridesRequest {
-        SetOverridesRequest {
+    fn req(feed: u8, spindle: u8, rapid: u8) -> Overrides {
+        Overrides {
             feed_percent: feed,
             spindle_percent: spindle,
             rapid_percent: rapid,

@@ -1,0 +1,232 @@
+//! Program memory on disk, as a control's program memory is: one folder per machine
+//! (`machine.program_directory`), a plain file per program (folders in a name such as
+//! `shafts/O0010.nc` are folders on disk), written durably, its total bounded by
+//! `machine.program_capacity_kib` (decisions D60). The rules ([`check_store`],
+//! [`valid_program_name`]) are pure, so the interpreter's core and `cnc program import`
+//! apply the same ones.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::MAX_PROGRAM_BYTES;
+
+/// Programs program memory holds at most (besides the byte capacity).
+pub const MAX_PROGRAMS: usize = 1000;
+
+/// Folder levels a program name may have (`a/b/c/NAME`).
+pub const MAX_FOLDER_DEPTH: usize = 4;
+
+/// A program name: folders and a file name separated by `/`, each of letters, digits, `.`,
+/// `_` and `-`, not starting with `.`; at most 128 characters and four folders.
+pub fn valid_program_name(name: &str) -> bool {
+    let parts: Vec<&str> = name.split('/').collect();
+    name.len() <= 128
+        && parts.len() <= MAX_FOLDER_DEPTH + 1
+        && parts.iter().all(|p| {
+            !p.is_empty()
+                && p.len() <= 64
+                && !p.starts_with('.')
+                && p.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c))
+        })
+}
+
+/// Why `text` may not be stored as `name` in a memory holding `sizes` (bytes by name) of at
+/// most `capacity` bytes, if it may not: name, size, count and capacity, each with its limit
+/// (alarm 70, FANUC's "no program space in memory").
+pub fn check_store(
+    sizes: &BTreeMap<String, usize>,
+    name: &str,
+    len: usize,
+    capacity: u64,
+) -> Result<(), String> {
+    if !valid_program_name(name) {
+        return Err(format!(
+            "invalid program name {name:?}: folders and a name separated by '/', each of \
+             letters, digits, '.', '_', '-', not starting with '.'; at most 128 characters \
+             and {MAX_FOLDER_DEPTH} folders"
+        ));
+    }
+    if len > MAX_PROGRAM_BYTES {
+        return Err(format!(
+            "program too large: {len} bytes, limit {MAX_PROGRAM_BYTES}"
+        ));
+    }
+    let replaced = sizes.get(name).copied();
+    if replaced.is_none() && sizes.len() >= MAX_PROGRAMS {
+        return Err(format!(
+            "program memory full: {MAX_PROGRAMS} programs (alarm 70)"
+        ));
+    }
+    let used: u64 = sizes.values().map(|&n| n as u64).sum();
+    let after = used - replaced.unwrap_or(0) as u64 + len as u64;
+    if after > capacity {
+        return Err(format!(
+            "program memory full: {name} needs {len} bytes, {} of {capacity} bytes free \
+             (alarm 70: delete programs first)",
+            capacity.saturating_sub(used - replaced.unwrap_or(0) as u64)
+        ));
+    }
+    Ok(())
+}
+
+/// The folder of one machine's programs.
+#[derive(Debug, Clone)]
+pub struct ProgramDir {
+    pub root: PathBuf,
+}
+
+impl ProgramDir {
+    pub fn new(root: &Path) -> ProgramDir {
+        ProgramDir {
+            root: root.to_path_buf(),
+        }
+    }
+
+    fn path(&self, name: &str) -> Result<PathBuf, String> {
+        if valid_program_name(name) {
+            Ok(self.root.join(name))
+        } else {
+            Err(format!("invalid program name {name:?}"))
+        }
+    }
+
+    /// Every program in the folder, and what was left out and why (a file too large or
+    /// badly named, a folder too deep). A missing folder is an empty memory.
+    pub fn read_all(&self) -> (BTreeMap<String, String>, Vec<String>) {
+        let mut programs = BTreeMap::new();
+        let mut problems = Vec::new();
+        self.walk(&self.root, "", 0, &mut programs, &mut problems);
+        (programs, problems)
+    }
+
+    fn walk(
+        &self,
+        dir: &Path,
+        prefix: &str,
+        depth: usize,
+        programs: &mut BTreeMap<String, String>,
+        problems: &mut Vec<String>,
+    ) {
+        let entries = match std::fs::read_dir(dir) {
+            Ok(e) => e,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return,
+            Err(e) => return problems.push(format!("{}: {e}", dir.display())),
+        };
+        let mut entries: Vec<_> = entries.flatten().collect();
+        entries.sort_by_key(|e| e.file_name());
+        for entry in entries {
+            let file = entry.file_name().to_string_lossy().to_string();
+            let name = format!("{prefix}{file}");
+            let path = entry.path();
+            // Left over by a write a crash cut short: the old file is still there.
+            if file.ends_with(".tmp") {
+                let _ = std::fs::remove_file(&path);
+                continue;
+            }
+            let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+            if is_dir && depth < MAX_FOLDER_DEPTH && valid_program_name(&name) {
+                self.walk(&path, &format!("{name}/"), depth + 1, programs, problems);
+                continue;
+            }
+            if is_dir || !valid_program_name(&name) {
+                problems.push(format!("{}: not a program name, left out", path.display()));
+                continue;
+            }
+            match std::fs::metadata(&path) {
+                Ok(m) if m.len() > MAX_PROGRAM_BYTES as u64 => problems.push(format!(
+                    "{}: {} bytes, limit {MAX_PROGRAM_BYTES}, left out",
+                    path.display(),
+                    m.len()
+                )),
+                _ => match std::fs::read_to_string(&path) {
+                    Ok(text) => {
+                        programs.insert(name, text);
+                    }
+                    Err(e) => problems.push(format!("{}: {e}, left out", path.display())),
+                },
+            }
+        }
+    }
+
+    /// Stores a program durably (its folders created).
+    pub fn store(&self, name: &str, text: &str) -> Result<(), String> {
+        crate::persist::write_atomic(&self.path(name)?, text)
+    }
+
+    /// Removes a program durably, and the folders it leaves empty.
+    pub fn remove(&self, name: &str) -> Result<(), String> {
+        let path = self.path(name)?;
+        crate::persist::remove_durable(&path)?;
+        let mut dir = path.parent().map(Path::to_path_buf);
+        while let Some(d) = dir.filter(|d| *d != self.root && d.starts_with(&self.root)) {
+            if std::fs::remove_dir(&d).is_err() {
+                break;
+            }
+            dir = d.parent().map(Path::to_path_buf);
+        }
+        Ok(())
+    }
+}
+
+/// The size in bytes of each program.
+pub fn sizes(programs: &BTreeMap<String, String>) -> BTreeMap<String, usize> {
+    programs.iter().map(|(n, t)| (n.clone(), t.len())).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_may_have_folders_but_never_leave_the_program_folder() {
+        for ok in ["O0010", "part.nc", "shafts/O0010.nc", "a/b/c/d/e.nc"] {
+            assert!(valid_program_name(ok), "{ok}");
+        }
+        for bad in [
+            "",
+            "../etc/passwd",
+            "/abs",
+            "a//b",
+            "a/./b",
+            ".hidden",
+            "a/b/c/d/e/f",
+            "sp ace",
+        ] {
+            assert!(!valid_program_name(bad), "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_capacity_counts_a_replaced_program_once() {
+        let sizes: BTreeMap<String, usize> = [("a".to_string(), 600)].into_iter().collect();
+        assert!(check_store(&sizes, "a", 1000, 1000).is_ok());
+        let e = check_store(&sizes, "b", 500, 1000).unwrap_err();
+        assert!(
+            e.contains("400 of 1000 bytes free") && e.contains("alarm 70"),
+            "{e}"
+        );
+        assert!(check_store(&sizes, "b", 400, 1000).is_ok());
+    }
+
+    #[test]
+    fn programs_and_their_folders_come_back_from_the_disk() {
+        let root = std::env::temp_dir().join(format!("cnc_programs_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let dir = ProgramDir::new(&root);
+        dir.store("O0001", "G0 X1\nM30\n").unwrap();
+        dir.store("shafts/O0010.nc", "M99\n").unwrap();
+        std::fs::write(root.join("half.tmp"), "cut").unwrap();
+        std::fs::write(root.join(".hidden"), "x").unwrap();
+        let (programs, problems) = dir.read_all();
+        assert_eq!(
+            programs.keys().collect::<Vec<_>>(),
+            ["O0001", "shafts/O0010.nc"]
+        );
+        assert_eq!(problems.len(), 1, "{problems:?}");
+        assert!(!root.join("half.tmp").exists());
+        dir.remove("shafts/O0010.nc").unwrap();
+        assert!(!root.join("shafts").exists());
+        let _ = std::fs::remove_dir_all(&root);
+    }
+}
