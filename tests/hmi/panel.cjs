@@ -59,6 +59,15 @@ async function waitFor(what, check, seconds) {
   await page.click("#mdi_run");
   await waitFor("the MDI refusal", async () => (await text("message")).includes("MDI refused: mode AUTO"), 10);
 
+  // A program near the services' 4 MiB limit loads from the panel too, though escaped in
+  // JSON it would be twice that (issue 26): every other byte a quote.
+  const big = '("")\n'.repeat(Math.floor((4 * 1024 * 1024 - 100) / 5)) + "M30\n";
+  await page.fill("#load_name", "BIG.nc");
+  await page.$eval("#load_text", (t, v) => { t.value = v; }, big);
+  await page.click("#load");
+  await waitFor("the large program's load answer", async () => (await text("message")).includes("BIG.nc stored"), 30);
+  await page.$eval("#load_text", (t) => { t.value = ""; });
+
   // Load, then cycle start.
   await page.fill("#load_name", "O0005");
   await page.fill("#load_text", PROGRAM);

@@ -74,13 +74,19 @@ impl Topic {
     }
 }
 
-/// A finished goal: id, acceptance time, final status and result.
+/// A finished goal: id, acceptance time, final status and result. A rejected goal is kept
+/// too (status ABORTED, the reason in the result's message), so that its GetResult is
+/// answered, though it never shows in the status array.
 struct Done {
     id: Uuid,
     accepted: Time,
     status: i8,
     result: RunProgramResult,
+    rejected: bool,
 }
+
+/// GetResult requests waiting for a running goal; more are answered at once as busy.
+const WAITING_LIMIT: usize = 64;
 
 pub struct RunProgramServer {
     send_goal: DualServer<RunProgramSendGoal>,
@@ -145,6 +151,7 @@ impl RunProgramServer {
         let mut list: Vec<GoalStatus> = self
             .done
             .iter()
+            .filter(|d| !d.rejected)
             .map(|d| GoalStatus {
                 goal_info: GoalInfo {
                     goal_id: d.id,
@@ -178,27 +185,58 @@ impl RunProgramServer {
             accepted,
             status: g.status(),
             result: g.result().clone(),
+            rejected: false,
         });
         self.answer_waiting();
         self.publish_status();
     }
 
+    /// Answers every GetResult whose goal has ended; one for a goal this server does not
+    /// know is answered STATUS_UNKNOWN at once, as rclcpp's action server does. Only
+    /// requests for the running goal wait, at most [`WAITING_LIMIT`] of them.
     fn answer_waiting(&mut self) {
         let waiting = std::mem::take(&mut self.waiting);
         for r in waiting {
-            match self.done.iter().find(|d| d.id == r.request.goal_id) {
-                Some(d) => {
-                    let response = RunProgramGetResultResponse {
-                        status: d.status,
-                        result: d.result.clone(),
-                    };
-                    if let Err(e) = self.get_result.reply(&r, &response) {
-                        log::error!("{e}");
-                    }
+            let id = r.request.goal_id;
+            let running = self.goal.as_ref().is_some_and(|(g, _)| g.id == id);
+            let response = match self.done.iter().find(|d| d.id == id) {
+                Some(d) => RunProgramGetResultResponse {
+                    status: d.status,
+                    result: d.result.clone(),
+                },
+                None if running && self.waiting.len() < WAITING_LIMIT => {
+                    self.waiting.push(r);
+                    continue;
                 }
-                None => self.waiting.push(r),
+                None => RunProgramGetResultResponse {
+                    status: GoalStatus::STATUS_UNKNOWN,
+                    result: RunProgramResult {
+                        message: if running {
+                            format!("busy: {WAITING_LIMIT} result requests wait; try again")
+                        } else {
+                            "unknown goal id (never sent, or its result was dropped)".into()
+                        },
+                        ..Default::default()
+                    },
+                },
+            };
+            if let Err(e) = self.get_result.reply(&r, &response) {
+                log::error!("{e}");
             }
         }
+    }
+
+    /// Whether a goal of this id runs or has ended here.
+    fn knows(&self, id: &Uuid) -> bool {
+        self.goal.as_ref().is_some_and(|(g, _)| &g.id == id)
+            || self.done.iter().any(|d| &d.id == id)
+    }
+
+    /// Takes the action's requests off DDS into their queues.
+    pub fn drain(&self) {
+        self.send_goal.drain();
+        self.cancel_goal.drain();
+        self.get_result.drain();
     }
 
     /// Serves requests and follows the running goal; returns the requests decided, for
@@ -240,6 +278,21 @@ impl RunProgramServer {
                 let lines = self.program_lines.get(&goal.program).copied().unwrap_or(0);
                 let run = GoalRun::new(r.request.goal_id, goal.clone(), lines, run_id, now);
                 self.goal = Some((run, response.stamp.clone()));
+            } else if let (Err(why), false) = (&outcome, self.knows(&r.request.goal_id)) {
+                // The reason reaches the client through GetResult, not only the log.
+                if self.done.len() == RESULTS_KEPT {
+                    self.done.pop_front();
+                }
+                self.done.push_back(Done {
+                    id: r.request.goal_id,
+                    accepted: response.stamp.clone(),
+                    status: GoalStatus::STATUS_ABORTED,
+                    result: RunProgramResult {
+                        message: format!("goal rejected: {why}"),
+                        ..Default::default()
+                    },
+                    rejected: true,
+                });
             }
             if let Err(e) = self.send_goal.reply(&r, &response) {
                 log::error!("{e}");

@@ -28,7 +28,7 @@ use crate::operation::Operation;
 use crate::parameters::Parameters;
 use crate::program_events::ProgramEvents;
 use crate::robot;
-use crate::server::{DualServer, Request};
+use crate::server::{Drain, DualServer, Request};
 use crate::web::WebHmi;
 
 /// How long a service waits for the interpreter's answer.
@@ -194,6 +194,28 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     publish_alarms(&active);
     while !shutdown.requested() {
         ros.refresh();
+        // Every service's requests into its queue first: a burst on one is taken off DDS
+        // before the others are served (a full queue refuses as busy).
+        let servers: [&dyn Drain; 15] = [
+            &load,
+            &start,
+            &stop,
+            &reset,
+            &list,
+            &delete,
+            &overrides_srv,
+            &mode_srv,
+            &mdi_srv,
+            &offsets_srv,
+            &tool_offset_srv,
+            &work_offset_srv,
+            &get_parameters_srv,
+            &set_parameter_srv,
+            &acknowledge_srv,
+        ];
+        servers.iter().for_each(|s| s.drain());
+        robot_srv.drain();
+        run_program.drain();
         let mut busy = false;
         let mut changed = false;
         discovery.drain_read_notifications();

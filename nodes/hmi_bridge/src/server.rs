@@ -1,7 +1,13 @@
 //! A service server that answers rmw_cyclonedds-style and rmw_fastrtps-style clients on the same
 //! topics, built on rustdds directly because ros2-client's `Server` speaks one mapping only.
+//!
+//! No request goes unanswered by silence (issue 26): requests are taken from DDS as they come
+//! (a reader history of [`READER_DEPTH`]) into a queue of [`QUEUE_LIMIT`]; one that finds the
+//! queue full is answered at once with a refusal that says "busy" (services whose response
+//! has no room for a reason count and log it).
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
+use std::collections::VecDeque;
 use std::marker::PhantomData;
 
 use byteorder::LittleEndian;
@@ -10,12 +16,32 @@ use ros2_client::dds::rustdds::{
     self,
     no_key::{DataWriter, SimpleDataReader},
     rpc::SampleIdentity,
-    QosPolicies, SequenceNumber, Timestamp, TopicKind, WriteOptionsBuilder,
+    QosPolicies, QosPolicyBuilder, SequenceNumber, Timestamp, TopicKind, WriteOptionsBuilder,
 };
+
+/// Requests of one service DDS holds until the bridge takes them.
+pub const READER_DEPTH: i32 = 256;
+/// Requests of one service waiting to be served; more are refused as busy.
+pub const QUEUE_LIMIT: usize = 256;
 use serde::{de::DeserializeOwned, Serialize};
 
 use crate::mapping::{classify, guess_mapping, Mapping};
 use cnc_msgs::srv::RosService;
+
+/// A server whose DDS requests can be taken into its queue ([`DualServer::drain`]).
+pub trait Drain {
+    fn drain(&self);
+}
+
+impl<S: RosService> Drain for DualServer<S>
+where
+    S::Request: DeserializeOwned,
+    S::Response: Serialize,
+{
+    fn drain(&self) {
+        DualServer::drain(self)
+    }
+}
 
 /// One received request, ready to be answered.
 #[derive(Clone)]
@@ -38,6 +64,9 @@ pub struct DualServer<S: RosService> {
     /// Undecodable requests seen since the last [`DualServer::take_malformed`]: writer GUID and
     /// what was wrong.
     malformed: RefCell<Vec<([u8; 16], String)>>,
+    queue: RefCell<VecDeque<Request<S::Request>>>,
+    /// Requests refused as busy (or, without a way to say so, dropped) since the start.
+    busy: Cell<u64>,
     _service: PhantomData<S>,
 }
 
@@ -75,8 +104,15 @@ where
                 TopicKind::NoKey,
             )
             .map_err(|e| format!("{service}: {e:?}"))?;
+        let deep = qos.modify_by(
+            &QosPolicyBuilder::new()
+                .history(rustdds::policy::History::KeepLast {
+                    depth: READER_DEPTH,
+                })
+                .build(),
+        );
         let subscriber = participant
-            .create_subscriber(&qos)
+            .create_subscriber(&deep)
             .map_err(|e| format!("{service}: {e:?}"))?;
         let publisher = participant
             .create_publisher(&qos)
@@ -93,6 +129,8 @@ where
             name: service.into(),
             refuse: None,
             malformed: RefCell::new(Vec::new()),
+            queue: RefCell::new(VecDeque::new()),
+            busy: Cell::new(0),
             _service: PhantomData,
         })
     }
@@ -109,9 +147,46 @@ where
         std::mem::take(&mut *self.malformed.borrow_mut())
     }
 
-    /// The next request, if any. Undecodable requests are logged and dropped: without a valid
-    /// request there is no reliable way to address a reply to the client.
+    /// The next request, if any, after taking what DDS holds into the queue ([`Self::drain`]).
     pub fn receive(&self) -> Option<Request<S::Request>> {
+        self.drain();
+        self.queue.borrow_mut().pop_front()
+    }
+
+    /// Takes every request DDS holds into the queue; one that finds it full is refused as
+    /// busy. The bridge calls it for every service each turn of its loop, before serving any.
+    pub fn drain(&self) {
+        while let Some(r) = self.take() {
+            let mut queue = self.queue.borrow_mut();
+            if queue.len() < QUEUE_LIMIT {
+                queue.push_back(r);
+                continue;
+            }
+            drop(queue);
+            self.busy.set(self.busy.get() + 1);
+            let why = format!(
+                "busy: {QUEUE_LIMIT} {} requests are waiting; try again",
+                self.name
+            );
+            match self.refuse {
+                Some(refuse) => {
+                    if let Err(e) = self.reply(&r, &refuse(why)) {
+                        log::warn!("{e}");
+                    }
+                }
+                None => log::warn!("{why} (dropped: the response cannot say so)"),
+            }
+        }
+    }
+
+    /// Requests refused as busy since the start.
+    pub fn busy_count(&self) -> u64 {
+        self.busy.get()
+    }
+
+    /// The next request DDS holds. Undecodable requests are logged and dropped: without a valid
+    /// request there is no reliable way to address a reply to the client.
+    fn take(&self) -> Option<Request<S::Request>> {
         self.reader.drain_read_notifications();
         loop {
             let dcc = match self.reader.try_take_one() {

@@ -244,7 +244,18 @@ $("mode_set").onclick = () => send({ op: "mode", mode: $("mode_select").value })
 $("mdi_run").onclick = () => send({ op: "mdi", text: $("mdi").value });
 $("ov_set").onclick = () =>
   send({ op: "overrides", feed: Number($("feed_ov").value), spindle: Number($("spindle_ov").value), rapid: Number($("rapid_ov").value) });
-$("load").onclick = () => send({ op: "load", name: $("load_name").value, text: $("load_text").value });
+// A program goes as a binary message (JSON header, zero byte, the text as it is): escaped in
+// JSON, a program near the 4 MiB limit would not fit in one message.
+$("load").onclick = () => {
+  if (!ws || ws.readyState !== WebSocket.OPEN) return;
+  const utf8 = new TextEncoder();
+  const head = utf8.encode(JSON.stringify({ id: nextId++, op: "load", name: $("load_name").value }));
+  const body = utf8.encode($("load_text").value);
+  const message = new Uint8Array(head.length + 1 + body.length);
+  message.set(head, 0);
+  message.set(body, head.length + 1);
+  ws.send(message);
+};
 $("select").onclick = () => { if ($("programs").value) send({ op: "read", name: $("programs").value }); };
 $("delete").onclick = () => { if ($("programs").value) send({ op: "delete", name: $("programs").value }); };
 $("refresh").onclick = () => send({ op: "list" });

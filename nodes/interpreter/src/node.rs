@@ -15,6 +15,7 @@ use cnc_msgs::msg::{
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{stamp, RosNode};
+use cnc_runtime::program_store::ProgramDir;
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
@@ -112,16 +113,45 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     if let Some(e) = memory_error {
         log::error!("interpreter: machine memory not read, using the config's offsets: {e}");
     }
-    let memory_path = cfg.machine.memory_file.clone();
+    // Kept variables and offsets are written at every change, on a thread of their own.
+    let mut memory_keeper = cfg
+        .machine
+        .memory_file
+        .clone()
+        .map(|p| cnc_runtime::persist::Keeper::new(p, "machine memory"));
     // Run ids grow across restarts of this node.
     let base = setup_from_config(&cfg, &cfg.home());
-    let mut core = RunCore::new(dialect, base, memory, monotonic_ns() / 1000);
+    let capacity = cfg.machine.program_capacity_kib.saturating_mul(1024);
+    let mut core = match &cfg.machine.program_directory {
+        Some(dir) => {
+            let dir = ProgramDir::new(dir);
+            let (programs, problems) = dir.read_all();
+            for p in problems {
+                log::error!("interpreter: program memory: {p}");
+            }
+            log::info!(
+                "interpreter: program memory {}: {} programs",
+                dir.root.display(),
+                programs.len()
+            );
+            RunCore::new(dialect, base, memory, monotonic_ns() / 1000).with_program_memory(
+                programs,
+                Box::new(dir),
+                capacity,
+            )
+        }
+        None => RunCore::new(dialect, base, memory, monotonic_ns() / 1000).with_program_memory(
+            Default::default(),
+            Box::new(cnc_runtime::program_store::InRam),
+            capacity,
+        ),
+    };
     let mut state = StateReporter {
         publisher: state_pub,
         last: None,
         last_ns: 0,
     };
-    let carry_out = |core: &mut RunCore| {
+    let mut carry_out = |core: &mut RunCore| {
         for effect in core.take_effects() {
             match effect {
                 Effect::Block(msg) => {
@@ -142,9 +172,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 }
                 Effect::Clear(number) => alarms.clear(number),
                 Effect::StoreMemory => {
-                    if let Some(p) = memory_path.as_deref() {
-                        if let Err(e) = save_memory(p, core.memory()) {
-                            log::error!("interpreter: machine memory not stored: {e}");
+                    if let Some(keeper) = memory_keeper.as_mut() {
+                        match serde_yaml::to_string(core.memory()) {
+                            Ok(text) => {
+                                keeper.keep(text.into_bytes());
+                            }
+                            Err(e) => log::error!("interpreter: machine memory not stored: {e}"),
                         }
                     }
                 }
@@ -184,6 +217,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     }
     core.shutdown();
     carry_out(&mut core);
+    // Dropping the keeper writes what is still pending.
+    drop(memory_keeper);
     Ok(())
 }
 

@@ -20,25 +20,15 @@ use crate::offset_page;
 use crate::setup::Memory;
 use crate::{Canon, Command, Dialect, Interpreter, Library, ProgramError, Setup};
 
+pub use cnc_runtime::program_store::{valid_program_name, MAX_PROGRAMS};
+use cnc_runtime::program_store::{InRam, ProgramStorage};
 pub use cnc_runtime::MAX_PROGRAM_BYTES;
-/// Programs kept in memory.
-pub const MAX_PROGRAMS: usize = 1000;
 /// The longest MDI entry: a few blocks typed at the panel.
 pub const MAX_MDI_BYTES: usize = 4096;
 /// Answers remembered so that a repeated command (same id) is answered, not executed again.
 const ANSWERS_KEPT: usize = 64;
 /// The alarm source of the interpreter's own alarms.
 pub const SOURCE: &str = "interpreter";
-
-/// A program name: what a control's directory shows, e.g. `O0001` or `part7.nc`.
-pub fn valid_program_name(name: &str) -> bool {
-    !name.is_empty()
-        && name.len() <= 64
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c))
-        && !name.starts_with('.')
-}
 
 /// One program run's block stream: commands go to motion while fewer than the queue's
 /// capacity are unfinished; the run is complete when motion has finished the program end.
@@ -156,6 +146,10 @@ pub struct RunCore {
     /// the memory.
     base: Setup,
     programs: BTreeMap<String, String>,
+    /// Where stored programs are kept (a folder on disk in the cell).
+    storage: Box<dyn ProgramStorage>,
+    /// Program memory's capacity, bytes.
+    capacity: u64,
     run: Option<Run>,
     answered: VecDeque<CommandResult>,
     /// The last run id given; ids grow across restarts of the node (the shell starts them
@@ -181,6 +175,8 @@ impl RunCore {
             dialect,
             base,
             programs: BTreeMap::new(),
+            storage: Box::new(InRam),
+            capacity: u64::MAX,
             run: None,
             answered: VecDeque::with_capacity(ANSWERS_KEPT),
             run_counter: first_run_id,
@@ -197,6 +193,20 @@ impl RunCore {
             memory,
             effects: Vec::new(),
         }
+    }
+
+    /// This core with program memory: the programs it holds, where it keeps what is stored
+    /// in it, and its capacity in bytes.
+    pub fn with_program_memory(
+        mut self,
+        programs: BTreeMap<String, String>,
+        storage: Box<dyn ProgramStorage>,
+        capacity: u64,
+    ) -> Self {
+        self.programs = programs;
+        self.storage = storage;
+        self.capacity = capacity;
+        self
     }
 
     /// The effects asked for since the last call, in order.
@@ -387,7 +397,13 @@ impl RunCore {
                 let this_runs = self.run.as_ref().is_some_and(|r| r.program == c.program);
                 if this_runs && running {
                     Err(format!("{} is running: stop it first", c.program))
-                } else if self.programs.remove(&c.program).is_some() {
+                } else if self.programs.contains_key(&c.program) {
+                    if c.program != MDI_PROGRAM {
+                        self.storage
+                            .remove(&c.program)
+                            .map_err(|e| format!("{} not deleted: {e}", c.program))?;
+                    }
+                    self.programs.remove(&c.program);
                     Ok(format!("{} deleted", c.program))
                 } else {
                     Err(not_found(&c.program))
@@ -414,25 +430,23 @@ impl RunCore {
     }
 
     fn load(&mut self, name: &str, text: &str) -> Result<String, String> {
-        if !valid_program_name(name) {
+        let mut sizes = cnc_runtime::program_store::sizes(&self.programs);
+        // The MDI entry is the panel's, not a stored program: it takes no capacity.
+        sizes.remove(MDI_PROGRAM);
+        cnc_runtime::program_store::check_store(&sizes, name, text.len(), self.capacity)?;
+        if name == MDI_PROGRAM {
             return Err(format!(
-                "invalid program name {name:?}: letters, digits, '.', '_', '-', at most 64"
+                "{MDI_PROGRAM} is the MDI entry's name (decisions D43)"
             ));
-        }
-        if text.len() > MAX_PROGRAM_BYTES {
-            return Err(format!(
-                "program too large: {} bytes, limit {MAX_PROGRAM_BYTES}",
-                text.len()
-            ));
-        }
-        if self.programs.len() >= MAX_PROGRAMS && !self.programs.contains_key(name) {
-            return Err(format!("program memory full ({MAX_PROGRAMS} programs)"));
         }
         if self.run.as_ref().is_some_and(|r| r.program == name)
             && self.execution == MachineState::ACTIVE
         {
             return Err(format!("{name} is running"));
         }
+        self.storage
+            .store(name, text)
+            .map_err(|e| format!("{name} not stored: {e}"))?;
         let lines = text.lines().count();
         self.programs.insert(name.to_string(), text.to_string());
         Ok(format!("{name} stored ({lines} lines)"))
@@ -527,6 +541,15 @@ impl RunCore {
                             self.execution = MachineState::STOPPED;
                         }
                     }
+                }
+            }
+            if busy {
+                // Kept variables and offsets a block just set are stored now, not at the
+                // end of the run: a crash keeps what the program wrote (decisions D59).
+                let now = r.stream.interpreter().memory();
+                if now != self.memory {
+                    self.memory = now;
+                    self.effects.push(Effect::StoreMemory);
                 }
             }
             let complete = self.status.run_id == r.id && r.stream.completed(self.status.done_seq);

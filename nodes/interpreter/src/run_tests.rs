@@ -299,11 +299,15 @@ fn what_a_run_leaves_in_memory_is_stored_and_offsets_wait_for_a_stop() {
     );
     c.motion_status(status(0, 0, 16, MotionStatus::STATE_IDLE));
     c.step();
-    let last = blocks(&c.take_effects()).last().map(|b| b.seq).unwrap_or(0);
+    // Stored as soon as the block that sets it is interpreted, not at the end of the run:
+    // a crash before the end keeps what the program wrote (issue 26).
+    let effects = c.take_effects();
+    assert!(effects.contains(&Effect::StoreMemory), "{effects:?}");
+    assert_eq!(c.memory().kept.get(&200), Some(&7.0));
+    let last = blocks(&effects).last().map(|b| b.seq).unwrap_or(0);
     c.motion_status(status(1001, last, 16, MotionStatus::STATE_IDLE));
     c.step();
     assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
-    assert!(c.take_effects().contains(&Effect::StoreMemory));
     assert_eq!(c.memory().kept.get(&200), Some(&7.0));
     // The next run starts from it.
     command(
@@ -318,4 +322,95 @@ fn what_a_run_leaves_in_memory_is_stored_and_offsets_wait_for_a_stop() {
     c.step();
     let b = c.take_effects();
     assert_eq!(blocks(&b)[0].end.first(), Some(&70.0), "{b:?}");
+}
+
+/// Program memory in a folder as the core sees it: what it was asked to keep, or a disk
+/// that refuses.
+#[derive(Clone, Default)]
+struct Disk {
+    files: std::sync::Arc<std::sync::Mutex<BTreeMap<String, String>>>,
+    broken: bool,
+}
+
+impl cnc_runtime::program_store::ProgramStorage for Disk {
+    fn store(&mut self, name: &str, text: &str) -> Result<(), String> {
+        if self.broken {
+            return Err("No space left on device".into());
+        }
+        if let Ok(mut f) = self.files.lock() {
+            f.insert(name.into(), text.into());
+        }
+        Ok(())
+    }
+    fn remove(&mut self, name: &str) -> Result<(), String> {
+        if self.broken {
+            return Err("Read-only file system".into());
+        }
+        if let Ok(mut f) = self.files.lock() {
+            f.remove(name);
+        }
+        Ok(())
+    }
+}
+
+/// Issue 26: programs lived in RAM only, and 120 loads of 4 MiB were all taken. Program
+/// memory keeps what it stores, refuses what exceeds its capacity with alarm 70, and a
+/// program the disk did not take is not reported stored.
+#[test]
+fn program_memory_is_kept_bounded_by_its_capacity_and_a_failed_write_is_no_load() {
+    let disk = Disk::default();
+    let held: BTreeMap<String, String> = [("O0001".to_string(), "M30\n".to_string())].into();
+    let mut c = core().with_program_memory(held, Box::new(disk.clone()), 1000);
+    let r = command(&mut c, 1, ProgramCommand::LIST, "", "");
+    assert!(r.message.contains("O0001"), "{r:?}");
+    let r = command(
+        &mut c,
+        2,
+        ProgramCommand::LOAD,
+        "shafts/O0010.nc",
+        &"G0X1\n".repeat(100),
+    );
+    assert!(r.accepted, "{r:?}");
+    assert!(disk.files.lock().unwrap().contains_key("shafts/O0010.nc"));
+    let r = command(
+        &mut c,
+        3,
+        ProgramCommand::LOAD,
+        "big.nc",
+        &"G0X1\n".repeat(100),
+    );
+    assert!(!r.accepted && r.message.contains("alarm 70"), "{r:?}");
+    assert!(r.message.contains("of 1000 bytes free"), "{r:?}");
+    let r = command(&mut c, 4, ProgramCommand::LOAD, "../escape.nc", "M30\n");
+    assert!(
+        !r.accepted && r.message.contains("invalid program name"),
+        "{r:?}"
+    );
+    let r = command(&mut c, 5, ProgramCommand::DELETE, "shafts/O0010.nc", "");
+    assert!(r.accepted, "{r:?}");
+    assert!(disk.files.lock().unwrap().is_empty());
+    // Deleting made room.
+    assert!(
+        command(
+            &mut c,
+            6,
+            ProgramCommand::LOAD,
+            "big.nc",
+            &"G0X1\n".repeat(100)
+        )
+        .accepted
+    );
+
+    let broken = Disk {
+        broken: true,
+        ..Disk::default()
+    };
+    let mut c = core().with_program_memory(BTreeMap::new(), Box::new(broken), 1 << 20);
+    let r = command(&mut c, 1, ProgramCommand::LOAD, "part.nc", "M30\n");
+    assert!(!r.accepted && r.message.contains("No space left"), "{r:?}");
+    let r = command(&mut c, 2, ProgramCommand::LIST, "", "");
+    assert!(
+        !r.message.contains("part.nc"),
+        "not in memory either: {r:?}"
+    );
 }

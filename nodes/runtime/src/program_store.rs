@@ -70,6 +70,34 @@ pub fn check_store(
     Ok(())
 }
 
+/// Where program memory keeps what is stored in it: the interpreter's core calls it inside
+/// a load or a delete, so the answer says whether the program is kept.
+pub trait ProgramStorage: Send {
+    fn store(&mut self, name: &str, text: &str) -> Result<(), String>;
+    fn remove(&mut self, name: &str) -> Result<(), String>;
+}
+
+/// Program memory for this run of the cell only (no `machine.program_directory`).
+pub struct InRam;
+
+impl ProgramStorage for InRam {
+    fn store(&mut self, _: &str, _: &str) -> Result<(), String> {
+        Ok(())
+    }
+    fn remove(&mut self, _: &str) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+impl ProgramStorage for ProgramDir {
+    fn store(&mut self, name: &str, text: &str) -> Result<(), String> {
+        ProgramDir::store(self, name, text)
+    }
+    fn remove(&mut self, name: &str) -> Result<(), String> {
+        ProgramDir::remove(self, name)
+    }
+}
+
 /// The folder of one machine's programs.
 #[derive(Debug, Clone)]
 pub struct ProgramDir {

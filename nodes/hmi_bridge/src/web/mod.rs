@@ -15,7 +15,7 @@ use serde_json::{json, Value};
 
 use crate::access::Who;
 use crate::operation::Operation;
-use server::{Outbox, WebEvent, WebServer};
+use server::{Outbox, Payload, WebEvent, WebServer};
 use view::View;
 
 /// How often pages get a state frame.
@@ -134,7 +134,14 @@ impl WebHmi {
                     accepted,
                     message,
                 } => self.logins.push((client, operator, accepted, message)),
-                WebEvent::Request { id, client, text } => match protocol::parse(&text) {
+                WebEvent::Request {
+                    id,
+                    client,
+                    payload,
+                } => match match payload {
+                    Payload::Text(text) => protocol::parse(&text),
+                    Payload::Binary(data) => protocol::parse_binary(&data),
+                } {
                     (request, Ok(op)) => out.push((
                         Who::Web(client),
                         op.clone(),

@@ -17,6 +17,37 @@ pub fn parse(text: &str) -> (u64, Result<Operation, String>) {
     (id, operation(&value))
 }
 
+/// A page's binary request: a JSON header (`{"id": 7, "op": "load", "name": "O0001"}`), a zero
+/// byte, and the program's text unescaped, so a program up to the services' limit fits in one
+/// WebSocket message (JSON escaping once pushed a 4 MiB program over it, issue 26).
+pub fn parse_binary(data: &[u8]) -> (u64, Result<Operation, String>) {
+    let Some(split) = data.iter().position(|&b| b == 0) else {
+        return (
+            0,
+            Err("binary request without its zero byte after the header".into()),
+        );
+    };
+    let header: Value = match serde_json::from_slice(&data[..split]) {
+        Ok(v) => v,
+        Err(e) => return (0, Err(format!("binary request header is not JSON: {e}"))),
+    };
+    let id = header.get("id").and_then(Value::as_u64).unwrap_or(0);
+    if header.get("op").and_then(Value::as_str) != Some("load") {
+        return (
+            id,
+            Err("a binary request loads a program: op must be \"load\"".into()),
+        );
+    }
+    let name = match string(&header, "name") {
+        Ok(n) => n,
+        Err(e) => return (id, Err(e)),
+    };
+    match String::from_utf8(data[split + 1..].to_vec()) {
+        Ok(text) => (id, Ok(Operation::Load { name, text })),
+        Err(e) => (id, Err(format!("program text is not UTF-8: {e}"))),
+    }
+}
+
 fn string(v: &Value, key: &str) -> Result<String, String> {
     v.get(key)
         .and_then(Value::as_str)
@@ -166,5 +197,26 @@ mod tests {
             let err = parse(text).1.unwrap_err();
             assert!(err.contains(why), "{text}: {err}");
         }
+    }
+
+    #[test]
+    fn a_program_at_the_services_limit_fits_in_one_binary_message() {
+        let text = "(\"\")\n".repeat((cnc_runtime::MAX_PROGRAM_BYTES - 100) / 5);
+        let mut message = br#"{"id": 9, "op": "load", "name": "BIG.nc"}"#.to_vec();
+        message.push(0);
+        message.extend_from_slice(text.as_bytes());
+        let max = crate::web::server::MAX_MESSAGE;
+        assert!(message.len() <= max);
+        let escaped = serde_json::to_string(&text).unwrap();
+        assert!(escaped.len() > max, "JSON would not fit: {}", escaped.len());
+        match parse_binary(&message) {
+            (9, Ok(Operation::Load { name, text: t })) => assert!(name == "BIG.nc" && t == text),
+            (id, other) => panic!("{id}: {other:?}"),
+        }
+        assert!(parse_binary(b"{\"op\": \"start\"}\0x").1.is_err());
+        assert!(parse_binary(b"{\"op\": \"load\", \"name\": \"a\"}\0\xff")
+            .1
+            .is_err());
+        assert!(parse_binary(b"no zero byte").1.is_err());
     }
 }

@@ -17,10 +17,18 @@ use tungstenite::{Message, WebSocket};
 use super::assets;
 use super::login::{session_cookie, Gate};
 
+/// What a page sent: a JSON request, or a binary one (a JSON header, a zero byte, the
+/// program's text as it is).
+#[derive(Debug)]
+pub enum Payload {
+    Text(String),
+    Binary(Vec<u8>),
+}
+
 /// The longest request head accepted (request line and headers).
 const MAX_HEAD: usize = 16 * 1024;
-/// The longest message a page may send (an MDI entry, an offset row; not programs, which are
-/// loaded through the same 4 MiB limit as the services).
+/// The longest message a page may send: a program as large as the services take, sent as a
+/// binary message (its text unescaped, [`super::protocol::parse_binary`]), and its header.
 pub const MAX_MESSAGE: usize = cnc_runtime::MAX_PROGRAM_BYTES + 64 * 1024;
 
 /// Connections served at once; more are answered 503 and closed, so a client that opens
@@ -47,11 +55,11 @@ pub enum WebEvent {
         client: String,
         outbox: Outbox,
     },
-    /// A page sent a text message.
+    /// A page sent a message: JSON text, or a binary program load.
     Request {
         id: u64,
         client: String,
-        text: String,
+        payload: Payload,
     },
     Closed {
         id: u64,
@@ -487,7 +495,14 @@ fn pump(
                 let _ = events.send(WebEvent::Request {
                     id,
                     client: client.to_string(),
-                    text: text.to_string(),
+                    payload: Payload::Text(text.to_string()),
+                });
+            }
+            Ok(Message::Binary(data)) => {
+                let _ = events.send(WebEvent::Request {
+                    id,
+                    client: client.to_string(),
+                    payload: Payload::Binary(data.to_vec()),
                 });
             }
             Ok(Message::Close(_)) => return Ok(()),
