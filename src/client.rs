@@ -15,6 +15,8 @@ pub struct CellClient {
     ros: RosNode,
     mapping: ServiceMapping,
     namespace: String,
+    /// How long a service call waits for its reply.
+    timeout: Duration,
     load: Client<LoadProgramRequest, LoadProgramResponse>,
     start: Client<StartProgramRequest, StartProgramResponse>,
     stop: Client<StopRequest, StopResponse>,
@@ -88,6 +90,7 @@ impl CellClient {
             ros,
             mapping,
             namespace: ns.into(),
+            timeout: Duration::from_secs(20),
             state: None,
             spindle: None,
             part_count: None,
@@ -95,6 +98,13 @@ impl CellClient {
             axes: None,
             servo_stats: None,
         })
+    }
+
+    /// This client with service calls that wait at most `timeout` for their reply (default
+    /// 20 s).
+    pub fn with_timeout(mut self, timeout: Duration) -> Self {
+        self.timeout = timeout;
+        self
     }
 
     /// Waits until the machine reports a state other than WAIT (the interpreter knows where the
@@ -145,6 +155,7 @@ impl CellClient {
 
     pub fn load_program(&mut self, name: &str, text: &str) -> Result<LoadProgramResponse, String> {
         call(
+            self.timeout,
             &self.load,
             LoadProgramRequest {
                 name: name.into(),
@@ -153,25 +164,33 @@ impl CellClient {
         )
     }
     pub fn start_program(&mut self, name: &str) -> Result<StartProgramResponse, String> {
-        call(&self.start, StartProgramRequest { name: name.into() })
+        call(
+            self.timeout,
+            &self.start,
+            StartProgramRequest { name: name.into() },
+        )
     }
     pub fn stop(&mut self, mode: u8) -> Result<StopResponse, String> {
-        call(&self.stop, StopRequest { mode })
+        call(self.timeout, &self.stop, StopRequest { mode })
     }
     pub fn reset(&mut self) -> Result<ResetResponse, String> {
-        call(&self.reset, ResetRequest::default())
+        call(self.timeout, &self.reset, ResetRequest::default())
     }
 
     /// A robot handshake request (`RobotRequestRequest::DOOR_OPEN` …).
     pub fn robot_request(&mut self, request: u8) -> Result<RobotRequestResponse, String> {
-        call(&self.robot, RobotRequestRequest { request })
+        call(self.timeout, &self.robot, RobotRequestRequest { request })
     }
 
     pub fn list_programs(&mut self) -> Result<ListProgramsResponse, String> {
-        call(&self.list, ListProgramsRequest::default())
+        call(self.timeout, &self.list, ListProgramsRequest::default())
     }
     pub fn delete_program(&mut self, name: &str) -> Result<DeleteProgramResponse, String> {
-        call(&self.delete, DeleteProgramRequest { name: name.into() })
+        call(
+            self.timeout,
+            &self.delete,
+            DeleteProgramRequest { name: name.into() },
+        )
     }
 
     pub fn set_overrides(
@@ -181,6 +200,7 @@ impl CellClient {
         rapid_percent: u8,
     ) -> Result<SetOverridesResponse, String> {
         call(
+            self.timeout,
             &self.overrides,
             SetOverridesRequest {
                 feed_percent,
@@ -201,6 +221,7 @@ impl CellClient {
         let ns = self.namespace.clone();
         Ok(ServiceClient {
             client: client::<S>(&mut self.ros, self.mapping, &ns, service)?,
+            timeout: self.timeout,
         })
     }
 }
@@ -208,21 +229,23 @@ impl CellClient {
 /// One service of the cell; see [`CellClient::service`].
 pub struct ServiceClient<S: RosService> {
     client: Client<S::Request, S::Response>,
+    timeout: Duration,
 }
 
 impl<S: RosService> ServiceClient<S> {
     pub fn call(&self, request: S::Request) -> Result<S::Response, String> {
-        call(&self.client, request)
+        call(self.timeout, &self.client, request)
     }
 }
 
 /// Calls a service. A request sent before discovery has matched the server is lost, so it is
 /// repeated every second (at most 3 copies); the first reply to any copy is the answer.
 fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
+    timeout: Duration,
     client: &Client<Req, Resp>,
     req: Req,
 ) -> Result<Resp, String> {
-    let deadline = Instant::now() + Duration::from_secs(20);
+    let deadline = Instant::now() + timeout;
     let mut ids = Vec::new();
     let mut last_send: Option<Instant> = None;
     while Instant::now() < deadline {

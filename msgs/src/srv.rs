@@ -101,6 +101,8 @@ ros_message! {
         consts {}
         names: Vec<String>,
         sizes: Vec<u64>,
+        accepted: bool,
+        message: String,
     }
 }
 ros_message! {
@@ -212,6 +214,8 @@ ros_message! {
         names: Vec<String>,
         values: Vec<String>,
         pending: Vec<String>,
+        accepted: bool,
+        message: String,
     }
 }
 ros_message! {
@@ -369,12 +373,22 @@ refusable!(
     AcknowledgeAlarmResponse
 );
 
-impl GetOffsetsResponse {
-    pub fn refused(message: String) -> Self {
-        GetOffsetsResponse {
-            accepted: false,
-            message,
-            ..Default::default()
+macro_rules! refusable_with_data {
+    ($($resp:ident),*) => {$(
+        impl $resp {
+            pub fn refused(message: String) -> Self {
+                $resp {
+                    accepted: false,
+                    message,
+                    ..Default::default()
+                }
+            }
         }
-    }
+    )*};
 }
+
+refusable_with_data!(
+    GetOffsetsResponse,
+    ListProgramsResponse,
+    GetParametersResponse
+);

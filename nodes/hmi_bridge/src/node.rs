@@ -98,7 +98,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         .refusing(StopResponse::refused);
     let reset = DualServer::<Reset>::new(&participant, &ns, "reset", sq.clone())?
         .refusing(ResetResponse::refused);
-    let list = DualServer::<ListPrograms>::new(&participant, &ns, "list_programs", sq.clone())?;
+    let list = DualServer::<ListPrograms>::new(&participant, &ns, "list_programs", sq.clone())?
+        .refusing(ListProgramsResponse::refused);
     let delete = DualServer::<DeleteProgram>::new(&participant, &ns, "delete_program", sq.clone())?
         .refusing(DeleteProgramResponse::refused);
     let overrides_srv =
@@ -118,7 +119,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         DualServer::<SetWorkOffset>::new(&participant, &ns, "set_work_offset", sq.clone())?
             .refusing(SetWorkOffsetResponse::refused);
     let get_parameters_srv =
-        DualServer::<GetParameters>::new(&participant, &ns, "get_parameters", sq.clone())?;
+        DualServer::<GetParameters>::new(&participant, &ns, "get_parameters", sq.clone())?
+            .refusing(GetParametersResponse::refused);
     let set_parameter_srv =
         DualServer::<SetParameter>::new(&participant, &ns, "set_parameter", sq.clone())?
             .refusing(SetParameterResponse::refused);
@@ -416,12 +418,17 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         if let Some(r) = list.receive() {
             let (accepted, text) = perform(Operation::List, &Who::Dds(r.writer));
-            let mut response = ListProgramsResponse::default();
+            let mut response = ListProgramsResponse {
+                accepted,
+                ..Default::default()
+            };
             if accepted {
                 for (name, size) in crate::operation::program_list(&text) {
                     response.names.push(name);
                     response.sizes.push(size);
                 }
+            } else {
+                response.message = text;
             }
             answer(&list, &r, &response);
         }
@@ -494,12 +501,19 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         if let Some(r) = get_parameters_srv.receive() {
             let prefix = r.request.prefix.clone();
-            let (_, text) = perform(Operation::Parameters { prefix }, &Who::Dds(r.writer));
-            let mut response = GetParametersResponse::default();
-            for (name, value, pending) in crate::operation::parameter_rows(&text) {
-                response.names.push(name);
-                response.values.push(value);
-                response.pending.push(pending);
+            let (accepted, text) = perform(Operation::Parameters { prefix }, &Who::Dds(r.writer));
+            let mut response = GetParametersResponse {
+                accepted,
+                ..Default::default()
+            };
+            if accepted {
+                for (name, value, pending) in crate::operation::parameter_rows(&text) {
+                    response.names.push(name);
+                    response.values.push(value);
+                    response.pending.push(pending);
+                }
+            } else {
+                response.message = text;
             }
             answer(&get_parameters_srv, &r, &response);
         }

@@ -88,8 +88,8 @@ pub fn load_memory(cfg: &LaunchConfig) -> (Memory, Option<String>) {
     }
 }
 
-/// Writes the machine memory: to a temporary file, then renamed over the old one, so a
-/// power cut leaves either the old or the new memory.
+/// Writes the machine memory durably (temporary file, fsync, rename, fsync of the folder), so
+/// a power cut leaves either the old or the new memory.
 pub fn save_memory(path: &std::path::Path, memory: &Memory) -> Result<(), String> {
     let text = serde_yaml::to_string(memory).map_err(|e| e.to_string())?;
     cnc_runtime::persist::write_atomic(path, &text)
@@ -113,12 +113,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     if let Some(e) = memory_error {
         log::error!("interpreter: machine memory not read, using the config's offsets: {e}");
     }
-    // Kept variables and offsets are written at every change, on a thread of their own.
-    let mut memory_keeper = cfg
-        .machine
-        .memory_file
-        .clone()
-        .map(|p| cnc_runtime::persist::Keeper::new(p, "machine memory"));
+    let memory_path = cfg.machine.memory_file.clone();
     // Run ids grow across restarts of this node.
     let base = setup_from_config(&cfg, &cfg.home());
     let capacity = cfg.machine.program_capacity_kib.saturating_mul(1024);
@@ -151,7 +146,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         last: None,
         last_ns: 0,
     };
-    let mut carry_out = |core: &mut RunCore| {
+    let carry_out = |core: &mut RunCore| {
         for effect in core.take_effects() {
             match effect {
                 Effect::Block(msg) => {
@@ -172,12 +167,10 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                 }
                 Effect::Clear(number) => alarms.clear(number),
                 Effect::StoreMemory => {
-                    if let Some(keeper) = memory_keeper.as_mut() {
-                        match serde_yaml::to_string(core.memory()) {
-                            Ok(text) => {
-                                keeper.keep(text.into_bytes());
-                            }
-                            Err(e) => log::error!("interpreter: machine memory not stored: {e}"),
+                    // Durable before the blocks that follow are published (write ahead).
+                    if let Some(p) = memory_path.as_deref() {
+                        if let Err(e) = save_memory(p, core.memory()) {
+                            log::error!("interpreter: machine memory not stored: {e}");
                         }
                     }
                 }
@@ -217,8 +210,6 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     }
     core.shutdown();
     carry_out(&mut core);
-    // Dropping the keeper writes what is still pending.
-    drop(memory_keeper);
     Ok(())
 }
 

@@ -116,7 +116,8 @@ pub enum Effect {
     },
     /// Clear the interpreter's alarm of this number.
     Clear(u32),
-    /// The machine memory changed: store [`RunCore::memory`].
+    /// The machine memory changed: store [`RunCore::memory`], durably, before carrying out
+    /// the effects after it.
     StoreMemory,
 }
 
@@ -504,6 +505,7 @@ impl RunCore {
             } else {
                 0
             };
+            let batch_start = self.effects.len();
             if !r.failed {
                 let (id, program) = (r.id, r.program.clone());
                 let effects = &mut self.effects;
@@ -544,12 +546,13 @@ impl RunCore {
                 }
             }
             if busy {
-                // Kept variables and offsets a block just set are stored now, not at the
-                // end of the run: a crash keeps what the program wrote (decisions D59).
+                // Kept variables and offsets these blocks set are stored before the blocks go
+                // to motion (write ahead): nothing a block did is seen, a counted part
+                // included, before what it wrote is kept (decisions D59).
                 let now = r.stream.interpreter().memory();
                 if now != self.memory {
                     self.memory = now;
-                    self.effects.push(Effect::StoreMemory);
+                    self.effects.insert(batch_start, Effect::StoreMemory);
                 }
             }
             let complete = self.status.run_id == r.id && r.stream.completed(self.status.done_seq);

@@ -601,9 +601,13 @@ impl Writer {
     } else {
       0
     };
+    // A submessage's length field (octetsToNextHeader) is 16 bits: a DATA submessage
+    // with its inline QoS must stay below 64 KiB however large the path's datagrams are
+    // (loopback's MTU is 64 KiB), or its length wraps and the message is malformed.
     budget
       .saturating_sub(hb_reserve)
       .saturating_sub(DATA_SUBMESSAGE_OVERHEAD)
+      .min(MAX_UNFRAGMENTED_PAYLOAD)
   }
 
   fn num_frags_and_frag_size(&self, payload_size: usize) -> (u32, u16) {
@@ -3050,3 +3054,7 @@ mod tests {
     }
   }
 }
+
+/// The largest payload sent in one DATA submessage: 64 KiB less room for the submessage's
+/// own header fields and inline QoS, so its 16-bit length never wraps.
+const MAX_UNFRAGMENTED_PAYLOAD: usize = u16::MAX as usize - 1024;

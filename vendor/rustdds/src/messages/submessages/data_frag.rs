@@ -87,7 +87,7 @@ impl DataFrag {
     2 + // fragmentsInSubmessage
     2 + // fragmentSize
     4 + // sampleSize
-    self.inline_qos.as_ref().map(|q| q.len_serialized() ).unwrap_or(0) + // QoS ParameterList
+    self.inline_qos.as_ref().filter(|q| !q.parameters.is_empty()).map(|q| q.len_serialized()).unwrap_or(0) + // QoS ParameterList, as written
     self.serialized_payload.len()
   }
 
@@ -301,8 +301,11 @@ impl<C: Context> Writable<C> for DataFrag {
     writer.write_value(&self.fragments_in_submessage)?;
     writer.write_value(&self.fragment_size)?;
     writer.write_value(&self.data_size)?;
-    if self.inline_qos.is_some() && !self.inline_qos.as_ref().unwrap().parameters.is_empty() {
-      writer.write_value(&self.inline_qos)?;
+    // The parameter list itself: writing the Option would add speedy's one-byte tag, which
+    // len_serialized does not count (a reply large enough to be fragmented, with its related
+    // sample identity as inline QoS, then had a wrong length; found by tests/bounded_inputs.rs).
+    if let Some(qos) = self.inline_qos.as_ref().filter(|q| !q.parameters.is_empty()) {
+      writer.write_value(qos)?;
     }
     writer.write_bytes(&self.serialized_payload)?;
     Ok(())
