@@ -183,7 +183,12 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         if let Some(msg) = parts.update(&plc, &fi, now_s, scans.is_multiple_of(500)) {
             held_parts = Some((msg, kept_version));
         }
-        let durable = keeper.as_ref().map_or(0, |k| k.durable());
+        // A disk that refuses the write (logged as an error) does not hold the count back.
+        let durable =
+            keeper.as_ref().map_or(
+                u64::MAX,
+                |k| if k.failing() { u64::MAX } else { k.durable() },
+            );
         if let Some((msg, _)) = held_parts.take_if(|(_, v)| *v <= durable) {
             let _ = parts_pub.publish(msg);
         }

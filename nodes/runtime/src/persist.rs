@@ -58,6 +58,8 @@ pub fn remove_durable(path: &Path) -> Result<(), String> {
 pub struct Keeper {
     to_writer: Option<mpsc::Sender<(u64, Vec<u8>)>>,
     written: Arc<AtomicU64>,
+    /// The last write failed (logged): what waits for the disk should not wait forever.
+    failing: Arc<std::sync::atomic::AtomicBool>,
     given: u64,
     writer: Option<std::thread::JoinHandle<()>>,
 }
@@ -68,6 +70,8 @@ impl Keeper {
         let (tx, rx) = mpsc::channel::<(u64, Vec<u8>)>();
         let written = Arc::new(AtomicU64::new(0));
         let done = written.clone();
+        let failing = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let failed = failing.clone();
         let writer = std::thread::Builder::new()
             .name(format!("keep {what}"))
             .spawn(move || {
@@ -76,8 +80,14 @@ impl Keeper {
                         next = newer;
                     }
                     match write_durable(&path, &next.1) {
-                        Ok(()) => done.store(next.0, Ordering::Release),
-                        Err(e) => log::error!("{what} not kept: {e}"),
+                        Ok(()) => {
+                            done.store(next.0, Ordering::Release);
+                            failed.store(false, Ordering::Release);
+                        }
+                        Err(e) => {
+                            log::error!("{what} not kept: {e}");
+                            failed.store(true, Ordering::Release);
+                        }
                     }
                 }
             })
@@ -85,6 +95,7 @@ impl Keeper {
         Keeper {
             to_writer: Some(tx),
             written,
+            failing,
             given: 0,
             writer,
         }
@@ -102,6 +113,11 @@ impl Keeper {
     /// The newest version on the disk (0: none yet).
     pub fn durable(&self) -> u64 {
         self.written.load(Ordering::Acquire)
+    }
+
+    /// Whether the last write failed (it was logged).
+    pub fn failing(&self) -> bool {
+        self.failing.load(Ordering::Acquire)
     }
 
     /// The newest version handed over.
