@@ -109,6 +109,13 @@ class Peer:
             w = DataWriter(self.dp, Topic(self.dp, f"rq/{self.ns}/{service}Request", req_t), qos=SERVICE)
             r = DataReader(self.dp, Topic(self.dp, f"rr/{self.ns}/{service}Reply", resp_t), qos=SERVICE)
             self.services[service] = (req_t, w, r)
+            # A request sent before the server's reader matched is lost, and a reply sent before
+            # its writer matched our reader too: a repeated start would then be answered "a
+            # program is running" although the first copy started it. Wait for both matches.
+            until = time.time() + 10.0
+            while time.time() < until and not (w.get_matched_subscriptions() and r.get_matched_publications()):
+                time.sleep(0.02)
+            time.sleep(0.3)  # the server's side of the same discovery
         req_t, w, r = self.services[service]
         sent = []
         deadline = time.time() + timeout

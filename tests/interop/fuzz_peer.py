@@ -83,6 +83,9 @@ def main():
     r = peer.call("load_program", "LoadProgram", name="part.nc",
                   text="G00 X60 Z5\nS800 M03\nG01 X50 F600\nZ-10\nG00 X60\nM05\nM30\n")
     check(r.accepted, f"a program to start: {r.message}")
+    guard_text = "O0999\nG00 X100\nM30\n"
+    r = peer.call("load_program", "LoadProgram", name="guard.nc", text=guard_text)
+    check(r.accepted, f"a program no fuzzed name can reach: {r.message}")
 
     srv_dir = peer.ifc.root / "srv"
     services = sorted(p.stem for p in srv_dir.glob("*.srv"))
@@ -127,7 +130,9 @@ def main():
     check(not unnamed, f"every refusal says why, naming the field: {unnamed[:5]}")
     check(not out_of_limits, f"nothing outside the ratings reached motion: {out_of_limits[:5]}")
     r = peer.call("list_programs", "ListPrograms", structure_needs_at_least_one_member=0)
-    check("part.nc" in r.names, "the cell still answers, its program memory intact")
+    kept = dict(zip(r.names, r.sizes))
+    check(r.accepted and kept.get("guard.nc") == len(guard_text),
+          "the cell still answers, its program memory intact")
     return session.exit_code()
 
 
