@@ -4,25 +4,12 @@
 
 mod common;
 
-use cnc::cell::Cell;
-
 /// 2,000 service requests in a burst while a program runs: each gets one reply, answered or
 /// refused ("busy" when a service's queue is full), counted by the peer; the program still
 /// runs to its end. Before the change, 1,885 of 2,000 got no answer at all.
 #[test]
 fn a_burst_of_two_thousand_requests_is_each_answered_or_refused() {
-    let cfg = common::sim_lathe(70);
-    let cell = Cell::start(&cfg).unwrap();
-    let out = common::cyclone_peer("burst_peer.py", 70);
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    println!("{stdout}");
-    assert!(
-        out.status.success(),
-        "burst_peer.py failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let (_, errors) = cell.stop();
-    assert!(errors.is_empty(), "{errors:?}");
+    common::peer_against_cell(&common::sim_lathe(70), "burst_peer.py");
 }
 
 /// Every service and the client input topic with random, extreme and non-finite values: every
@@ -38,17 +25,7 @@ fn fuzzed_services_and_inputs_never_take_the_machine_outside_its_ratings() {
     let dir = std::env::temp_dir().join(format!("cnc_fuzz_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     cfg.machine.parameter_file = Some(dir.join("parameters.yaml"));
-    let cell = Cell::start(&cfg).unwrap();
-    let out = common::cyclone_peer("fuzz_peer.py", 72);
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    println!("{stdout}");
-    assert!(
-        out.status.success(),
-        "fuzz_peer.py failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let (_, errors) = cell.stop();
-    assert!(errors.is_empty(), "{errors:?}");
+    common::peer_against_cell(&cfg, "fuzz_peer.py");
     // What was written still loads: the machine starts again on it.
     let written = cnc_runtime::parameters::load_file(&dir.join("parameters.yaml")).unwrap();
     cnc_runtime::parameters::apply(common::sim_lathe(72), &written).expect("written values apply");

@@ -5,24 +5,10 @@
 
 mod common;
 
-use cnc::cell::Cell;
-
-/// Runs `tests/interop/<script>` with the venv's Python against a cell in `domain`; returns
-/// its output after checking it passed.
+/// Runs `tests/interop/<script>` against a cell in `domain`; returns its output after checking
+/// it passed.
 fn run_peer(script: &str, domain: u16) -> String {
-    let cfg = common::sim_lathe(domain);
-    let cell = Cell::start(&cfg).unwrap();
-    let out = common::cyclone_peer(script, domain);
-    let (_, errors) = cell.stop();
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    println!("{stdout}");
-    assert!(
-        out.status.success(),
-        "{script} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(errors.is_empty(), "{errors:?}");
-    stdout
+    common::peer_against_cell(&common::sim_lathe(domain), script)
 }
 
 #[test]

@@ -344,14 +344,17 @@ service!(
     AcknowledgeAlarmResponse
 );
 
-/// Answers of the services that say yes or no with a reason: `refused(why)` is the no.
+/// Answers of the services that say yes or no with a reason: `refused(why)` is the no (any
+/// data the answer carries left empty).
 macro_rules! refusable {
     ($($resp:ident),*) => {$(
         impl $resp {
+            #[allow(clippy::needless_update)] // most answers are only `accepted` and `message`
             pub fn refused(message: String) -> Self {
                 $resp {
                     accepted: false,
                     message,
+                    ..Default::default()
                 }
             }
         }
@@ -370,24 +373,7 @@ refusable!(
     SetModeResponse,
     MdiResponse,
     SetParameterResponse,
-    AcknowledgeAlarmResponse
-);
-
-macro_rules! refusable_with_data {
-    ($($resp:ident),*) => {$(
-        impl $resp {
-            pub fn refused(message: String) -> Self {
-                $resp {
-                    accepted: false,
-                    message,
-                    ..Default::default()
-                }
-            }
-        }
-    )*};
-}
-
-refusable_with_data!(
+    AcknowledgeAlarmResponse,
     GetOffsetsResponse,
     ListProgramsResponse,
     GetParametersResponse

@@ -46,6 +46,33 @@ pub fn cyclone_peer(script: &str, domain: u16) -> std::process::Output {
         .expect("python runs")
 }
 
+/// Runs `tests/interop/<script>` as [`cyclone_peer`] does, prints what it printed and fails the
+/// calling test unless the peer passed; returns its output.
+#[allow(dead_code)]
+pub fn passing_peer(script: &str, domain: u16) -> String {
+    let out = cyclone_peer(script, domain);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    println!("{stdout}");
+    assert!(
+        out.status.success(),
+        "{script} failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// Starts the cell of `cfg`, runs a [`passing_peer`] on its domain, stops the cell and fails
+/// if any node ended with an error (a panic included); returns the peer's output.
+#[allow(dead_code)]
+pub fn peer_against_cell(cfg: &LaunchConfig, script: &str) -> String {
+    let domain = cfg.network.domain_id.expect("a test's own domain");
+    let cell = cnc::cell::Cell::start(cfg).expect("the cell starts");
+    let stdout = passing_peer(script, domain);
+    let (_, errors) = cell.stop();
+    assert!(errors.is_empty(), "{errors:?}");
+    stdout
+}
+
 /// A node outside the machine that follows `/lathe1/command_events`, as an auditor would.
 #[allow(dead_code)]
 pub struct Auditor {

@@ -3,10 +3,10 @@
 //!
 //! No request goes unanswered by silence (issue 26): requests are taken from DDS as they come
 //! (a reader history of [`READER_DEPTH`]) into a queue of [`QUEUE_LIMIT`]; one that finds the
-//! queue full is answered at once with a refusal that says "busy" (services whose response
-//! has no room for a reason count and log it).
+//! queue full is answered at once with a refusal that says "busy" (a service whose response
+//! has no room for a reason logs it).
 
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::marker::PhantomData;
 
@@ -65,8 +65,6 @@ pub struct DualServer<S: RosService> {
     /// what was wrong.
     malformed: RefCell<Vec<([u8; 16], String)>>,
     queue: RefCell<VecDeque<Request<S::Request>>>,
-    /// Requests refused as busy (or, without a way to say so, dropped) since the start.
-    busy: Cell<u64>,
     _service: PhantomData<S>,
 }
 
@@ -130,7 +128,6 @@ where
             refuse: None,
             malformed: RefCell::new(Vec::new()),
             queue: RefCell::new(VecDeque::new()),
-            busy: Cell::new(0),
             _service: PhantomData,
         })
     }
@@ -163,7 +160,6 @@ where
                 continue;
             }
             drop(queue);
-            self.busy.set(self.busy.get() + 1);
             let why = format!(
                 "busy: {QUEUE_LIMIT} {} requests are waiting; try again",
                 self.name
@@ -177,11 +173,6 @@ where
                 None => log::warn!("{why} (dropped: the response cannot say so)"),
             }
         }
-    }
-
-    /// Requests refused as busy since the start.
-    pub fn busy_count(&self) -> u64 {
-        self.busy.get()
     }
 
     /// The next request DDS holds. Undecodable requests are logged and dropped: without a valid

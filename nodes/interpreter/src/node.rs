@@ -15,7 +15,7 @@ use cnc_msgs::msg::{
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{stamp, RosNode};
-use cnc_runtime::program_store::ProgramDir;
+use cnc_runtime::program_store::{InRam, ProgramDir, ProgramStorage};
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
@@ -117,30 +117,25 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     // Run ids grow across restarts of this node.
     let base = setup_from_config(&cfg, &cfg.home());
     let capacity = cfg.machine.program_capacity_kib.saturating_mul(1024);
-    let mut core = match &cfg.machine.program_directory {
-        Some(dir) => {
-            let dir = ProgramDir::new(dir);
-            let (programs, problems) = dir.read_all();
-            for p in problems {
-                log::error!("interpreter: program memory: {p}");
+    let (programs, storage): (BTreeMap<String, String>, Box<dyn ProgramStorage>) =
+        match &cfg.machine.program_directory {
+            Some(dir) => {
+                let dir = ProgramDir::new(dir);
+                let (programs, problems) = dir.read_all();
+                for p in problems {
+                    log::error!("interpreter: program memory: {p}");
+                }
+                log::info!(
+                    "interpreter: program memory {}: {} programs",
+                    dir.root.display(),
+                    programs.len()
+                );
+                (programs, Box::new(dir))
             }
-            log::info!(
-                "interpreter: program memory {}: {} programs",
-                dir.root.display(),
-                programs.len()
-            );
-            RunCore::new(dialect, base, memory, monotonic_ns() / 1000).with_program_memory(
-                programs,
-                Box::new(dir),
-                capacity,
-            )
-        }
-        None => RunCore::new(dialect, base, memory, monotonic_ns() / 1000).with_program_memory(
-            Default::default(),
-            Box::new(cnc_runtime::program_store::InRam),
-            capacity,
-        ),
-    };
+            None => (BTreeMap::new(), Box::new(InRam)),
+        };
+    let mut core = RunCore::new(dialect, base, memory, monotonic_ns() / 1000)
+        .with_program_memory(programs, storage, capacity);
     let mut state = StateReporter {
         publisher: state_pub,
         last: None,

@@ -141,6 +141,25 @@ impl Memory {
         }
     }
 
+    /// Whether `r` is what this memory retains now, compared in place: the scan asks every
+    /// time, so it must not build a [`Retained`] to find out.
+    pub fn retains(&self, r: &Retained) -> bool {
+        self.table(Space::K) == r.k.as_slice()
+            && self.table(Space::D) == r.d.as_slice()
+            && r.timer_presets.len() == TIMERS as usize
+            && r.counter_presets.len() == COUNTERS as usize
+            && r.timer_presets.iter().all(|(n, v)| {
+                self.timers
+                    .get(*n as usize)
+                    .is_some_and(|t| t.preset_ms == *v)
+            })
+            && r.counter_presets.iter().all(|(n, v)| {
+                self.counters
+                    .get(*n as usize)
+                    .is_some_and(|c| c.preset == *v)
+            })
+    }
+
     /// Restores what a previous run kept; sizes that do not match are cut or padded.
     pub fn restore(&mut self, r: &Retained) {
         for (space, data) in [(Space::K, &r.k), (Space::D, &r.d)] {
@@ -172,4 +191,37 @@ pub struct Retained {
     pub timer_presets: BTreeMap<u16, u32>,
     #[serde(default)]
     pub counter_presets: BTreeMap<u16, i64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn retains_tells_a_change_of_what_is_kept_and_only_that() {
+        let mut m = Memory::default();
+        let kept = m.retained();
+        assert!(m.retains(&kept));
+        // A relay that is not kept changes nothing kept.
+        m.set_byte(
+            ByteAddr {
+                space: Space::R,
+                index: 3,
+            },
+            7,
+        );
+        assert!(m.retains(&kept));
+        m.set_byte(
+            ByteAddr {
+                space: Space::D,
+                index: 100,
+            },
+            1,
+        );
+        assert!(!m.retains(&kept));
+        let kept = m.retained();
+        m.counters[2].preset = 5;
+        assert!(!m.retains(&kept));
+        assert!(m.retains(&m.retained()));
+    }
 }

@@ -169,8 +169,8 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         let now_s = (monotonic_ns() - t0) as f64 * 1e-9;
         let kept_version = match keeper.as_mut() {
             Some(k) => {
-                let now = plc.retained();
-                if saved.as_ref() != Some(&now) {
+                if !saved.as_ref().is_some_and(|s| plc.retains(s)) {
+                    let now = plc.retained();
                     if let Ok(text) = serde_yaml::to_string(&now) {
                         k.keep(text.into_bytes());
                     }

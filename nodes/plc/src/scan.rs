@@ -159,6 +159,10 @@ impl Plc {
     pub fn retained(&self) -> Retained {
         self.mem.retained()
     }
+    /// Whether `r` is what the PLC retains now ([`crate::memory::Memory::retains`]).
+    pub fn retains(&self, r: &Retained) -> bool {
+        self.mem.retains(r)
+    }
     pub fn fault(&self) -> Option<&str> {
         self.fault.as_deref()
     }

@@ -1,0 +1,306 @@
+//! The machine section: axes, offset pages, kept-memory and program files, dialect.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MachineConfig {
+    /// ROS 2 namespace of every topic and service, e.g. `lathe1` → `/lathe1/spindle`.
+    pub namespace: String,
+    /// Program dialect: one of [`DIALECTS`].
+    pub dialect: String,
+    pub axes: Vec<AxisEntry>,
+    /// Arc plane as (horizontal, vertical) axis names; G02 is clockwise seen this way.
+    #[serde(default = "default_arc_plane")]
+    pub arc_plane: [String; 2],
+    /// Where the turret sits: `rear` (behind the spindle axis, X up in the drawing) or
+    /// `front` (toward the operator). G41/G42 swap sides with it (`000` §6.1, decision D30).
+    #[serde(default)]
+    pub tool_post: ToolPost,
+    /// The offset page: tool offsets by offset number (T0101 → 1; on the mill H/D 1–200).
+    #[serde(default)]
+    pub tools: BTreeMap<u32, ToolEntry>,
+    /// A mill tool table file (`number length_mm diameter_mm` per line, [`crate::tool_table`]),
+    /// relative to the config file's folder; its entries join `tools` when the config loads.
+    #[serde(default)]
+    pub tool_table: Option<std::path::PathBuf>,
+    /// Work offsets by code (`G54`…`G59`; on GTC2E the offset groups of G54–G57), per axis.
+    #[serde(default)]
+    pub work_offsets: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Where the kept variables (#200–#289) and the offset page as programs leave them are
+    /// stored (YAML, relative to the config file's folder); absent: kept for this run of the
+    /// cell only.
+    #[serde(default)]
+    pub memory_file: Option<std::path::PathBuf>,
+    /// Program memory: a folder of plain program files, relative to the config file's
+    /// folder ([`crate::program_store`]); absent: programs are kept for this run only.
+    #[serde(default)]
+    pub program_directory: Option<std::path::PathBuf>,
+    /// The program memory's capacity in KiB (all programs together; alarm 70 when full).
+    #[serde(default = "default_program_capacity")]
+    pub program_capacity_kib: u64,
+    /// Huaxing S#170: a T word calls this program (O number, 1–9999) as the tool-change
+    /// macro; absent: T goes to the PLC.
+    #[serde(default)]
+    pub tool_change_macro: Option<u32>,
+    /// Where parameters written from the cell (SetParameter) are stored; they are applied over
+    /// this file at start (decisions D44), relative to the config file's folder. Absent:
+    /// parameters cannot be written.
+    #[serde(default)]
+    pub parameter_file: Option<std::path::PathBuf>,
+    /// How far a lathe roughing contour (G71/G72) may leave its start point or turn back
+    /// before the cycle is refused, mm (Huaxing GS#33).
+    #[serde(default = "default_contour_tolerance")]
+    pub contour_tolerance: f64,
+    /// How a number without a decimal point reads: `calculator` (X50 is 50 mm) or
+    /// `increment` (X50 is 50 least input increments, 0.050 mm on the mill); absent: as the
+    /// dialect's manual says (decision D52).
+    #[serde(default)]
+    pub decimal_point: Option<DecimalPoint>,
+}
+
+/// How a number without a decimal point reads (FANUC's parameter DPI).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DecimalPoint {
+    Calculator,
+    Increment,
+}
+
+fn default_program_capacity() -> u64 {
+    64 * 1024
+}
+
+fn default_contour_tolerance() -> f64 {
+    0.05
+}
+
+/// `G54` → 0 … `G59` → 5 (case and surrounding blanks ignored).
+pub fn work_offset_index(code: &str) -> Option<u8> {
+    match code.trim().to_ascii_uppercase().as_str() {
+        "G54" => Some(0),
+        "G55" => Some(1),
+        "G56" => Some(2),
+        "G57" => Some(3),
+        "G58" => Some(4),
+        "G59" => Some(5),
+        _ => None,
+    }
+}
+
+/// The program dialects a launch config may name (the interpreter's `Dialect::from_name`
+/// knows each; its tests check that).
+pub const DIALECTS: [&str; 4] = ["huaxing-lathe", "gtc2e-lathe", "iso-lathe", "fanuc-mill"];
+
+/// One row of the offset page (`000` §5.2, `002` §3.7): geometry and wear (X as diameter),
+/// nose radius and imaginary tip direction 0–9.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToolEntry {
+    #[serde(default)]
+    pub x: f64,
+    #[serde(default)]
+    pub z: f64,
+    #[serde(default)]
+    pub wear_x: f64,
+    #[serde(default)]
+    pub wear_z: f64,
+    #[serde(default)]
+    pub radius: f64,
+    #[serde(default)]
+    pub tip: u8,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ToolPost {
+    #[default]
+    Rear,
+    Front,
+}
+
+fn default_arc_plane() -> [String; 2] {
+    ["Z".into(), "X".into()]
+}
+
+/// One axis: limits in display units (X as diameter when `diameter`).
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisEntry {
+    pub name: String,
+    #[serde(default)]
+    pub diameter: bool,
+    pub min: f64,
+    pub max: f64,
+    /// Rapid rate, mm/min of slide travel.
+    pub max_velocity: f64,
+    /// mm/s² of slide travel.
+    pub max_acceleration: f64,
+    /// mm/s³ of slide travel, for S-curve profiles; default: the acceleration reached in
+    /// [`DEFAULT_JERK_TIME`].
+    #[serde(default)]
+    pub max_jerk: Option<f64>,
+    #[serde(default = "default_in_position")]
+    pub in_position: f64,
+    /// Largest distance the slide may lag its setpoint, mm; default: 1.5 × what the rapid
+    /// rate gives over the drive lag and ten servo periods of 4 ms (feedback may come a few
+    /// ticks late on a machine without a real-time kernel), at least 1 mm.
+    #[serde(default)]
+    pub following_error: Option<f64>,
+    /// Simulated drive time constant, s.
+    #[serde(default = "default_drive_lag")]
+    pub drive_lag: f64,
+    /// Simulated power-on position, display units.
+    #[serde(default)]
+    pub home: f64,
+    /// The second reference point (FANUC G30, the mill's tool-change position), machine
+    /// coordinates, display units; default: the reference point (`home`).
+    #[serde(default)]
+    pub second_reference: Option<f64>,
+}
+
+impl AxisEntry {
+    /// Display units → slide travel: a diameter axis moves half of what it shows.
+    pub fn scale(&self) -> f64 {
+        if self.diameter {
+            0.5
+        } else {
+            1.0
+        }
+    }
+
+    /// Following-error limit, mm of slide travel.
+    pub fn following_error_limit(&self) -> f64 {
+        self.following_error.unwrap_or_else(|| {
+            (1.5 * self.max_velocity / 60.0 * (self.drive_lag + 10.0 * 0.004)).max(1.0)
+        })
+    }
+
+    /// Jerk limit, mm/s³ of slide travel.
+    pub fn jerk(&self) -> f64 {
+        self.max_jerk
+            .unwrap_or(self.max_acceleration / DEFAULT_JERK_TIME)
+    }
+
+    /// The axis's address letter (names are validated to be one letter).
+    pub fn letter(&self) -> char {
+        self.name.chars().next().unwrap_or('?')
+    }
+}
+
+/// Time to ramp up to full acceleration when an axis names no jerk limit, s.
+pub const DEFAULT_JERK_TIME: f64 = 0.05;
+
+fn default_in_position() -> f64 {
+    0.0005
+}
+fn default_drive_lag() -> f64 {
+    0.008
+}
+
+impl MachineConfig {
+    /// The machine section's own rules; an error names the setting and what it may be.
+    pub(crate) fn validate(&self) -> Result<(), String> {
+        let ns = &self.namespace;
+        if !DIALECTS.contains(&self.dialect.as_str()) {
+            return Err(format!(
+                "machine.dialect {:?}: one of {}",
+                self.dialect,
+                DIALECTS.join(", ")
+            ));
+        }
+        if ns.is_empty()
+            || !ns.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+            || ns.starts_with(|c: char| c.is_ascii_digit())
+        {
+            return Err(format!(
+                "machine.namespace {ns:?}: letters, digits and _ only, not starting with a digit"
+            ));
+        }
+        let tol = self.contour_tolerance;
+        if !(0.001..=1.0).contains(&tol) {
+            return Err(format!(
+                "machine.contour_tolerance {tol}: 0.001–1 mm (GS#33)"
+            ));
+        }
+        let n = self.axes.len();
+        if n == 0 || n > cnc_msgs::servo::MAX_AXES {
+            return Err(format!(
+                "machine.axes: 1..{} axes, found {n}",
+                cnc_msgs::servo::MAX_AXES
+            ));
+        }
+        for (i, a) in self.axes.iter().enumerate() {
+            if a.name.len() != 1
+                || !a.name.chars().all(|c| c.is_ascii_uppercase())
+                || self.axes[..i].iter().any(|b| b.name == a.name)
+            {
+                return Err(format!(
+                    "axis name {:?}: one upper-case letter, each axis once",
+                    a.name
+                ));
+            }
+            let ok = a.min < a.max
+                && a.max_velocity > 0.0
+                && a.max_acceleration > 0.0
+                && a.in_position > 0.0
+                && a.drive_lag >= 0.0
+                && a.max_jerk.is_none_or(|j| j > 0.0)
+                && a.following_error.is_none_or(|f| f > 0.0);
+            if !ok || a.home < a.min || a.home > a.max {
+                return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, jerk, in_position", a.name));
+            }
+            if let Some(r) = a.second_reference.filter(|r| !(a.min..=a.max).contains(r)) {
+                return Err(format!(
+                    "axis {}: second_reference {r} lies outside min..max",
+                    a.name
+                ));
+            }
+        }
+        let cap = self.program_capacity_kib;
+        if !(1..=1024 * 1024).contains(&cap) {
+            return Err(format!(
+                "machine.program_capacity_kib {cap}: 1..1048576 (1 GiB)"
+            ));
+        }
+        for p in &self.arc_plane {
+            if !self.axes.iter().any(|a| &a.name == p) {
+                return Err(format!(
+                    "machine.arc_plane names axis {p}, which is not configured"
+                ));
+            }
+        }
+        if let Some(p) = self.tool_change_macro {
+            if !(1..=9999).contains(&p) {
+                return Err(format!(
+                    "machine.tool_change_macro {p}: a program number 1..9999"
+                ));
+            }
+        }
+        for (n, t) in &self.tools {
+            let finite = [t.x, t.z, t.wear_x, t.wear_z, t.radius]
+                .iter()
+                .all(|v| v.is_finite() && v.abs() <= 10_000.0);
+            let max = crate::tool_table::MAX_TOOL_NUMBER;
+            if !(1..=max).contains(n) || !finite || t.radius < 0.0 || t.tip > 9 {
+                return Err(format!(
+                    "machine.tools[{n}]: offset 1..{max}, finite values within ±10000, radius ≥ 0, tip 0..9"
+                ));
+            }
+        }
+        for (code, axes) in &self.work_offsets {
+            if work_offset_index(code).is_none() {
+                return Err(format!("machine.work_offsets: {code:?} is not G54..G59"));
+            }
+            for (axis, v) in axes {
+                if !self.axes.iter().any(|a| &a.name == axis) || !v.is_finite() {
+                    return Err(format!(
+                        "machine.work_offsets.{code}: axis {axis:?} not configured or value not finite"
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,107 @@
+//! The launch config: one YAML file describes the machine, the network and the nodes.
+//! `machine.rs` holds the machine section (what the control's setting pages hold), `nodes.rs`
+//! the sections of the cell's nodes (network, servo, simulator, PLC, recorder, HMI, real
+//! time), `files.rs` reading the file and the files it names; the ratings are
+//! [`crate::limits`].
+
+mod files;
+mod machine;
+mod nodes;
+
+pub use machine::*;
+pub use nodes::*;
+
+use serde::Deserialize;
+
+/// Top level of `launch_configs/*.yaml`.
+#[derive(Debug, Clone, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LaunchConfig {
+    pub machine: MachineConfig,
+    #[serde(default)]
+    pub network: NetworkConfig,
+    #[serde(default)]
+    pub servo: ServoConfig,
+    #[serde(default)]
+    pub sim: SimConfig,
+    #[serde(default)]
+    pub plc: PlcConfig,
+    #[serde(default)]
+    pub recorder: RecorderConfig,
+    #[serde(default)]
+    pub hmi: HmiConfig,
+    #[serde(default)]
+    pub realtime: RealtimeConfig,
+    /// The machine builder's ratings (travel, drives, spindle): set by this file only,
+    /// never a parameter ([`crate::limits`]).
+    #[serde(default)]
+    pub limits: crate::limits::MachineLimits,
+}
+
+impl LaunchConfig {
+    /// Every section's rules, then the machine against its ratings. Called for the file as
+    /// read and for every parameter write ([`crate::parameters::set`]).
+    pub(crate) fn validate(&self) -> Result<(), String> {
+        self.machine.validate()?;
+        self.limits.check(&self.machine.axes)?;
+        nodes::validate(self)
+    }
+
+    pub fn axis_index(&self, name: &str) -> Option<usize> {
+        self.machine.axes.iter().position(|a| a.name == name)
+    }
+
+    /// Power-on slide positions (X as radius).
+    pub fn home_slide(&self) -> Vec<f64> {
+        self.machine
+            .axes
+            .iter()
+            .map(|a| a.home * a.scale())
+            .collect()
+    }
+
+    /// The axis address letters in machine order, e.g. `['X', 'Z']`.
+    pub fn axis_letters(&self) -> Vec<char> {
+        self.machine.axes.iter().map(AxisEntry::letter).collect()
+    }
+
+    /// Per axis: programmed and displayed in diameter.
+    pub fn diameter_axes(&self) -> Vec<bool> {
+        self.machine.axes.iter().map(|a| a.diameter).collect()
+    }
+
+    /// Power-on position in display units.
+    pub fn second_reference(&self) -> Vec<f64> {
+        self.machine
+            .axes
+            .iter()
+            .map(|a| a.second_reference.unwrap_or(a.home))
+            .collect()
+    }
+
+    pub fn home(&self) -> Vec<f64> {
+        self.machine.axes.iter().map(|a| a.home).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The mill's config with `second_reference: z` on its Z axis.
+    fn mill_with_second_reference(z: &str) -> Result<LaunchConfig, String> {
+        let text = include_str!("../../../../launch_configs/sim_mill.yaml").replace(
+            "max: 100.0, home: 0.0,",
+            &format!("max: 100.0, home: 0.0, second_reference: {z},"),
+        );
+        LaunchConfig::from_yaml(&text)
+    }
+
+    #[test]
+    fn the_second_reference_point_must_lie_within_the_axis_travel() {
+        let cfg = mill_with_second_reference("80.0").expect("within travel");
+        assert_eq!(cfg.second_reference(), [0.0, 0.0, 80.0]);
+        let e = mill_with_second_reference("150.0").unwrap_err();
+        assert!(e.contains("second_reference 150"), "{e}");
+    }
+}
