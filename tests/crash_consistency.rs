@@ -30,6 +30,10 @@ use ros2_client::ServiceMapping;
 
 const DOMAIN: u16 = 71;
 const KILLS: usize = 50;
+/// The part's last move (`G00 X60`, line 6): after it come #200, M05 and M30, then the count.
+const LAST_MOVE_LINE: u32 = 6;
+/// End-of-part kills fall this long after the last move shows, at random.
+const END_WINDOW_S: f64 = 0.8;
 const PART: &str =
     "O0001\nG00 X60 Z5\nS600 M03\nG01 X50 F3000\nZ-5\nG00 X60\n#200=#200+1\nM05\nM30\n";
 
@@ -170,7 +174,6 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
     let mut lookahead = (cfg.servo.lookahead.to_string(), None::<String>);
     let mut programs: BTreeMap<String, String> = BTreeMap::new();
     let mut in_flight_program: Option<(String, String)> = None;
-    let mut part_time = 2.0;
     let mut extra_counts = 0;
     let mut kill_moments = Vec::new();
 
@@ -260,15 +263,12 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
 
         // The round: writes, then a part; the kill comes at a random moment.
         let t0 = Instant::now();
-        let kill_at = if round == 0 {
-            None // the first part runs to its end: its time sets where the others are cut
-        } else if round % 2 == 1 {
-            Some(Duration::from_secs_f64(rng.next() * 0.3))
-        } else {
-            Some(Duration::from_secs_f64(
-                part_time + (rng.next() - 0.5) * 0.6,
-            ))
-        };
+        // Odd rounds: during the writes, by the clock. Even rounds (but the first, which runs
+        // its part to the end): around the end of the part, from when its last move shows.
+        let kill_at = (round % 2 == 1).then(|| Duration::from_secs_f64(rng.next() * 0.3));
+        let end_delay = (round > 0 && round % 2 == 0)
+            .then(|| Duration::from_secs_f64(rng.next() * END_WINDOW_S));
+        let mut end_kill: Option<Instant> = None;
         let killed = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
         let killer = kill_at.map(|at| {
             let pid = cell.id();
@@ -327,11 +327,20 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
         loop {
             client.poll();
             if let Some(p) = &client.part_count {
-                if p.count > seen_count {
-                    seen_count = p.count;
-                    if round == 0 {
-                        part_time = t0.elapsed().as_secs_f64();
-                    }
+                seen_count = seen_count.max(p.count);
+            }
+            if let Some(delay) = end_delay {
+                let at_end = client
+                    .state
+                    .as_ref()
+                    .is_some_and(|s| s.program == "part.nc" && s.line >= LAST_MOVE_LINE);
+                if end_kill.is_none() && (at_end || t0.elapsed() > Duration::from_secs(30)) {
+                    end_kill = Some(Instant::now() + delay);
+                }
+                if end_kill.is_some_and(|t| Instant::now() >= t) && alive() {
+                    // SAFETY: kill(2) with a pid this test spawned and has not yet waited for.
+                    unsafe { libc::kill(cell.id() as i32, libc::SIGKILL) };
+                    killed.store(true, std::sync::atomic::Ordering::SeqCst);
                 }
             }
             if round == 0 && seen_count > kept.count {
@@ -348,7 +357,6 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
         }
         if round == 0 {
             let _ = cell.kill();
-            println!("a round takes {part_time:.2} s from its writes to its part's count");
         }
         let _ = cell.wait();
         if let Some(k) = killer {
@@ -358,7 +366,7 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
         drop(client);
     }
     println!(
-        "{KILLS} kills at {:.2}..{:.2} s into a round; parts counted {seen_count}; \
+        "{KILLS} kills; rounds ended {:.2}..{:.2} s after their writes began; parts counted {seen_count}; \
          counted before the supervisor heard of it {extra_counts} times; #200 ahead of the count by {drift}",
         kill_moments.iter().cloned().fold(f64::INFINITY, f64::min),
         kill_moments.iter().cloned().fold(0.0, f64::max)
