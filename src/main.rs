@@ -221,6 +221,7 @@ extern "C" fn on_signal(_: libc::c_int) {
 }
 
 fn main() -> ExitCode {
+    cnc_runtime::heap::return_large_blocks();
     env_logger::Builder::from_env(
         env_logger::Env::default().default_filter_or("warn,rustdds=off,ros2_client=error"),
     )

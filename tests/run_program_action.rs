@@ -119,11 +119,34 @@ fn run_program_reports_every_block_and_a_cancel_stops_the_machine_ready_for_the_
     let client = action_client(&mut supervisor);
     std::thread::sleep(Duration::from_secs(2)); // discovery of the action's services
 
-    // Refused goals change nothing.
-    let (_, accepted) = send(&client, goal("missing.nc", 1));
-    assert!(!accepted);
-    let (_, accepted) = send(&client, goal("short.nc", 0));
-    assert!(!accepted);
+    // Refused goals change nothing, and each says why through GetResult (issue 26: the
+    // reason was only in the log, and GetResult for it never came back).
+    for (program, cycles, why) in [("missing.nc", 1, "missing.nc"), ("short.nc", 0, "cycles")] {
+        let (id, accepted) = send(&client, goal(program, cycles));
+        assert!(!accepted, "{program} × {cycles} accepted");
+        let (feedback, status, result) = follow(&client, id, Duration::from_secs(15), |_| {});
+        assert!(feedback.is_empty());
+        assert_eq!(status, GoalStatusEnum::Aborted, "{}", result.message);
+        assert!(
+            result.message.starts_with("goal rejected: ") && result.message.contains(why),
+            "{program} × {cycles}: {}",
+            result.message
+        );
+        assert_eq!(result.parts_made, 0);
+    }
+    // A result asked for a goal never sent is answered at once, not left waiting.
+    let (_, status, result) = follow(
+        &client,
+        ros2_client::action::GoalId::new_random(),
+        Duration::from_secs(15),
+        |_| {},
+    );
+    assert_eq!(status, GoalStatusEnum::Unknown, "{}", result.message);
+    assert!(
+        result.message.contains("unknown goal"),
+        "{}",
+        result.message
+    );
 
     // Two cycles with feedback per block.
     let (id, accepted) = send(&client, goal("short.nc", 2));

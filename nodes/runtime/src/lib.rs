@@ -6,6 +6,7 @@ pub mod bus;
 pub mod clock;
 pub mod config;
 pub mod dds;
+pub mod heap;
 pub mod lifecycle;
 pub mod limits;
 pub mod overrides;

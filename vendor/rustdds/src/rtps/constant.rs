@@ -82,6 +82,13 @@ pub const MAX_TRACKED_CHANGES_PER_WRITER: usize = DEFAULT_WRITER_MAX_SAMPLES;
 // are handed over.
 pub const MAX_WITHHELD_BYTES_PER_TOPIC: usize = 16 * 1024 * 1024;
 
+// cnc patch (the cnc workspace's decision D63): most payload bytes a TopicCache keeps
+// for samples its readers may still take. Beyond this the oldest samples go, even under a
+// deeper KeepLast history (the newest is always kept): samples leave the cache only by its
+// history limits, so a history of 256 requests of 4 MiB programs kept 1 GiB of samples the
+// reader had long taken.
+pub const MAX_KEPT_BYTES_PER_TOPIC: usize = 32 * 1024 * 1024;
+
 // Default / fallback UDP-payload budget (RTPS header + submessages) used to
 // size datagrams built by the writer's DATA-coalescing and DATAFRAG packing
 // paths when the per-peer path MTU is unknown (peer behind a router, IPv6, or

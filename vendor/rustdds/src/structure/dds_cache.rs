@@ -19,7 +19,7 @@ use crate::{
     typedesc::TypeDesc,
     CreateError, CreateResult,
   },
-  rtps::constant::MAX_WITHHELD_BYTES_PER_TOPIC,
+  rtps::constant::{MAX_KEPT_BYTES_PER_TOPIC, MAX_WITHHELD_BYTES_PER_TOPIC},
   structure::{sequence_number::SequenceNumber, time::Timestamp},
   GUID,
 };
@@ -264,6 +264,25 @@ impl TopicCache {
       .min()
   }
 
+  // cnc patch: how many of the oldest changes must go so that the rest stay within
+  // MAX_KEPT_BYTES_PER_TOPIC (never the newest).
+  fn over_byte_budget(&self) -> usize {
+    let mut kept: usize = self
+      .changes
+      .values()
+      .map(|cc| cc.data_value.payload_size())
+      .sum();
+    let mut remove = 0;
+    for cc in self.changes.values() {
+      if kept <= MAX_KEPT_BYTES_PER_TOPIC || remove + 1 >= self.changes.len() {
+        break;
+      }
+      kept -= cc.data_value.payload_size();
+      remove += 1;
+    }
+    remove
+  }
+
   // Payload bytes retained from the oldest withheld change onwards.
   fn withheld_bytes(&self, from: Timestamp) -> usize {
     self
@@ -498,6 +517,8 @@ impl TopicCache {
     // must_remove_count = sample_count - max_keep_samples
     let must_remove_count = sample_count.saturating_sub(self.max_keep_samples as usize);
     // Saturating sub takes care that this does not underflow below zero.
+    // cnc patch: and enough to stay within MAX_KEPT_BYTES_PER_TOPIC, keeping the newest.
+    let must_remove_count = max(must_remove_count, self.over_byte_budget());
 
     let may_remove_count = match self.min_keep_samples {
       // We are erquested to KeepAll, so do not remove more than absolutely required.
