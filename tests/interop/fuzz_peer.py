@@ -39,11 +39,18 @@ STRINGS = ["", "O0001", "part.nc", "../../etc/passwd", "/etc/passwd", "1e308", "
            "A" * 70000, "G01 X10 F0\n" * 50]
 
 
+def rust_quoted(text):
+    """`text` as Rust's `{:?}` prints a string, without its quotes: backslash, double quote and
+    control characters escaped, the rest as it is."""
+    named = {"\t": "\\t", "\r": "\\r", "\n": "\\n", "\\": "\\\\", '"': '\\"', "\0": "\\0"}
+    return "".join(named.get(c) or (f"\\u{{{ord(c):x}}}" if ord(c) < 0x20 or 0x7F <= ord(c) < 0xA0 else c)
+                   for c in text)
+
+
 def names(name, message):
-    """Whether a refusal names `name`: as given, or quoted as the cell quotes names (Rust's `{:?}`:
-    a backslash or double quote in the name is escaped, so the name reads unambiguously)."""
-    quoted = name.replace("\\", "\\\\").replace('"', '\\"')
-    return name in message or quoted in message
+    """Whether a refusal names `name`: as given, or quoted as the cell quotes names (so that a
+    name with quotes or line breaks reads unambiguously)."""
+    return name in message or rust_quoted(name) in message
 
 
 def snake(name):
