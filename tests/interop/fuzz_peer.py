@@ -107,6 +107,7 @@ def main():
     calls = refused = 0
     silent = []
     unnamed = []
+    reasons = {}  # service → the refusals' reasons, shortened, for the log
     for round_ in range(ROUNDS):
         for srv in services:
             request_text = (srv_dir / f"{srv}.srv").read_text().split("\n---")[0]
@@ -127,6 +128,7 @@ def main():
             if hasattr(reply, "accepted") and not reply.accepted:
                 refused += 1
                 msg = reply.message
+                reasons.setdefault(srv, set()).add(re.sub(r"\s+", " ", msg)[:90])
                 if not msg.strip():
                     unnamed.append(f"{srv} refused without a reason")
                 elif srv == "SetParameter" and not names(fields["name"].strip(), msg) and "program runs" not in msg:
@@ -141,6 +143,8 @@ def main():
         session.wait(lambda: False, 0.5)
 
     print(f"{calls} calls, {refused} refused", flush=True)
+    for srv, why in sorted(reasons.items()):
+        print(f"  {srv}: " + " | ".join(sorted(why)), flush=True)
     check(not silent, f"every request was answered: {silent[:5]}")
     check(not unnamed, f"every refusal says why, naming the field: {unnamed[:5]}")
     check(not out_of_limits, f"nothing outside the ratings reached motion: {out_of_limits[:5]}")
