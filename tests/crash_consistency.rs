@@ -10,7 +10,10 @@
 //! - #200 less the part count never falls (a counted part's increment is never lost) and
 //!   rises by at most one per kill (a part killed between its last block and its count);
 //! - the tool offset and the parameter: the last acknowledged value, or the one in flight;
-//! - every acknowledged program, byte for byte, in program memory and on disk.
+//! - every acknowledged program, byte for byte, in program memory and on disk;
+//! - the kept program position: whole, naming the part, at one of its lines (how often it was
+//!   at or past the line the supervisor last saw is printed: the position is written behind
+//!   the machine, never ahead of what it reached).
 //!
 //! The random moments come from a seed printed at the start (`CNC_CRASH_SEED` repeats a run).
 
@@ -20,6 +23,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use cnc::client::CellClient;
+use cnc_interpreter::position::ProgramPosition;
 use cnc_msgs::msg::ToolOffset;
 use cnc_msgs::srv::{
     GetOffsets, GetOffsetsRequest, GetParameters, GetParametersRequest, SetParameter,
@@ -166,6 +170,7 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
         .clone()
         .expect("program folder");
     let log = dir.join("cell.log");
+    let position_file = cfg.machine.position_file.clone().expect("position file");
 
     // What the supervisor was told, and what was in flight at the kill.
     let mut seen_count = 0u32;
@@ -176,6 +181,10 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
     let mut in_flight_program: Option<(String, String)> = None;
     let mut extra_counts = 0;
     let mut kill_moments = Vec::new();
+    // The part's line the supervisor saw last before the kill, and how often the kept
+    // position was at or past it.
+    let mut line_seen = 0u32;
+    let mut position_caught_up = 0;
 
     for round in 0..=KILLS {
         let t_start = Instant::now();
@@ -253,6 +262,14 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
                 "round {round}: {:?}",
                 kept.programs
             );
+            let text = std::fs::read_to_string(&position_file).expect("a kept position");
+            let position = ProgramPosition::from_yaml(&text)
+                .unwrap_or_else(|e| panic!("round {round}: {e}: {text:?}"));
+            assert!(
+                position.program == "part.nc" && (1..=9).contains(&position.line),
+                "round {round}: kept position {position:?}"
+            );
+            position_caught_up += (position.line >= line_seen) as u32;
         }
         seen_count = kept.count;
         if round == KILLS {
@@ -321,6 +338,7 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
             let _ = client.reset();
         }
         if alive() {
+            line_seen = 0;
             let _ = client.start_program("part.nc");
         }
         // Follow the part count until the kill (or, in round 0, the part's end).
@@ -328,6 +346,11 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
             client.poll();
             if let Some(p) = &client.part_count {
                 seen_count = seen_count.max(p.count);
+            }
+            if let Some(s) = client.state.as_ref().filter(|s| s.program == "part.nc") {
+                if s.line > 0 {
+                    line_seen = s.line;
+                }
             }
             if let Some(delay) = end_delay {
                 let at_end = client
@@ -367,7 +390,8 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
     }
     println!(
         "{KILLS} kills; rounds ended {:.2}..{:.2} s after their writes began; parts counted {seen_count}; \
-         counted before the supervisor heard of it {extra_counts} times; #200 ahead of the count by {drift}",
+         counted before the supervisor heard of it {extra_counts} times; #200 ahead of the count by {drift}; \
+         kept position at or past the line the supervisor saw {position_caught_up} times",
         kill_moments.iter().cloned().fold(f64::INFINITY, f64::min),
         kill_moments.iter().cloned().fold(0.0, f64::max)
     );

@@ -32,6 +32,7 @@ fn config_yaml(domain: u16, records: &Path) -> String {
     v["recorder"]["directory"] = records.to_string_lossy().to_string().into();
     v["plc"]["memory_file"] = serde_yaml::Value::Null;
     v["machine"]["memory_file"] = serde_yaml::Value::Null;
+    v["machine"]["position_file"] = serde_yaml::Value::Null;
     v["machine"]["program_directory"] = serde_yaml::Value::Null;
     serde_yaml::to_string(&v).unwrap()
 }

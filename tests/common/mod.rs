@@ -3,7 +3,7 @@
 use cnc_runtime::LaunchConfig;
 
 /// `launch_configs/sim_lathe.yaml` in DDS `domain` (one per test, so tests never hear each
-/// other), with no kept memory (part count, variables and programs start empty) and no parameter file and no recorder
+/// other), with no kept memory (part count, variables, position and programs start empty) and no parameter file and no recorder
 /// (`tests/recording.rs` tests that), and no alarms for servo lateness.
 pub fn sim_lathe(domain: u16) -> LaunchConfig {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/launch_configs/sim_lathe.yaml");
@@ -12,6 +12,7 @@ pub fn sim_lathe(domain: u16) -> LaunchConfig {
     cfg.network.domain_id = Some(domain);
     cfg.plc.memory_file = None;
     cfg.machine.memory_file = None;
+    cfg.machine.position_file = None;
     cfg.machine.parameter_file = None;
     cfg.machine.program_directory = None;
     cfg.recorder.enabled = false;

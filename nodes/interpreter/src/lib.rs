@@ -5,7 +5,7 @@
 //! that read the dialects and lower them onto the core: the FANUC family base ([`fanuc`]) and
 //! its dialects [`huaxing`], [`gtc2e`], [`iso`] and [`mill`], named in one place
 //! ([`dialect`]). Around them: the public [`interpreter`], program libraries ([`library`]),
-//! the program run ([`run`]), [`trace`] (the stream as text for checks and golden files) and
+//! the program run ([`run`]) and where it is ([`position`]), [`trace`] (the stream as text for checks and golden files) and
 //! [`node`] (the ROS 2 shell).
 
 pub mod dialect;
@@ -19,6 +19,7 @@ pub mod library;
 pub mod mill;
 pub mod node;
 pub mod offset_page;
+pub mod position;
 pub mod run;
 pub mod setup;
 pub mod trace;

@@ -15,10 +15,12 @@ use cnc_msgs::msg::{
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{stamp, RosNode};
+use cnc_runtime::persist::Keeper;
 use cnc_runtime::program_store::{InRam, ProgramDir, ProgramStorage};
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
+use crate::position::{PositionTracker, ProgramPosition};
 use crate::run::{self, Effect, RunCore, StateView};
 use crate::setup::Memory;
 use crate::{Dialect, Setup};
@@ -95,6 +97,26 @@ pub fn save_memory(path: &std::path::Path, memory: &Memory) -> Result<(), String
     cnc_runtime::persist::write_atomic(path, &text)
 }
 
+/// The keeper of `machine.position_file`; what the file held at start is logged, since it says
+/// where an interrupted program can be restarted.
+fn kept_position(cfg: &LaunchConfig) -> Option<Keeper> {
+    let path = cfg.machine.position_file.clone()?;
+    match std::fs::read_to_string(&path).map(|t| ProgramPosition::from_yaml(&t)) {
+        Ok(Ok(p)) if p.interrupted() => log::warn!(
+            "interpreter: program {} was left at line {} ({}); kept in {}",
+            p.program,
+            p.line,
+            p.state,
+            path.display()
+        ),
+        Ok(Ok(p)) => log::info!("interpreter: program {} last ran to its end", p.program),
+        Ok(Err(e)) => log::error!("interpreter: {}: {e}", path.display()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => log::error!("interpreter: {}: {e}", path.display()),
+    }
+    Some(Keeper::new(path, "program position"))
+}
+
 pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let dialect = Dialect::from_name(&cfg.machine.dialect)
         .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
@@ -140,6 +162,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         publisher: state_pub,
         last: None,
         last_ns: 0,
+        position: kept_position(&cfg),
+        tracker: PositionTracker::default(),
     };
     let carry_out = |core: &mut RunCore| {
         for effect in core.take_effects() {
@@ -213,10 +237,17 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
 struct StateReporter {
     publisher: cnc_runtime::dds::Publisher<MachineState>,
     last: Option<StateView>,
+    /// Keeps the program position on the disk (`machine.position_file`), if configured.
+    position: Option<Keeper>,
+    tracker: PositionTracker,
     last_ns: u64,
 }
 
 fn report_state(state: &mut StateReporter, view: StateView) {
+    // The position first: its write is under way before the state is published.
+    if let (Some(keeper), Some(position)) = (state.position.as_mut(), state.tracker.update(&view)) {
+        keeper.keep(position.to_yaml().into_bytes());
+    }
     let now = monotonic_ns();
     if state.last.as_ref() != Some(&view) || now - state.last_ns > 500_000_000 {
         state.last_ns = now;

@@ -57,6 +57,7 @@ impl LaunchConfig {
         let files = [
             &mut m.tool_table,
             &mut m.memory_file,
+            &mut m.position_file,
             &mut m.program_directory,
             &mut m.parameter_file,
             &mut self.plc.program,
@@ -79,6 +80,9 @@ impl LaunchConfig {
         let m = &self.machine;
         if let Some(f) = &m.memory_file {
             out.push(("kept variables and offsets", f.as_path()));
+        }
+        if let Some(f) = &m.position_file {
+            out.push(("program position", f.as_path()));
         }
         if let Some(f) = &m.program_directory {
             out.push(("program memory", f.as_path()));

@@ -33,6 +33,11 @@ pub struct MachineConfig {
     /// cell only.
     #[serde(default)]
     pub memory_file: Option<std::path::PathBuf>,
+    /// Where the program in automatic operation and its line are kept at every change, for a
+    /// restart after a power loss (YAML, relative to the config file's folder; decisions D64);
+    /// absent: not kept.
+    #[serde(default)]
+    pub position_file: Option<std::path::PathBuf>,
     /// Program memory: a folder of plain program files, relative to the config file's
     /// folder ([`crate::program_store`]); absent: programs are kept for this run only.
     #[serde(default)]

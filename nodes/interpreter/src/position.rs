@@ -1,0 +1,149 @@
+//! Where the program in automatic operation is: the program and its line as the machine runs
+//! it, kept across a power loss or a kill so that the operator or the supervisor knows where
+//! to restart (issue 26; decisions D64). The shell hands every change to a
+//! [`cnc_runtime::persist::Keeper`], so the servo-paced loop never waits for the disk; what is
+//! on the disk lags the machine by at most the write in progress.
+
+use cnc_msgs::msg::MachineState;
+use serde::{Deserialize, Serialize};
+
+use crate::run::StateView;
+
+/// The kept position: the program, the line the machine was at (the block in progress is run
+/// again on a restart) and its state then (`execution_name` of `MachineState`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ProgramPosition {
+    pub program: String,
+    pub line: u32,
+    pub state: String,
+}
+
+impl ProgramPosition {
+    /// The position `view` shows, if it is one worth keeping: a program in automatic operation
+    /// that has reached a line, or has ended. A machine idle after a start or in another mode
+    /// changes nothing, so the last position stays until the next program runs.
+    pub fn of(view: &StateView) -> Option<ProgramPosition> {
+        let running = matches!(
+            view.execution,
+            MachineState::ACTIVE
+                | MachineState::FEED_HOLD
+                | MachineState::INTERRUPTED
+                | MachineState::STOPPED
+                | MachineState::PROGRAM_STOPPED
+        );
+        let ended = view.execution == MachineState::PROGRAM_COMPLETED;
+        if view.mode != MachineState::MODE_AUTO
+            || view.program.is_empty()
+            || !(ended || running && view.line > 0)
+        {
+            return None;
+        }
+        Some(ProgramPosition {
+            program: view.program.clone(),
+            line: view.line,
+            state: MachineState::execution_name_of(view.execution).into(),
+        })
+    }
+
+    /// Whether the program was left before its end: a restart would resume it.
+    pub fn interrupted(&self) -> bool {
+        self.state != MachineState::execution_name_of(MachineState::PROGRAM_COMPLETED)
+    }
+
+    /// The file's contents.
+    pub fn to_yaml(&self) -> String {
+        serde_yaml::to_string(self).unwrap_or_default()
+    }
+
+    /// A kept position read back; a file that is not one is an error, not a position.
+    pub fn from_yaml(text: &str) -> Result<ProgramPosition, String> {
+        serde_yaml::from_str(text).map_err(|e| format!("not a program position: {e}"))
+    }
+}
+
+/// Which positions go to the disk: each one that differs from the last handed over.
+#[derive(Default)]
+pub struct PositionTracker {
+    last: Option<ProgramPosition>,
+}
+
+impl PositionTracker {
+    /// The position to keep now, if `view` moved it.
+    pub fn update(&mut self, view: &StateView) -> Option<ProgramPosition> {
+        let now = ProgramPosition::of(view)?;
+        if self.last.as_ref() == Some(&now) {
+            return None;
+        }
+        self.last = Some(now.clone());
+        Some(now)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(mode: u8, execution: u8, program: &str, line: u32) -> StateView {
+        StateView {
+            mode,
+            execution,
+            program: program.into(),
+            line,
+            emergency_stop: false,
+            alarm_active: false,
+        }
+    }
+
+    #[test]
+    fn each_line_of_a_program_in_auto_is_kept_once_and_idle_states_keep_the_last() {
+        let auto = MachineState::MODE_AUTO;
+        let mut t = PositionTracker::default();
+        // Idle, before any program, or a start that has not reached a line: nothing.
+        assert_eq!(t.update(&view(auto, MachineState::READY, "", 0)), None);
+        assert_eq!(t.update(&view(auto, MachineState::ACTIVE, "p.nc", 0)), None);
+        let first = t
+            .update(&view(auto, MachineState::ACTIVE, "p.nc", 2))
+            .unwrap();
+        assert_eq!((first.program.as_str(), first.line), ("p.nc", 2));
+        assert!(first.interrupted());
+        // The same again is not written again; the next line and a feed hold are.
+        assert_eq!(t.update(&view(auto, MachineState::ACTIVE, "p.nc", 2)), None);
+        assert_eq!(
+            t.update(&view(auto, MachineState::ACTIVE, "p.nc", 3))
+                .unwrap()
+                .line,
+            3
+        );
+        let held = t
+            .update(&view(auto, MachineState::FEED_HOLD, "p.nc", 3))
+            .unwrap();
+        assert_eq!(held.state, "FEED_HOLD");
+        // MDI and a machine back at READY leave the kept position alone.
+        assert_eq!(
+            t.update(&view(
+                MachineState::MODE_MDI,
+                MachineState::ACTIVE,
+                "MDI",
+                1
+            )),
+            None
+        );
+        assert_eq!(t.update(&view(auto, MachineState::READY, "p.nc", 0)), None);
+        let done = t
+            .update(&view(auto, MachineState::PROGRAM_COMPLETED, "p.nc", 9))
+            .unwrap();
+        assert!(!done.interrupted());
+    }
+
+    #[test]
+    fn a_kept_position_reads_back_and_a_damaged_file_is_an_error() {
+        let p = ProgramPosition {
+            program: "jobs/O0010.nc".into(),
+            line: 42,
+            state: "INTERRUPTED".into(),
+        };
+        assert_eq!(ProgramPosition::from_yaml(&p.to_yaml()).unwrap(), p);
+        assert!(ProgramPosition::from_yaml("program: [").is_err());
+        assert!(ProgramPosition::from_yaml("line: 3").is_err());
+    }
+}
