@@ -245,10 +245,12 @@ struct StateReporter {
 
 fn report_state(state: &mut StateReporter, view: StateView) {
     // The position first: its write is under way before the state is published.
-    if let (Some(keeper), Some(position)) = (state.position.as_mut(), state.tracker.update(&view)) {
-        keeper.keep(position.to_yaml().into_bytes());
-    }
     let now = monotonic_ns();
+    if let Some(keeper) = state.position.as_mut() {
+        if let Some(position) = state.tracker.update(&view, now) {
+            keeper.keep(position.to_yaml().into_bytes());
+        }
+    }
     if state.last.as_ref() != Some(&view) || now - state.last_ns > 500_000_000 {
         state.last_ns = now;
         let _ = state.publisher.publish(MachineState {

@@ -1,8 +1,8 @@
 //! Where the program in automatic operation is: the program and its line as the machine runs
 //! it, kept across a power loss or a kill so that the operator or the supervisor knows where
 //! to restart (issue 26; decisions D64). The shell hands every change to a
-//! [`cnc_runtime::persist::Keeper`], so the servo-paced loop never waits for the disk; what is
-//! on the disk lags the machine by at most the write in progress.
+//! [`cnc_runtime::persist::Keeper`], so the interpreter's loop never waits for the disk; what is
+//! on the disk lags the machine by at most [`LINE_INTERVAL_NS`] and the write in progress.
 
 use cnc_msgs::msg::MachineState;
 use serde::{Deserialize, Serialize};
@@ -61,21 +61,42 @@ impl ProgramPosition {
     }
 }
 
-/// Which positions go to the disk: each one that differs from the last handed over.
+/// Line changes are written at most this often (a change of program or state at once): a
+/// flash disk is not worn by a write per block of a program of short blocks.
+pub const LINE_INTERVAL_NS: u64 = 100_000_000;
+
+/// Which positions go to the disk: a new program or state at once, a new line at most every
+/// [`LINE_INTERVAL_NS`], and the newest line once that interval has passed.
 #[derive(Default)]
 pub struct PositionTracker {
-    last: Option<ProgramPosition>,
+    written: Option<ProgramPosition>,
+    written_ns: u64,
+    pending: Option<ProgramPosition>,
 }
 
 impl PositionTracker {
-    /// The position to keep now, if `view` moved it.
-    pub fn update(&mut self, view: &StateView) -> Option<ProgramPosition> {
-        let now = ProgramPosition::of(view)?;
-        if self.last.as_ref() == Some(&now) {
+    /// The position to keep now, if `view` at monotonic time `now_ns` moved it (or a line
+    /// held back is due).
+    pub fn update(&mut self, view: &StateView, now_ns: u64) -> Option<ProgramPosition> {
+        if let Some(p) = ProgramPosition::of(view) {
+            self.pending = Some(p);
+        }
+        let next = self.pending.as_ref()?;
+        let due = match &self.written {
+            None => true,
+            Some(w) if w == next => return None,
+            Some(w) => {
+                w.program != next.program
+                    || w.state != next.state
+                    || now_ns.saturating_sub(self.written_ns) >= LINE_INTERVAL_NS
+            }
+        };
+        if !due {
             return None;
         }
-        self.last = Some(now.clone());
-        Some(now)
+        self.written_ns = now_ns;
+        self.written = self.pending.clone();
+        self.written.clone()
     }
 }
 
@@ -95,44 +116,57 @@ mod tests {
     }
 
     #[test]
-    fn each_line_of_a_program_in_auto_is_kept_once_and_idle_states_keep_the_last() {
+    fn a_program_in_auto_is_kept_by_state_at_once_and_by_line_at_most_ten_times_a_second() {
         let auto = MachineState::MODE_AUTO;
+        let ms = 1_000_000;
         let mut t = PositionTracker::default();
         // Idle, before any program, or a start that has not reached a line: nothing.
-        assert_eq!(t.update(&view(auto, MachineState::READY, "", 0)), None);
-        assert_eq!(t.update(&view(auto, MachineState::ACTIVE, "p.nc", 0)), None);
+        assert_eq!(t.update(&view(auto, MachineState::READY, "", 0), 0), None);
+        assert_eq!(
+            t.update(&view(auto, MachineState::ACTIVE, "p.nc", 0), 0),
+            None
+        );
         let first = t
-            .update(&view(auto, MachineState::ACTIVE, "p.nc", 2))
+            .update(&view(auto, MachineState::ACTIVE, "p.nc", 2), ms)
             .unwrap();
         assert_eq!((first.program.as_str(), first.line), ("p.nc", 2));
         assert!(first.interrupted());
-        // The same again is not written again; the next line and a feed hold are.
-        assert_eq!(t.update(&view(auto, MachineState::ACTIVE, "p.nc", 2)), None);
+        // The same again is not written again; the next lines wait for the interval, and
+        // the newest of them is written when it has passed, even with no new view.
         assert_eq!(
-            t.update(&view(auto, MachineState::ACTIVE, "p.nc", 3))
-                .unwrap()
-                .line,
-            3
-        );
-        let held = t
-            .update(&view(auto, MachineState::FEED_HOLD, "p.nc", 3))
-            .unwrap();
-        assert_eq!(held.state, "FEED_HOLD");
-        // MDI and a machine back at READY leave the kept position alone.
-        assert_eq!(
-            t.update(&view(
-                MachineState::MODE_MDI,
-                MachineState::ACTIVE,
-                "MDI",
-                1
-            )),
+            t.update(&view(auto, MachineState::ACTIVE, "p.nc", 2), 2 * ms),
             None
         );
-        assert_eq!(t.update(&view(auto, MachineState::READY, "p.nc", 0)), None);
-        let done = t
-            .update(&view(auto, MachineState::PROGRAM_COMPLETED, "p.nc", 9))
-            .unwrap();
-        assert!(!done.interrupted());
+        assert_eq!(
+            t.update(&view(auto, MachineState::ACTIVE, "p.nc", 3), 3 * ms),
+            None
+        );
+        assert_eq!(
+            t.update(&view(auto, MachineState::ACTIVE, "p.nc", 4), 4 * ms),
+            None
+        );
+        let idle = view(auto, MachineState::ACTIVE, "p.nc", 4);
+        assert_eq!(t.update(&idle, 100 * ms), None);
+        assert_eq!(t.update(&idle, 101 * ms).unwrap().line, 4);
+        // A feed hold is written at once.
+        assert_eq!(
+            t.update(&view(auto, MachineState::ACTIVE, "p.nc", 5), 102 * ms),
+            None
+        );
+        let held = t.update(&view(auto, MachineState::FEED_HOLD, "p.nc", 5), 103 * ms);
+        assert_eq!(
+            held.map(|h| (h.state, h.line)),
+            Some(("FEED_HOLD".into(), 5))
+        );
+        // MDI and a machine back at READY leave the kept position alone.
+        let mdi = view(MachineState::MODE_MDI, MachineState::ACTIVE, "MDI", 1);
+        assert_eq!(t.update(&mdi, 500 * ms), None);
+        assert_eq!(
+            t.update(&view(auto, MachineState::READY, "p.nc", 0), 600 * ms),
+            None
+        );
+        let done = view(auto, MachineState::PROGRAM_COMPLETED, "p.nc", 9);
+        assert!(!t.update(&done, 601 * ms).unwrap().interrupted());
     }
 
     #[test]

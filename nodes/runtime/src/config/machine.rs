@@ -33,7 +33,7 @@ pub struct MachineConfig {
     /// cell only.
     #[serde(default)]
     pub memory_file: Option<std::path::PathBuf>,
-    /// Where the program in automatic operation and its line are kept at every change, for a
+    /// Where the program in automatic operation and its line are kept (within 0.1 s), for a
     /// restart after a power loss (YAML, relative to the config file's folder; decisions D64);
     /// absent: not kept.
     #[serde(default)]
