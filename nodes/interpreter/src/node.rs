@@ -244,7 +244,7 @@ struct StateReporter {
 }
 
 fn report_state(state: &mut StateReporter, view: StateView) {
-    // The position first: its write is under way before the state is published.
+    // The position goes to its keeper (when due) before the state is published.
     let now = monotonic_ns();
     if let Some(keeper) = state.position.as_mut() {
         if let Some(position) = state.tracker.update(&view, now) {
