@@ -4,10 +4,15 @@
 use std::path::PathBuf;
 use std::thread::JoinHandle;
 
+use cnc_runtime::instance_lock::{self, InstanceLock};
 use cnc_runtime::shm::instance;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 pub struct Cell {
+    /// Each node's hold on this machine's instance on the host, taken before anything starts
+    /// (a second controller of the same namespace and domain is refused untouched), released
+    /// after every node has stopped.
+    locks: Vec<InstanceLock>,
     shutdown: Shutdown,
     threads: Vec<(&'static str, JoinHandle<Result<String, String>>)>,
     /// The recorder stops after the other nodes, so it keeps what they sent last.
@@ -23,8 +28,22 @@ impl Cell {
         cnc_hmi_bridge::web::check(&cfg.hmi)?;
         let domain = cfg.network.effective_domain_id()?;
         let inst = instance(&cfg.machine.namespace, domain);
+        let nodes = [
+            "io",
+            "plc",
+            "motion",
+            "interpreter",
+            "hmi_bridge",
+            "recorder",
+        ];
+        let locks = nodes
+            .iter()
+            .filter(|n| **n != "recorder" || cfg.recorder.enabled)
+            .map(|n| instance_lock::acquire(&inst, n))
+            .collect::<Result<Vec<_>, _>>()?;
         let shutdown = Shutdown::default();
         let mut cell = Cell {
+            locks,
             shutdown: shutdown.clone(),
             threads: Vec::new(),
             recorder: None,
@@ -127,6 +146,7 @@ impl Cell {
                 Err(_) => errors.push("recorder: panicked".into()),
             }
         }
+        drop(self.locks);
         (summary, errors)
     }
 }

@@ -481,11 +481,27 @@ enum NodeName {
     Recorder,
 }
 
+impl NodeName {
+    /// The node's name in its instance lock, as the in-process cell names it.
+    fn lock_name(&self) -> &'static str {
+        match self {
+            NodeName::Io => "io",
+            NodeName::Plc => "plc",
+            NodeName::Motion => "motion",
+            NodeName::Interpreter => "interpreter",
+            NodeName::HmiBridge => "hmi_bridge",
+            NodeName::Recorder => "recorder",
+        }
+    }
+}
+
 fn run_node(node: NodeName, config: Option<&Path>) -> Result<(), String> {
     let (cfg, _) = machines::load(config, None)?;
     install_signal_handlers();
     let inst =
         cnc_runtime::shm::instance(&cfg.machine.namespace, cfg.network.effective_domain_id()?);
+    // Held until this process ends: a second copy of this node of this machine is refused.
+    let _lock = cnc_runtime::instance_lock::acquire(&inst, node.lock_name())?;
     let shutdown = cnc_runtime::Shutdown::default();
     let s = shutdown.clone();
     let worker = std::thread::spawn(move || match node {

@@ -7,6 +7,7 @@ pub mod clock;
 pub mod config;
 pub mod dds;
 pub mod heap;
+pub mod instance_lock;
 pub mod lifecycle;
 pub mod limits;
 pub mod overrides;
