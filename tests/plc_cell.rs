@@ -387,3 +387,72 @@ fn robot_handshake_from_cycle_complete_to_the_next_cycle_start() {
     r.run_until(0.05, |_| false);
     assert!(!r.yi.get(y::CYCLE_COMPLETE) && !r.bit("A4.0"));
 }
+
+/// Presses a panel key for two scans and lets it go.
+fn press(r: &mut Rig, key: cnc_msgs::signals::Bit) {
+    r.sim.devices.inputs.set(key, true);
+    r.run_until(SCAN * 2.0, |_| false);
+    r.sim.devices.inputs.set(key, false);
+    r.run_until(SCAN * 2.0, |_| false);
+}
+
+/// Issue 28, program-proving switches through the standard ladder: the machine-lock and
+/// aux-lock keys (X19.0, X19.1) toggle G44.1 MLK and G5.6 AFL; a whole program runs, its
+/// positions follow the program while the slides never move, and M03 S600 never reaches the
+/// spindle. Released, the position is the slides' again.
+#[test]
+fn machine_lock_and_aux_lock_run_a_program_without_moving_the_machine() {
+    let mut r = Rig::new(
+        "O0001\nG98 G97 S600 M03\nG01 X100 Z-20 F3000\nG02 X120 Z-30 R10\nG00 X150 Z50\nM05\nM30\n",
+        None,
+    );
+    r.run_until(0.1, |_| false);
+    press(&mut r, x::KEY_MACHINE_LOCK);
+    press(&mut r, x::KEY_AUX_LOCK);
+    assert!(
+        r.gi.get(g::MLK) && r.gi.get(g::AFL),
+        "G44.1 and G5.6 from the keys"
+    );
+    assert!(
+        r.nc().get(f::MMLK) && r.nc().get(f::MAFL),
+        "F4.1 and F4.4 answer"
+    );
+    let slides = r.fb.position;
+    let start = r.motion.commanded_display();
+    r.started = true;
+    let mut moved = false;
+    let mut turned = false;
+    let mut strobes = vec![];
+    let ok = r.run_until(30.0, |r| {
+        moved |= r.fb.position != slides;
+        turned |= r.sim.spindle_rpm().abs() > 0.0;
+        let m = r.nc().get(f::MF).then(|| r.nc().read_i32(f::M_CODE));
+        if m.is_some() && strobes.last() != Some(&m) {
+            strobes.push(m);
+        }
+        r.program_done()
+    });
+    assert!(ok, "the program ran to its end; events {:?}", r.events);
+    assert!(!moved, "a slide moved under machine lock");
+    assert!(!turned, "the spindle turned under aux lock");
+    assert!(
+        strobes.iter().all(|m| *m == Some(30)),
+        "only M30 reaches the PLC: {strobes:?}"
+    );
+    let end = r.motion.commanded_display();
+    assert!(
+        (end[0] - 150.0).abs() < 1e-9 && (end[1] - 50.0).abs() < 1e-9,
+        "the displayed position followed the program: {end:?} from {start:?}"
+    );
+
+    // Both keys again: released at rest, the position is where the slides stand.
+    press(&mut r, x::KEY_MACHINE_LOCK);
+    press(&mut r, x::KEY_AUX_LOCK);
+    assert!(!r.nc().get(f::MMLK) && !r.nc().get(f::MAFL));
+    assert_eq!(r.motion.commanded_display(), start);
+    // The dry-run key, which the ladder did not wire before, toggles G46.7 the same way.
+    press(&mut r, x::KEY_DRY_RUN);
+    assert!(r.gi.get(g::DRN) && r.nc().get(f::DRUR));
+    press(&mut r, x::KEY_DRY_RUN);
+    assert!(!r.gi.get(g::DRN) && !r.nc().get(f::DRUR));
+}

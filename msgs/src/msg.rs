@@ -306,7 +306,10 @@ ros_message! {
             ROBOT_DOOR_CLOSE: u8 = 9,
             ROBOT_CYCLE_START: u8 = 10,
             CYCLE_START_KEY: u8 = 11,
-            RESET_KEY: u8 = 12
+            RESET_KEY: u8 = 12,
+            MACHINE_LOCK_KEY: u8 = 13,
+            AUX_LOCK_KEY: u8 = 14,
+            DRY_RUN_KEY: u8 = 15
         }
         input: u8,
         value: bool,

@@ -178,6 +178,10 @@ pub mod f {
     /// Automatic mode (the only mode of the cell's NC so far).
     pub const MCYC: Bit = bit(3, 5);
     pub const MSBK: Bit = bit(4, 3);
+    /// Machine lock in effect (the axes do not move; `000` App.2 F4.1).
+    pub const MMLK: Bit = bit(4, 1);
+    /// Auxiliary function lock in effect (M, S, T not output; F4.4).
+    pub const MAFL: Bit = bit(4, 4);
     pub const TF: Bit = bit(7, 3);
     pub const SF: Bit = bit(7, 2);
     pub const MF: Bit = bit(7, 0);
@@ -198,6 +202,9 @@ pub mod g {
     use super::{bit, Bit};
     /// Completion of the M/S/T function.
     pub const FIN: Bit = bit(4, 3);
+    /// Auxiliary function lock: M, S and T are not output, M00/M01/M02/M30 still are
+    /// (`000` §13, G5.6).
+    pub const AFL: Bit = bit(5, 6);
     /// Cycle start (the NC acts on its rising edge).
     pub const ST: Bit = bit(7, 2);
     /// Feed hold, active low.
@@ -213,6 +220,8 @@ pub mod g {
     /// Optional stop switch: not in the manual's G table (the key lamp is PLC-only there), so
     /// it takes the free bit G44.2 next to block skip BDT1 (G44.0).
     pub const MOPS: Bit = bit(44, 2);
+    /// Machine lock: the program runs and its positions count, the axes do not move (G44.1).
+    pub const MLK: Bit = bit(44, 1);
     pub const DRN: Bit = bit(46, 7);
     pub const SBK: Bit = bit(46, 1);
     /// Current tool number of turret 1, binary.
@@ -268,6 +277,11 @@ pub mod x {
     pub const SPINDLE_OVERRIDE_SWITCH: u16 = 17;
     /// Rapid override switch, as G14's ROV2/ROV1 code: 0 = 100 %, 1 = 50 %, 2 = 25 %, 3 = F0.
     pub const RAPID_OVERRIDE_SWITCH: u16 = 18;
+    /// Program-proving keys. The manual has them as soft keys of its screen (enabled by
+    /// GB35); the cell's panel gives them the free byte X19 (decisions D66).
+    pub const KEY_MACHINE_LOCK: Bit = bit(19, 0);
+    pub const KEY_AUX_LOCK: Bit = bit(19, 1);
+    pub const KEY_DRY_RUN: Bit = bit(19, 2);
 }
 
 /// Outputs of the standard lathe (`000` §19.1.6, inventory §9.3).

@@ -40,6 +40,9 @@ fn input_bit(input: u8) -> Option<Bit> {
         SimInput::ROBOT_CYCLE_START => x::ROBOT_CYCLE_START,
         SimInput::CYCLE_START_KEY => x::KEY_CYCLE_START,
         SimInput::RESET_KEY => x::KEY_RESET,
+        SimInput::MACHINE_LOCK_KEY => x::KEY_MACHINE_LOCK,
+        SimInput::AUX_LOCK_KEY => x::KEY_AUX_LOCK,
+        SimInput::DRY_RUN_KEY => x::KEY_DRY_RUN,
         _ => return None,
     })
 }

@@ -43,6 +43,12 @@ pub struct Panel {
     pub dry_run: bool,
     /// Optional stop: M01 stops like M00.
     pub optional_stop: bool,
+    /// Machine lock: the program runs and its positions count, the drives are held where the
+    /// slides stand. Taken and released with the machine at rest (decisions D66).
+    pub machine_lock: bool,
+    /// Auxiliary function lock: M, S and T complete without reaching the PLC, except M00,
+    /// M01, M02 and M30.
+    pub aux_lock: bool,
 }
 
 impl Default for Panel {
@@ -53,6 +59,8 @@ impl Default for Panel {
             single_block: false,
             dry_run: false,
             optional_stop: false,
+            machine_lock: false,
+            aux_lock: false,
         }
     }
 }
@@ -115,8 +123,13 @@ pub struct Motion {
     done_seq: u64,
     line: u32,
     active: Option<(Block, Active)>,
-    /// Commanded slide position per axis.
+    /// Commanded slide position per axis: where the program has brought the axes.
     commanded: Vec<f64>,
+    /// The setpoint the drives get: the commanded position, or under machine lock where the
+    /// slides stood when the lock was taken.
+    drive: Vec<f64>,
+    /// Machine lock in effect (the switch is taken at rest only).
+    locked: bool,
     /// Last actual slide position per axis.
     actual: Vec<f64>,
     feed_hold: bool,
@@ -213,6 +226,8 @@ impl Motion {
             line: 0,
             active: None,
             actual: commanded.clone(),
+            drive: commanded.clone(),
+            locked: false,
             commanded,
             feed_hold: false,
             cycle_stop: false,
@@ -325,6 +340,8 @@ impl Motion {
             single_block: plc.get(g::SBK),
             dry_run: plc.get(g::DRN),
             optional_stop: plc.get(g::MOPS),
+            machine_lock: plc.get(g::MLK),
+            aux_lock: plc.get(g::AFL),
         });
         if !plc.get(g::SP_N) && plc.get(g::ESP_N) {
             self.feed_hold();
@@ -391,6 +408,10 @@ impl Motion {
     pub fn commanded(&self) -> &[f64] {
         &self.commanded
     }
+    /// The setpoint sent to the drives last tick (under machine lock not the commanded one).
+    pub fn setpoint(&self) -> &[f64] {
+        &self.drive
+    }
     pub fn f_image(&self) -> &FImage {
         &self.f
     }
@@ -434,7 +455,8 @@ impl Motion {
     }
 
     /// One servo period. `actual` is the drives' slide position (None if no feedback arrived).
-    /// Returns the new commanded slide position.
+    /// Returns the setpoint for the drives: the new commanded slide position, unless machine
+    /// lock holds them.
     pub fn tick(&mut self, actual: Option<&[f64]>, plc: &GImage) -> &[f64] {
         if let Some(a) = actual {
             for (dst, src) in self.actual.iter_mut().zip(a) {
@@ -457,7 +479,7 @@ impl Motion {
         if self.servo_off {
             // Setpoints stay where they were; the drives are disabled (see `servo_enabled`).
             self.update_f();
-            return &self.commanded;
+            return self.drive_setpoint();
         }
         if !plc.get(g::ESP_N) {
             // Servo hold where the slides are, the run dropped. The PLC raises the alarm.
@@ -471,12 +493,13 @@ impl Motion {
             }
             self.commanded.clone_from(&self.actual);
             self.update_f();
-            return &self.commanded;
+            return self.drive_setpoint();
         }
         if self.emergency_stop {
             self.emergency_stop = false;
             self.planner.reset(self.commanded_point());
         }
+        self.take_machine_lock();
         let dt = self.cfg.period;
         let mut budget = 8; // blocks that can finish within one tick (zero-length moves, aux)
         while budget > 0 && !self.alarm {
@@ -553,7 +576,31 @@ impl Motion {
             self.feed_hold = false;
         }
         self.update_f();
-        &self.commanded
+        self.drive_setpoint()
+    }
+
+    /// Machine lock is taken and released only with the machine at rest, so a running move
+    /// never jumps. Released, the program's position goes back to where the slides stand
+    /// (the interpreter takes its next start from there).
+    fn take_machine_lock(&mut self) {
+        let at_rest = self.active.is_none() && self.queue.is_empty();
+        if !at_rest || self.panel.machine_lock == self.locked {
+            return;
+        }
+        self.locked = self.panel.machine_lock;
+        if !self.locked {
+            self.commanded.clone_from(&self.drive);
+            let here = self.commanded_point();
+            self.planner.reset(here);
+        }
+    }
+
+    /// What the drives get this tick: the commanded position, unless machine lock holds them.
+    fn drive_setpoint(&mut self) -> &[f64] {
+        if !self.locked {
+            self.drive.clone_from(&self.commanded);
+        }
+        &self.drive
     }
 
     /// Whether the drives may be enabled: false after a drive fault until reset.
@@ -567,7 +614,7 @@ impl Motion {
             return;
         }
         let lagging = self.cfg.axes.iter().enumerate().find_map(|(i, a)| {
-            let lag = (self.commanded[i] - self.actual[i]).abs();
+            let lag = (self.drive[i] - self.actual[i]).abs();
             let limit = a.following_error_limit();
             (lag > limit).then(|| {
                 format!(
@@ -841,6 +888,8 @@ impl Motion {
         fi.set(f::MCYC, true);
         fi.set(f::MSBK, self.panel.single_block);
         fi.set(f::DRUR, self.panel.dry_run);
+        fi.set(f::MMLK, self.locked);
+        fi.set(f::MAFL, self.panel.aux_lock);
         fi.set(f::RST, self.reset_ticks > 0);
         self.reset_ticks = self.reset_ticks.saturating_sub(1);
     }
@@ -1085,11 +1134,17 @@ impl Motion {
     }
 
     fn in_position(&self) -> bool {
+        // Under machine lock the slides stand at the held setpoint, not at the program's.
+        let target = if self.locked {
+            &self.drive
+        } else {
+            &self.commanded
+        };
         self.cfg
             .axes
             .iter()
             .enumerate()
-            .all(|(i, a)| (self.actual[i] - self.commanded[i]).abs() <= a.in_position)
+            .all(|(i, a)| (self.actual[i] - target[i]).abs() <= a.in_position)
     }
 
     /// Advances the active block by one tick; true when it is finished.
@@ -1191,6 +1246,11 @@ impl Motion {
                 }
                 if !in_pos || hold || plc.get(g::FIN) {
                     return false;
+                }
+                // Auxiliary function lock: done without the PLC; the program stops stay.
+                let program_stop = matches!(*code, Aux::M(0 | 1 | 2 | 30));
+                if self.panel.aux_lock && !program_stop {
+                    return true;
                 }
                 *raised = true;
                 let fi = &mut self.f;

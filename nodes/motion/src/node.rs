@@ -346,8 +346,9 @@ fn servo_loop(
         if have_feedback {
             motion.spindle_feedback(spindle.0, spindle.1);
         }
-        let mut commanded = [0.0; MAX_AXES];
-        commanded[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
+        // What the drives get; under machine lock it is not the commanded position.
+        let mut setpoint = [0.0; MAX_AXES];
+        setpoint[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
         let mut fi = *motion.f_image();
         fi.seq = seq + 1;
         f_out.send(fi)?;
@@ -356,7 +357,7 @@ fn servo_loop(
         setpoints.send(ServoSetpoint {
             seq,
             sent_ns: monotonic_ns(),
-            position: commanded,
+            position: setpoint,
             axis_count: n as u32,
             enable: u32::from(motion.servo_enabled()),
         })?;
@@ -414,6 +415,8 @@ fn servo_loop(
             let _ = reports.send(Report::Status(msg));
         }
         if seq.is_multiple_of(10) {
+            let mut commanded = [0.0; MAX_AXES];
+            commanded[..n].copy_from_slice(motion.commanded());
             let _ = reports.send(Report::Axes(commanded, actual));
         }
         if seq.is_multiple_of(250) {

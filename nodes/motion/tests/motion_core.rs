@@ -819,3 +819,125 @@ fn arcs_turn_in_the_plane_they_name() {
     assert_eq!(m.state(), RunState::Alarm);
     assert_eq!(m.commanded_display(), vec![10.0, 0.0, 0.0]);
 }
+
+/// Ticks on a perfect drive that follows the setpoints motion sends (not the commanded
+/// position, which machine lock separates from them), answering every strobe with FIN.
+/// Returns the setpoints sent and the strobes seen as (signal, code).
+fn run_on_drive(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(&'static str, i32)>) {
+    let mut sent = vec![];
+    let mut strobes = vec![];
+    let mut g = GImage::released();
+    let mut slides = m.setpoint().to_vec();
+    for _ in 0..max_ticks {
+        slides = m.tick(Some(&slides), &g).to_vec();
+        sent.push(slides.clone());
+        let fi = *m.f_image();
+        for (name, strobe, code) in [
+            ("M", f::MF, f::M_CODE),
+            ("S", f::SF, f::S_CODE),
+            ("T", f::TF, f::T_CODE),
+        ] {
+            if fi.get(strobe) && !g.get(g::FIN) {
+                strobes.push((name, fi.read_i32(code)));
+                g.set(g::FIN, true);
+            }
+        }
+        if !(fi.get(f::MF) || fi.get(f::SF) || fi.get(f::TF)) {
+            g.set(g::FIN, false);
+        }
+        if matches!(m.state(), RunState::Idle | RunState::Alarm) {
+            break;
+        }
+    }
+    (sent, strobes)
+}
+
+#[test]
+fn machine_lock_runs_the_program_and_holds_the_drives_where_the_slides_stand() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.set_panel(Panel {
+        machine_lock: true,
+        ..Panel::default()
+    });
+    run_on_drive(&mut m, 1); // the switch is taken at rest
+    assert!(m.f_image().get(f::MMLK));
+    three_lines(&mut m);
+    let (sent, _) = run_on_drive(&mut m, 20_000);
+    assert_eq!(m.state(), RunState::Idle);
+    assert!(m.take_events().is_empty(), "no following error, no alarm");
+    assert!(m.f_image().get(f::MMLK));
+    // The program's position followed every line; the drives never moved.
+    assert_eq!(m.commanded_display(), vec![50.0, -30.0]);
+    assert!(
+        sent.len() > 100 && sent.iter().all(|s| s == &vec![25.0, 0.0]),
+        "{:?}",
+        sent.last()
+    );
+
+    // Released at rest: the program's position is where the slides are again.
+    m.set_panel(Panel::default());
+    let (sent, _) = run_on_drive(&mut m, 1);
+    assert_eq!(sent, vec![vec![25.0, 0.0]]);
+    assert_eq!(m.commanded_display(), vec![50.0, 0.0]);
+    assert!(!m.f_image().get(f::MMLK));
+}
+
+#[test]
+fn machine_lock_switched_during_a_run_waits_for_the_machine_at_rest() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    three_lines(&mut m);
+    let (_, _) = run_on_drive(&mut m, 50);
+    let moving = m.commanded().to_vec();
+    assert_ne!(moving[1], 0.0, "the run is under way");
+    // Lock on mid-run: the slides keep following the program to its end.
+    m.set_panel(Panel {
+        machine_lock: true,
+        ..Panel::default()
+    });
+    let (sent, _) = run_on_drive(&mut m, 20_000);
+    assert_eq!(m.state(), RunState::Idle);
+    assert_eq!(sent.last().map(|s| s[1]), Some(-30.0));
+    assert!(!m.f_image().get(f::MMLK));
+    // At rest it takes effect: the next run moves nothing.
+    run_on_drive(&mut m, 1);
+    assert!(m.f_image().get(f::MMLK));
+    m.push(block(
+        5,
+        50,
+        Command::Linear {
+            end: vec![30.0, -30.0],
+            feed: 600.0,
+        },
+    ));
+    m.push(block(6, 60, Command::ProgramEnd));
+    let (sent, _) = run_on_drive(&mut m, 20_000);
+    assert!(
+        sent.iter().all(|s| s == &vec![25.0, -30.0]),
+        "{:?}",
+        sent.last()
+    );
+    assert_eq!(m.commanded_display(), vec![30.0, -30.0]);
+}
+
+#[test]
+fn aux_lock_keeps_m_s_and_t_from_the_plc_but_not_the_program_stops() {
+    for lock in [false, true] {
+        let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+        m.set_panel(Panel {
+            aux_lock: lock,
+            ..Panel::default()
+        });
+        let codes = [Aux::M(3), Aux::S(800.0), Aux::T(3), Aux::M(8), Aux::M(0)];
+        for (k, code) in codes.into_iter().enumerate() {
+            m.push(block(k as u64 + 1, k as u32 + 1, Command::Aux(code)));
+        }
+        m.push(block(6, 6, Command::ProgramEnd));
+        let (_, strobes) = run_on_drive(&mut m, 2_000);
+        let all = vec![("M", 3), ("S", 800), ("T", 3), ("M", 8), ("M", 0)];
+        let expected = if lock { vec![("M", 0)] } else { all };
+        assert_eq!(strobes, expected, "aux lock {lock}");
+        assert_eq!(m.f_image().get(f::MAFL), lock);
+        // M00 holds in both cases, after its FIN.
+        assert_eq!(m.state(), RunState::Hold, "aux lock {lock}");
+    }
+}
