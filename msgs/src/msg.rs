@@ -79,6 +79,7 @@ ros_message! {
         consts {}
         stamp: Time,
         axes: Vec<Axis>,
+        machine_lock: bool,
     }
 }
 

@@ -412,6 +412,10 @@ impl Motion {
     pub fn setpoint(&self) -> &[f64] {
         &self.drive
     }
+    /// Whether machine lock holds the drives.
+    pub fn machine_locked(&self) -> bool {
+        self.locked
+    }
     pub fn f_image(&self) -> &FImage {
         &self.f
     }

@@ -37,7 +37,8 @@ enum Report {
     /// A tick later than the warning limit (its interval, µs), or the warning cleared.
     Late(Option<f64>),
     /// Commanded and actual slide positions.
-    Axes([f64; MAX_AXES], [f64; MAX_AXES]),
+    /// Commanded, actual and drive setpoint positions, and whether machine lock holds them.
+    Axes([f64; MAX_AXES], [f64; MAX_AXES], [f64; MAX_AXES], bool),
     Alarm(u32, String, u32),
     Stats(ServoStats),
 }
@@ -149,7 +150,7 @@ fn dds_loop(
                     0,
                 )),
                 Ok(Report::Late(None)) => alarms.clear(alarm::SERVO_LATE),
-                Ok(Report::Axes(commanded, actual)) => {
+                Ok(Report::Axes(commanded, actual, setpoint, machine_lock)) => {
                     let axes = axes
                         .iter()
                         .enumerate()
@@ -159,7 +160,7 @@ fn dds_loop(
                                 name: a.name.clone(),
                                 commanded_position: cmd,
                                 actual_position: act,
-                                following_error: cmd - act,
+                                following_error: setpoint[i] / a.scale() - act,
                                 homed: true,
                             }
                         })
@@ -169,6 +170,7 @@ fn dds_loop(
                         AxisState {
                             stamp: stamp(),
                             axes,
+                            machine_lock,
                         },
                     );
                 }
@@ -417,7 +419,8 @@ fn servo_loop(
         if seq.is_multiple_of(10) {
             let mut commanded = [0.0; MAX_AXES];
             commanded[..n].copy_from_slice(motion.commanded());
-            let _ = reports.send(Report::Axes(commanded, actual));
+            let locked = motion.machine_locked();
+            let _ = reports.send(Report::Axes(commanded, actual, setpoint, locked));
         }
         if seq.is_multiple_of(250) {
             let _ = reports.send(Report::Stats(stats.message(mcfg.period)));
