@@ -89,17 +89,17 @@ impl Cell {
                 Box::new(move || cnc_plc::node::run(c, i, s).map(|_| String::new())),
             )?,
         ));
-        let (c, i, s) = (cfg.clone(), inst, shutdown.clone());
+        let (c, i, s) = (cfg.clone(), inst.clone(), shutdown.clone());
         cell.threads.push((
             "motion",
             spawn("motion", Box::new(move || cnc_motion::node::run(c, i, s)))?,
         ));
-        let (c, s) = (cfg.clone(), shutdown.clone());
+        let (c, i, s) = (cfg.clone(), inst.clone(), shutdown.clone());
         cell.threads.push((
             "interpreter",
             spawn(
                 "interpreter",
-                Box::new(move || cnc_interpreter::node::run(c, s).map(|_| String::new())),
+                Box::new(move || cnc_interpreter::node::run(c, i, s).map(|_| String::new())),
             )?,
         ));
         let (c, s) = (cfg.clone(), shutdown);

@@ -508,7 +508,7 @@ fn run_node(node: NodeName, config: Option<&Path>) -> Result<(), String> {
         NodeName::Io => cnc_io::node::run(cfg, inst, s).map(|_| String::new()),
         NodeName::Plc => cnc_plc::node::run(cfg, inst, s).map(|_| String::new()),
         NodeName::Motion => cnc_motion::node::run(cfg, inst, s),
-        NodeName::Interpreter => cnc_interpreter::node::run(cfg, s).map(|_| String::new()),
+        NodeName::Interpreter => cnc_interpreter::node::run(cfg, inst, s).map(|_| String::new()),
         NodeName::HmiBridge => cnc_hmi_bridge::node::run(cfg, s).map(|_| String::new()),
         NodeName::Recorder => {
             cnc_recorder::node::run(cfg, s).map(|dir| format!("recorded into {}", dir.display()))

@@ -455,4 +455,11 @@ fn machine_lock_and_aux_lock_run_a_program_without_moving_the_machine() {
     assert!(r.gi.get(g::DRN) && r.nc().get(f::DRUR));
     press(&mut r, x::KEY_DRY_RUN);
     assert!(!r.gi.get(g::DRN) && !r.nc().get(f::DRUR));
+    // Block skip is on from the first power-up (K2.0), as the interpreter's default, and the
+    // key turns it off and on (G44.0, answered on F4.0).
+    assert!(r.gi.get(g::BDT1) && r.nc().get(f::MBDT));
+    press(&mut r, x::KEY_BLOCK_SKIP);
+    assert!(!r.gi.get(g::BDT1) && !r.nc().get(f::MBDT));
+    press(&mut r, x::KEY_BLOCK_SKIP);
+    assert!(r.gi.get(g::BDT1) && r.nc().get(f::MBDT));
 }

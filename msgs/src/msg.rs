@@ -310,7 +310,8 @@ ros_message! {
             RESET_KEY: u8 = 12,
             MACHINE_LOCK_KEY: u8 = 13,
             AUX_LOCK_KEY: u8 = 14,
-            DRY_RUN_KEY: u8 = 15
+            DRY_RUN_KEY: u8 = 15,
+            BLOCK_SKIP_KEY: u8 = 16
         }
         input: u8,
         value: bool,

@@ -182,6 +182,8 @@ pub mod f {
     pub const MMLK: Bit = bit(4, 1);
     /// Auxiliary function lock in effect (M, S, T not output; F4.4).
     pub const MAFL: Bit = bit(4, 4);
+    /// Block skip in effect (F4.0).
+    pub const MBDT: Bit = bit(4, 0);
     pub const TF: Bit = bit(7, 3);
     pub const SF: Bit = bit(7, 2);
     pub const MF: Bit = bit(7, 0);
@@ -222,6 +224,8 @@ pub mod g {
     pub const MOPS: Bit = bit(44, 2);
     /// Machine lock: the program runs and its positions count, the axes do not move (G44.1).
     pub const MLK: Bit = bit(44, 1);
+    /// Block skip: blocks that begin with `/` are skipped (G44.0 BDT1).
+    pub const BDT1: Bit = bit(44, 0);
     pub const DRN: Bit = bit(46, 7);
     pub const SBK: Bit = bit(46, 1);
     /// Current tool number of turret 1, binary.
@@ -282,6 +286,7 @@ pub mod x {
     pub const KEY_MACHINE_LOCK: Bit = bit(19, 0);
     pub const KEY_AUX_LOCK: Bit = bit(19, 1);
     pub const KEY_DRY_RUN: Bit = bit(19, 2);
+    pub const KEY_BLOCK_SKIP: Bit = bit(19, 3);
 }
 
 /// Outputs of the standard lathe (`000` §19.1.6, inventory §9.3).

@@ -30,6 +30,12 @@ impl Interpreter {
         }
     }
 
+    /// The block-skip switch: blocks read from now on that begin with `/` are skipped (on) or
+    /// run (off). Blocks already read stay as they were read, as on the control.
+    pub fn set_block_skip(&mut self, on: bool) {
+        self.front.core_mut().setup.block_skip = on;
+    }
+
     /// The next canonical command; `Ok(None)` once the program has ended.
     pub fn next_command(&mut self) -> Result<Option<Canon>, ProgramError> {
         next_command(&mut *self.front)

@@ -12,11 +12,13 @@ use cnc_msgs::msg::{
     Alarm, AlarmEvent, AxisState, CommandResult, MachineState, MotionBlock, MotionStatus,
     ProgramCommand,
 };
+use cnc_msgs::signals::{g, GImage, SignalTable};
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{stamp, RosNode};
 use cnc_runtime::persist::Keeper;
 use cnc_runtime::program_store::{InRam, ProgramDir, ProgramStorage};
+use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
@@ -117,7 +119,9 @@ fn kept_position(cfg: &LaunchConfig) -> Option<Keeper> {
     Some(Keeper::new(path, "program position"))
 }
 
-pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
+/// Runs the interpreter node of the machine `instance` ([`cnc_runtime::shm::instance`]) until
+/// `shutdown`.
+pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
     let dialect = Dialect::from_name(&cfg.machine.dialect)
         .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
@@ -130,6 +134,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let alarm_sub = ros.subscription::<AlarmEvent>(&topics::ALARM_EVENTS)?;
     let state_pub = ros.publisher::<MachineState>(&topics::MACHINE_STATE)?;
     let alarms = AlarmReporter::new(&mut ros, run::SOURCE)?;
+    // The PLC's G image, for the block-skip switch (G44.0): the interpreter reads the blocks.
+    let shm = ShmNode::new(&instance, "interpreter")?;
+    let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
 
     let (memory, memory_error) = load_memory(&cfg);
     if let Some(e) = memory_error {
@@ -209,6 +216,9 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         while let Ok(Some(e)) = alarm_sub.take() {
             core.alarm_event(&e);
+        }
+        if let Ok(Some(g)) = g_in.latest() {
+            core.block_skip_switch(g.get(g::BDT1));
         }
         carry_out(&mut core);
         while let Ok(Some(c)) = commands.take() {

@@ -98,6 +98,11 @@ impl ProgramRun {
     pub fn interpreter(&self) -> &Interpreter {
         &self.interp
     }
+
+    /// The block-skip switch for the blocks still to be read ([`Interpreter::set_block_skip`]).
+    pub fn set_block_skip(&mut self, on: bool) {
+        self.interp.set_block_skip(on);
+    }
 }
 
 /// What the run core asks its shell to do.
@@ -599,6 +604,18 @@ impl RunCore {
                 .iter()
                 .any(|(s, n)| s == "plc" && *n == 65),
             alarm_active: !self.active_alarms.is_empty(),
+        }
+    }
+
+    /// The operator's block-skip switch (the PLC's G44.0): it applies to the blocks the run
+    /// reads from now on, and to the runs after it.
+    pub fn block_skip_switch(&mut self, on: bool) {
+        if self.base.block_skip == on {
+            return;
+        }
+        self.base.block_skip = on;
+        if let Some(run) = self.run.as_mut() {
+            run.stream.set_block_skip(on);
         }
     }
 

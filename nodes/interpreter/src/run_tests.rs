@@ -414,3 +414,39 @@ fn program_memory_is_kept_bounded_by_its_capacity_and_a_failed_write_is_no_load(
         "not in memory either: {r:?}"
     );
 }
+
+#[test]
+fn the_block_skip_switch_applies_to_the_blocks_read_after_it() {
+    const SKIPPY: &str = "G00 X100 Z20\n/G00 X150\nG01 Z10 F3000\n/G00 X160\nM30\n";
+    let lines_sent = |c: &mut RunCore, credit: u32| {
+        c.step();
+        // The lines the blocks came from (M30 is two blocks: its strobe and the end).
+        let mut sent: Vec<u32> = blocks(&c.take_effects()).iter().map(|b| b.line).collect();
+        sent.dedup();
+        c.motion_status(status(
+            c.run_counter,
+            0,
+            credit,
+            MotionStatus::STATE_RUNNING,
+        ));
+        sent
+    };
+    for (on, expected) in [(true, vec![1, 3, 5]), (false, vec![1, 2, 3, 4, 5])] {
+        let mut c = ready();
+        assert!(command(&mut c, 3, ProgramCommand::LOAD, "skip.nc", SKIPPY).accepted);
+        c.block_skip_switch(on);
+        assert!(command(&mut c, 4, ProgramCommand::START, "skip.nc", "").accepted);
+        c.motion_status(status(0, 0, 100, MotionStatus::STATE_IDLE));
+        assert_eq!(lines_sent(&mut c, 100), expected, "switch {on}");
+    }
+    // Turned off during the run: the first skip block was read with it on, the second after.
+    let mut c = ready();
+    assert!(command(&mut c, 3, ProgramCommand::LOAD, "skip.nc", SKIPPY).accepted);
+    assert!(command(&mut c, 4, ProgramCommand::START, "skip.nc", "").accepted);
+    c.motion_status(status(0, 0, 2, MotionStatus::STATE_IDLE));
+    let first = lines_sent(&mut c, 2);
+    assert_eq!(first, vec![1, 3]);
+    c.block_skip_switch(false);
+    c.motion_status(status(c.run_counter, 2, 2, MotionStatus::STATE_RUNNING));
+    assert_eq!(lines_sent(&mut c, 2), vec![4, 5]);
+}

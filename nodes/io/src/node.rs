@@ -43,6 +43,7 @@ fn input_bit(input: u8) -> Option<Bit> {
         SimInput::MACHINE_LOCK_KEY => x::KEY_MACHINE_LOCK,
         SimInput::AUX_LOCK_KEY => x::KEY_AUX_LOCK,
         SimInput::DRY_RUN_KEY => x::KEY_DRY_RUN,
+        SimInput::BLOCK_SKIP_KEY => x::KEY_BLOCK_SKIP,
         _ => return None,
     })
 }

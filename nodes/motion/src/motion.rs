@@ -130,6 +130,8 @@ pub struct Motion {
     drive: Vec<f64>,
     /// Machine lock in effect (the switch is taken at rest only).
     locked: bool,
+    /// The block-skip switch as the PLC gives it, answered on F4.0.
+    block_skip: bool,
     /// Last actual slide position per axis.
     actual: Vec<f64>,
     feed_hold: bool,
@@ -228,6 +230,7 @@ impl Motion {
             actual: commanded.clone(),
             drive: commanded.clone(),
             locked: false,
+            block_skip: false,
             commanded,
             feed_hold: false,
             cycle_stop: false,
@@ -343,6 +346,8 @@ impl Motion {
             machine_lock: plc.get(g::MLK),
             aux_lock: plc.get(g::AFL),
         });
+        // The interpreter acts on the switch (it reads blocks); motion answers its lamp.
+        self.block_skip = plc.get(g::BDT1);
         if !plc.get(g::SP_N) && plc.get(g::ESP_N) {
             self.feed_hold();
         }
@@ -894,6 +899,7 @@ impl Motion {
         fi.set(f::DRUR, self.panel.dry_run);
         fi.set(f::MMLK, self.locked);
         fi.set(f::MAFL, self.panel.aux_lock);
+        fi.set(f::MBDT, self.block_skip);
         fi.set(f::RST, self.reset_ticks > 0);
         self.reset_ticks = self.reset_ticks.saturating_sub(1);
     }
