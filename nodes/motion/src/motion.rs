@@ -1257,9 +1257,13 @@ impl Motion {
                 if !in_pos || hold || plc.get(g::FIN) {
                     return false;
                 }
-                // Auxiliary function lock: done without the PLC; the program stops stay.
+                // Auxiliary function lock: done without the PLC; the program stops stay. The
+                // NC still knows the programmed speed (feed per revolution is computed from it).
                 let program_stop = matches!(*code, Aux::M(0 | 1 | 2 | 30));
                 if self.panel.aux_lock && !program_stop {
+                    if let Aux::S(s) = *code {
+                        self.spindle_rpm = s;
+                    }
                     return true;
                 }
                 *raised = true;

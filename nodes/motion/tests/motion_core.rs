@@ -927,16 +927,28 @@ fn aux_lock_keeps_m_s_and_t_from_the_plc_but_not_the_program_stops() {
             aux_lock: lock,
             ..Panel::default()
         });
-        let codes = [Aux::M(3), Aux::S(800.0), Aux::T(3), Aux::M(8), Aux::M(0)];
-        for (k, code) in codes.into_iter().enumerate() {
-            m.push(block(k as u64 + 1, k as u32 + 1, Command::Aux(code)));
+        let mut kinds: Vec<Command> = [Aux::M(3), Aux::S(800.0), Aux::T(3), Aux::M(8)]
+            .into_iter()
+            .map(Command::Aux)
+            .collect();
+        // The programmed speed is known either way: a feed per revolution runs.
+        kinds.push(Command::FeedMode { per_rev: true });
+        kinds.push(Command::Linear {
+            end: vec![50.0, -1.0],
+            feed: 0.1,
+        });
+        kinds.push(Command::Aux(Aux::M(0)));
+        kinds.push(Command::ProgramEnd);
+        for (k, kind) in kinds.into_iter().enumerate() {
+            m.push(block(k as u64 + 1, k as u32 + 1, kind));
         }
-        m.push(block(6, 6, Command::ProgramEnd));
-        let (_, strobes) = run_on_drive(&mut m, 2_000);
+        let (_, strobes) = run_on_drive(&mut m, 5_000);
         let all = vec![("M", 3), ("S", 800), ("T", 3), ("M", 8), ("M", 0)];
         let expected = if lock { vec![("M", 0)] } else { all };
         assert_eq!(strobes, expected, "aux lock {lock}");
         assert_eq!(m.f_image().get(f::MAFL), lock);
+        assert!(m.take_events().is_empty(), "aux lock {lock}");
+        assert_eq!(m.commanded_display(), vec![50.0, -1.0], "aux lock {lock}");
         // M00 holds in both cases, after its FIN.
         assert_eq!(m.state(), RunState::Hold, "aux lock {lock}");
     }
