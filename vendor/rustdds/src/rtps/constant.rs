@@ -85,8 +85,8 @@ pub const MAX_WITHHELD_BYTES_PER_TOPIC: usize = 16 * 1024 * 1024;
 // cnc patch (the cnc workspace's decision D63): most payload bytes a TopicCache keeps
 // for samples its readers may still take. Beyond this the oldest samples go, even under a
 // deeper KeepLast history (the newest is always kept): samples leave the cache only by its
-// history limits, so a history of 256 requests of 4 MiB programs kept 1 GiB of samples the
-// reader had long taken.
+// history and sample limits, so a service reader kept up to 64 requests of 4 MiB programs
+// (1,024 with a history of 1,024) the bridge had long taken.
 pub const MAX_KEPT_BYTES_PER_TOPIC: usize = 32 * 1024 * 1024;
 
 // Default / fallback UDP-payload budget (RTPS header + submessages) used to
