@@ -1,5 +1,7 @@
-//! The motion core: block queue, the look-ahead planner's window, rapids, dwells, soft limits,
-//! drive faults, M/S/T handshake with the PLC.
+//! The motion core: the run's block queue, the servo tick, rapids, dwells, drive faults, the
+//! M/S/T handshake and the NC's state signals to the PLC. What a block becomes is in
+//! `activate.rs` (soft limits, checks, segments), how blocks join the look-ahead window in
+//! `window.rs`, the operator's switches and machine lock in `panel.rs`.
 //!
 //! Pure: the shell calls [`Motion::tick`] every servo period with the latest drive feedback and
 //! PLC image and sends the returned setpoint to the drives. Positions inside are slide travel
@@ -19,6 +21,11 @@ use crate::profile::{Ahead, Limits, Mover};
 use crate::thread::{Piece, ThreadChain};
 
 pub use crate::alarm;
+pub use panel::Panel;
+
+mod activate;
+mod panel;
+mod window;
 
 /// Something the shell must publish.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,41 +35,6 @@ pub enum MotionEvent {
         text: String,
         line: u32,
     },
-}
-
-/// The operator's switches as motion sees them (`000` §7.3, §7.4; decision D38).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Panel {
-    /// Feed override, 0–1.5 (the manual's steps 0–150 %). Threads ignore it.
-    pub feed_override: f64,
-    /// Rapid override, 0–1 (the manual's F0 = 0 %, 25 %, 50 %, 100 %).
-    pub rapid_override: f64,
-    /// Single block: stop after each program line (a cycle is one line).
-    pub single_block: bool,
-    /// Dry run: feed moves at `servo.dry_run_feed` instead of F (threads stay locked).
-    pub dry_run: bool,
-    /// Optional stop: M01 stops like M00.
-    pub optional_stop: bool,
-    /// Machine lock: the program runs and its positions count, the drives are held where the
-    /// slides stand. Taken and released with the machine at rest (decisions D66).
-    pub machine_lock: bool,
-    /// Auxiliary function lock: M, S and T complete without reaching the PLC, except M00,
-    /// M01, M02 and M30.
-    pub aux_lock: bool,
-}
-
-impl Default for Panel {
-    fn default() -> Self {
-        Panel {
-            feed_override: 1.0,
-            rapid_override: 1.0,
-            single_block: false,
-            dry_run: false,
-            optional_stop: false,
-            machine_lock: false,
-            aux_lock: false,
-        }
-    }
 }
 
 /// Run state reported to the interpreter.
@@ -130,8 +102,6 @@ pub struct Motion {
     drive: Vec<f64>,
     /// Machine lock in effect (the switch is taken at rest only).
     locked: bool,
-    /// The block-skip switch as the PLC gives it, answered on F4.0.
-    block_skip: bool,
     /// Last actual slide position per axis.
     actual: Vec<f64>,
     feed_hold: bool,
@@ -178,26 +148,6 @@ pub struct Motion {
     thread_lead_time: [f64; MAX_AXES],
 }
 
-/// Most spindle revolutions one thread block may take (a million: 2 h at 8000 rpm).
-const MAX_THREAD_REVS: f64 = 1e6;
-
-/// Most lines merged into one chord.
-const MAX_MERGE: usize = 32;
-/// Share of the path tolerance merging may use; blends at the chord's ends use the rest.
-const MERGE_SHARE: f64 = 0.5;
-/// Blocks the planner must hold before a merge waits for more lines from the interpreter.
-const MERGE_WAIT_BLOCKS: usize = 8;
-
-/// Lines merged into one chord.
-struct Merged {
-    end: Point,
-    /// Block number of the last line merged.
-    seq: u64,
-    blocks: usize,
-    /// Largest distance of a programmed point from the chord, mm.
-    deviation: f64,
-}
-
 impl Motion {
     /// `start` is the slide position the drives report at start-up.
     pub fn new(cfg: MotionConfig, start: &[f64]) -> Self {
@@ -215,7 +165,7 @@ impl Motion {
             thread,
             encoder: Encoder::default(),
             panel: Panel::default(),
-            merge_points: Vec::with_capacity(MAX_MERGE),
+            merge_points: Vec::with_capacity(window::MAX_MERGE),
             block_stop: false,
             last_line: None,
             thread_lead_time,
@@ -230,7 +180,6 @@ impl Motion {
             actual: commanded.clone(),
             drive: commanded.clone(),
             locked: false,
-            block_skip: false,
             commanded,
             feed_hold: false,
             cycle_stop: false,
@@ -316,46 +265,6 @@ impl Motion {
     /// angle after the index pulse in degrees.
     pub fn spindle_feedback(&mut self, rpm: f64, angle_deg: f64) {
         self.encoder.read(rpm, angle_deg);
-    }
-
-    /// The operator's switches; overrides take effect on the next tick.
-    pub fn set_panel(&mut self, panel: Panel) {
-        let clean = |v: f64, max: f64| {
-            if v.is_finite() {
-                v.clamp(0.0, max)
-            } else {
-                1.0
-            }
-        };
-        self.panel = Panel {
-            feed_override: clean(panel.feed_override, crate::planner::MAX_FEED_OVERRIDE),
-            rapid_override: clean(panel.rapid_override, 1.0),
-            ..panel
-        };
-    }
-
-    /// The operator's signals in the PLC's G image, applied every tick: overrides and
-    /// switches as levels, feed hold while `*SP` is low, cycle start on the rising edge of ST.
-    pub fn plc_signals(&mut self, plc: &GImage) {
-        self.set_panel(Panel {
-            feed_override: plc.feed_override(),
-            rapid_override: plc.rapid_override(),
-            single_block: plc.get(g::SBK),
-            dry_run: plc.get(g::DRN),
-            optional_stop: plc.get(g::MOPS),
-            machine_lock: plc.get(g::MLK),
-            aux_lock: plc.get(g::AFL),
-        });
-        // The interpreter acts on the switch (it reads blocks); motion answers its lamp.
-        self.block_skip = plc.get(g::BDT1);
-        if !plc.get(g::SP_N) && plc.get(g::ESP_N) {
-            self.feed_hold();
-        }
-        let start = plc.get(g::ST);
-        if start && !self.plc_start && plc.get(g::SP_N) {
-            self.cycle_start();
-        }
-        self.plc_start = start;
     }
 
     /// Feed hold: decelerate on the path and wait for [`Motion::cycle_start`].
@@ -588,30 +497,6 @@ impl Motion {
         self.drive_setpoint()
     }
 
-    /// Machine lock is taken and released only with the machine at rest, so a running move
-    /// never jumps. Released, the program's position goes back to where the slides stand
-    /// (the interpreter takes its next start from there).
-    fn take_machine_lock(&mut self) {
-        let at_rest = self.active.is_none() && self.queue.is_empty();
-        if !at_rest || self.panel.machine_lock == self.locked {
-            return;
-        }
-        self.locked = self.panel.machine_lock;
-        if !self.locked {
-            self.commanded.clone_from(&self.drive);
-            let here = self.commanded_point();
-            self.planner.reset(here);
-        }
-    }
-
-    /// What the drives get this tick: the commanded position, unless machine lock holds them.
-    fn drive_setpoint(&mut self) -> &[f64] {
-        if !self.locked {
-            self.drive.clone_from(&self.commanded);
-        }
-        &self.drive
-    }
-
     /// Whether the drives may be enabled: false after a drive fault until reset.
     pub fn servo_enabled(&self) -> bool {
         !self.servo_off
@@ -662,184 +547,6 @@ impl Motion {
         let here = self.commanded_point();
         self.planner.reset(here);
         self.clear_strobe();
-    }
-
-    /// Path blocks waiting in the queue join the planner's window while it has room, so
-    /// corners between them are blended and the speed carries over.
-    fn extend_chain(&mut self) -> Result<(), (u32, String, u32)> {
-        if !matches!(self.active, Some((_, Active::Path))) {
-            return Ok(());
-        }
-        while self.planner.has_room() {
-            let Some(next) = self.queue.front() else {
-                break;
-            };
-            let (seq, line) = (next.seq, next.line);
-            if self.panel.single_block && line != self.line {
-                break;
-            }
-            match &next.kind {
-                Command::Linear { .. } if !self.exact_stop => {
-                    let start = self.planner.end();
-                    let (seg, feed) = self
-                        .segment_for(next, &start)
-                        .map_err(|(n, t)| (n, t, line))?;
-                    let Some(merged) = self.merge_lines(&start, seg.end()) else {
-                        break; // wait for more blocks to merge with
-                    };
-                    let seg = Segment::Line {
-                        start,
-                        end: merged.end,
-                    };
-                    self.planner
-                        .push(seg, feed, merged.seq, line, true, merged.deviation);
-                    for _ in 0..merged.blocks {
-                        self.queue.pop_front();
-                    }
-                    continue;
-                }
-                Command::Linear { .. } | Command::Arc { .. } => {
-                    let (seg, feed) = self
-                        .segment_for(next, &self.planner.end())
-                        .map_err(|(n, t)| (n, t, line))?;
-                    let blend = !self.exact_stop;
-                    self.planner.push(seg, feed, seq, line, blend, 0.0);
-                }
-                Command::FeedMode { per_rev } => {
-                    self.feed_per_rev = *per_rev;
-                    self.planner.push_marker(seq, line);
-                }
-                Command::PathMode { exact_stop } => {
-                    self.exact_stop = *exact_stop;
-                    self.planner.push_marker(seq, line);
-                }
-                _ => break,
-            }
-            self.queue.pop_front();
-        }
-        Ok(())
-    }
-
-    /// Lines at the front of the queue that lie within half the path tolerance of one chord
-    /// from `start` are cut as that chord (decision D34: "collinear short segments merged"), so a
-    /// curve given as short chords with rounded coordinates is not a string of kinks. The
-    /// first line (ending at `first_end`) is always taken. `None`: the queue ran out while more
-    /// lines might still merge and the planner has enough ahead to wait for them.
-    fn merge_lines(&mut self, start: &Point, first_end: Point) -> Option<Merged> {
-        let tolerance = self.cfg.tolerance * MERGE_SHARE;
-        let first = self.queue.front()?;
-        let (feed, line) = match &first.kind {
-            Command::Linear { feed, .. } => (*feed, first.line),
-            _ => return None,
-        };
-        let mut merged = Merged {
-            end: first_end,
-            seq: first.seq,
-            blocks: 1,
-            deviation: 0.0,
-        };
-        self.merge_points.clear();
-        loop {
-            if merged.blocks >= MAX_MERGE {
-                return Some(merged);
-            }
-            let Some(b) = self.queue.get(merged.blocks) else {
-                // More lines may come: wait for them while the window has plenty to cut (a
-                // program's last line is followed by its end, which closes the merge).
-                return (self.planner.blocks() < MERGE_WAIT_BLOCKS).then_some(merged);
-            };
-            let same = matches!(&b.kind, Command::Linear { feed: f, .. } if *f == feed)
-                && !(self.panel.single_block && b.line != line);
-            if !same || self.check_block(&b.kind).is_err() {
-                return Some(merged);
-            }
-            let Some(end) = b.kind.end().filter(|e| self.check_limits(e).is_ok()) else {
-                return Some(merged);
-            };
-            let candidate = self.to_slide(end);
-            self.merge_points.push(merged.end);
-            match path::chord_deviation(start, &candidate, &self.merge_points) {
-                Some(d) if d <= tolerance => {
-                    merged.end = candidate;
-                    merged.seq = b.seq;
-                    merged.blocks += 1;
-                    merged.deviation = d;
-                }
-                _ => return Some(merged),
-            }
-        }
-    }
-
-    /// Thread blocks that follow the one being cut join its chain (continuous threading,
-    /// `000` §5.23.1); once the chain is complete enough, it is synchronised to the spindle.
-    fn extend_thread(&mut self) -> Result<(), (u32, String, u32)> {
-        let Some((first, Active::Thread { shift })) = &self.active else {
-            return Ok(());
-        };
-        let (shift, line) = (*shift, first.line);
-        while self.thread.accepts() {
-            let Some(next) = self.queue.front() else {
-                break;
-            };
-            if !matches!(next.kind, Command::Thread { .. }) {
-                break;
-            }
-            let start = self.thread_end();
-            let piece = self
-                .thread_piece(next, &start)
-                .map_err(|(n, t)| (n, t, next.line))?;
-            self.thread.push(piece);
-            self.queue.pop_front();
-        }
-        // Under feed hold the thread does not start; once started, it is cut to its end.
-        if self.thread.synchronised() || self.feed_hold {
-            return Ok(());
-        }
-        // `000` §5.23: the thread starts only with the spindle turning (alarm 36).
-        let omega = self.encoder.omega();
-        if omega * 60.0 < 1.0 {
-            return Err((
-                alarm::SPINDLE_NOT_TURNING,
-                "thread cutting with the spindle stopped".into(),
-                line,
-            ));
-        }
-        if let Some((axis, v)) = self.thread.too_fast(omega) {
-            return Err((
-                alarm::THREAD_RUN_IN,
-                format!(
-                    "thread feed {:.0} mm/min on {} at {:.0} rpm exceeds the axis's rapid rate",
-                    v * 60.0,
-                    self.cfg.axes.get(axis).map_or("?", |a| a.name.as_str()),
-                    self.encoder.rpm.abs()
-                ),
-                line,
-            ));
-        }
-        let ramp = self.thread.ramp_for(omega);
-        if self.thread.total() < ramp {
-            return Err((
-                alarm::THREAD_RUN_IN,
-                format!(
-                    "thread of {:.2} revolutions too short: run-in and run-out need {ramp:.2} at {:.0} rpm",
-                    self.thread.total(),
-                    self.encoder.rpm.abs()
-                ),
-                line,
-            ));
-        }
-        let lead_time = self.thread_lead_time.iter().copied().fold(0.0, f64::max);
-        let e = self.encoder;
-        self.thread
-            .synchronise(e.revs, e.angle, shift, omega, ramp, lead_time);
-        Ok(())
-    }
-
-    /// Where the last piece of the thread chain ends (slide coordinates).
-    fn thread_end(&self) -> Point {
-        self.thread
-            .last_end()
-            .unwrap_or_else(|| self.commanded_point())
     }
 
     fn stopped_on_path(&self) -> bool {
@@ -899,7 +606,7 @@ impl Motion {
         fi.set(f::DRUR, self.panel.dry_run);
         fi.set(f::MMLK, self.locked);
         fi.set(f::MAFL, self.panel.aux_lock);
-        fi.set(f::MBDT, self.block_skip);
+        fi.set(f::MBDT, self.panel.block_skip);
         fi.set(f::RST, self.reset_ticks > 0);
         self.reset_ticks = self.reset_ticks.saturating_sub(1);
     }
@@ -907,254 +614,6 @@ impl Motion {
     /// The commanded slide position as a planner point.
     fn commanded_point(&self) -> Point {
         path::point_from(&self.commanded)
-    }
-
-    /// Slide positions of a display-unit point.
-    fn to_slide(&self, p: &[f64]) -> Point {
-        let mut out = [0.0; MAX_AXES];
-        for (i, a) in self.cfg.axes.iter().take(MAX_AXES).enumerate() {
-            out[i] = p.get(i).copied().unwrap_or(0.0) * a.scale();
-        }
-        out
-    }
-
-    /// Display units of a slide point.
-    fn to_display(&self, p: &Point) -> Vec<f64> {
-        self.cfg
-            .axes
-            .iter()
-            .enumerate()
-            .map(|(i, a)| p[i] / a.scale())
-            .collect()
-    }
-
-    /// Checks a display-unit point against the soft limits.
-    fn check_limits(&self, p: &[f64]) -> Result<(), (u32, String)> {
-        for (i, a) in self.cfg.axes.iter().enumerate() {
-            let v = p.get(i).copied().unwrap_or(0.0);
-            if v < a.min - 1e-9 || v > a.max + 1e-9 {
-                return Err((
-                    alarm::SOFT_LIMIT,
-                    format!(
-                        "soft limit: {} {:.4} outside {:.3}..{:.3}",
-                        a.name, v, a.min, a.max
-                    ),
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// Turns a block into its active form; soft limits are checked here, before any motion.
-    fn activate(&mut self, block: &Block) -> Result<Active, (u32, String)> {
-        let n = self.cfg.axes.len();
-        let start = self.commanded_point();
-        match &block.kind {
-            Command::Rapid { end } => {
-                self.check_block(&block.kind)?;
-                self.check_limits(end)?;
-                let end = self.to_slide(end);
-                let mut axes = [RapidAxis {
-                    length: 0.0,
-                    travelled: 0.0,
-                    mover: Mover::default(),
-                }; MAX_AXES];
-                for (i, ax) in axes.iter_mut().enumerate().take(n) {
-                    ax.length = (end[i] - start[i]).abs();
-                }
-                Ok(Active::Rapid { start, end, axes })
-            }
-            Command::Linear { .. } | Command::Arc { .. } => {
-                let (seg, feed) = self.segment_for(block, &start)?;
-                self.planner.reset(start);
-                self.planner
-                    .push(seg, feed, block.seq, block.line, !self.exact_stop, 0.0);
-                Ok(Active::Path)
-            }
-            Command::Thread { start_angle, .. } => {
-                let piece = self.thread_piece(block, &start)?;
-                self.thread.clear();
-                self.thread.push(piece);
-                Ok(Active::Thread {
-                    shift: *start_angle,
-                })
-            }
-            Command::Dwell { seconds } => Ok(Active::Dwell {
-                remaining: *seconds,
-            }),
-            // Feed and path mode were taken over when the block was popped.
-            Command::FeedMode { .. } | Command::PathMode { .. } => {
-                Ok(Active::Dwell { remaining: 0.0 })
-            }
-            Command::Aux(code) => Ok(Active::Aux {
-                code: *code,
-                raised: false,
-            }),
-            Command::ProgramEnd => Ok(Active::End),
-        }
-    }
-
-    /// A block's end point and arc centre must name every axis with a finite value.
-    fn check_block(&self, kind: &Command) -> Result<(), (u32, String)> {
-        let n = self.cfg.axes.len();
-        let bad_len = |v: &[f64]| v.len() != n || v.iter().any(|x| !x.is_finite());
-        if let Some(end) = kind.end() {
-            if bad_len(end) {
-                return Err((
-                    alarm::BAD_BLOCK,
-                    format!("block has {} axis values, machine has {n}", end.len()),
-                ));
-            }
-        }
-        if let Command::Arc { center, .. } = kind {
-            if bad_len(center) {
-                return Err((
-                    alarm::BAD_BLOCK,
-                    "arc centre has the wrong number of axes".into(),
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// The path segment of a line, arc or thread starting at `start` (slide units), and its
-    /// feed in mm/s. Soft limits are checked here, before the block joins the plan.
-    fn segment_for(&self, block: &Block, start: &Point) -> Result<(Segment, f64), (u32, String)> {
-        self.check_block(&block.kind)?;
-        match &block.kind {
-            Command::Linear { end, feed } => {
-                let feed = self.feed_mm_per_min(*feed)?;
-                self.check_limits(end)?;
-                let end = self.to_slide(end);
-                Ok((Segment::Line { start: *start, end }, feed / 60.0))
-            }
-            Command::Arc {
-                end,
-                center,
-                clockwise,
-                feed,
-                plane,
-            } => {
-                let feed = self.feed_mm_per_min(*feed)?;
-                self.check_limits(end)?;
-                let (h, v) = match plane {
-                    None => self.cfg.arc_plane,
-                    Some([h, v]) => (usize::from(*h), usize::from(*v)),
-                };
-                if h >= self.cfg.axes.len() || v >= self.cfg.axes.len() {
-                    return Err((
-                        alarm::BAD_BLOCK,
-                        format!(
-                            "arc plane axes {h}, {v}: the machine has {} axes",
-                            self.cfg.axes.len()
-                        ),
-                    ));
-                }
-                let end = self.to_slide(end);
-                let c = self.to_slide(center);
-                let seg = path::arc(start, &end, &c, (h, v), *clockwise)
-                    .ok_or((alarm::BAD_BLOCK, "arc of zero radius".to_string()))?;
-                let Segment::Arc {
-                    radius, a0, sweep, ..
-                } = seg
-                else {
-                    return Err((alarm::BAD_BLOCK, "not an arc".into()));
-                };
-                // Soft limits at the arc's extreme points (every quadrant crossing).
-                let quarter = TAU / 4.0;
-                let first = (a0 / quarter).floor() as i64;
-                let mut k = first;
-                loop {
-                    let ang = if sweep > 0.0 {
-                        (k + 1) as f64 * quarter
-                    } else {
-                        k as f64 * quarter
-                    };
-                    let passed = if sweep > 0.0 {
-                        ang - a0 < sweep
-                    } else {
-                        ang - a0 > sweep && ang < a0
-                    };
-                    if !passed || (k - first).abs() > 5 {
-                        break;
-                    }
-                    let mut p = self.to_display(start);
-                    p[h] = (c[h] + radius * ang.cos()) / self.cfg.axes[h].scale();
-                    p[v] = (c[v] + radius * ang.sin()) / self.cfg.axes[v].scale();
-                    self.check_limits(&p)?;
-                    k += if sweep > 0.0 { 1 } else { -1 };
-                }
-                Ok((seg, feed / 60.0))
-            }
-            _ => Err((alarm::BAD_BLOCK, "not a path block".into())),
-        }
-    }
-
-    /// A thread block as a piece of a thread chain starting at `start` (slide units): the
-    /// long axis (X as radius, `000` §5.23.1) advances one lead per spindle revolution.
-    fn thread_piece(&self, block: &Block, start: &Point) -> Result<Piece, (u32, String)> {
-        self.check_block(&block.kind)?;
-        let Command::Thread { end, lead, .. } = &block.kind else {
-            return Err((alarm::BAD_BLOCK, "not a thread block".into()));
-        };
-        self.check_limits(end)?;
-        let n = self.cfg.axes.len().min(MAX_AXES);
-        let end = self.to_slide(end);
-        let long = (0..n)
-            .map(|i| (end[i] - start[i]).abs())
-            .fold(0.0, f64::max);
-        // Blocks come from anyone on the DDS domain: a lead so small that the thread would
-        // take longer than any spindle could turn is refused, not waited for.
-        let revs = long / lead;
-        if !(revs.is_finite() && revs <= MAX_THREAD_REVS) {
-            return Err((
-                alarm::BAD_BLOCK,
-                format!("thread of lead {lead} mm over {long:.4} mm: {revs:e} revolutions"),
-            ));
-        }
-        Ok(Piece {
-            start: *start,
-            end,
-            revs,
-            seq: block.seq,
-            line: block.line,
-        })
-    }
-
-    fn spindle_rpm_for(&self, what: &str) -> Result<f64, (u32, String)> {
-        if self.spindle_rpm > 0.0 {
-            Ok(self.spindle_rpm)
-        } else {
-            Err((
-                alarm::SPINDLE_NOT_TURNING,
-                format!("{what} with no spindle speed commanded"),
-            ))
-        }
-    }
-
-    /// A programmed feed in mm/min, from mm/rev under G99; the dry-run feed under dry run.
-    fn feed_mm_per_min(&self, feed: f64) -> Result<f64, (u32, String)> {
-        if self.panel.dry_run {
-            Ok(self.cfg.dry_run_feed)
-        } else if self.feed_per_rev {
-            Ok(feed * self.spindle_rpm_for("feed per revolution")?)
-        } else {
-            Ok(feed)
-        }
-    }
-
-    fn in_position(&self) -> bool {
-        // Under machine lock the slides stand at the held setpoint, not at the program's.
-        let target = if self.locked {
-            &self.drive
-        } else {
-            &self.commanded
-        };
-        self.cfg
-            .axes
-            .iter()
-            .enumerate()
-            .all(|(i, a)| (self.actual[i] - target[i]).abs() <= a.in_position)
     }
 
     /// Advances the active block by one tick; true when it is finished.
