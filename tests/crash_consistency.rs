@@ -18,9 +18,10 @@
 //! The random moments come from a seed printed at the start (`CNC_CRASH_SEED` repeats a run).
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::path::Path;
 use std::time::{Duration, Instant};
+
+mod common;
 
 use cnc::client::CellClient;
 use cnc_interpreter::position::ProgramPosition;
@@ -50,34 +51,6 @@ impl Rng {
         self.0 ^= self.0 << 17;
         (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
-}
-
-fn config(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/launch_configs/sim_lathe.yaml"
-    ))
-    .expect("sim_lathe.yaml");
-    let mut v: serde_yaml::Value = serde_yaml::from_str(&text).expect("yaml");
-    v["network"]["domain_id"] = DOMAIN.into();
-    v["recorder"]["enabled"] = false.into();
-    v["hmi"]["web_address"] = "".into();
-    v["servo"]["late_warning_ms"] = 60000.0.into();
-    v["servo"]["late_alarm_ticks"] = 1_000_000u32.into();
-    let path = dir.join("crash_lathe.yaml");
-    std::fs::write(&path, serde_yaml::to_string(&v).expect("yaml")).expect("config written");
-    path
-}
-
-fn start_cell(config: &Path, log: &Path) -> Child {
-    let out = std::fs::File::create(log).expect("log");
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .arg("run")
-        .arg(config)
-        .stdout(Stdio::from(out.try_clone().expect("log")))
-        .stderr(Stdio::from(out))
-        .spawn()
-        .expect("cnc runs")
 }
 
 /// What the restarted machine reports and keeps.
@@ -161,7 +134,7 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
     let dir = std::env::temp_dir().join(format!("cnc_crash_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
-    let config = config(&dir);
+    let config = common::sim_lathe_file(&dir, "crash_lathe.yaml", DOMAIN, |_| {});
     let cfg = LaunchConfig::load(&config).expect("config");
     let memory_file = cfg.machine.memory_file.clone().expect("memory file");
     let program_dir = cfg
@@ -188,7 +161,7 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
 
     for round in 0..=KILLS {
         let t_start = Instant::now();
-        let mut cell = start_cell(&config, &log);
+        let mut cell = common::cnc_run(&config, &log);
         let mut client = CellClient::new(
             &cfg.network,
             "lathe1",

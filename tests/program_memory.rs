@@ -4,8 +4,9 @@
 //! resident memory is read from `/proc/<pid>/status`; this test is its supervisor.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::time::Duration;
+
+mod common;
 
 use cnc::client::CellClient;
 use cnc_runtime::LaunchConfig;
@@ -17,25 +18,11 @@ const LOADS: usize = 120;
 /// The simulated lathe with its program memory in `dir`, large enough for every load (the
 /// default 64 MiB would refuse the 17th with alarm 70: that is the interpreter's unit test).
 fn config(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/launch_configs/sim_lathe.yaml"
-    ))
-    .expect("sim_lathe.yaml");
-    let mut v: serde_yaml::Value = serde_yaml::from_str(&text).expect("yaml");
-    v["network"]["domain_id"] = DOMAIN.into();
-    v["recorder"]["enabled"] = false.into();
-    v["hmi"]["web_address"] = "".into();
-    v["servo"]["late_warning_ms"] = 60000.0.into();
-    v["servo"]["late_alarm_ticks"] = 1_000_000u32.into();
-    v["machine"]["memory_file"] = dir.join("memory.yaml").display().to_string().into();
-    v["machine"]["program_directory"] = dir.join("programs").display().to_string().into();
-    v["machine"]["program_capacity_kib"] = (1024u32 * 1024).into();
-    v["plc"]["memory_file"] = dir.join("plc.yaml").display().to_string().into();
-    v["machine"]["parameter_file"] = serde_yaml::Value::Null;
-    let path = dir.join("memory_lathe.yaml");
-    std::fs::write(&path, serde_yaml::to_string(&v).expect("yaml")).expect("config written");
-    path
+    common::sim_lathe_file(dir, "memory_lathe.yaml", DOMAIN, |v| {
+        v["machine"]["program_directory"] = "programs".into();
+        v["machine"]["program_capacity_kib"] = (1024u32 * 1024).into();
+        v["machine"]["parameter_file"] = serde_yaml::Value::Null;
+    })
 }
 
 /// Resident memory of process `pid` in MiB: total (`VmRSS`), its peak (`VmHWM`), and of it the
@@ -89,14 +76,6 @@ fn big_program(n: usize) -> String {
     text
 }
 
-struct Cell(Child);
-impl Drop for Cell {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
 #[test]
 fn a_hundred_and_twenty_programs_of_4_mib_are_kept_on_disk_and_their_memory_returned() {
     let dir = std::env::temp_dir().join(format!("cnc_program_memory_{}", std::process::id()));
@@ -104,16 +83,7 @@ fn a_hundred_and_twenty_programs_of_4_mib_are_kept_on_disk_and_their_memory_retu
     std::fs::create_dir_all(&dir).expect("temp dir");
     let config = config(&dir);
     let cfg = LaunchConfig::load(&config).expect("config");
-    let log = std::fs::File::create(dir.join("cell.log")).expect("log");
-    let cell = Cell(
-        Command::new(env!("CARGO_BIN_EXE_cnc"))
-            .arg("run")
-            .arg(&config)
-            .stdout(Stdio::from(log.try_clone().expect("log")))
-            .stderr(Stdio::from(log))
-            .spawn()
-            .expect("cnc runs"),
-    );
+    let cell = common::KillOnDrop(common::cnc_run(&config, &dir.join("cell.log")));
     let pid = cell.0.id();
     let mut client = CellClient::new(
         &cfg.network,

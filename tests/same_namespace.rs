@@ -3,9 +3,9 @@
 //! first is not disturbed: it goes on answering and runs a part to its end. Both run as their
 //! own processes (`cnc run`), as they would on a host.
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
+
+mod common;
 
 use cnc::client::CellClient;
 use cnc_msgs::msg::MachineState;
@@ -15,51 +15,14 @@ use ros2_client::ServiceMapping;
 const DOMAIN: u16 = 75;
 const PART: &str = "O0001\nG00 X60 Z5\nS600 M03\nG01 X50 F3000\nZ-5\nG00 X60\nM05\nM30\n";
 
-/// The simulated lathe in this test's domain, its kept files in `dir`.
-fn config(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/launch_configs/sim_lathe.yaml"
-    ))
-    .expect("sim_lathe.yaml");
-    let mut v: serde_yaml::Value = serde_yaml::from_str(&text).expect("yaml");
-    v["network"]["domain_id"] = DOMAIN.into();
-    v["recorder"]["enabled"] = false.into();
-    v["hmi"]["web_address"] = "".into();
-    v["servo"]["late_warning_ms"] = 60000.0.into();
-    v["servo"]["late_alarm_ticks"] = 1_000_000u32.into();
-    let path = dir.join("lathe.yaml");
-    std::fs::write(&path, serde_yaml::to_string(&v).expect("yaml")).expect("config written");
-    path
-}
-
-struct Running(Child);
-impl Drop for Running {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn cnc_run(config: &Path, log: &Path) -> Child {
-    let out = std::fs::File::create(log).expect("log");
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .arg("run")
-        .arg(config)
-        .stdout(Stdio::from(out.try_clone().expect("log")))
-        .stderr(Stdio::from(out))
-        .spawn()
-        .expect("cnc runs")
-}
-
 #[test]
 fn a_second_controller_with_the_same_namespace_is_refused_and_the_first_runs_on() {
     let dir = std::env::temp_dir().join(format!("cnc_same_ns_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
-    let config = config(&dir);
+    let config = common::sim_lathe_file(&dir, "lathe.yaml", DOMAIN, |_| {});
     let cfg = LaunchConfig::load(&config).expect("config");
-    let mut first = Running(cnc_run(&config, &dir.join("first.log")));
+    let mut first = common::KillOnDrop(common::cnc_run(&config, &dir.join("first.log")));
     let mut client = CellClient::new(
         &cfg.network,
         "lathe1",
@@ -74,7 +37,7 @@ fn a_second_controller_with_the_same_namespace_is_refused_and_the_first_runs_on(
     assert!(r.accepted, "{}", r.message);
 
     // The second: same config, same host. It must end on its own, refused.
-    let mut second = cnc_run(&config, &dir.join("second.log"));
+    let mut second = common::cnc_run(&config, &dir.join("second.log"));
     let t0 = Instant::now();
     let status = loop {
         if let Some(s) = second.try_wait().expect("wait") {

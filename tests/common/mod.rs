@@ -1,10 +1,62 @@
 //! What the cell tests share: the simulated lathe's launch config for one test.
 
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
 use cnc_runtime::LaunchConfig;
+
+/// `launch_configs/sim_lathe.yaml` for a cell run as its own process (`cnc run`), written as
+/// `name` into `dir`, where its kept files go too (the config's paths are relative to it): DDS
+/// `domain`, no recorder, no web panel, no alarms for servo lateness; `edit` changes more.
+#[allow(dead_code)]
+pub fn sim_lathe_file(
+    dir: &Path,
+    name: &str,
+    domain: u16,
+    edit: impl FnOnce(&mut serde_yaml::Value),
+) -> PathBuf {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/launch_configs/sim_lathe.yaml");
+    let text = std::fs::read_to_string(path).expect("sim_lathe.yaml");
+    let mut v: serde_yaml::Value = serde_yaml::from_str(&text).expect("yaml");
+    v["network"]["domain_id"] = domain.into();
+    v["recorder"]["enabled"] = false.into();
+    v["hmi"]["web_address"] = "".into();
+    v["servo"]["late_warning_ms"] = 60000.0.into();
+    v["servo"]["late_alarm_ticks"] = 1_000_000u32.into();
+    edit(&mut v);
+    let file = dir.join(name);
+    std::fs::write(&file, serde_yaml::to_string(&v).expect("yaml")).expect("config written");
+    file
+}
+
+/// `cnc run <config>` as its own process, its output in `log`.
+#[allow(dead_code)]
+pub fn cnc_run(config: &Path, log: &Path) -> Child {
+    let out = std::fs::File::create(log).expect("log");
+    Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("run")
+        .arg(config)
+        .stdout(Stdio::from(out.try_clone().expect("log")))
+        .stderr(Stdio::from(out))
+        .spawn()
+        .expect("cnc runs")
+}
+
+/// A `cnc run` process that is killed when the test ends, passed or failed.
+#[allow(dead_code)]
+pub struct KillOnDrop(pub Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
 
 /// `launch_configs/sim_lathe.yaml` in DDS `domain` (one per test, so tests never hear each
 /// other), with no kept memory (part count, variables, position and programs start empty) and no parameter file and no recorder
 /// (`tests/recording.rs` tests that), and no alarms for servo lateness.
+#[allow(dead_code)]
 pub fn sim_lathe(domain: u16) -> LaunchConfig {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/launch_configs/sim_lathe.yaml");
     let text = std::fs::read_to_string(path).expect("sim_lathe.yaml");
