@@ -55,28 +55,13 @@ fn ticks(m: &mut Motion, g: &GImage, n: usize) {
     }
 }
 
-/// Runs until idle or alarm; answers every strobe with FIN after `fin_delay` ticks.
+/// Runs until idle or alarm on a perfect drive, answering every strobe with FIN: the displayed
+/// positions per tick and the M codes strobed, numbered.
 fn run(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(u64, i32)>) {
-    let mut trace = vec![];
-    let mut strobes = vec![];
-    let mut g = GImage::released();
-    for _ in 0..max_ticks {
-        let actual = m.commanded().to_vec();
-        m.tick(Some(&actual), &g);
-        let fi = *m.f_image();
-        if fi.get(f::MF) && !g.get(g::FIN) {
-            strobes.push((strobes.len() as u64 + 1, fi.read_i32(f::M_CODE)));
-            g.set(g::FIN, true);
-        }
-        if !(fi.get(f::MF) || fi.get(f::SF) || fi.get(f::TF)) {
-            g.set(g::FIN, false);
-        }
-        trace.push(m.commanded_display());
-        if matches!(m.state(), RunState::Idle | RunState::Alarm) {
-            break;
-        }
-    }
-    (trace, strobes)
+    let d = drive(m, max_ticks);
+    let m_codes = d.strobes.iter().filter(|(s, _)| *s == "M");
+    let numbered = m_codes.enumerate().map(|(k, (_, c))| (k as u64 + 1, *c));
+    (d.displayed, numbered.collect())
 }
 
 #[test]
@@ -820,17 +805,31 @@ fn arcs_turn_in_the_plane_they_name() {
     assert_eq!(m.commanded_display(), vec![10.0, 0.0, 0.0]);
 }
 
-/// Ticks on a perfect drive that follows the setpoints motion sends (not the commanded
-/// position, which machine lock separates from them), answering every strobe with FIN.
-/// Returns the setpoints sent and the strobes seen as (signal, code).
-fn run_on_drive(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(&'static str, i32)>) {
-    let mut sent = vec![];
-    let mut strobes = vec![];
+/// What a run on a perfect drive showed, tick by tick.
+struct Driven {
+    /// The commanded position in display units.
+    displayed: Vec<Vec<f64>>,
+    /// The setpoints the drives got (slide units).
+    sent: Vec<Vec<f64>>,
+    /// Strobes seen, as (signal, code).
+    strobes: Vec<(&'static str, i32)>,
+}
+
+/// Ticks until idle or alarm on a perfect drive that follows the setpoints motion sends (not
+/// the commanded position, which machine lock separates from them), answering every strobe
+/// with FIN.
+fn drive(m: &mut Motion, max_ticks: usize) -> Driven {
+    let mut d = Driven {
+        displayed: vec![],
+        sent: vec![],
+        strobes: vec![],
+    };
     let mut g = GImage::released();
     let mut slides = m.setpoint().to_vec();
     for _ in 0..max_ticks {
         slides = m.tick(Some(&slides), &g).to_vec();
-        sent.push(slides.clone());
+        d.sent.push(slides.clone());
+        d.displayed.push(m.commanded_display());
         let fi = *m.f_image();
         for (name, strobe, code) in [
             ("M", f::MF, f::M_CODE),
@@ -838,7 +837,7 @@ fn run_on_drive(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(&'stat
             ("T", f::TF, f::T_CODE),
         ] {
             if fi.get(strobe) && !g.get(g::FIN) {
-                strobes.push((name, fi.read_i32(code)));
+                d.strobes.push((name, fi.read_i32(code)));
                 g.set(g::FIN, true);
             }
         }
@@ -849,7 +848,7 @@ fn run_on_drive(m: &mut Motion, max_ticks: usize) -> (Vec<Vec<f64>>, Vec<(&'stat
             break;
         }
     }
-    (sent, strobes)
+    d
 }
 
 #[test]
@@ -859,10 +858,10 @@ fn machine_lock_runs_the_program_and_holds_the_drives_where_the_slides_stand() {
         machine_lock: true,
         ..Panel::default()
     });
-    run_on_drive(&mut m, 1); // the switch is taken at rest
+    drive(&mut m, 1); // the switch is taken at rest
     assert!(m.f_image().get(f::MMLK));
     three_lines(&mut m);
-    let (sent, _) = run_on_drive(&mut m, 20_000);
+    let sent = drive(&mut m, 20_000).sent;
     assert_eq!(m.state(), RunState::Idle);
     assert!(m.take_events().is_empty(), "no following error, no alarm");
     assert!(m.f_image().get(f::MMLK));
@@ -876,7 +875,7 @@ fn machine_lock_runs_the_program_and_holds_the_drives_where_the_slides_stand() {
 
     // Released at rest: the program's position is where the slides are again.
     m.set_panel(Panel::default());
-    let (sent, _) = run_on_drive(&mut m, 1);
+    let sent = drive(&mut m, 1).sent;
     assert_eq!(sent, vec![vec![25.0, 0.0]]);
     assert_eq!(m.commanded_display(), vec![50.0, 0.0]);
     assert!(!m.f_image().get(f::MMLK));
@@ -886,7 +885,7 @@ fn machine_lock_runs_the_program_and_holds_the_drives_where_the_slides_stand() {
 fn machine_lock_switched_during_a_run_waits_for_the_machine_at_rest() {
     let mut m = Motion::new(lathe(), &[25.0, 0.0]);
     three_lines(&mut m);
-    let (_, _) = run_on_drive(&mut m, 50);
+    drive(&mut m, 50);
     let moving = m.commanded().to_vec();
     assert_ne!(moving[1], 0.0, "the run is under way");
     // Lock on mid-run: the slides keep following the program to its end.
@@ -894,12 +893,12 @@ fn machine_lock_switched_during_a_run_waits_for_the_machine_at_rest() {
         machine_lock: true,
         ..Panel::default()
     });
-    let (sent, _) = run_on_drive(&mut m, 20_000);
+    let sent = drive(&mut m, 20_000).sent;
     assert_eq!(m.state(), RunState::Idle);
     assert_eq!(sent.last().map(|s| s[1]), Some(-30.0));
     assert!(!m.f_image().get(f::MMLK));
     // At rest it takes effect: the next run moves nothing.
-    run_on_drive(&mut m, 1);
+    drive(&mut m, 1);
     assert!(m.f_image().get(f::MMLK));
     m.push(block(
         5,
@@ -910,7 +909,7 @@ fn machine_lock_switched_during_a_run_waits_for_the_machine_at_rest() {
         },
     ));
     m.push(block(6, 60, Command::ProgramEnd));
-    let (sent, _) = run_on_drive(&mut m, 20_000);
+    let sent = drive(&mut m, 20_000).sent;
     assert!(
         sent.iter().all(|s| s == &vec![25.0, -30.0]),
         "{:?}",
@@ -942,7 +941,7 @@ fn aux_lock_keeps_m_s_and_t_from_the_plc_but_not_the_program_stops() {
         for (k, kind) in kinds.into_iter().enumerate() {
             m.push(block(k as u64 + 1, k as u32 + 1, kind));
         }
-        let (_, strobes) = run_on_drive(&mut m, 5_000);
+        let strobes = drive(&mut m, 5_000).strobes;
         let all = vec![("M", 3), ("S", 800), ("T", 3), ("M", 8), ("M", 0)];
         let expected = if lock { vec![("M", 0)] } else { all };
         assert_eq!(strobes, expected, "aux lock {lock}");
