@@ -203,7 +203,7 @@ pub fn simulate(
         // Keep motion's queue full, with the interpreter node's credit loop.
         let done = motion.done_seq();
         stream
-            .feed(done, capacity, |seq, Canon { line, command }, _| {
+            .feed(done, capacity, |seq, Canon { line, command, .. }, _| {
                 if let Command::Aux(Aux::S(s)) = command {
                     spindle_rpm = s;
                 }

@@ -82,7 +82,7 @@ impl Rig {
             let done = self.motion.done_seq();
             let motion = &mut self.motion;
             self.stream
-                .feed(done, 32, |seq, Canon { line, command }, _| {
+                .feed(done, 32, |seq, Canon { line, command, .. }, _| {
                     motion.push(Block {
                         run_id: 1,
                         seq,

@@ -75,7 +75,7 @@ fn run(program: &str, factors: &[f64]) -> Vec<Pass> {
     for _tick in 0..2_000_000 {
         let done = motion.done_seq();
         stream
-            .feed(done, 64, |seq, Canon { line, command }, _| {
+            .feed(done, 64, |seq, Canon { line, command, .. }, _| {
                 motion.push(Block {
                     run_id: 1,
                     seq,

@@ -21,6 +21,7 @@ pub mod node;
 pub mod offset_page;
 pub mod position;
 pub mod run;
+pub mod search;
 pub mod setup;
 pub mod trace;
 

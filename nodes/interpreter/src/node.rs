@@ -24,6 +24,7 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::position::{PositionTracker, ProgramPosition};
 use crate::run::{self, Effect, RunCore, StateView};
+use crate::search::Approach;
 use crate::setup::Memory;
 use crate::{Dialect, Setup};
 
@@ -99,24 +100,53 @@ pub fn save_memory(path: &std::path::Path, memory: &Memory) -> Result<(), String
     cnc_runtime::persist::write_atomic(path, &text)
 }
 
-/// The keeper of `machine.position_file`; what the file held at start is logged, since it says
-/// where an interrupted program can be restarted.
-fn kept_position(cfg: &LaunchConfig) -> Option<Keeper> {
-    let path = cfg.machine.position_file.clone()?;
-    match std::fs::read_to_string(&path).map(|t| ProgramPosition::from_yaml(&t)) {
-        Ok(Ok(p)) if p.interrupted() => log::warn!(
-            "interpreter: program {} was left at line {} ({}); kept in {}",
-            p.program,
-            p.line,
-            p.state,
-            path.display()
-        ),
-        Ok(Ok(p)) => log::info!("interpreter: program {} last ran to its end", p.program),
-        Ok(Err(e)) => log::error!("interpreter: {}: {e}", path.display()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => log::error!("interpreter: {}: {e}", path.display()),
+/// The keeper of `machine.position_file` and what the file held at start; that is logged,
+/// since it says where an interrupted program can be restarted (decisions D67).
+fn kept_position(cfg: &LaunchConfig) -> (Option<Keeper>, Option<ProgramPosition>) {
+    let Some(path) = cfg.machine.position_file.clone() else {
+        return (None, None);
+    };
+    let kept = match std::fs::read_to_string(&path).map(|t| ProgramPosition::from_yaml(&t)) {
+        Ok(Ok(p)) => {
+            if p.interrupted() {
+                log::warn!(
+                    "interpreter: program {} was left at line {} (block {}, {}); kept in {}: \
+                     start it with `interrupted` to restart there",
+                    p.program,
+                    p.line,
+                    p.block,
+                    p.state,
+                    path.display()
+                );
+            } else {
+                log::info!("interpreter: program {} last ran to its end", p.program);
+            }
+            Some(p)
+        }
+        Ok(Err(e)) => {
+            log::error!("interpreter: {}: {e}", path.display());
+            None
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(e) => {
+            log::error!("interpreter: {}: {e}", path.display());
+            None
+        }
+    };
+    (Some(Keeper::new(path, "program position")), kept)
+}
+
+/// The restart approach the config gives (`machine.restart`), over the machine's usual one.
+fn approach_from_config(cfg: &LaunchConfig, axes: &[char]) -> Approach {
+    let mut a = Approach::default_for(axes);
+    if let Ok(Some((axis, positive))) = cfg.machine.restart.retract_axis(&cfg.machine.axes) {
+        a.retract_axis = axis;
+        a.retract_positive = positive;
     }
-    Some(Keeper::new(path, "program position"))
+    if let Some(f) = cfg.machine.restart.approach_feed {
+        a.feed = f;
+    }
+    a
 }
 
 /// Runs the interpreter node of the machine `instance` ([`cnc_runtime::shm::instance`]) until
@@ -163,13 +193,17 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             }
             None => (BTreeMap::new(), Box::new(InRam)),
         };
+    let (keeper, kept) = kept_position(&cfg);
+    let approach = approach_from_config(&cfg, &base.axes);
     let mut core = RunCore::new(dialect, base, memory, monotonic_ns() / 1000)
-        .with_program_memory(programs, storage, capacity);
+        .with_program_memory(programs, storage, capacity)
+        .with_approach(approach)
+        .with_kept_position(kept);
     let mut state = StateReporter {
         publisher: state_pub,
         last: None,
         last_ns: 0,
-        position: kept_position(&cfg),
+        position: keeper,
         tracker: PositionTracker::default(),
     };
     let carry_out = |core: &mut RunCore| {
@@ -229,10 +263,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         }
         // A start is reported before any block of it runs: a program that fails in its first
         // blocks still shows ACTIVE, then STOPPED, in that order.
-        report_state(&mut state, core.state());
+        report_state(&mut state, core.state(), core.position());
         busy |= core.step();
         carry_out(&mut core);
-        report_state(&mut state, core.state());
+        report_state(&mut state, core.state(), core.position());
         if !busy {
             std::thread::sleep(Duration::from_millis(1));
         }
@@ -253,11 +287,11 @@ struct StateReporter {
     last_ns: u64,
 }
 
-fn report_state(state: &mut StateReporter, view: StateView) {
+fn report_state(state: &mut StateReporter, view: StateView, latest: Option<&ProgramPosition>) {
     // The position goes to its keeper (when due) before the state is published.
     let now = monotonic_ns();
     if let Some(keeper) = state.position.as_mut() {
-        if let Some(position) = state.tracker.update(&view, now) {
+        if let Some(position) = state.tracker.update(latest, now) {
             keeper.keep(position.to_yaml().into_bytes());
         }
     }

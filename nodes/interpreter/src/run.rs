@@ -17,6 +17,8 @@ use cnc_msgs::msg::{
 use cnc_runtime::MDI_PROGRAM;
 
 use crate::offset_page;
+use crate::position::{text_hash, ProgramPosition};
+use crate::search::{search, Approach, SearchTarget};
 use crate::setup::Memory;
 use crate::{Canon, Command, Dialect, Interpreter, Library, ProgramError, Setup};
 
@@ -34,6 +36,12 @@ pub const SOURCE: &str = "interpreter";
 /// capacity are unfinished; the run is complete when motion has finished the program end.
 pub struct ProgramRun {
     interp: Interpreter,
+    /// Commands sent before the interpreter's next: a restart's preamble and its first block.
+    queued: VecDeque<Canon>,
+    /// The program's commands a block search ran without motion (decisions D67).
+    skipped: u64,
+    /// Commands of the restart's preamble, sent first.
+    preamble: u64,
     /// Sequence number of the last command sent (the first is 1).
     sent: u64,
     /// Sequence number of the program end, once sent.
@@ -44,9 +52,34 @@ impl ProgramRun {
     pub fn new(interp: Interpreter) -> Self {
         ProgramRun {
             interp,
+            queued: VecDeque::new(),
+            skipped: 0,
+            preamble: 0,
             sent: 0,
             end: None,
         }
+    }
+
+    /// A run restarted at a block found by [`crate::search::search`] in `interp`: its
+    /// preamble first, then the program from the restart block on.
+    pub fn restarted(interp: Interpreter, restart: crate::search::Restart) -> Self {
+        let preamble = restart.preamble.len() as u64;
+        let mut queued: VecDeque<Canon> = restart.preamble.into();
+        queued.push_back(restart.first);
+        ProgramRun {
+            interp,
+            queued,
+            skipped: restart.skipped,
+            preamble,
+            sent: 0,
+            end: None,
+        }
+    }
+
+    /// The program's own block number (from 1, as in an uninterrupted run) of this run's
+    /// command `seq`; a preamble command counts as the restart block.
+    pub fn program_block(&self, seq: u64) -> u64 {
+        self.skipped + seq.saturating_sub(self.preamble).max(1)
     }
 
     /// Sends commands to `send(seq, command, interpreter)` while fewer than `capacity` (at
@@ -66,7 +99,11 @@ impl ProgramRun {
             if self.end.is_some() {
                 break;
             }
-            match self.interp.next_command()? {
+            let next = match self.queued.pop_front() {
+                Some(c) => Some(c),
+                None => self.interp.next_command()?,
+            };
+            match next {
                 Some(canon) => {
                     self.sent += 1;
                     count += 1;
@@ -141,6 +178,10 @@ struct Run {
     id: u64,
     program: String,
     stream: ProgramRun,
+    /// The program text's fingerprint and the kept variables as the run found them: what a
+    /// restart at its interrupted block needs to run it again as it ran (decisions D67).
+    text_hash: String,
+    kept_at_start: BTreeMap<i64, f64>,
     /// Stopped by an alarm or a cycle stop: nothing more is sent.
     failed: bool,
 }
@@ -171,6 +212,11 @@ pub struct RunCore {
     stop_command_id: u64,
     memory: Memory,
     effects: Vec<Effect>,
+    /// How a restarted program approaches its restart block.
+    approach: Approach,
+    /// Where the program in automatic operation is, kept for a restart (decisions D64, D67);
+    /// the last one stays until another program runs.
+    position_kept: Option<ProgramPosition>,
 }
 
 impl RunCore {
@@ -179,7 +225,6 @@ impl RunCore {
     pub fn new(dialect: Dialect, base: Setup, memory: Memory, first_run_id: u64) -> Self {
         RunCore {
             dialect,
-            base,
             programs: BTreeMap::new(),
             storage: Box::new(InRam),
             capacity: u64::MAX,
@@ -198,7 +243,28 @@ impl RunCore {
             stop_command_id: 0,
             memory,
             effects: Vec::new(),
+            approach: Approach::default_for(&base.axes),
+            base,
+            position_kept: None,
         }
+    }
+
+    /// This core with the machine's restart approach (`machine.restart` of the config).
+    pub fn with_approach(mut self, approach: Approach) -> Self {
+        self.approach = approach;
+        self
+    }
+
+    /// This core with the program position kept before the node started (the position
+    /// file): the interrupted program it names can be restarted at its block.
+    pub fn with_kept_position(mut self, position: Option<ProgramPosition>) -> Self {
+        self.position_kept = position;
+        self
+    }
+
+    /// Where the program in automatic operation is (or was last), to keep.
+    pub fn position(&self) -> Option<&ProgramPosition> {
+        self.position_kept.as_ref()
     }
 
     /// This core with program memory: the programs it holds, where it keeps what is stored
@@ -321,7 +387,7 @@ impl RunCore {
                     return Err(why);
                 }
                 self.programs.insert(MDI_PROGRAM.into(), c.text.clone());
-                self.start(MDI_PROGRAM)
+                self.start(MDI_PROGRAM, "")
             }
             ProgramCommand::START
                 if self.mode != MachineState::MODE_AUTO
@@ -332,7 +398,7 @@ impl RunCore {
                     MachineState::mode_name_of(self.mode)
                 ))
             }
-            ProgramCommand::START => self.start(&c.program),
+            ProgramCommand::START => self.start(&c.program, &c.text),
             ProgramCommand::MODE => self.set_mode(&c.text),
             ProgramCommand::READ => self
                 .programs
@@ -458,7 +524,10 @@ impl RunCore {
         Ok(format!("{name} stored ({lines} lines)"))
     }
 
-    fn start(&mut self, name: &str) -> Result<String, String> {
+    /// Cycle start of the program `name` at the top, or at the block `at` says (block search,
+    /// [`SearchTarget::parse`], or `interrupted`: where the kept position says the last run
+    /// was left). Empty `name` and `at` in feed hold: the run goes on.
+    fn start(&mut self, name: &str, at: &str) -> Result<String, String> {
         if !self.active_alarms.is_empty() {
             return Err(format!(
                 "alarm active ({} alarms): reset first",
@@ -468,36 +537,88 @@ impl RunCore {
         if self.execution == MachineState::ACTIVE {
             return Err("a program is running".into());
         }
-        if self.execution == MachineState::FEED_HOLD && name.is_empty() {
+        if self.execution == MachineState::FEED_HOLD && name.is_empty() && at.is_empty() {
             self.execution = MachineState::ACTIVE;
             return Ok("resumed".into());
         }
-        let Some(text) = self.programs.get(name).cloned() else {
-            return Err(not_found(name));
+        // What the last run left is taken first: this run starts from it.
+        self.remember();
+        let (name, target, kept) = if at.trim() == "interrupted" {
+            let (name, block, kept) = self.interrupted(name)?;
+            (name, Some(SearchTarget::Block(block)), kept)
+        } else {
+            let target = SearchTarget::parse(at)?;
+            (name.to_string(), target, self.memory.kept.clone())
+        };
+        let Some(text) = self.programs.get(&name).cloned() else {
+            return Err(not_found(&name));
         };
         let Some(start) = self.position.clone() else {
             return Err("no axis position from motion yet".into());
         };
-        // What the last run left is taken first: this run starts from it.
-        self.remember();
         let mut setup = self.base.clone();
-        setup.start = start;
-        setup.kept = self.memory.kept.clone();
+        setup.start = start.clone();
+        setup.kept = kept.clone();
         setup.offsets.tools = self.memory.tools.clone();
         setup.offsets.work = self.memory.work.clone();
         // The cell runs programs as the operator would: M99 or G27 loops go on until stop.
         setup.single_pass = false;
-        let interp = Interpreter::with_library(self.dialect, &text, setup, library(&self.programs));
+        let mut interp =
+            Interpreter::with_library(self.dialect, &text, setup, library(&self.programs));
+        let (stream, message) = match &target {
+            None => (ProgramRun::new(interp), format!("{name} started")),
+            Some(t) => {
+                let found = search(self.dialect, &mut interp, &text, t, &start, &self.approach)
+                    .map_err(|e| format!("{name}: {e}"))?;
+                let message = format!(
+                    "{name} started at line {} (block {}, {} blocks searched)",
+                    found.first.line,
+                    found.skipped + 1,
+                    found.skipped
+                );
+                (ProgramRun::restarted(interp, found), message)
+            }
+        };
         self.run_counter += 1;
         self.run = Some(Run {
             id: self.run_counter,
-            program: name.to_string(),
-            stream: ProgramRun::new(interp),
+            program: name.clone(),
+            stream,
             failed: false,
+            text_hash: text_hash(&text),
+            kept_at_start: kept,
         });
-        self.program_name = name.to_string();
+        self.program_name = name;
         self.execution = MachineState::ACTIVE;
-        Ok(format!("{name} started"))
+        Ok(message)
+    }
+
+    /// The program, block and kept variables of the interrupted run the kept position names
+    /// (`name` empty: whichever it names); refused when there is none, when it names another
+    /// program, or when the program was edited since.
+    fn interrupted(&self, name: &str) -> Result<(String, u64, BTreeMap<i64, f64>), String> {
+        let p = self
+            .position_kept
+            .as_ref()
+            .filter(|p| p.interrupted() && p.block > 0)
+            .ok_or("no interrupted program is kept: start it by line or from the top")?;
+        if !name.is_empty() && name != p.program {
+            return Err(format!(
+                "{} was interrupted (line {}), not {name}",
+                p.program, p.line
+            ));
+        }
+        let text = self
+            .programs
+            .get(&p.program)
+            .ok_or_else(|| not_found(&p.program))?;
+        if text_hash(text) != p.text_hash {
+            return Err(format!(
+                "{} was edited since it was interrupted at line {}: start it by line",
+                p.program, p.line
+            ));
+        }
+        Ok((p.program.clone(), p.block, p.kept_at_start.clone()))
     }
 
     /// Feeds motion while credit lasts, notes completion and feed hold. Returns whether it
@@ -580,7 +701,48 @@ impl RunCore {
                 }
             }
         }
+        self.keep_position();
         busy
+    }
+
+    /// Notes where the program is, if the state shows one worth keeping: with the block in
+    /// progress (the first motion has not finished) while the run is there.
+    fn keep_position(&mut self) {
+        let Some(mut p) = ProgramPosition::of(&self.state()) else {
+            return;
+        };
+        let run = self.run.as_ref().filter(|r| r.program == p.program);
+        let old = self
+            .position_kept
+            .as_ref()
+            .filter(|o| o.program == p.program);
+        // The run has ended (completed): the last block and start state stay.
+        p.block = match (run, old) {
+            (Some(r), _) => {
+                let done = if self.status.run_id == r.id {
+                    self.status.done_seq
+                } else {
+                    0
+                };
+                r.stream.program_block(done + 1)
+            }
+            (None, Some(o)) => o.block,
+            (None, None) => 0,
+        };
+        let same = old.is_some_and(|o| (o.line, o.block, &o.state) == (p.line, p.block, &p.state));
+        if same {
+            return;
+        }
+        if let Some(r) = run {
+            p.text_hash.clone_from(&r.text_hash);
+            p.kept_at_start.clone_from(&r.kept_at_start);
+        } else if let Some(o) = old {
+            p.text_hash.clone_from(&o.text_hash);
+            p.kept_at_start.clone_from(&o.kept_at_start);
+        }
+        if self.position_kept.as_ref() != Some(&p) {
+            self.position_kept = Some(p);
+        }
     }
 
     /// The machine state as it stands.

@@ -74,6 +74,11 @@ impl Core {
         &mut self.levels[last]
     }
 
+    /// The main program's line being run (the calling line while a called program runs).
+    pub fn main_line(&self) -> u32 {
+        self.levels[0].pos.line
+    }
+
     /// The innermost call level, to read.
     pub fn current(&self) -> &CallLevel {
         &self.levels[self.levels.len() - 1]

@@ -306,6 +306,7 @@ impl Core {
     pub fn push(&mut self, command: Command) {
         self.pending.push_back(Canon {
             line: self.line,
+            main_line: self.main_line(),
             command,
         });
     }
@@ -334,6 +335,7 @@ impl Core {
                 from + i,
                 Canon {
                     line: self.line,
+                    main_line: self.main_line(),
                     command: Command::PathMode { exact_stop: true },
                 },
             );

@@ -63,6 +63,41 @@ pub struct MachineConfig {
     /// dialect's manual says (decision D52).
     #[serde(default)]
     pub decimal_point: Option<DecimalPoint>,
+    /// How a program restarted at a block (block search) approaches it (decisions D67).
+    #[serde(default)]
+    pub restart: RestartConfig,
+}
+
+/// The approach to a restart block: first the retract axis away from the work, then the other
+/// axes, then the retract axis onto the block's start at `approach_feed`.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RestartConfig {
+    /// The retract axis and the direction away from the work, e.g. `+X` (a lathe's
+    /// outside work), `-X` (its boring), `+Z` (a mill); absent: `+Z` on a machine with a Y
+    /// axis, else `+X`.
+    #[serde(default)]
+    pub retract: Option<String>,
+    /// mm/min for the last leg onto the restart point; absent: 500.
+    #[serde(default)]
+    pub approach_feed: Option<f64>,
+}
+
+impl RestartConfig {
+    /// The retract axis (index among `axes`) and whether away is positive, when given.
+    pub fn retract_axis(&self, axes: &[AxisEntry]) -> Result<Option<(usize, bool)>, String> {
+        let Some(r) = self.retract.as_deref() else {
+            return Ok(None);
+        };
+        let bad = || format!("machine.restart.retract {r:?}: a sign and an axis, e.g. +X or -Z");
+        let (positive, letter) = match r.trim().split_at_checked(1) {
+            Some(("+", l)) => (true, l),
+            Some(("-", l)) => (false, l),
+            _ => return Err(bad()),
+        };
+        let index = axes.iter().position(|a| a.name == letter).ok_or_else(bad)?;
+        Ok(Some((index, positive)))
+    }
 }
 
 /// How a number without a decimal point reads (FANUC's parameter DPI).
@@ -228,6 +263,14 @@ impl MachineConfig {
             return Err(format!(
                 "machine.contour_tolerance {tol}: 0.001–1 mm (GS#33)"
             ));
+        }
+        self.restart.retract_axis(&self.axes)?;
+        if let Some(f) = self.restart.approach_feed {
+            if !(f.is_finite() && f > 0.0 && f <= 100_000.0) {
+                return Err(format!(
+                    "machine.restart.approach_feed {f}: 0–100000 mm/min"
+                ));
+            }
         }
         let n = self.axes.len();
         if n == 0 || n > cnc_msgs::servo::MAX_AXES {
