@@ -137,9 +137,12 @@ fn kept_position(cfg: &LaunchConfig) -> (Option<Keeper>, Option<ProgramPosition>
 }
 
 /// The restart approach the config gives (`machine.restart`), over the machine's usual one.
-fn approach_from_config(cfg: &LaunchConfig, axes: &[char]) -> Approach {
-    let mut a = Approach::default_for(axes);
+fn approach_from_config(cfg: &LaunchConfig, machine: &Setup) -> Approach {
+    let mut a = Approach::default_for(machine);
     if let Ok(Some((axis, positive))) = cfg.machine.restart.retract_axis(&cfg.machine.axes) {
+        if a.tool_change_at.is_some() {
+            a.tool_change_at = machine.second_reference.get(axis).copied();
+        }
         a.retract_axis = axis;
         a.retract_positive = positive;
     }
@@ -194,7 +197,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             None => (BTreeMap::new(), Box::new(InRam)),
         };
     let (keeper, kept) = kept_position(&cfg);
-    let approach = approach_from_config(&cfg, &base.axes);
+    let approach = approach_from_config(&cfg, &base);
     let mut core = RunCore::new(dialect, base, memory, monotonic_ns() / 1000)
         .with_program_memory(programs, storage, capacity)
         .with_approach(approach)

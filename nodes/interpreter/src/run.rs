@@ -243,7 +243,7 @@ impl RunCore {
             stop_command_id: 0,
             memory,
             effects: Vec::new(),
-            approach: Approach::default_for(&base.axes),
+            approach: Approach::default_for(&base),
             base,
             position_kept: None,
         }

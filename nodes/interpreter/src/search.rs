@@ -10,7 +10,7 @@
 use cnc_interpreter_core::Fault;
 
 use crate::interpreter::MAX_CHECK_COMMANDS;
-use crate::{Aux, Canon, Command, Dialect, Interpreter, ProgramError};
+use crate::{Aux, Canon, Command, Dialect, Interpreter, ProgramError, Setup};
 
 /// Where a program starts.
 #[derive(Debug, Clone, PartialEq)]
@@ -76,17 +76,27 @@ pub struct Approach {
     /// The last leg, onto the restart point, runs at this feed (mm/min): the tool may arrive
     /// in the cut.
     pub feed: f64,
+    /// Where the retract axis must stand for an M06 tool change (a mill's second reference
+    /// point, `003` §6.2); `None`: the tool changes where the axes stand (a lathe's turret).
+    pub tool_change_at: Option<f64>,
 }
 
 impl Approach {
-    /// The usual machine of these `axes`: a mill (with Y) retracts Z upwards, a lathe X
-    /// outwards; 500 mm/min onto the point.
-    pub fn default_for(axes: &[char]) -> Approach {
-        let letter = if axes.contains(&'Y') { 'Z' } else { 'X' };
+    /// The usual approach on `machine`: a mill (with Y) retracts Z upwards and changes tools
+    /// at Z's second reference point, a lathe retracts X outwards; 500 mm/min onto the point.
+    pub fn default_for(machine: &Setup) -> Approach {
+        let mill = machine.axes.contains(&'Y');
+        let letter = if mill { 'Z' } else { 'X' };
+        let retract_axis = machine.axes.iter().position(|&a| a == letter).unwrap_or(0);
         Approach {
-            retract_axis: axes.iter().position(|&a| a == letter).unwrap_or(0),
+            retract_axis,
             retract_positive: true,
             feed: DEFAULT_APPROACH_FEED,
+            tool_change_at: machine
+                .second_reference
+                .get(retract_axis)
+                .copied()
+                .filter(|_| mill),
         }
     }
 }
@@ -102,9 +112,10 @@ pub struct Collected {
     pub position: Option<Vec<f64>>,
     pub feed_per_rev: Option<bool>,
     pub exact_stop: Option<bool>,
+    /// The last T: on a lathe the turret's station, on a mill the tool put ready.
     pub tool: Option<i32>,
-    /// An M06 came after the last T (a mill's tool change; the T alone preselects).
-    pub tool_change: bool,
+    /// The tool the last M06 put in a mill's spindle (the T before it).
+    pub loaded: Option<i32>,
     pub speed: Option<f64>,
     /// M03, M04, M05 or M19.
     pub spindle: Option<i32>,
@@ -125,24 +136,21 @@ impl Collected {
         match *c {
             Command::FeedMode { per_rev } => self.feed_per_rev = Some(per_rev),
             Command::PathMode { exact_stop } => self.exact_stop = Some(exact_stop),
-            Command::Aux(Aux::T(t)) => {
-                self.tool = Some(t);
-                self.tool_change = false;
-            }
+            Command::Aux(Aux::T(t)) => self.tool = Some(t),
             Command::Aux(Aux::S(s)) => self.speed = Some(s),
             Command::Aux(Aux::M(m)) => match m {
                 3 | 4 | 5 | 19 => self.spindle = Some(m),
                 7..=9 => self.coolant = Some(m),
                 41..=44 => self.gear = Some(m),
-                6 => self.tool_change = true,
+                6 => self.loaded = self.tool,
                 _ => {}
             },
             _ => {}
         }
     }
 
-    /// What the machine is given before the restart block, from `here`: tool, gear range,
-    /// speed, spindle, coolant, then the approach (retract axis away from the work, the other
+    /// What the machine is given before the restart block, from `here`: tool (a mill's tool
+    /// change at its change position), gear range, speed, spindle, coolant, then the approach (retract axis away from the work, the other
     /// axes, the retract axis onto the point at the approach feed) and the modes the block
     /// runs in. Each command is on `line` of the restart block.
     pub fn preamble(&self, here: &[f64], approach: &Approach, line: u32, main: u32) -> Vec<Canon> {
@@ -154,11 +162,19 @@ impl Collected {
                 command,
             })
         };
-        if let Some(t) = self.tool {
-            push(Command::Aux(Aux::T(t)));
-            if self.tool_change {
-                push(Command::Aux(Aux::M(6)));
+        let mut here = here.to_vec();
+        let r = approach.retract_axis.min(here.len().saturating_sub(1));
+        if let Some(t) = self.loaded {
+            // A mill changes tools with the tool axis at its change position.
+            if let Some(h) = approach.tool_change_at.filter(|h| here.get(r) != Some(h)) {
+                here[r] = h;
+                push(Command::Rapid { end: here.clone() });
             }
+            push(Command::Aux(Aux::T(t)));
+            push(Command::Aux(Aux::M(6)));
+        }
+        if let Some(t) = self.tool.filter(|t| self.loaded != Some(*t)) {
+            push(Command::Aux(Aux::T(t)));
         }
         for m in [self.gear].into_iter().flatten() {
             push(Command::Aux(Aux::M(m)));
@@ -172,9 +188,8 @@ impl Collected {
         if let Some(target) = self
             .position
             .as_ref()
-            .filter(|t| t.len() == here.len() && *t != here)
+            .filter(|t| t.len() == here.len() && **t != here)
         {
-            let r = approach.retract_axis.min(here.len().saturating_sub(1));
             let away = if approach.retract_positive {
                 here[r].max(target[r])
             } else {

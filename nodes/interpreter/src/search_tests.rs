@@ -15,7 +15,7 @@ fn found(text: &str, target: SearchTarget) -> Result<Restart, ProgramError> {
         text,
         &target,
         &lathe_here(),
-        &Approach::default_for(&['X', 'Z']),
+        &Approach::default_for(&Setup::lathe([0.0, 0.0])),
     )
 }
 
@@ -119,7 +119,7 @@ fn a_tool_retracted_below_the_point_goes_out_first_and_the_restart_point_is_reac
         PART,
         &SearchTarget::Line(6),
         &[30.0, -10.0],
-        &Approach::default_for(&['X', 'Z']),
+        &Approach::default_for(&Setup::lathe([0.0, 0.0])),
     )
     .unwrap();
     let moves: Vec<&Command> = r
@@ -183,7 +183,7 @@ fn main_lines_name_the_calling_line_inside_a_subprogram() {
         main,
         &SearchTarget::Line(3),
         &lathe_here(),
-        &Approach::default_for(&['X', 'Z']),
+        &Approach::default_for(&Setup::lathe([0.0, 0.0])),
     )
     .unwrap();
     assert_eq!(r.skipped, 5);
