@@ -91,6 +91,7 @@ fn goal(program: &str, cycles: u32) -> RunProgramGoal {
         program: program.into(),
         cycles,
         start_line: 0,
+        start_block: String::new(),
     }
 }
 

@@ -74,6 +74,7 @@ ros_message! {
         program: String,
         cycles: u32,
         start_line: u32,
+        start_block: String,
     }
 }
 

@@ -15,7 +15,7 @@ use ros2_client::dds::rustdds::{
 };
 use serde::Serialize;
 
-use crate::run_program::{check, GoalRun, Step, View};
+use crate::run_program::{check, start_at, GoalRun, Step, View};
 use crate::server::{DualServer, Request};
 
 /// Finished goals whose results can still be asked for.
@@ -261,7 +261,8 @@ impl RunProgramServer {
                 Err("a RunProgram goal is running: cancel it first".to_string())
             } else {
                 check(&goal, true).and_then(|()| {
-                    let (ok, msg) = commands.call(ProgramCommand::START, &goal.program, "");
+                    let at = start_at(&goal);
+                    let (ok, msg) = commands.call(ProgramCommand::START, &goal.program, &at);
                     if ok {
                         Ok(msg)
                     } else {

@@ -7,6 +7,18 @@ use cnc_msgs::msg::{Alarm, MachineState};
 
 /// Most cycles one goal may ask for.
 pub const MAX_CYCLES: u32 = 10_000;
+/// The longest `start_block` (a label or `interrupted`, not a program).
+const MAX_START_BLOCK: usize = 64;
+
+/// Where the goal's first cycle starts, as the interpreter's cycle start takes it (`text` of
+/// START; the interpreter searches the block and refuses what it cannot find).
+pub fn start_at(goal: &RunProgramGoal) -> String {
+    if goal.start_line != 0 {
+        format!("line {}", goal.start_line)
+    } else {
+        goal.start_block.trim().to_string()
+    }
+}
 
 /// What the shell must do for the goal.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,10 +53,15 @@ pub fn check(goal: &RunProgramGoal, known: bool) -> Result<(), String> {
     if goal.cycles == 0 || goal.cycles > MAX_CYCLES {
         return Err(format!("cycles {}: 1..{MAX_CYCLES}", goal.cycles));
     }
-    if goal.start_line != 0 {
+    if goal.start_line != 0 && !goal.start_block.trim().is_empty() {
         return Err(format!(
-            "start_line {}: starting in mid-program is not supported; use 0",
-            goal.start_line
+            "start_line {} and start_block {:?}: give one of them",
+            goal.start_line, goal.start_block
+        ));
+    }
+    if goal.start_block.len() > MAX_START_BLOCK || goal.start_block.chars().any(char::is_control) {
+        return Err(format!(
+            "start_block: at most {MAX_START_BLOCK} characters, no control characters"
         ));
     }
     if !known {
@@ -219,6 +236,7 @@ mod tests {
             program: "p.nc".into(),
             cycles,
             start_line: 0,
+            start_block: String::new(),
         }
     }
 
@@ -244,6 +262,15 @@ mod tests {
             .contains("load it first"));
         let mut g = goal(1);
         g.start_line = 5;
+        assert!(check(&g, true).is_ok());
+        assert_eq!(start_at(&g), "line 5");
+        g.start_block = "N40".into();
+        assert!(check(&g, true).unwrap_err().contains("one of them"));
+        g.start_line = 0;
+        assert_eq!(start_at(&g), "N40");
+        g.start_block = "x".repeat(65);
+        assert!(check(&g, true).is_err());
+        g.start_block = "interrupted\n".into();
         assert!(check(&g, true).is_err());
     }
 
