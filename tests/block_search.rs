@@ -7,8 +7,9 @@
 //! - a machine model fed only the preamble stands where the uninterrupted run stood before the
 //!   block, with the same tool, spindle, speed, coolant and feed and path modes;
 //! - the interpreter's program zero (work offset, shifts, tool offset) is the same;
-//! - the approach moves the retract axis away from the work first and arrives last, and a
-//!   mill's tool change happens with Z at the tool change position.
+//! - the approach moves the retract axis away from the work first, closes in on it only
+//!   over the point, and arrives last; a mill's tool change happens with Z at the tool change
+//!   position.
 //!
 //! The machine model here knows only what the M codes mean on the machine; it shares no code
 //! with the search.
@@ -224,9 +225,17 @@ fn check_restarts(p: &Program, here: &[f64]) -> usize {
                 &target_point[..],
                 "{what}: approach ends at the block"
             );
+            // Every move but the last stays out at the retract height, except the rapid down
+            // to the clearance, which comes once the other axes are over the point.
             let away = start[r].max(target_point[r]);
             for m in &moves[..moves.len() - 1] {
-                assert!(m[r] >= away - 1e-9, "{what}: approach dips in: {moves:?}");
+                let over_point = (0..m.len()).all(|k| k == r || m[k] == target_point[k]);
+                let floor = if over_point {
+                    target_point[r] + approach.clearance.min(away - target_point[r])
+                } else {
+                    away
+                };
+                assert!(m[r] >= floor - 1e-9, "{what}: approach dips in: {moves:?}");
             }
             if first[r] != start[r] {
                 let others_still = (0..start.len()).all(|k| k == r || first[k] == start[k]);

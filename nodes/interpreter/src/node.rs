@@ -149,6 +149,9 @@ fn approach_from_config(cfg: &LaunchConfig, machine: &Setup) -> Approach {
     if let Some(f) = cfg.machine.restart.approach_feed {
         a.feed = f;
     }
+    if let Some(c) = cfg.machine.restart.clearance {
+        a.clearance = c;
+    }
     a
 }
 

@@ -499,7 +499,7 @@ fn a_program_starts_at_a_line_with_its_preamble_then_the_rest_of_it() {
     assert!(r.accepted, "{}", r.message);
     assert!(r.message.contains("at line 5"), "{}", r.message);
     let sent = run_to_end(&mut c, 1001);
-    // S500 M03, then the approach: X stays out at 200, Z over to 10, X onto 101.
+    // S500 M03, then the approach: X stays out at 200, Z over to 10, X to 102 and onto 101.
     let ends: Vec<&Vec<f64>> = sent
         .iter()
         .filter(|b| b.0 != MotionBlock::KIND_AUX && !b.1.is_empty())
@@ -509,6 +509,7 @@ fn a_program_starts_at_a_line_with_its_preamble_then_the_rest_of_it() {
         ends,
         [
             &vec![200.0, 10.0],
+            &vec![102.0, 10.0],
             &vec![101.0, 10.0],
             &vec![101.0, 5.0],
             &vec![120.0, 5.0]

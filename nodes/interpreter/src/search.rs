@@ -76,6 +76,9 @@ pub struct Approach {
     /// The last leg, onto the restart point, runs at this feed (mm/min): the tool may arrive
     /// in the cut.
     pub feed: f64,
+    /// The last leg's length (mm): the retract axis comes at rapid to this distance from the
+    /// point, then at the approach feed.
+    pub clearance: f64,
     /// Where the retract axis must stand for an M06 tool change (a mill's second reference
     /// point, `003` §6.2); `None`: the tool changes where the axes stand (a lathe's turret).
     pub tool_change_at: Option<f64>,
@@ -92,6 +95,7 @@ impl Approach {
             retract_axis,
             retract_positive: true,
             feed: DEFAULT_APPROACH_FEED,
+            clearance: DEFAULT_CLEARANCE,
             tool_change_at: machine
                 .second_reference
                 .get(retract_axis)
@@ -103,6 +107,8 @@ impl Approach {
 
 /// The approach's last leg, mm/min, unless the config says otherwise.
 pub const DEFAULT_APPROACH_FEED: f64 = 500.0;
+/// The approach's last leg, mm, unless the config says otherwise.
+pub const DEFAULT_CLEARANCE: f64 = 1.0;
 
 /// The state a stream of commands leaves the machine in, as the PLC and motion see it: the
 /// last of each modal code. A restart gives the machine these before the restart block.
@@ -205,6 +211,12 @@ impl Collected {
             let mut over = target.clone();
             over[r] = away;
             if over != at {
+                push(Command::Rapid { end: over.clone() });
+            }
+            // Rapid to the clearance short of the point, then the approach feed.
+            if (away - target[r]).abs() > approach.clearance {
+                let sign = if approach.retract_positive { 1.0 } else { -1.0 };
+                over[r] = target[r] + sign * approach.clearance;
                 push(Command::Rapid { end: over.clone() });
             }
             if over != *target {

@@ -65,7 +65,8 @@ fn targets_read_as_the_operator_writes_them() {
 #[test]
 fn a_line_a_sequence_number_and_a_label_find_the_same_kind_of_restart() {
     // Line 6 is `G01 Z-30`: the tool, S800 M03, M08 and G99 come first, then the approach:
-    // X out to 200 (already there), Z over to 2, X down onto 52 at the approach feed.
+    // X out to 200 (already there), Z over to 2, X down to 53 (the clearance, 1 mm of
+    // diameter) and onto 52 at the approach feed.
     let r = found(PART, SearchTarget::Line(6)).unwrap();
     assert_eq!(r.first.line, 6);
     assert_eq!(r.skipped, 6);
@@ -81,6 +82,9 @@ fn a_line_a_sequence_number_and_a_label_find_the_same_kind_of_restart() {
             Command::PathMode { exact_stop: true },
             Command::Rapid {
                 end: vec![200.0, 2.0]
+            },
+            Command::Rapid {
+                end: vec![53.0, 2.0]
             },
             Command::Linear {
                 end: vec![52.0, 2.0],

@@ -69,7 +69,8 @@ pub struct MachineConfig {
 }
 
 /// The approach to a restart block: first the retract axis away from the work, then the other
-/// axes, then the retract axis onto the block's start at `approach_feed`.
+/// axes, then the retract axis at rapid to `clearance` from the block's start and onto it at
+/// `approach_feed`.
 #[derive(Debug, Clone, PartialEq, Default, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RestartConfig {
@@ -81,6 +82,10 @@ pub struct RestartConfig {
     /// mm/min for the last leg onto the restart point; absent: 500.
     #[serde(default)]
     pub approach_feed: Option<f64>,
+    /// The last leg's length in mm (the retract axis comes at rapid to this distance from
+    /// the point); absent: 1.
+    #[serde(default)]
+    pub clearance: Option<f64>,
 }
 
 impl RestartConfig {
@@ -270,6 +275,11 @@ impl MachineConfig {
                 return Err(format!(
                     "machine.restart.approach_feed {f}: 0–100000 mm/min"
                 ));
+            }
+        }
+        if let Some(c) = self.restart.clearance {
+            if !(c.is_finite() && (0.0..=100.0).contains(&c)) {
+                return Err(format!("machine.restart.clearance {c}: 0–100 mm"));
             }
         }
         let n = self.axes.len();
