@@ -1,5 +1,6 @@
 // Drives the operator's web HMI in headless Debian chromium (playwright-core, no downloaded
-// browser): loads a program, starts it, watches the line and the part count advance, checks
+// browser): loads a program, starts it (twice from the top, once at a line), watches the line
+// and the part count advance, checks
 // refusals, the offset page, the ladder monitor and the tool path, and keeps a screenshot.
 // Usage: node panel.cjs <url> <screenshot.png>; PLAYWRIGHT_CORE names the module. Exits 1 with
 // the reason when something is not as it should be.
@@ -100,6 +101,13 @@ async function waitFor(what, check, seconds) {
   };
   const first = await cycle(1);
   const second = await cycle(2);
+  // Block search from the panel: the third part starts at line 5 (`Z-15`); no line before it
+  // runs, and the field is cleared for the next cycle start.
+  await page.fill("#start_at", "line 5");
+  const third = await cycle(3);
+  if (Math.min(...third) < 5) fail(`a restart at line 5 ran lines ${third}`);
+  if (!(await text("message")).includes("started at line 5")) fail(`restart answered ${await text("message")}`);
+  if ((await page.inputValue("#start_at")) !== "") fail("the start field was not cleared");
 
   // Positions, the tool path, the offset page, the ladder monitor.
   const axes = await page.$$eval("#axes tr", (rows) => rows.map((r) => r.textContent));
@@ -143,6 +151,6 @@ async function waitFor(what, check, seconds) {
   await page.click("#mode_set");
   await waitFor("AUTO mode", async () => (await text("mode")) === "AUTO", 10);
 
-  console.log(JSON.stringify({ first, second, points, rungs, paramRows, parts: Number(await text("parts")) }));
+  console.log(JSON.stringify({ first, second, third, points, rungs, paramRows, parts: Number(await text("parts")) }));
   await browser.close();
 })().catch((e) => fail(e.stack || String(e)));

@@ -394,7 +394,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         }
         if let Some(r) = start.receive() {
             let name = r.request.name.clone();
-            let (accepted, message) = perform(Operation::Start { name }, &Who::Dds(r.writer));
+            let (accepted, message) = perform(
+                Operation::Start {
+                    name,
+                    at: String::new(),
+                },
+                &Who::Dds(r.writer),
+            );
             answer(&start, &r, &StartProgramResponse { accepted, message });
         }
         if let Some(r) = stop.receive() {
@@ -574,7 +580,13 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
                             .map(|m| m.program.clone())
                             .filter(|p| !p.is_empty() && p != MDI_PROGRAM);
                         let (accepted, message) = match selected {
-                            Some(name) => perform(Operation::Start { name }, &Who::Dds(r.writer)),
+                            Some(name) => perform(
+                                Operation::Start {
+                                    name,
+                                    at: String::new(),
+                                },
+                                &Who::Dds(r.writer),
+                            ),
                             None => {
                                 let why = "cycle start refused: no program started yet (start_program or RunProgram first)";
                                 record("robot_request", op.name(), &Who::Dds(r.writer), false, why);
@@ -847,7 +859,7 @@ fn execute(op: &Operation, desk: &mut Desk) -> (bool, String) {
             }
             (accepted, message)
         }
-        Operation::Start { name } => commands.call(ProgramCommand::START, name, ""),
+        Operation::Start { name, at } => commands.call(ProgramCommand::START, name, at),
         Operation::Stop { mode } => match *mode {
             StopRequest::FEED_HOLD => commands.call(ProgramCommand::FEED_HOLD, "", ""),
             StopRequest::CYCLE_STOP => commands.call(ProgramCommand::CYCLE_STOP, "", ""),

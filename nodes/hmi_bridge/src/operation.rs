@@ -11,9 +11,12 @@ pub enum Operation {
         name: String,
         text: String,
     },
-    /// Cycle start of a stored program; an empty name resumes after feed hold.
+    /// Cycle start of a stored program; an empty name resumes after feed hold. `at` starts it
+    /// in mid-program (block search, decisions D67): empty (the top), `line 12`, `N120`,
+    /// `label NAME` or `interrupted`; the interpreter checks it.
     Start {
         name: String,
+        at: String,
     },
     /// `StopRequest::FEED_HOLD` or `CYCLE_STOP`.
     Stop {
@@ -86,8 +89,9 @@ impl Operation {
     /// What the event says about it besides the command.
     pub fn detail(&self) -> String {
         match self {
+            Operation::Start { name, at } if !at.is_empty() => format!("{name} at {at}"),
             Operation::Load { name, .. }
-            | Operation::Start { name }
+            | Operation::Start { name, .. }
             | Operation::Delete { name }
             | Operation::Read { name } => name.clone(),
             Operation::Stop { mode } => format!("mode {mode}"),
@@ -169,7 +173,11 @@ mod tests {
         assert!(!Operation::Stop { mode: 1 }.moves());
         assert!(!Operation::Reset.moves());
         assert!(!Operation::Offsets.moves());
-        assert!(Operation::Start { name: "O1".into() }.moves());
+        assert!(Operation::Start {
+            name: "O1".into(),
+            at: String::new()
+        }
+        .moves());
         // Program memory is guarded: a program overwritten is the next part cut wrong.
         assert!(Operation::Load {
             name: "O1".into(),

@@ -236,7 +236,10 @@ $("cycle_start").onclick = () => {
   const execution = $("execution").textContent;
   // In feed hold cycle start resumes; otherwise it starts the program shown or selected.
   const name = execution === "FEED_HOLD" ? "" : listingName || stored || "";
-  send({ op: "start", name });
+  // A start in mid-program (block search) applies to this cycle start only.
+  const at = execution === "FEED_HOLD" ? "" : $("start_at").value.trim();
+  $("start_at").value = "";
+  send({ op: "start", name, at });
 };
 $("feed_hold").onclick = () => send({ op: "feed_hold" });
 $("reset").onclick = () => send({ op: "reset" });

@@ -70,9 +70,16 @@ fn operation(v: &Value) -> Result<Operation, String> {
             name: string(v, "name")?,
             text: string(v, "text")?,
         },
-        "start" => Operation::Start {
-            name: string(v, "name").unwrap_or_default(),
-        },
+        "start" => {
+            let at = string(v, "at").unwrap_or_default();
+            if at.len() > 64 || at.chars().any(char::is_control) {
+                return Err("at: at most 64 characters, no control characters".into());
+            }
+            Operation::Start {
+                name: string(v, "name").unwrap_or_default(),
+                at: at.trim().to_string(),
+            }
+        }
         "feed_hold" => Operation::Stop {
             mode: cnc_msgs::srv::StopRequest::FEED_HOLD,
         },
@@ -146,10 +153,21 @@ mod tests {
             (
                 3,
                 Ok(Operation::Start {
-                    name: "O0001".into()
+                    name: "O0001".into(),
+                    at: String::new()
                 })
             )
         );
+        assert_eq!(
+            parse(r#"{"id":4,"op":"start","name":"O0001","at":" line 12 "}"#).1,
+            Ok(Operation::Start {
+                name: "O0001".into(),
+                at: "line 12".into()
+            })
+        );
+        assert!(parse(r#"{"id":5,"op":"start","name":"O1","at":"line\n1"}"#)
+            .1
+            .is_err());
         assert_eq!(
             parse(r#"{"op":"acknowledge"}"#).1,
             Ok(Operation::Acknowledge {
