@@ -275,6 +275,7 @@ ros_message! {
             OFFSETS: u8 = 11,
             SET_TOOL_OFFSET: u8 = 12,
             SET_WORK_OFFSET: u8 = 13,
+            REFERENCE_RETURN: u8 = 14,
         }
         id: u64,
         command: u8,

@@ -50,6 +50,12 @@ pub struct ServoFeedback {
     /// Spindle encoder: speed in rpm and angle in degrees (0..360).
     pub spindle_rpm: f64,
     pub spindle_angle_deg: f64,
+    /// Bit per axis: its reference deceleration dog is pressed (`*DEC`).
+    pub reference_dog: u32,
+    /// Bit per axis: the encoder passed its index mark in this period, at
+    /// `marker_position` (the drive latches the count, so the position is exact).
+    pub marker: u32,
+    pub marker_position: [f64; MAX_AXES],
 }
 
 impl Default for ServoFeedback {
@@ -62,6 +68,9 @@ impl Default for ServoFeedback {
             drive_fault: 0,
             spindle_rpm: 0.0,
             spindle_angle_deg: 0.0,
+            reference_dog: 0,
+            marker: 0,
+            marker_position: [0.0; MAX_AXES],
         }
     }
 }

@@ -184,6 +184,13 @@ pub mod f {
     pub const MAFL: Bit = bit(4, 4);
     /// Block skip in effect (F4.0).
     pub const MBDT: Bit = bit(4, 0);
+    /// Reference return in progress (`000` App.2 F4.5).
+    pub const MREF: Bit = bit(4, 5);
+    /// Reference return complete of axis `k` (0–5: X, Y, Z, A, B, C; F94.0–F94.5): the
+    /// axis knows its machine position.
+    pub const fn zp(k: usize) -> Bit {
+        bit(94, k as u8)
+    }
     pub const TF: Bit = bit(7, 3);
     pub const SF: Bit = bit(7, 2);
     pub const MF: Bit = bit(7, 0);

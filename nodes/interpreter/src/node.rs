@@ -253,6 +253,13 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         while let Ok(Some(a)) = axes_sub.take() {
             let commanded: Vec<f64> = a.axes.iter().map(|x| x.commanded_position).collect();
             core.axes(&commanded);
+            core.unreferenced_axes(
+                a.axes
+                    .iter()
+                    .filter(|x| !x.homed)
+                    .map(|x| x.name.clone())
+                    .collect(),
+            );
         }
         while let Ok(Some(e)) = alarm_sub.take() {
             core.alarm_event(&e);

@@ -217,6 +217,8 @@ pub struct RunCore {
     /// Where the program in automatic operation is, kept for a restart (decisions D64, D67);
     /// the last one stays until another program runs.
     position_kept: Option<ProgramPosition>,
+    /// Axes motion reports not referenced (incremental encoders after power-on, D68).
+    unreferenced: Vec<String>,
 }
 
 impl RunCore {
@@ -246,7 +248,14 @@ impl RunCore {
             approach: Approach::default_for(&base),
             base,
             position_kept: None,
+            unreferenced: Vec::new(),
         }
+    }
+
+    /// The axes motion reports without a reference point yet (`AxisState.homed` false): no
+    /// program starts until they have returned to it (alarm 224, D68).
+    pub fn unreferenced_axes(&mut self, names: Vec<String>) {
+        self.unreferenced = names;
     }
 
     /// This core with the machine's restart approach (`machine.restart` of the config).
@@ -382,6 +391,18 @@ impl RunCore {
         match c.command {
             // An MDI entry is stored as the program `MDI` and started as a program is
             // (decisions D43); cycle start runs programs in AUTO only.
+            ProgramCommand::START | ProgramCommand::MDI if self.mode == MachineState::MODE_HOME => {
+                self.reference_return()
+            }
+            ProgramCommand::START | ProgramCommand::MDI
+                if !self.unreferenced.is_empty() && self.execution != MachineState::FEED_HOLD =>
+            {
+                Err(format!(
+                    "alarm 224: reference return not done ({}): select HOME and press cycle \
+                     start",
+                    self.unreferenced.join(", ")
+                ))
+            }
             ProgramCommand::MDI => {
                 if let Some(why) = mdi_refusal(self.mode, running, &c.text) {
                     return Err(why);
@@ -483,6 +504,28 @@ impl RunCore {
             }
             other => Err(format!("unknown command {other}")),
         }
+    }
+
+    /// Cycle start in HOME mode: motion returns the axes with incremental encoders to their
+    /// reference point, in the config's order (D68).
+    fn reference_return(&mut self) -> Result<String, String> {
+        if !self.active_alarms.is_empty() {
+            return Err(format!(
+                "alarm active ({} alarms): reset first",
+                self.active_alarms.len()
+            ));
+        }
+        if self.running() {
+            return Err("a program is running".into());
+        }
+        self.stop_command_id += 1;
+        self.effects.push(Effect::ToMotion(ProgramCommand {
+            id: self.stop_command_id,
+            command: ProgramCommand::REFERENCE_RETURN,
+            program: String::new(),
+            text: String::new(),
+        }));
+        Ok("reference return started".into())
     }
 
     fn set_mode(&mut self, text: &str) -> Result<String, String> {

@@ -14,7 +14,7 @@ use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
-use crate::sim::{DeviceConfig, SimConfig, SimLathe};
+use crate::sim::{DeviceConfig, Encoder, SimConfig, SimLathe};
 
 pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
     SimConfig {
@@ -26,6 +26,19 @@ pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
             coolant_delay: cfg.sim.coolant_delay,
             ..DeviceConfig::default()
         },
+        encoders: cfg
+            .machine
+            .axes
+            .iter()
+            .map(|a| {
+                a.reference.map(|r| Encoder {
+                    reference: a.home * a.scale(),
+                    positive: r.positive,
+                    grid: r.grid,
+                    dog_length: r.dog_length,
+                })
+            })
+            .collect(),
     }
 }
 
@@ -101,7 +114,13 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let outputs = shm.receiver::<YImage>(channel::Y_IMAGE, false)?;
     let x_out = shm.sender::<XImage>(channel::X_IMAGE, false)?;
     let period = cfg.servo.period_ms / 1000.0;
-    let mut sim = SimLathe::new(sim_config(&cfg), &cfg.home_slide());
+    let power_on: Vec<f64> = cfg
+        .machine
+        .axes
+        .iter()
+        .map(|a| a.power_on() * a.scale())
+        .collect();
+    let mut sim = SimLathe::new(sim_config(&cfg), &power_on);
     let mut y = YImage::default();
     // Report the power-on position before motion starts.
     let idle = ServoSetpoint::default();

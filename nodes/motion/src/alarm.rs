@@ -25,3 +25,10 @@ pub const PLC_SILENT: u32 = 1092;
 pub const SERVO_OVERRUN: u32 = 54;
 /// One servo tick later than `servo.late_warning_ms`: a warning (not in the manual: D57).
 pub const SERVO_LATE: u32 = 1093;
+/// A program started before every axis with an incremental encoder has returned to its
+/// reference point. The Huaxing tables have none (its bus axes have absolute encoders); the
+/// FANUC family's number for "return to reference point not done" (decisions D68).
+pub const REFERENCE_NOT_DONE: u32 = 224;
+/// A reference return that found no dog or index mark within the axis's travel (not in the
+/// manuals: D68).
+pub const REFERENCE_FAILED: u32 = 1094;

@@ -27,6 +27,8 @@ pub struct MotionConfig {
     pub feedback_lost_ticks: u32,
     /// Feed under dry run, mm/min.
     pub dry_run_feed: f64,
+    /// Axis indices in the order the reference return takes them.
+    pub reference_order: Vec<usize>,
 }
 
 impl MotionConfig {
@@ -45,6 +47,7 @@ impl MotionConfig {
             shape: cfg.servo.profile,
             feedback_lost_ticks: cfg.servo.feedback_lost_ticks,
             dry_run_feed: cfg.servo.dry_run_feed,
+            reference_order: cfg.reference_order(),
         }
     }
 

@@ -21,6 +21,7 @@ use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::motion::alarm;
+use crate::motion::ReferenceInputs;
 use crate::servo::{LateWatch, Lateness, ServoStatistics};
 use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 
@@ -37,8 +38,9 @@ enum Report {
     /// A tick later than the warning limit (its interval, µs), or the warning cleared.
     Late(Option<f64>),
     /// Commanded and actual slide positions.
-    /// Commanded, actual and drive setpoint positions, and whether machine lock holds them.
-    Axes([f64; MAX_AXES], [f64; MAX_AXES], [f64; MAX_AXES], bool),
+    /// Commanded, actual and drive setpoint positions (machine coordinates), whether machine
+    /// lock holds them, and a bit per referenced axis.
+    Axes([f64; MAX_AXES], [f64; MAX_AXES], [f64; MAX_AXES], bool, u32),
     Alarm(u32, String, u32),
     Stats(ServoStats),
 }
@@ -150,7 +152,7 @@ fn dds_loop(
                     0,
                 )),
                 Ok(Report::Late(None)) => alarms.clear(alarm::SERVO_LATE),
-                Ok(Report::Axes(commanded, actual, setpoint, machine_lock)) => {
+                Ok(Report::Axes(commanded, actual, setpoint, machine_lock, referenced)) => {
                     let axes = axes
                         .iter()
                         .enumerate()
@@ -161,7 +163,7 @@ fn dds_loop(
                                 commanded_position: cmd,
                                 actual_position: act,
                                 following_error: setpoint[i] / a.scale() - act,
-                                homed: true,
+                                homed: referenced & (1 << i) != 0,
                             }
                         })
                         .collect();
@@ -258,6 +260,8 @@ fn servo_loop(
     let first = first.ok_or("no feedback from the drives within 30 s (is io running?)")?;
     let mut actual = first.position;
     let mut spindle = (first.spindle_rpm, first.spindle_angle_deg);
+    // The dogs and index marks of the latest feedback; a mark is passed on once.
+    let mut reference = ReferenceInputs::default();
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
     let mut g = GImage::default();
@@ -326,6 +330,12 @@ fn servo_loop(
                     plc.reported = false;
                 }
                 Input::Command(ProgramCommand::START) => motion.cycle_start(),
+                Input::Command(ProgramCommand::REFERENCE_RETURN) => {
+                    match motion.reference_return() {
+                        Ok(m) => log::info!("motion: {m}"),
+                        Err(e) => log::warn!("motion: {e}"),
+                    }
+                }
                 Input::Command(_) => {}
             }
         }
@@ -348,6 +358,8 @@ fn servo_loop(
         if have_feedback {
             motion.spindle_feedback(spindle.0, spindle.1);
         }
+        motion.reference_inputs(reference);
+        reference.marker = 0;
         // What the drives get; under machine lock it is not the commanded position.
         let mut setpoint = [0.0; MAX_AXES];
         setpoint[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
@@ -372,6 +384,15 @@ fn servo_loop(
         ))? {
             actual = fb.position;
             spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
+            reference.dog = fb.reference_dog;
+            if fb.marker != 0 {
+                reference.marker |= fb.marker;
+                for i in 0..n {
+                    if fb.marker & (1 << i) != 0 {
+                        reference.marker_position[i] = fb.marker_position[i];
+                    }
+                }
+            }
             have_feedback = true;
             if fb.seq == seq {
                 stats
@@ -419,8 +440,17 @@ fn servo_loop(
         if seq.is_multiple_of(10) {
             let mut commanded = [0.0; MAX_AXES];
             commanded[..n].copy_from_slice(motion.commanded());
+            let mut machine = [0.0; MAX_AXES];
+            machine[..n].copy_from_slice(motion.actual());
+            let mut drive = [0.0; MAX_AXES];
+            drive[..n].copy_from_slice(motion.setpoint());
             let locked = motion.machine_locked();
-            let _ = reports.send(Report::Axes(commanded, actual, setpoint, locked));
+            let referenced = motion
+                .referenced()
+                .iter()
+                .enumerate()
+                .fold(0u32, |bits, (i, r)| bits | (u32::from(*r) << i));
+            let _ = reports.send(Report::Axes(commanded, machine, drive, locked, referenced));
         }
         if seq.is_multiple_of(250) {
             let _ = reports.send(Report::Stats(stats.message(mcfg.period)));

@@ -21,6 +21,7 @@ fn lathe() -> MotionConfig {
         drive_lag: 0.008,
         home: 0.0,
         second_reference: None,
+        reference: None,
     };
     MotionConfig {
         axes: vec![
@@ -35,6 +36,7 @@ fn lathe() -> MotionConfig {
         shape: cnc_motion::profile::Shape::SCurve,
         feedback_lost_ticks: 3,
         dry_run_feed: 1000.0,
+        reference_order: vec![0, 1],
     }
 }
 
@@ -733,6 +735,7 @@ fn mill() -> MotionConfig {
     };
     cfg.axes = vec![axis("X"), axis("Y"), axis("Z")];
     cfg.arc_plane = (0, 1);
+    cfg.reference_order = vec![2, 0, 1];
     cfg
 }
 

@@ -1,6 +1,7 @@
 //! The simulated lathe: axes that follow setpoints with a first-order drive lag (interpolating
 //! linearly between setpoints, as drives do, so a slide at constant speed lags its setpoint by
-//! exactly speed × time constant), a spindle that
+//! exactly speed × time constant), incremental encoders with a deceleration dog and index
+//! marks where the config asks for them ([`Encoder`]), a spindle that
 //! ramps to its commanded speed with a brake, an emergency-stop input, and the [`devices`] the
 //! PLC drives (turret, chuck, door, tailstock, coolant, air).
 //!
@@ -23,13 +24,63 @@ pub struct SimConfig {
     /// "At speed" window, fraction of the commanded speed.
     pub at_speed_tolerance: f64,
     pub devices: DeviceConfig,
+    /// Per axis: an incremental encoder (`Some`), or an absolute one that reports the slide's
+    /// machine position from power-on (`None`).
+    pub encoders: Vec<Option<Encoder>>,
+}
+
+/// An incremental encoder and its reference dog, in slide travel (mm): the encoder counts
+/// from 0 where the slide stood at power-on; index marks every `grid` mm, one of them at the
+/// machine's `reference` point; the dog ends half a grid before the reference point on the
+/// side the axis approaches from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Encoder {
+    pub reference: f64,
+    pub positive: bool,
+    pub grid: f64,
+    pub dog_length: f64,
+}
+
+impl Encoder {
+    /// Whether the dog is pressed with the slide at `x` (machine position).
+    fn dog(&self, x: f64) -> bool {
+        let near = self.reference - self.grid / 2.0;
+        let far = near - self.dog_length;
+        if self.positive {
+            (far..=near).contains(&x)
+        } else {
+            let (near, far) = (2.0 * self.reference - near, 2.0 * self.reference - far);
+            (near..=far).contains(&x)
+        }
+    }
+
+    /// The index mark the slide passed going from `a` to `b`, if any: a mark is passed when
+    /// the slide reaches it (one that stops on a mark passes it once, going on or turning
+    /// back). At one servo period a slide moves far less than a grid, so there is at most one.
+    fn mark_between(&self, a: f64, b: f64) -> Option<f64> {
+        let g = self.grid;
+        let m = if a < b {
+            self.reference + (((a - self.reference) / g).floor() + 1.0) * g
+        } else if b < a {
+            self.reference + (((a - self.reference) / g).ceil() - 1.0) * g
+        } else {
+            return None;
+        };
+        let passed = if a < b { m <= b } else { m >= b };
+        passed.then_some(m)
+    }
 }
 
 #[derive(Debug, Clone)]
 pub struct SimLathe {
     cfg: SimConfig,
+    /// Slide positions in machine coordinates.
     position: [f64; MAX_AXES],
-    /// The setpoint of the previous step, where this step's interpolation starts.
+    /// Machine position less what the encoder reports: where an incremental encoder's count
+    /// began; 0 for an absolute encoder.
+    encoder_offset: [f64; MAX_AXES],
+    /// The setpoint of the previous step (machine coordinates), where this step's
+    /// interpolation starts.
     last_setpoint: [f64; MAX_AXES],
     spindle_rpm: f64,
     spindle_angle: f64,
@@ -45,9 +96,16 @@ impl SimLathe {
         for (p, s) in position.iter_mut().zip(start) {
             *p = *s;
         }
+        let mut encoder_offset = [0.0; MAX_AXES];
+        for (i, e) in cfg.encoders.iter().enumerate().take(MAX_AXES) {
+            if e.is_some() {
+                encoder_offset[i] = position[i];
+            }
+        }
         SimLathe {
             devices: Devices::new(cfg.devices.clone()),
             cfg,
+            encoder_offset,
             position,
             last_setpoint: position,
             spindle_rpm: 0.0,
@@ -61,6 +119,7 @@ impl SimLathe {
         self.emergency_stop = pressed;
     }
 
+    /// Slide positions in machine coordinates (what an absolute encoder would report).
     pub fn position(&self) -> &[f64] {
         &self.position[..self.cfg.drive_lag.len()]
     }
@@ -72,9 +131,10 @@ impl SimLathe {
     /// Advances by `dt`: drives follow `setpoint` when enabled; devices follow `y`.
     pub fn step(&mut self, setpoint: &ServoSetpoint, y: &YImage, dt: f64) -> ServoFeedback {
         let n = self.cfg.drive_lag.len().min(MAX_AXES);
+        let before = self.position;
         if setpoint.enable != 0 && !self.emergency_stop {
             for i in 0..n {
-                let target = setpoint.position[i];
+                let target = setpoint.position[i] + self.encoder_offset[i];
                 if !target.is_finite() {
                     continue;
                 }
@@ -94,7 +154,7 @@ impl SimLathe {
         let enabled = setpoint.enable != 0 && !self.emergency_stop;
         for i in 0..n {
             self.last_setpoint[i] = if enabled && setpoint.position[i].is_finite() {
-                setpoint.position[i]
+                setpoint.position[i] + self.encoder_offset[i]
             } else {
                 self.position[i]
             };
@@ -112,15 +172,29 @@ impl SimLathe {
         self.spindle_angle =
             (self.spindle_angle + self.spindle_rpm / 60.0 * 360.0 * dt).rem_euclid(360.0);
         self.devices.step(y, dt);
-        ServoFeedback {
+        let mut fb = ServoFeedback {
             seq: setpoint.seq,
             setpoint_sent_ns: setpoint.sent_ns,
-            position: self.position,
             axis_count: n as u32,
-            drive_fault: 0,
             spindle_rpm: self.spindle_rpm,
             spindle_angle_deg: self.spindle_angle,
+            ..ServoFeedback::default()
+        };
+        for (i, was) in before.iter().enumerate().take(n) {
+            let (now, offset) = (self.position[i], self.encoder_offset[i]);
+            fb.position[i] = now - offset;
+            let Some(e) = self.cfg.encoders.get(i).copied().flatten() else {
+                continue;
+            };
+            if e.dog(now) {
+                fb.reference_dog |= 1 << i;
+            }
+            if let Some(m) = e.mark_between(*was, now) {
+                fb.marker |= 1 << i;
+                fb.marker_position[i] = m - offset;
+            }
         }
+        fb
     }
 
     /// The machine's inputs as the PLC reads them.
@@ -164,6 +238,7 @@ mod tests {
                 spindle_acceleration: 2000.0,
                 at_speed_tolerance: 0.02,
                 devices: DeviceConfig::default(),
+                encoders: vec![None, None],
             },
             &[10.0, 20.0],
         )
@@ -225,5 +300,57 @@ mod tests {
         }
         assert_eq!(m.spindle_rpm(), 0.0);
         assert!(!m.x_image(&y).get(x::ESP_N));
+    }
+
+    #[test]
+    fn an_incremental_encoder_counts_from_power_on_and_shows_its_dog_and_index_marks() {
+        let e = Encoder {
+            reference: 100.0,
+            positive: true,
+            grid: 5.0,
+            dog_length: 20.0,
+        };
+        let mut m = SimLathe::new(
+            SimConfig {
+                drive_lag: vec![0.0],
+                spindle_acceleration: 2000.0,
+                at_speed_tolerance: 0.02,
+                devices: DeviceConfig::default(),
+                encoders: vec![Some(e)],
+            },
+            &[60.0],
+        );
+        let mut sp = ServoSetpoint {
+            enable: 1,
+            axis_count: 1,
+            ..Default::default()
+        };
+        // Walk the slide from 60 to 110 (machine) in 0.5 mm steps; the encoder starts at 0.
+        let (mut dog_on, mut marks) = (Vec::new(), Vec::new());
+        for k in 0..=100 {
+            sp.position[0] = 0.5 * f64::from(k);
+            let fb = m.step(&sp, &YImage::default(), 0.004);
+            assert_eq!(fb.position[0], 0.5 * f64::from(k));
+            if fb.reference_dog & 1 != 0 {
+                dog_on.push(m.position()[0]);
+            }
+            if fb.marker & 1 != 0 {
+                marks.push(fb.marker_position[0] + 60.0);
+            }
+        }
+        // The dog: 77.5..=97.5, ending half a grid before the reference point.
+        assert_eq!(dog_on.first(), Some(&77.5));
+        assert_eq!(dog_on.last(), Some(&97.5));
+        assert_eq!(
+            marks,
+            [65.0, 70.0, 75.0, 80.0, 85.0, 90.0, 95.0, 100.0, 105.0, 110.0]
+        );
+        // Back down: the mark at 110, where the slide stands, is not passed again.
+        sp.position[0] = 49.0;
+        let fb = m.step(&sp, &YImage::default(), 0.004);
+        assert_eq!(fb.marker, 0);
+        sp.position[0] = 45.0;
+        let fb = m.step(&sp, &YImage::default(), 0.004);
+        assert_eq!((fb.marker, fb.marker_position[0] + 60.0), (1, 105.0));
     }
 }

@@ -25,7 +25,10 @@ pub use panel::Panel;
 
 mod activate;
 mod panel;
+mod reference;
 mod window;
+
+pub use reference::ReferenceInputs;
 
 /// Something the shell must publish.
 #[derive(Debug, Clone, PartialEq)]
@@ -146,6 +149,14 @@ pub struct Motion {
     /// one servo period (the setpoint is reached at the end of the coming period) plus the
     /// drive lag (the slide trails a moving setpoint by it).
     thread_lead_time: [f64; MAX_AXES],
+    /// Per axis: it knows its machine position (an absolute encoder, or referenced).
+    referenced: Vec<bool>,
+    /// Per axis: machine position less the encoder's count, set by the reference return.
+    shift: Vec<f64>,
+    /// The setpoint as the drives count (the drive setpoint less `shift`).
+    encoder_setpoint: Vec<f64>,
+    reference: Option<reference::ReferenceReturn>,
+    reference_inputs: ReferenceInputs,
 }
 
 impl Motion {
@@ -161,7 +172,13 @@ impl Motion {
             *l = cfg.period + a.drive_lag.max(0.0);
         }
         let thread = ThreadChain::new(cfg.lookahead.max(1), cfg.planner().limits);
+        let referenced = cfg.axes.iter().map(|a| a.reference.is_none()).collect();
         Motion {
+            referenced,
+            shift: vec![0.0; n],
+            encoder_setpoint: commanded.clone(),
+            reference: None,
+            reference_inputs: ReferenceInputs::default(),
             thread,
             encoder: Encoder::default(),
             panel: Panel::default(),
@@ -216,6 +233,24 @@ impl Motion {
                     block.seq, block.run_id, self.run_id
                 );
                 self.raise(alarm::BAD_BLOCK, text, block.line);
+                return;
+            }
+            if !self.all_referenced() || self.reference.is_some() {
+                // No run begins before every axis knows where it is (D68); the run is let go.
+                let names: Vec<&str> = self
+                    .cfg
+                    .axes
+                    .iter()
+                    .zip(&self.referenced)
+                    .filter(|(_, r)| !**r)
+                    .map(|(a, _)| a.name.as_str())
+                    .collect();
+                let text = format!(
+                    "reference return not done ({}): return the axes to their reference point",
+                    names.join(", ")
+                );
+                self.dead_run = block.run_id;
+                self.raise(alarm::REFERENCE_NOT_DONE, text, block.line);
                 return;
             }
             self.run_id = block.run_id;
@@ -299,6 +334,7 @@ impl Motion {
         self.block_stop = false;
         self.last_line = None;
         self.clear_strobe();
+        self.reference = None;
         self.commanded.clone_from(&self.actual);
         let here = self.commanded_point();
         self.planner.reset(here);
@@ -344,7 +380,7 @@ impl Motion {
             || self.feed_hold && (self.active.is_some() || !self.queue.is_empty())
         {
             RunState::Hold
-        } else if self.active.is_some() || !self.queue.is_empty() {
+        } else if self.active.is_some() || !self.queue.is_empty() || self.reference.is_some() {
             RunState::Running
         } else {
             RunState::Idle
@@ -376,9 +412,30 @@ impl Motion {
     /// Returns the setpoint for the drives: the new commanded slide position, unless machine
     /// lock holds them.
     pub fn tick(&mut self, actual: Option<&[f64]>, plc: &GImage) -> &[f64] {
+        self.tick_machine(actual, plc);
+        for ((e, d), s) in self
+            .encoder_setpoint
+            .iter_mut()
+            .zip(&self.drive)
+            .zip(&self.shift)
+        {
+            *e = d - s;
+        }
+        &self.encoder_setpoint
+    }
+
+    /// The slides' positions in machine coordinates (the encoders' counts and the shift the
+    /// reference return set).
+    pub fn actual(&self) -> &[f64] {
+        &self.actual
+    }
+
+    /// [`Motion::tick`] in machine coordinates: `actual` is what the encoders count, the
+    /// drive setpoint is left in `self.drive`.
+    fn tick_machine(&mut self, actual: Option<&[f64]>, plc: &GImage) {
         if let Some(a) = actual {
-            for (dst, src) in self.actual.iter_mut().zip(a) {
-                *dst = *src;
+            for ((dst, src), s) in self.actual.iter_mut().zip(a).zip(&self.shift) {
+                *dst = *src + *s;
             }
             self.missed_feedback = 0;
             self.check_following_error();
@@ -396,8 +453,10 @@ impl Motion {
         }
         if self.servo_off {
             // Setpoints stay where they were; the drives are disabled (see `servo_enabled`).
+            self.reference = None;
             self.update_f();
-            return self.drive_setpoint();
+            self.drive_setpoint();
+            return;
         }
         if !plc.get(g::ESP_N) {
             // Servo hold where the slides are, the run dropped. The PLC raises the alarm.
@@ -408,17 +467,25 @@ impl Motion {
                 self.feed_hold = false;
                 self.cycle_stop = false;
                 self.block_stop = false;
+                self.reference = None;
             }
             self.commanded.clone_from(&self.actual);
             self.update_f();
-            return self.drive_setpoint();
+            self.drive_setpoint();
+            return;
         }
         if self.emergency_stop {
             self.emergency_stop = false;
             self.planner.reset(self.commanded_point());
         }
-        self.take_machine_lock();
         let dt = self.cfg.period;
+        if self.reference.is_some() && !self.alarm {
+            self.reference_tick(dt);
+            self.update_f();
+            self.drive_setpoint();
+            return;
+        }
+        self.take_machine_lock();
         let mut budget = 8; // blocks that can finish within one tick (zero-length moves, aux)
         while budget > 0 && !self.alarm {
             budget -= 1;
@@ -494,7 +561,7 @@ impl Motion {
             self.feed_hold = false;
         }
         self.update_f();
-        self.drive_setpoint()
+        self.drive_setpoint();
     }
 
     /// Whether the drives may be enabled: false after a drive fault until reset.
@@ -562,6 +629,7 @@ impl Motion {
     fn raise(&mut self, number: u32, text: String, line: u32) {
         self.alarm = true;
         self.active = None;
+        self.reference = None;
         let here = self.commanded_point();
         self.planner.reset(here);
         self.clear_strobe();
@@ -585,6 +653,12 @@ impl Motion {
             ))
         );
         let hold = self.state() == RunState::Hold;
+        for (a, r) in self.cfg.axes.iter().zip(&self.referenced) {
+            if let Some(k) = "XYZABC".find(a.name.as_str()) {
+                self.f.set(f::zp(k), *r);
+            }
+        }
+        self.f.set(f::MREF, self.reference.is_some());
         let fi = &mut self.f;
         fi.set(f::OP, running);
         fi.set(f::STL, running && !hold);

@@ -66,6 +66,10 @@ pub struct MachineConfig {
     /// How a program restarted at a block (block search) approaches it (decisions D67).
     #[serde(default)]
     pub restart: RestartConfig,
+    /// The order of the reference return, axis names; default: Z first on a machine with a
+    /// Y axis (the tool leaves the work first), else the order of `axes` (decisions D68).
+    #[serde(default)]
+    pub reference_order: Vec<String>,
 }
 
 /// The approach to a restart block: first the retract axis away from the work, then the other
@@ -203,9 +207,77 @@ pub struct AxisEntry {
     /// coordinates, display units; default: the reference point (`home`).
     #[serde(default)]
     pub second_reference: Option<f64>,
+    /// An incremental encoder with a deceleration dog and index marks: the axis must return
+    /// to its reference point (`home`) after power-on (decisions D68). Absent: an absolute
+    /// encoder, referenced at power-on.
+    #[serde(default)]
+    pub reference: Option<ReferenceEntry>,
+}
+
+/// How an axis with an incremental encoder finds its reference point: at `fast_feed` toward
+/// the dog, at `slow_feed` off it, then the first index mark is the reference point (`home`).
+/// Feeds are mm/min and lengths mm of slide travel.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceEntry {
+    /// The axis approaches the dog in its positive direction (else negative).
+    #[serde(default = "default_true")]
+    pub positive: bool,
+    /// Default: half the rapid rate (Huaxing S#63, 50 % of G00).
+    #[serde(default)]
+    pub fast_feed: Option<f64>,
+    #[serde(default = "default_slow_feed")]
+    pub slow_feed: f64,
+    /// Distance between index marks: one motor turn on the ball screw.
+    #[serde(default = "default_grid")]
+    pub grid: f64,
+    /// The simulated dog's length; it ends half a grid before the reference point.
+    #[serde(default = "default_dog_length")]
+    pub dog_length: f64,
+    /// Where the simulated slide stands at power-on, display units (the encoder counts from
+    /// there); default 50 mm of slide before the dog.
+    #[serde(default)]
+    pub power_on: Option<f64>,
+}
+
+fn default_true() -> bool {
+    true
+}
+fn default_slow_feed() -> f64 {
+    200.0
+}
+fn default_grid() -> f64 {
+    5.0
+}
+fn default_dog_length() -> f64 {
+    20.0
+}
+
+impl ReferenceEntry {
+    /// mm/min of the fast approach on an axis of rapid rate `rapid`.
+    pub fn fast(&self, rapid: f64) -> f64 {
+        self.fast_feed.unwrap_or(rapid * 0.5)
+    }
 }
 
 impl AxisEntry {
+    /// The simulated slide's power-on position, display units: `home` for an absolute
+    /// encoder; for an incremental one `reference.power_on`, else 50 mm of slide before the
+    /// dog.
+    pub fn power_on(&self) -> f64 {
+        match &self.reference {
+            None => self.home,
+            Some(r) => r.power_on.unwrap_or_else(|| {
+                let before = (r.grid / 2.0 + r.dog_length + 50.0) / self.scale();
+                if r.positive {
+                    self.home - before
+                } else {
+                    self.home + before
+                }
+            }),
+        }
+    }
+
     /// Display units → slide travel: a diameter axis moves half of what it shows.
     pub fn scale(&self) -> f64 {
         if self.diameter {
@@ -270,6 +342,11 @@ impl MachineConfig {
             ));
         }
         self.restart.retract_axis(&self.axes)?;
+        for name in &self.reference_order {
+            if !self.axes.iter().any(|a| &a.name == name) {
+                return Err(format!("machine.reference_order: no axis {name:?}"));
+            }
+        }
         if let Some(f) = self.restart.approach_feed {
             if !(f.is_finite() && f > 0.0 && f <= 100_000.0) {
                 return Err(format!(
@@ -314,6 +391,22 @@ impl MachineConfig {
                     "axis {}: second_reference {r} lies outside min..max",
                     a.name
                 ));
+            }
+            if let Some(r) = &a.reference {
+                let fast = r.fast(a.max_velocity);
+                let ok = [r.slow_feed, r.grid, r.dog_length, fast]
+                    .iter()
+                    .all(|v| v.is_finite() && *v > 0.0)
+                    && fast <= a.max_velocity
+                    && r.slow_feed <= fast
+                    && r.power_on.is_none_or(|p| (a.min..=a.max).contains(&p));
+                if !ok {
+                    return Err(format!(
+                        "axis {}: reference needs positive grid, dog_length and feeds, \
+                         slow_feed ≤ fast_feed ≤ max_velocity, power_on within min..max",
+                        a.name
+                    ));
+                }
             }
         }
         let cap = self.program_capacity_kib;

@@ -82,6 +82,26 @@ impl LaunchConfig {
     pub fn home(&self) -> Vec<f64> {
         self.machine.axes.iter().map(|a| a.home).collect()
     }
+
+    /// Axis indices in reference-return order (`machine.reference_order`, D68): the named
+    /// ones first, then the rest; by default Z first on a machine with a Y axis.
+    pub fn reference_order(&self) -> Vec<usize> {
+        let axes = &self.machine.axes;
+        let mut names = self.machine.reference_order.clone();
+        if names.is_empty() && axes.iter().any(|a| a.name == "Y") {
+            names.push("Z".into());
+        }
+        let mut order: Vec<usize> = names
+            .iter()
+            .filter_map(|n| axes.iter().position(|a| &a.name == n))
+            .collect();
+        for i in 0..axes.len() {
+            if !order.contains(&i) {
+                order.push(i);
+            }
+        }
+        order
+    }
 }
 
 #[cfg(test)]

@@ -1,0 +1,215 @@
+//! Issue 28, must-show 1 without DDS: the simulated lathe with incremental encoders (a dog and
+//! index marks per axis) and the motion core in one deterministic loop on a simulated clock.
+//! From power-on: nothing knows where the slides are, a run is refused with alarm 224; the
+//! reference return takes X, then Z, fast onto the dog, slow off it, to the first index mark;
+//! each axis then stands on its reference point within one encoder count (0.001 mm), in the
+//! machine's coordinates and in the simulator's; then a program's move runs to its end point.
+//! A machine whose dog is missing ends its reference return with alarm 1094.
+
+use std::path::Path;
+
+use cnc_io::node::sim_config;
+use cnc_io::SimLathe;
+use cnc_motion::motion::ReferenceInputs;
+use cnc_motion::{Block, Command, Motion, MotionConfig, MotionEvent, RunState};
+use cnc_msgs::servo::{ServoSetpoint, MAX_AXES};
+use cnc_msgs::signals::{f, GImage, SignalTable, YImage};
+use cnc_runtime::LaunchConfig;
+
+/// One encoder count, mm.
+const COUNT: f64 = 0.001;
+
+/// `launch_configs/sim_lathe.yaml` with incremental encoders on both axes.
+fn incremental_lathe(dog_length: f64) -> LaunchConfig {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("launch_configs/sim_lathe.yaml");
+    let mut v: serde_yaml::Value =
+        serde_yaml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    for axis in v["machine"]["axes"].as_sequence_mut().unwrap() {
+        axis["reference"] = serde_yaml::from_str(&format!(
+            "{{ slow_feed: 300, grid: 5, dog_length: {dog_length} }}"
+        ))
+        .unwrap();
+    }
+    let text = serde_yaml::to_string(&v).unwrap();
+    LaunchConfig::from_yaml_in(&text, Path::new("/tmp"), None).unwrap()
+}
+
+/// The machine and the control, ticked together.
+struct Rig {
+    sim: SimLathe,
+    motion: Motion,
+    feedback: cnc_msgs::servo::ServoFeedback,
+    plc: GImage,
+    period: f64,
+    /// Per axis, the first and last tick its slide moved (more than 0.25 mm/s), as the
+    /// simulator saw it.
+    moved: Vec<Option<(usize, usize)>>,
+    ticks: usize,
+    alarms: Vec<u32>,
+}
+
+impl Rig {
+    fn new(cfg: &LaunchConfig) -> Rig {
+        let power_on: Vec<f64> = cfg
+            .machine
+            .axes
+            .iter()
+            .map(|a| a.power_on() * a.scale())
+            .collect();
+        let mut sim = SimLathe::new(sim_config(cfg), &power_on);
+        let feedback = sim.step(&ServoSetpoint::default(), &YImage::default(), 0.0);
+        let n = cfg.machine.axes.len();
+        let motion = Motion::new(MotionConfig::from_launch(cfg), &feedback.position[..n]);
+        Rig {
+            sim,
+            motion,
+            feedback,
+            plc: GImage::released(),
+            period: cfg.servo.period_ms / 1000.0,
+            moved: vec![None; n],
+            ticks: 0,
+            alarms: Vec::new(),
+        }
+    }
+
+    fn tick(&mut self) {
+        let n = self.motion.commanded().len();
+        self.motion.reference_inputs(ReferenceInputs {
+            dog: self.feedback.reference_dog,
+            marker: self.feedback.marker,
+            marker_position: self.feedback.marker_position,
+        });
+        let before = self.sim.position().to_vec();
+        let mut sp = ServoSetpoint {
+            enable: 1,
+            axis_count: n as u32,
+            ..ServoSetpoint::default()
+        };
+        let actual = self.feedback.position;
+        sp.position[..n].copy_from_slice(self.motion.tick(Some(&actual[..n]), &self.plc));
+        self.feedback = self.sim.step(&sp, &YImage::default(), self.period);
+        self.ticks += 1;
+        for (i, (a, b)) in before.iter().zip(self.sim.position()).enumerate() {
+            if (a - b).abs() > 0.001 {
+                let first = self.moved[i].map_or(self.ticks, |(f, _)| f);
+                self.moved[i] = Some((first, self.ticks));
+            }
+        }
+        for e in self.motion.take_events() {
+            let MotionEvent::Alarm { number, .. } = e;
+            self.alarms.push(number);
+        }
+    }
+
+    fn run_until(&mut self, max_ticks: usize, mut done: impl FnMut(&Rig) -> bool) -> bool {
+        for _ in 0..max_ticks {
+            self.tick();
+            if done(self) {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+fn rapid(seq: u64, run_id: u64, end: &[f64]) -> Block {
+    Block {
+        run_id,
+        seq,
+        line: 1,
+        kind: Command::Rapid { end: end.to_vec() },
+    }
+}
+
+#[test]
+fn from_power_on_a_start_is_refused_the_axes_find_their_reference_points_then_a_move_runs() {
+    let cfg = incremental_lathe(20.0);
+    let home = cfg.home();
+    let mut rig = Rig::new(&cfg);
+    assert_eq!(rig.motion.referenced(), &[false, false]);
+    // The encoders count from 0 at power-on; the slides stand 95 mm (X: diameter) before home.
+    println!(
+        "power-on: slides at {:?} (machine), encoders {:?}",
+        rig.sim.position(),
+        &rig.feedback.position[..2]
+    );
+    assert_eq!(&rig.feedback.position[..2], &[0.0, 0.0]);
+
+    // A run is refused, and moves nothing.
+    rig.motion.push(rapid(1, 7, &[150.0, 50.0]));
+    rig.run_until(50, |_| false);
+    assert_eq!(rig.alarms, [cnc_motion::alarm::REFERENCE_NOT_DONE]);
+    assert!(
+        rig.moved.iter().all(Option::is_none),
+        "moved {:?}",
+        rig.moved
+    );
+    rig.motion.reset();
+    rig.alarms.clear();
+    rig.run_until(30, |_| false);
+
+    // Reference return: X, then Z.
+    let m = rig.motion.reference_return().expect("started");
+    assert!(m.contains("X, Z"), "{m}");
+    let mut saw_mref = false;
+    let ok = rig.run_until(20_000, |r| {
+        saw_mref |= r.motion.f_image().get(f::MREF);
+        !r.motion.referencing()
+    });
+    assert!(ok, "the reference return did not end");
+    assert!(saw_mref, "F4.5 MREF never on");
+    assert!(rig.alarms.is_empty(), "alarms {:?}", rig.alarms);
+    let (x, z) = (rig.moved[0].unwrap(), rig.moved[1].unwrap());
+    println!("X moved in ticks {x:?}, Z in {z:?}");
+    assert!(x.1 < z.0, "X first, then Z: {x:?} {z:?}");
+    assert_eq!(rig.motion.referenced(), &[true, true]);
+    assert_eq!(rig.motion.state(), RunState::Idle);
+    // Let the drives settle on the point.
+    rig.run_until(100, |_| false);
+    let scale = [0.5, 1.0];
+    for i in 0..2 {
+        let machine = rig.motion.actual()[i] / scale[i];
+        let slide = rig.sim.position()[i] / scale[i];
+        println!(
+            "axis {i}: machine {machine:.6}, simulator {slide:.6}, home {}",
+            home[i]
+        );
+        assert!((machine - home[i]).abs() <= COUNT, "axis {i} at {machine}");
+        assert!(
+            (slide - home[i]).abs() <= COUNT,
+            "axis {i} really at {slide}"
+        );
+    }
+    assert!(rig.motion.f_image().get(f::zp(0)) && rig.motion.f_image().get(f::zp(2)));
+
+    // Now a program's move runs, to where it says, in the machine's coordinates.
+    rig.motion.push(rapid(1, 8, &[150.0, 50.0]));
+    let ok = rig.run_until(5_000, |r| r.motion.done_seq() == 1);
+    assert!(ok && rig.alarms.is_empty(), "alarms {:?}", rig.alarms);
+    rig.run_until(100, |_| false);
+    let at: Vec<f64> = rig
+        .sim
+        .position()
+        .iter()
+        .zip(scale)
+        .map(|(p, s)| p / s)
+        .collect();
+    assert!(
+        (at[0] - 150.0).abs() < COUNT && (at[1] - 50.0).abs() < COUNT,
+        "{at:?}"
+    );
+}
+
+#[test]
+fn a_missing_dog_ends_the_reference_return_with_an_alarm_within_the_travel() {
+    // A dog of length 0 is never seen pressed.
+    let mut cfg = incremental_lathe(20.0);
+    cfg.machine.axes[0].reference.as_mut().unwrap().dog_length = 1e-9;
+    let mut rig = Rig::new(&cfg);
+    rig.motion.reference_return().expect("started");
+    let ended = rig.run_until(200_000, |r| !r.motion.referencing());
+    assert!(ended);
+    assert_eq!(rig.alarms, [cnc_motion::alarm::REFERENCE_FAILED]);
+    assert_eq!(rig.motion.referenced(), &[false, false]);
+    assert_eq!(MAX_AXES, 8);
+}
