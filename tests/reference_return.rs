@@ -8,6 +8,8 @@
 
 use std::path::Path;
 
+mod common;
+
 use cnc_io::node::sim_config;
 use cnc_io::SimLathe;
 use cnc_motion::motion::ReferenceInputs;
@@ -212,4 +214,134 @@ fn a_missing_dog_ends_the_reference_return_with_an_alarm_within_the_travel() {
     assert_eq!(rig.alarms, [cnc_motion::alarm::REFERENCE_FAILED]);
     assert_eq!(rig.motion.referenced(), &[false, false]);
     assert_eq!(MAX_AXES, 8);
+}
+
+/// The same through the whole cell on DDS (runs in scripts/test.sh's network namespace): a
+/// supervisor's start is refused with alarm 224 after power-on; in HOME mode cycle start
+/// returns X and Z to their reference points, `axes.homed` turns true and the positions are
+/// the configured ones within one encoder count; back in AUTO the part runs to its end.
+#[test]
+fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() {
+    use cnc::cell::Cell;
+    use cnc::client::CellClient;
+    use cnc_msgs::msg::MachineState;
+    use cnc_msgs::srv::{SetMode, SetModeRequest};
+    use cnc_runtime::config::ReferenceEntry;
+    use ros2_client::ServiceMapping;
+    use std::time::{Duration, Instant};
+
+    let mut cfg = common::sim_lathe(78);
+    for a in &mut cfg.machine.axes {
+        a.reference = Some(ReferenceEntry {
+            positive: true,
+            fast_feed: None,
+            slow_feed: 300.0,
+            grid: 5.0,
+            dog_length: 20.0,
+            power_on: None,
+        });
+    }
+    let home = cfg.home();
+    let cell = Cell::start(&cfg).expect("cell starts");
+    let mut c = CellClient::new(
+        &cfg.network,
+        "lathe1",
+        "supervisor",
+        ServiceMapping::Enhanced,
+    )
+    .expect("client")
+    .with_timeout(Duration::from_secs(10));
+    c.wait_ready(Duration::from_secs(30)).expect("ready");
+    let part = "O0001\nG00 X150 Z50\nS600 M03\nG01 X140 Z40 F2000\nG00 X180 Z80\nM05\nM30\n";
+    assert!(c.load_program("part.nc", part).expect("load").accepted);
+    let wait_axes =
+        |c: &mut CellClient, what: &str, ok: &dyn Fn(&cnc_msgs::msg::AxisState) -> bool| {
+            let t0 = Instant::now();
+            loop {
+                c.poll();
+                if c.axes.as_ref().is_some_and(ok) {
+                    return;
+                }
+                assert!(
+                    t0.elapsed() < Duration::from_secs(90),
+                    "{what}: {:?}",
+                    c.axes
+                );
+                std::thread::sleep(Duration::from_millis(10));
+            }
+        };
+    wait_axes(&mut c, "axes state", &|a| a.axes.iter().all(|x| !x.homed));
+
+    // Power-on: the start is refused with the alarm number.
+    let r = c.start_program("part.nc").expect("start");
+    println!("start before the reference return: {}", r.message);
+    assert!(!r.accepted && r.message.contains("224"), "{}", r.message);
+
+    // HOME mode, cycle start: the reference return.
+    let mode = |c: &mut CellClient, mode: u8| {
+        let r = c
+            .service::<SetMode>("set_mode")
+            .and_then(|s| s.call(SetModeRequest { mode }))
+            .expect("set_mode");
+        assert!(r.accepted, "{}", r.message);
+    };
+    mode(&mut c, MachineState::MODE_HOME);
+    let t0 = Instant::now();
+    let r = c.start_program("").expect("start");
+    assert!(r.accepted, "{}", r.message);
+    wait_axes(&mut c, "reference return", &|a| {
+        a.axes.iter().all(|x| x.homed)
+    });
+    println!("reference return took {:.1} s", t0.elapsed().as_secs_f64());
+    // Settled on the reference points.
+    std::thread::sleep(Duration::from_millis(300));
+    c.poll();
+    let axes = c.axes.clone().expect("axes");
+    for (x, h) in axes.axes.iter().zip(&home) {
+        println!("{}: {:.4} (reference point {h})", x.name, x.actual_position);
+        assert!(
+            (x.actual_position - h).abs() <= COUNT,
+            "{} at {}",
+            x.name,
+            x.actual_position
+        );
+    }
+
+    // AUTO: the part runs.
+    mode(&mut c, MachineState::MODE_AUTO);
+    let r = c.start_program("part.nc").expect("start");
+    assert!(r.accepted, "{}", r.message);
+    let t0 = Instant::now();
+    loop {
+        c.poll();
+        if c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+        {
+            break;
+        }
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "part: {:?}",
+            c.state
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    c.poll();
+    let end: Vec<f64> = c
+        .axes
+        .as_ref()
+        .unwrap()
+        .axes
+        .iter()
+        .map(|x| x.actual_position)
+        .collect();
+    assert!(
+        (end[0] - 180.0).abs() < 0.005 && (end[1] - 80.0).abs() < 0.005,
+        "{end:?}"
+    );
+    drop(c);
+    let (_, failed) = cell.stop();
+    assert!(failed.is_empty(), "nodes failed: {failed:?}");
 }
