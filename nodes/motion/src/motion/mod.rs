@@ -24,6 +24,7 @@ pub use crate::alarm;
 pub use panel::Panel;
 
 mod activate;
+pub mod jog;
 mod panel;
 mod reference;
 mod window;
@@ -157,6 +158,7 @@ pub struct Motion {
     encoder_setpoint: Vec<f64>,
     reference: Option<reference::ReferenceReturn>,
     reference_inputs: ReferenceInputs,
+    jog: Option<jog::Jog>,
 }
 
 impl Motion {
@@ -179,6 +181,7 @@ impl Motion {
             encoder_setpoint: commanded.clone(),
             reference: None,
             reference_inputs: ReferenceInputs::default(),
+            jog: None,
             thread,
             encoder: Encoder::default(),
             panel: Panel::default(),
@@ -335,6 +338,7 @@ impl Motion {
         self.last_line = None;
         self.clear_strobe();
         self.reference = None;
+        self.jog = None;
         self.commanded.clone_from(&self.actual);
         let here = self.commanded_point();
         self.planner.reset(here);
@@ -380,7 +384,11 @@ impl Motion {
             || self.feed_hold && (self.active.is_some() || !self.queue.is_empty())
         {
             RunState::Hold
-        } else if self.active.is_some() || !self.queue.is_empty() || self.reference.is_some() {
+        } else if self.active.is_some()
+            || !self.queue.is_empty()
+            || self.reference.is_some()
+            || self.jog.is_some()
+        {
             RunState::Running
         } else {
             RunState::Idle
@@ -454,6 +462,7 @@ impl Motion {
         if self.servo_off {
             // Setpoints stay where they were; the drives are disabled (see `servo_enabled`).
             self.reference = None;
+            self.jog = None;
             self.update_f();
             self.drive_setpoint();
             return;
@@ -468,6 +477,7 @@ impl Motion {
                 self.cycle_stop = false;
                 self.block_stop = false;
                 self.reference = None;
+                self.jog = None;
             }
             self.commanded.clone_from(&self.actual);
             self.update_f();
@@ -481,6 +491,12 @@ impl Motion {
         let dt = self.cfg.period;
         if self.reference.is_some() && !self.alarm {
             self.reference_tick(dt);
+            self.update_f();
+            self.drive_setpoint();
+            return;
+        }
+        if self.jog.is_some() && !self.alarm {
+            self.jog_tick(dt);
             self.update_f();
             self.drive_setpoint();
             return;
@@ -630,6 +646,7 @@ impl Motion {
         self.alarm = true;
         self.active = None;
         self.reference = None;
+        self.jog = None;
         let here = self.commanded_point();
         self.planner.reset(here);
         self.clear_strobe();

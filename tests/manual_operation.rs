@@ -345,3 +345,91 @@ fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() 
     let (_, failed) = cell.stop();
     assert!(failed.is_empty(), "nodes failed: {failed:?}");
 }
+
+/// The lathe as shipped (absolute encoders), in the rig.
+fn absolute_lathe() -> LaunchConfig {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("launch_configs/sim_lathe.yaml");
+    LaunchConfig::load(&path).unwrap()
+}
+
+/// Display position of axis `i` as the simulator has it.
+fn slide(rig: &Rig, i: usize) -> f64 {
+    let scale = [0.5, 1.0];
+    rig.sim.position()[i] / scale[i]
+}
+
+#[test]
+fn a_held_jog_moves_at_its_feed_and_stops_within_200_ms_of_the_last_request() {
+    let mut rig = Rig::new(&absolute_lathe());
+    let start = slide(&rig, 0);
+    // X+ at 600 mm/min (diameter), the request repeated every 40 ms for one second.
+    for k in 0..250 {
+        if k % 10 == 0 {
+            rig.motion.jog(0, true, 600.0, None).expect("jog");
+        }
+        rig.tick();
+    }
+    let moved = slide(&rig, 0) - start;
+    println!("one second of X+ jog at 600 mm/min: {moved:.3} mm");
+    assert!((moved - 10.0).abs() < 0.5, "{moved}");
+    // Another axis is refused while X moves.
+    assert!(rig.motion.jog(1, true, 600.0, None).is_err());
+    // The requests stop: the slide stands within 200 ms (50 ticks) of the last one (at tick
+    // 240, 10 ticks ago).
+    let mut still_after = None;
+    for t in 0..100 {
+        let before = slide(&rig, 0);
+        rig.tick();
+        // Standing: less than 0.25 mm/s (the drive's lag settles after that).
+        if (slide(&rig, 0) - before).abs() < COUNT && !rig.motion.jogging() {
+            still_after = Some(10 + t + 1);
+            break;
+        }
+    }
+    let ticks = still_after.expect("the jog did not stop");
+    println!("stopped {} ms after the last request", ticks * 4);
+    assert!(ticks * 4 <= 200, "{ticks} ticks");
+    assert!(rig.alarms.is_empty(), "{:?}", rig.alarms);
+}
+
+#[test]
+fn an_increment_moves_exactly_its_step_and_a_jog_stops_at_the_soft_limit() {
+    let mut rig = Rig::new(&absolute_lathe());
+    for (axis, positive, step) in [
+        (0, true, 0.001),
+        (0, false, 0.1),
+        (1, false, 1.0),
+        (1, true, 10.0),
+    ] {
+        let start = slide(&rig, axis);
+        rig.motion
+            .jog(axis, positive, 1000.0, Some(step))
+            .expect("increment");
+        assert!(rig.run_until(5_000, |r| !r.motion.jogging()));
+        rig.run_until(50, |_| false);
+        let moved = slide(&rig, axis) - start;
+        let want = if positive { step } else { -step };
+        println!("axis {axis} increment {want}: moved {moved:.4}");
+        assert!((moved - want).abs() <= COUNT / 2.0, "{moved} for {want}");
+    }
+    // Z+ held toward its soft limit (max 100 + from the config) stops on it.
+    let max = absolute_lathe().machine.axes[1].max;
+    for k in 0..10_000 {
+        if k % 10 == 0 {
+            rig.motion.jog(1, true, 6000.0, None).expect("jog");
+        }
+        rig.tick();
+        if slide(&rig, 1) > max + COUNT {
+            panic!("past the soft limit: {}", slide(&rig, 1));
+        }
+        if k > 2_000 {
+            break;
+        }
+    }
+    rig.run_until(100, |r| !r.motion.jogging());
+    println!(
+        "Z held toward +: stands at {:.4} (soft limit {max})",
+        slide(&rig, 1)
+    );
+    assert!((slide(&rig, 1) - max).abs() < 0.01);
+}
