@@ -433,3 +433,132 @@ fn an_increment_moves_exactly_its_step_and_a_jog_stops_at_the_soft_limit() {
     );
     assert!((slide(&rig, 1) - max).abs() < 0.01);
 }
+
+/// Jog through the cell's `jog` service (runs in scripts/test.sh's network namespace): refused
+/// in AUTO; in JOG mode a held jog moves at its feed; the client then disappears and the axis
+/// stands soon after its last request (dead man), measured on the `axes` topic's time stamps
+/// (175 ms on an idle machine); an increment moves exactly its step.
+#[test]
+fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
+    use cnc::cell::Cell;
+    use cnc::client::CellClient;
+    use cnc_msgs::msg::MachineState;
+    use cnc_msgs::srv::{Jog, JogRequest, SetMode, SetModeRequest};
+    use ros2_client::ServiceMapping;
+    use std::time::{Duration, Instant};
+
+    let cfg = common::sim_lathe(79);
+    let cell = Cell::start(&cfg).expect("cell starts");
+    let mut watch = CellClient::new(
+        &cfg.network,
+        "lathe1",
+        "jog_watch",
+        ServiceMapping::Enhanced,
+    )
+    .expect("client");
+    watch.wait_ready(Duration::from_secs(30)).expect("ready");
+    let x = |c: &CellClient| {
+        c.axes
+            .as_ref()
+            .map_or(f64::NAN, |a| a.axes[0].actual_position)
+    };
+    let request = |direction: i8, feed: f64, increment: f64| JogRequest {
+        axis: "X".into(),
+        direction,
+        feed,
+        increment,
+    };
+    let mut robot = CellClient::new(&cfg.network, "lathe1", "robot", ServiceMapping::Enhanced)
+        .expect("robot client")
+        .with_timeout(Duration::from_secs(5));
+    robot.wait_ready(Duration::from_secs(30)).expect("ready");
+    let robot_jog = robot.service::<Jog>("jog").expect("jog client");
+    let jog = |client: &cnc::client::ServiceClient<Jog>, direction, feed, increment| {
+        client
+            .call(request(direction, feed, increment))
+            .expect("jog answered")
+    };
+    // The service is discovered once; the first call may wait for it.
+    let r = jog(&robot_jog, 1, 1200.0, 0.0);
+    assert!(!r.accepted && r.message.contains("AUTO"), "{}", r.message);
+    let r = robot
+        .service::<SetMode>("set_mode")
+        .and_then(|s| {
+            s.call(SetModeRequest {
+                mode: MachineState::MODE_JOG,
+            })
+        })
+        .expect("set_mode");
+    assert!(r.accepted, "{}", r.message);
+
+    // Held for one second: a request every 50 ms.
+    watch.poll();
+    let start = x(&watch);
+    let t0 = Instant::now();
+    let mut last_request = t0;
+    while t0.elapsed() < Duration::from_secs(1) {
+        let r = jog(&robot_jog, 1, 1200.0, 0.0);
+        assert!(r.accepted, "{}", r.message);
+        last_request = Instant::now();
+        std::thread::sleep(Duration::from_millis(50));
+        watch.poll();
+    }
+    // The robot is gone: no more requests, its participant closed. The axes samples of the
+    // next second, by motion's time stamps: the first at the final position is an upper bound
+    // of when X stood (samples come every 40 ms).
+    let last_request_wall =
+        std::time::SystemTime::now() - Instant::now().saturating_duration_since(last_request);
+    drop(robot_jog);
+    drop(robot);
+    let mut samples: Vec<(std::time::SystemTime, f64)> = Vec::new();
+    let gone = Instant::now();
+    while gone.elapsed() < Duration::from_secs(1) {
+        watch.poll();
+        if let Some(a) = watch.axes.as_ref() {
+            let t =
+                std::time::UNIX_EPOCH + Duration::new(a.stamp.sec.max(0) as u64, a.stamp.nanosec);
+            if samples.last().is_none_or(|(s, _)| *s != t) {
+                samples.push((t, a.axes[0].actual_position));
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let end = samples.last().expect("axes samples").1;
+    let stood = samples
+        .iter()
+        .find(|(_, x)| (x - end).abs() < 1e-4)
+        .map(|(t, _)| *t)
+        .expect("a sample at the end");
+    let stop_ms = stood
+        .duration_since(last_request_wall)
+        .unwrap_or_default()
+        .as_secs_f64()
+        * 1000.0;
+    let moved = x(&watch) - start;
+    println!(
+        "held jog: X moved {moved:.2} mm in {:.2} s; stood {stop_ms:.0} ms after the last request",
+        last_request.duration_since(t0).as_secs_f64()
+    );
+    assert!(moved > 15.0 && moved < 25.0, "{moved}");
+    assert!(
+        stop_ms <= 200.0,
+        "stood {stop_ms:.0} ms after the last request"
+    );
+
+    // An increment of 0.1 mm (diameter) from the watcher's own client.
+    std::thread::sleep(Duration::from_millis(300));
+    watch.poll();
+    let before = x(&watch);
+    let watch_jog = watch.service::<Jog>("jog").expect("jog client");
+    let r = jog(&watch_jog, -1, 600.0, 0.1);
+    assert!(r.accepted, "{}", r.message);
+    std::thread::sleep(Duration::from_millis(800));
+    watch.poll();
+    let step = x(&watch) - before;
+    println!("increment -0.1: moved {step:.4}");
+    drop(watch_jog);
+    assert!((step + 0.1).abs() <= COUNT, "{step}");
+    drop(watch);
+    let (_, failed) = cell.stop();
+    assert!(failed.is_empty(), "nodes failed: {failed:?}");
+}

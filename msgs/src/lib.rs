@@ -10,6 +10,7 @@
 
 pub mod action;
 pub mod canon;
+pub mod jog;
 pub mod msg;
 pub mod servo;
 pub mod signals;

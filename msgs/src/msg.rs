@@ -276,6 +276,8 @@ ros_message! {
             SET_TOOL_OFFSET: u8 = 12,
             SET_WORK_OFFSET: u8 = 13,
             REFERENCE_RETURN: u8 = 14,
+            JOG: u8 = 15,
+            MOTION_JOG: u8 = 16,
         }
         id: u64,
         command: u8,

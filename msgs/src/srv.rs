@@ -190,6 +190,22 @@ ros_message! {
     }
 }
 ros_message! {
+    pub struct JogRequest("cnc_msgs/srv/Jog_Request") {
+        consts {}
+        axis: String,
+        direction: i8,
+        feed: f64,
+        increment: f64,
+    }
+}
+ros_message! {
+    pub struct JogResponse("cnc_msgs/srv/Jog_Response") {
+        consts {}
+        accepted: bool,
+        message: String,
+    }
+}
+ros_message! {
     pub struct MdiRequest("cnc_msgs/srv/Mdi_Request") {
         consts {}
         text: String,
@@ -325,6 +341,7 @@ service!(
 );
 service!(SetMode, "SetMode", SetModeRequest, SetModeResponse);
 service!(Mdi, "Mdi", MdiRequest, MdiResponse);
+service!(Jog, "Jog", JogRequest, JogResponse);
 service!(
     GetParameters,
     "GetParameters",
@@ -361,6 +378,7 @@ macro_rules! refusable {
     )*};
 }
 refusable!(
+    JogResponse,
     LoadProgramResponse,
     StartProgramResponse,
     StopResponse,

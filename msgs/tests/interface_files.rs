@@ -148,6 +148,7 @@ fn every_srv_file_matches_its_rust_types() {
     check_srv::<SetWorkOffset>();
     check_srv::<SetMode>();
     check_srv::<Mdi>();
+    check_srv::<Jog>();
     check_srv::<GetParameters>();
     check_srv::<SetParameter>();
     check_srv::<AcknowledgeAlarm>();
@@ -213,6 +214,7 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "SetWorkOffset",
         "SetMode",
         "Mdi",
+        "Jog",
         "GetParameters",
         "SetParameter",
         "AcknowledgeAlarm",

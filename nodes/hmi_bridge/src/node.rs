@@ -110,6 +110,8 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         .refusing(SetModeResponse::refused);
     let mdi_srv = DualServer::<Mdi>::new(&participant, &ns, "mdi", sq.clone())?
         .refusing(MdiResponse::refused);
+    let jog_srv = DualServer::<Jog>::new(&participant, &ns, "jog", sq.clone())?
+        .refusing(JogResponse::refused);
     let offsets_srv = DualServer::<GetOffsets>::new(&participant, &ns, "get_offsets", sq.clone())?
         .refusing(GetOffsetsResponse::refused);
     let tool_offset_srv =
@@ -198,7 +200,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         ros.refresh();
         // Every service's requests into its queue first: a burst on one is taken off DDS
         // before the others are served (a full queue refuses as busy).
-        let servers: [&dyn Drain; 15] = [
+        let servers: [&dyn Drain; 16] = [
             &load,
             &start,
             &stop,
@@ -208,6 +210,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             &overrides_srv,
             &mode_srv,
             &mdi_srv,
+            &jog_srv,
             &offsets_srv,
             &tool_offset_srv,
             &work_offset_srv,
@@ -452,6 +455,17 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             let (accepted, message) = perform(Operation::Mode { mode }, &Who::Dds(r.writer));
             answer(&mode_srv, &r, &SetModeResponse { accepted, message });
         }
+        if let Some(r) = jog_srv.receive() {
+            let q = &r.request;
+            let op = Operation::Jog {
+                axis: q.axis.clone(),
+                direction: q.direction,
+                feed: q.feed,
+                increment: q.increment,
+            };
+            let (accepted, message) = perform(op, &Who::Dds(r.writer));
+            answer(&jog_srv, &r, &JogResponse { accepted, message });
+        }
         if let Some(r) = mdi_srv.receive() {
             let text = r.request.text.clone();
             let (accepted, message) = perform(Operation::Mdi { text }, &Who::Dds(r.writer));
@@ -672,6 +686,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
             ("get_offsets", offsets_srv.take_malformed()),
             ("get_parameters", get_parameters_srv.take_malformed()),
             ("mdi", mdi_srv.take_malformed()),
+            ("jog", jog_srv.take_malformed()),
             ("set_tool_offset", tool_offset_srv.take_malformed()),
             ("set_work_offset", work_offset_srv.take_malformed()),
             ("set_parameter", set_parameter_srv.take_malformed()),
@@ -891,6 +906,15 @@ fn execute(op: &Operation, desk: &mut Desk) -> (bool, String) {
             }
         }
         Operation::Mode { mode } => commands.call(ProgramCommand::MODE, "", &mode.to_string()),
+        Operation::Jog {
+            axis,
+            direction,
+            feed,
+            increment,
+        } => match cnc_msgs::jog::JogText::new(axis, *direction, *feed, *increment) {
+            Ok(j) => commands.call(ProgramCommand::JOG, "", &j.to_text()),
+            Err(why) => (false, why),
+        },
         Operation::Mdi { text } => commands.call(ProgramCommand::MDI, "", text),
         Operation::Read { name } => commands.call(ProgramCommand::READ, name, ""),
         Operation::Offsets => commands.call(ProgramCommand::OFFSETS, "", ""),

@@ -18,6 +18,14 @@ pub enum Operation {
         name: String,
         at: String,
     },
+    /// A jog of one axis (JOG and HANDWHEEL modes, D69); a continuous one is held by
+    /// repeating it.
+    Jog {
+        axis: String,
+        direction: i8,
+        feed: f64,
+        increment: f64,
+    },
     /// `StopRequest::FEED_HOLD` or `CYCLE_STOP`.
     Stop {
         mode: u8,
@@ -69,6 +77,7 @@ impl Operation {
         match self {
             Operation::Load { .. } => "load_program",
             Operation::Start { .. } => "start_program",
+            Operation::Jog { .. } => "jog",
             Operation::Stop { .. } => "stop",
             Operation::Reset => "reset",
             Operation::List => "list_programs",
@@ -95,6 +104,12 @@ impl Operation {
             | Operation::Delete { name }
             | Operation::Read { name } => name.clone(),
             Operation::Stop { mode } => format!("mode {mode}"),
+            Operation::Jog {
+                axis,
+                direction,
+                feed,
+                increment,
+            } => format!("{axis} {direction:+} F{feed} step {increment}"),
             Operation::Overrides(o) => format!(
                 "feed {} %, spindle {} %, rapid {} %",
                 o.feed_percent, o.spindle_percent, o.rapid_percent
@@ -118,6 +133,7 @@ impl Operation {
         matches!(
             self,
             Operation::Start { .. }
+                | Operation::Jog { .. }
                 | Operation::Load { .. }
                 | Operation::Delete { .. }
                 | Operation::Overrides(_)

@@ -421,6 +421,7 @@ impl RunCore {
             }
             ProgramCommand::START => self.start(&c.program, &c.text),
             ProgramCommand::MODE => self.set_mode(&c.text),
+            ProgramCommand::JOG => self.jog(&c.text),
             ProgramCommand::READ => self
                 .programs
                 .get(&c.program)
@@ -526,6 +527,35 @@ impl RunCore {
             text: String::new(),
         }));
         Ok("reference return started".into())
+    }
+
+    /// A jog request, passed on to motion in JOG and HANDWHEEL modes (D69): `text` is
+    /// `<axis> <+|-|0> <feed> <increment>`, checked by [`cnc_msgs::jog::JogText::parse`].
+    fn jog(&mut self, text: &str) -> Result<String, String> {
+        if !matches!(
+            self.mode,
+            MachineState::MODE_JOG | MachineState::MODE_HANDWHEEL
+        ) {
+            return Err(format!(
+                "jog refused: mode {}, not JOG or HANDWHEEL",
+                MachineState::mode_name_of(self.mode)
+            ));
+        }
+        if self.running() {
+            return Err("jog refused: a program is running".into());
+        }
+        let j = cnc_msgs::jog::JogText::parse(text)?;
+        if !self.base.axes.iter().any(|a| a.to_string() == j.axis) {
+            return Err(format!("jog refused: no axis {}", j.axis));
+        }
+        self.stop_command_id += 1;
+        self.effects.push(Effect::ToMotion(ProgramCommand {
+            id: self.stop_command_id,
+            command: ProgramCommand::MOTION_JOG,
+            program: String::new(),
+            text: j.to_text(),
+        }));
+        Ok(format!("jog {}", j.to_text()))
     }
 
     fn set_mode(&mut self, text: &str) -> Result<String, String> {

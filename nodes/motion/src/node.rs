@@ -31,6 +31,8 @@ const PLC_TIMEOUT_NS: u64 = 500_000_000;
 enum Input {
     Block(Block),
     Command(u8),
+    /// Axis index, direction (+1, -1, 0 stops), feed mm/min, increment mm (0: continuous).
+    Jog(usize, i8, f64, f64),
 }
 
 enum Report {
@@ -135,6 +137,19 @@ fn dds_loop(
                 for number in std::mem::take(&mut raised) {
                     alarms.clear(number);
                 }
+            }
+            if c.command == ProgramCommand::MOTION_JOG {
+                // The interpreter checked the mode; the values are checked again here.
+                match cnc_msgs::jog::JogText::parse(&c.text) {
+                    Ok(j) => match axes.iter().position(|a| a.name == j.axis) {
+                        Some(i) => {
+                            let _ = to_servo.send(Input::Jog(i, j.direction, j.feed, j.increment));
+                        }
+                        None => log::warn!("motion: jog of unknown axis {}", j.axis),
+                    },
+                    Err(e) => log::warn!("motion: {e}"),
+                }
+                continue;
             }
             let _ = to_servo.send(Input::Command(c.command));
         }
@@ -334,6 +349,18 @@ fn servo_loop(
                     match motion.reference_return() {
                         Ok(m) => log::info!("motion: {m}"),
                         Err(e) => log::warn!("motion: {e}"),
+                    }
+                }
+                Input::Jog(axis, direction, feed, increment) => {
+                    let result = if direction == 0 {
+                        motion.jog_stop();
+                        Ok(())
+                    } else {
+                        let step = (increment > 0.0).then_some(increment);
+                        motion.jog(axis, direction > 0, feed, step)
+                    };
+                    if let Err(e) = result {
+                        log::warn!("motion: {e}");
                     }
                 }
                 Input::Command(_) => {}

@@ -6,10 +6,10 @@
 
 use super::{Motion, RunState};
 
-/// How long one continuous jog request holds the axis moving: 120 ms at 4 ms, so that with
+/// How long one continuous jog request holds the axis moving: 100 ms at 4 ms, so that with
 /// the deceleration, the drive lag and a request's way through the cell the axis stands
 /// within 200 ms of the client's last request.
-pub const DEAD_MAN_TICKS: u32 = 30;
+pub const DEAD_MAN_TICKS: u32 = 25;
 
 /// A manual move in progress.
 #[derive(Debug, Clone)]
@@ -116,8 +116,10 @@ impl Motion {
             }),
             (e, l) => e.or(l),
         };
+        // The feed override applies to jogging (`000` §2: jog feed × override).
+        let speed = j.speed * self.panel.feed_override;
         let mut target = if j.end.is_some() || j.held > 0 {
-            j.direction * j.speed
+            j.direction * speed
         } else {
             0.0
         };
