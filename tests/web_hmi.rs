@@ -1,6 +1,6 @@
 //! The operator's web HMI in a real browser: headless Debian chromium, driven by playwright-core
 //! (`tests/hmi/panel.cjs`), loads a program, starts it twice and once at line 5 (block search),
-//! watches the line and the part
+//! jogs X with the panel's keys in JOG mode (held, and a step), watches the line and the part
 //! count advance, is refused MDI in AUTO and an out-of-range override, reads the offset page and
 //! the live ladder, and runs an MDI block in MDI mode. The screenshot, taken while the program
 //! runs, is kept at `target/hmi/panel.png`. The page's commands go through the services' command
@@ -92,6 +92,7 @@ fn the_operator_runs_a_program_from_the_web_hmi_in_chromium() {
     };
     // Events published before this subscriber matched may be missed; the late ones are not.
     assert!(from_page("set_mode", true) >= 1, "{seen:#?}");
+    assert!(from_page("jog", true) >= 2, "{seen:#?}");
     assert!(
         seen.iter()
             .any(|e| e.command == "start_program" && e.detail == "O0005 at line 5"),

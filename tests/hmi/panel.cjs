@@ -1,6 +1,6 @@
 // Drives the operator's web HMI in headless Debian chromium (playwright-core, no downloaded
 // browser): loads a program, starts it (twice from the top, once at a line), watches the line
-// and the part count advance, checks
+// and the part count advance, jogs X with its keys (held, and a step), checks
 // refusals, the offset page, the ladder monitor and the tool path, and keeps a screenshot.
 // Usage: node panel.cjs <url> <screenshot.png>; PLAYWRIGHT_CORE names the module. Exits 1 with
 // the reason when something is not as it should be.
@@ -147,10 +147,31 @@ async function waitFor(what, check, seconds) {
   // An out-of-range override is refused at the bridge.
   await page.evaluate(() => send({ op: "overrides", feed: 7, spindle: 100, rapid: 100 }));
   await waitFor("the override refusal", async () => (await text("message")).includes("feed override 7 %"), 10);
+  // Jog keys in JOG mode: held, X moves at the jog feed; released, it stops; a step of 0.1.
+  await page.selectOption("#mode_select", "JOG");
+  await page.click("#mode_set");
+  await waitFor("JOG mode", async () => (await text("mode")) === "JOG", 10);
+  await waitFor("the jog keys", async () => (await page.$$("#jog_Xplus")).length === 1, 10);
+  const machineX = () => page.$eval("#axes tr", (r) => Number(r.children[1].textContent));
+  const x0 = await machineX();
+  await page.hover("#jog_Xplus");
+  await page.mouse.down();
+  await page.waitForTimeout(600);
+  await page.mouse.up();
+  await page.waitForTimeout(500);
+  const x1 = await machineX();
+  await page.waitForTimeout(300);
+  if ((await machineX()) !== x1) fail(`X still moving after the key was released: ${x1}`);
+  // 1000 mm/min for 0.6 s, and what the last request still holds: 10 to 15 mm.
+  if (!(x1 - x0 > 8 && x1 - x0 < 16)) fail(`held jog moved X from ${x0} to ${x1}`);
+  await page.selectOption("#jog_step", "0.1");
+  await page.click("#jog_Xminus");
+  await waitFor("the 0.1 mm step", async () => Math.abs((await machineX()) - (x1 - 0.1)) < 0.0015, 5);
+  const jog = { from: x0, held: x1, step: await machineX() };
   await page.selectOption("#mode_select", "AUTO");
   await page.click("#mode_set");
   await waitFor("AUTO mode", async () => (await text("mode")) === "AUTO", 10);
 
-  console.log(JSON.stringify({ first, second, third, points, rungs, paramRows, parts: Number(await text("parts")) }));
+  console.log(JSON.stringify({ first, second, third, jog, points, rungs, paramRows, parts: Number(await text("parts")) }));
   await browser.close();
 })().catch((e) => fail(e.stack || String(e)));

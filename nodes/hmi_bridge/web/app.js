@@ -39,6 +39,7 @@ function connect() {
     $("link").textContent = "offline";
     $("link").className = "off";
     // A closed panel on the network may mean an expired session: ask again before retrying.
+    jogStop();
     setTimeout(start, 1000);
   };
   ws.onmessage = (e) => {
@@ -76,6 +77,7 @@ const handlers = {
         markLine(s.line);
       }
     }
+    if (m.axes && m.axes.length) jogKeys(m.axes.map((a) => a.name));
     $("axes").innerHTML = (m.axes || [])
       .map((a) => `<tr><th>${a.name}</th><td>${fmt(a.machine)}</td><td>${fmt(a.work)}</td><td>${fmt(a.to_go)}</td></tr>`)
       .join("");
@@ -241,6 +243,43 @@ $("cycle_start").onclick = () => {
   $("start_at").value = "";
   send({ op: "start", name, at });
 };
+// Jog keys, one pair per axis once the axes are known. A continuous jog is held by repeating
+// the request every 50 ms while the key is down; released, or the connection lost, the
+// machine stops the axis by itself within 200 ms (dead man, decisions D69).
+let jogTimer = null;
+function jogStop() {
+  if (jogTimer === null) return;
+  clearInterval(jogTimer.interval);
+  send({ op: "jog", axis: jogTimer.axis, direction: 0 });
+  jogTimer = null;
+}
+function jogKeys(names) {
+  const box = $("jog_keys");
+  if (box.dataset.axes === names.join()) return;
+  box.dataset.axes = names.join();
+  box.innerHTML = "";
+  for (const axis of names) {
+    for (const [label, direction] of [["-", -1], ["+", 1]]) {
+      const b = document.createElement("button");
+      b.id = `jog_${axis}${label === "+" ? "plus" : "minus"}`;
+      b.textContent = `${label}${axis}`;
+      b.onpointerdown = () => {
+        const feed = Number($("jog_feed").value) || 0;
+        const increment = Number($("jog_step").value) || 0;
+        const ask = () => send({ op: "jog", axis, direction, feed, increment });
+        ask();
+        if (increment === 0) {
+          jogStop();
+          jogTimer = { axis, interval: setInterval(ask, 50) };
+        }
+      };
+      b.onpointerup = jogStop;
+      b.onpointerleave = jogStop;
+      box.appendChild(b);
+    }
+  }
+}
+window.addEventListener("blur", jogStop);
 $("feed_hold").onclick = () => send({ op: "feed_hold" });
 $("reset").onclick = () => send({ op: "reset" });
 $("mode_set").onclick = () => send({ op: "mode", mode: $("mode_select").value });

@@ -111,6 +111,17 @@ fn operation(v: &Value) -> Result<Operation, String> {
         "mdi" => Operation::Mdi {
             text: string(v, "text")?,
         },
+        "jog" => {
+            let number = |key: &str| v.get(key).and_then(Value::as_f64).unwrap_or(0.0);
+            let direction = v.get("direction").and_then(Value::as_i64).unwrap_or(0);
+            Operation::Jog {
+                axis: string(v, "axis")?,
+                direction: i8::try_from(direction)
+                    .map_err(|_| format!("direction {direction}: +1, -1 or 0"))?,
+                feed: number("feed"),
+                increment: number("increment"),
+            }
+        }
         "offsets" => Operation::Offsets,
         "set_tool_offset" => Operation::SetToolOffset {
             number: string(v, "number")?,
@@ -165,6 +176,18 @@ mod tests {
                 at: "line 12".into()
             })
         );
+        assert_eq!(
+            parse(r#"{"id":6,"op":"jog","axis":"X","direction":-1,"feed":600}"#).1,
+            Ok(Operation::Jog {
+                axis: "X".into(),
+                direction: -1,
+                feed: 600.0,
+                increment: 0.0
+            })
+        );
+        assert!(parse(r#"{"id":7,"op":"jog","axis":"X","direction":300}"#)
+            .1
+            .is_err());
         assert!(parse(r#"{"id":5,"op":"start","name":"O1","at":"line\n1"}"#)
             .1
             .is_err());
