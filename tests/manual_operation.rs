@@ -437,7 +437,7 @@ fn an_increment_moves_exactly_its_step_and_a_jog_stops_at_the_soft_limit() {
 /// Jog through the cell's `jog` service (runs in scripts/test.sh's network namespace): refused
 /// in AUTO; in JOG mode a held jog moves at its feed; the client then disappears and the axis
 /// stands soon after its last request (dead man), measured on the `axes` topic's time stamps
-/// (175 ms on an idle machine); an increment moves exactly its step.
+/// (177–196 ms on an idle machine); an increment moves exactly its step.
 #[test]
 fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
     use cnc::cell::Cell;
