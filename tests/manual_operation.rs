@@ -81,6 +81,10 @@ impl Rig {
             marker: self.feedback.marker,
             marker_position: self.feedback.marker_position,
         });
+        self.motion.overtravel_inputs(
+            self.feedback.overtravel_plus,
+            self.feedback.overtravel_minus,
+        );
         let before = self.sim.position().to_vec();
         let mut sp = ServoSetpoint {
             enable: 1,
@@ -203,16 +207,23 @@ fn from_power_on_a_start_is_refused_the_axes_find_their_reference_points_then_a_
 }
 
 #[test]
-fn a_missing_dog_ends_the_reference_return_with_an_alarm_within_the_travel() {
-    // A dog of length 0 is never seen pressed.
-    let mut cfg = incremental_lathe(20.0);
-    cfg.machine.axes[0].reference.as_mut().unwrap().dog_length = 1e-9;
-    let mut rig = Rig::new(&cfg);
-    rig.motion.reference_return().expect("started");
-    let ended = rig.run_until(200_000, |r| !r.motion.referencing());
-    assert!(ended);
-    assert_eq!(rig.alarms, [cnc_motion::alarm::REFERENCE_FAILED]);
-    assert_eq!(rig.motion.referenced(), &[false, false]);
+fn a_missing_dog_ends_the_reference_return_on_the_overtravel_switch_or_within_the_travel() {
+    // A dog of length 0 is never seen pressed: X runs on to its + overtravel switch (alarm
+    // 40); on a machine whose switches are out of reach, the travel guard stops it (1094).
+    for (switches, alarm) in [
+        (None, cnc_motion::alarm::OVERTRAVEL_PLUS),
+        (Some([-1e6, 1e6]), cnc_motion::alarm::REFERENCE_FAILED),
+    ] {
+        let mut cfg = incremental_lathe(20.0);
+        cfg.machine.axes[0].reference.as_mut().unwrap().dog_length = 1e-9;
+        cfg.machine.axes[0].overtravel = switches;
+        let mut rig = Rig::new(&cfg);
+        rig.motion.reference_return().expect("started");
+        let ended = rig.run_until(200_000, |r| !r.motion.referencing());
+        assert!(ended);
+        assert_eq!(rig.alarms, [alarm], "switches {switches:?}");
+        assert_eq!(rig.motion.referenced(), &[false, false]);
+    }
     assert_eq!(MAX_AXES, 8);
 }
 
@@ -561,4 +572,53 @@ fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
     drop(watch);
     let (_, failed) = cell.stop();
     assert!(failed.is_empty(), "nodes failed: {failed:?}");
+}
+
+#[test]
+fn an_axis_on_its_overtravel_switch_stops_with_the_alarm_and_jogs_off_it_only_the_other_way() {
+    // The + switch of X at 220 (diameter), inside the soft limit, as a misadjusted dog would be.
+    let mut cfg = absolute_lathe();
+    let max = cfg.machine.axes[0].max;
+    cfg.machine.axes[0].overtravel = Some([-5.0, 220.0]);
+    assert!(max > 225.0, "X max {max}");
+    let mut rig = Rig::new(&cfg);
+    let mut k = 0;
+    while rig.alarms.is_empty() && k < 5_000 {
+        if k % 10 == 0 {
+            let _ = rig.motion.jog(0, true, 3000.0, None);
+        }
+        rig.tick();
+        k += 1;
+    }
+    assert_eq!(rig.alarms, [cnc_motion::alarm::OVERTRAVEL_PLUS]);
+    rig.run_until(50, |_| false);
+    let stood = slide(&rig, 0);
+    println!("X ran onto its + switch at 220: stands at {stood:.3}");
+    assert!(
+        (220.0..221.0).contains(&stood),
+        "on the switch, past it by the stop: {stood}"
+    );
+    assert!(!rig.motion.jogging());
+    // Reset: X+ is still refused, and so is a program; X− moves it off the switch.
+    rig.motion.reset();
+    rig.alarms.clear();
+    rig.run_until(5, |_| false);
+    let refused = rig.motion.jog(0, true, 600.0, Some(1.0)).unwrap_err();
+    assert!(refused.contains("overtravel"), "{refused}");
+    rig.motion.push(rapid(1, 9, &[150.0, 50.0]));
+    rig.run_until(10, |_| false);
+    assert_eq!(rig.alarms, [cnc_motion::alarm::OVERTRAVEL_PLUS]);
+    rig.motion.reset();
+    rig.alarms.clear();
+    rig.run_until(5, |_| false);
+    rig.motion
+        .jog(0, false, 600.0, Some(2.0))
+        .expect("jog off the switch");
+    assert!(rig.run_until(2_000, |r| !r.motion.jogging()));
+    rig.run_until(50, |_| false);
+    assert!(!rig.motion.overtravel_pressed());
+    assert!(rig.alarms.is_empty(), "{:?}", rig.alarms);
+    rig.motion
+        .jog(0, true, 600.0, Some(0.5))
+        .expect("X+ again, off the switch");
 }

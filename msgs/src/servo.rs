@@ -56,6 +56,10 @@ pub struct ServoFeedback {
     /// `marker_position` (the drive latches the count, so the position is exact).
     pub marker: u32,
     pub marker_position: [f64; MAX_AXES],
+    /// Bit per axis: its + / − overtravel limit switch is pressed (the drive's limit inputs,
+    /// as bus servo drives report them).
+    pub overtravel_plus: u32,
+    pub overtravel_minus: u32,
 }
 
 impl Default for ServoFeedback {
@@ -71,6 +75,8 @@ impl Default for ServoFeedback {
             reference_dog: 0,
             marker: 0,
             marker_position: [0.0; MAX_AXES],
+            overtravel_plus: 0,
+            overtravel_minus: 0,
         }
     }
 }

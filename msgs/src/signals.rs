@@ -247,6 +247,9 @@ pub mod x {
     /// Spindle at the commanded speed (the manual's "spindle reached").
     pub const SPINDLE_AT_SPEED: Bit = bit(0, 1);
     pub const CHUCK_CLAMPED: Bit = bit(0, 3);
+    /// Some axis is on its − / + overtravel switch (`000` XJ2: X0.2 LIM−, X0.4 LIM+).
+    pub const LIMIT_MINUS: Bit = bit(0, 2);
+    pub const LIMIT_PLUS: Bit = bit(0, 4);
     pub const CHUCK_UNCLAMPED: Bit = bit(0, 5);
     /// Emergency stop, normally closed: 1 = released.
     pub const ESP_N: Bit = bit(1, 0);

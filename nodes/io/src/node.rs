@@ -39,6 +39,16 @@ pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
                 })
             })
             .collect(),
+        overtravel: cfg
+            .machine
+            .axes
+            .iter()
+            .map(|a| {
+                let [lo, hi] = a.overtravel_switches();
+                let (lo, hi) = (lo * a.scale(), hi * a.scale());
+                [lo.min(hi), lo.max(hi)]
+            })
+            .collect(),
     }
 }
 

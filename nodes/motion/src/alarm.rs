@@ -32,3 +32,8 @@ pub const REFERENCE_NOT_DONE: u32 = 224;
 /// A reference return that found no dog or index mark within the axis's travel (not in the
 /// manuals: D68).
 pub const REFERENCE_FAILED: u32 = 1094;
+/// An axis on its + overtravel switch (`000` alarm 40, "+ hardware limit").
+pub const OVERTRAVEL_PLUS: u32 = 40;
+/// An axis on its − overtravel switch (`000` alarm 66, "limit alarm": its tables have no
+/// number of their own for the − switch; decisions D70).
+pub const OVERTRAVEL_MINUS: u32 = 66;

@@ -277,6 +277,8 @@ fn servo_loop(
     let mut spindle = (first.spindle_rpm, first.spindle_angle_deg);
     // The dogs and index marks of the latest feedback; a mark is passed on once.
     let mut reference = ReferenceInputs::default();
+    // The drives' overtravel switches of the latest feedback (+, −).
+    let mut overtravel = (first.overtravel_plus, first.overtravel_minus);
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
     let mut g = GImage::default();
@@ -387,6 +389,7 @@ fn servo_loop(
         }
         motion.reference_inputs(reference);
         reference.marker = 0;
+        motion.overtravel_inputs(overtravel.0, overtravel.1);
         // What the drives get; under machine lock it is not the commanded position.
         let mut setpoint = [0.0; MAX_AXES];
         setpoint[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
@@ -412,6 +415,7 @@ fn servo_loop(
             actual = fb.position;
             spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
             reference.dog = fb.reference_dog;
+            overtravel = (fb.overtravel_plus, fb.overtravel_minus);
             if fb.marker != 0 {
                 reference.marker |= fb.marker;
                 for i in 0..n {

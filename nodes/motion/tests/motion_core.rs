@@ -22,6 +22,7 @@ fn lathe() -> MotionConfig {
         home: 0.0,
         second_reference: None,
         reference: None,
+        overtravel: None,
     };
     MotionConfig {
         axes: vec![

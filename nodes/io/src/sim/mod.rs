@@ -27,6 +27,9 @@ pub struct SimConfig {
     /// Per axis: an incremental encoder (`Some`), or an absolute one that reports the slide's
     /// machine position from power-on (`None`).
     pub encoders: Vec<Option<Encoder>>,
+    /// Per axis: where the − and + overtravel switches are pressed (slide travel, machine
+    /// coordinates); none given: no switches.
+    pub overtravel: Vec<[f64; 2]>,
 }
 
 /// An incremental encoder and its reference dog, in slide travel (mm): the encoder counts
@@ -87,6 +90,8 @@ pub struct SimLathe {
     pub devices: Devices,
     emergency_stop: bool,
     x_seq: u64,
+    /// Overtravel switches pressed at the last step (bits per axis), for the PLC's inputs.
+    overtravel: (u32, u32),
 }
 
 impl SimLathe {
@@ -112,6 +117,7 @@ impl SimLathe {
             spindle_angle: 0.0,
             emergency_stop: false,
             x_seq: 0,
+            overtravel: (0, 0),
         }
     }
 
@@ -183,6 +189,14 @@ impl SimLathe {
         for (i, was) in before.iter().enumerate().take(n) {
             let (now, offset) = (self.position[i], self.encoder_offset[i]);
             fb.position[i] = now - offset;
+            if let Some([minus, plus]) = self.cfg.overtravel.get(i) {
+                if now <= *minus {
+                    fb.overtravel_minus |= 1 << i;
+                }
+                if now >= *plus {
+                    fb.overtravel_plus |= 1 << i;
+                }
+            }
             let Some(e) = self.cfg.encoders.get(i).copied().flatten() else {
                 continue;
             };
@@ -194,6 +208,7 @@ impl SimLathe {
                 fb.marker_position[i] = m - offset;
             }
         }
+        self.overtravel = (fb.overtravel_minus, fb.overtravel_plus);
         fb
     }
 
@@ -208,6 +223,8 @@ impl SimLathe {
             ..Default::default()
         };
         xi.set(x::ESP_N, !self.emergency_stop);
+        xi.set(x::LIMIT_MINUS, self.overtravel.0 != 0);
+        xi.set(x::LIMIT_PLUS, self.overtravel.1 != 0);
         xi.set(
             x::SPINDLE_AT_SPEED,
             (self.spindle_rpm - commanded).abs() <= tol,
@@ -239,6 +256,7 @@ mod tests {
                 at_speed_tolerance: 0.02,
                 devices: DeviceConfig::default(),
                 encoders: vec![None, None],
+                overtravel: Vec::new(),
             },
             &[10.0, 20.0],
         )
@@ -317,6 +335,7 @@ mod tests {
                 at_speed_tolerance: 0.02,
                 devices: DeviceConfig::default(),
                 encoders: vec![Some(e)],
+                overtravel: Vec::new(),
             },
             &[60.0],
         );

@@ -48,6 +48,13 @@ impl Motion {
         if self.state() == RunState::Alarm || self.servo_off {
             return Err("jog refused: alarm or emergency stop (reset first)".into());
         }
+        if self.on_overtravel_switch(axis, positive) {
+            return Err(format!(
+                "jog refused: {} is on its {} overtravel switch: jog it the other way",
+                a.name,
+                if positive { "+" } else { "−" }
+            ));
+        }
         let direction = if positive { 1.0 } else { -1.0 };
         if let Some(j) = self.jog.as_mut() {
             let same = j.axis == axis && j.direction == direction;

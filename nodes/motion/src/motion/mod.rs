@@ -25,6 +25,7 @@ pub use panel::Panel;
 
 mod activate;
 pub mod jog;
+mod overtravel;
 mod panel;
 mod reference;
 mod window;
@@ -159,6 +160,8 @@ pub struct Motion {
     reference: Option<reference::ReferenceReturn>,
     reference_inputs: ReferenceInputs,
     jog: Option<jog::Jog>,
+    /// Overtravel switches pressed, bits per axis: (+, −).
+    overtravel: (u32, u32),
 }
 
 impl Motion {
@@ -182,6 +185,7 @@ impl Motion {
             reference: None,
             reference_inputs: ReferenceInputs::default(),
             jog: None,
+            overtravel: (0, 0),
             thread,
             encoder: Encoder::default(),
             panel: Panel::default(),
@@ -236,6 +240,12 @@ impl Motion {
                     block.seq, block.run_id, self.run_id
                 );
                 self.raise(alarm::BAD_BLOCK, text, block.line);
+                return;
+            }
+            if self.overtravel_pressed() {
+                let (number, text) = self.overtravel_alarm(self.overtravel.0, self.overtravel.1);
+                self.dead_run = block.run_id;
+                self.raise(number, text, block.line);
                 return;
             }
             if !self.all_referenced() || self.reference.is_some() {

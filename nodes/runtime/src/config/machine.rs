@@ -212,6 +212,11 @@ pub struct AxisEntry {
     /// encoder, referenced at power-on.
     #[serde(default)]
     pub reference: Option<ReferenceEntry>,
+    /// Where the hard overtravel switches sit, display units, machine coordinates (the
+    /// simulator presses them there; decisions D70); default 1 mm (slide) beyond `min` and
+    /// `max`.
+    #[serde(default)]
+    pub overtravel: Option<[f64; 2]>,
 }
 
 /// How an axis with an incremental encoder finds its reference point: at `fast_feed` toward
@@ -261,6 +266,13 @@ impl ReferenceEntry {
 }
 
 impl AxisEntry {
+    /// The overtravel switches' positions, display units: `overtravel`, else 1 mm of slide
+    /// beyond the soft limits.
+    pub fn overtravel_switches(&self) -> [f64; 2] {
+        self.overtravel
+            .unwrap_or([self.min - 1.0 / self.scale(), self.max + 1.0 / self.scale()])
+    }
+
     /// The simulated slide's power-on position, display units: `home` for an absolute
     /// encoder; for an incremental one `reference.power_on`, else 50 mm of slide before the
     /// dog.
