@@ -622,3 +622,102 @@ fn an_axis_on_its_overtravel_switch_stops_with_the_alarm_and_jogs_off_it_only_th
         .jog(0, true, 600.0, Some(0.5))
         .expect("X+ again, off the switch");
 }
+
+/// Overtravel through the cell (runs in scripts/test.sh's network namespace): a robot holds
+/// X+ until X runs onto its switch; the alarm comes, `axes` shows X on its + switch, and a jog
+/// is refused until the reset; then X+ is refused by name and X− takes it off the switch.
+#[test]
+fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way() {
+    use cnc::cell::Cell;
+    use cnc::client::CellClient;
+    use cnc_msgs::msg::MachineState;
+    use cnc_msgs::srv::{Jog, JogRequest, SetMode, SetModeRequest};
+    use ros2_client::ServiceMapping;
+    use std::time::{Duration, Instant};
+
+    let mut cfg = common::sim_lathe(80);
+    cfg.machine.axes[0].overtravel = Some([-5.0, 220.0]);
+    let cell = Cell::start(&cfg).expect("cell starts");
+    let mut c = CellClient::new(&cfg.network, "lathe1", "robot", ServiceMapping::Enhanced)
+        .expect("client")
+        .with_timeout(Duration::from_secs(5));
+    c.wait_ready(Duration::from_secs(30)).expect("ready");
+    let r = c
+        .service::<SetMode>("set_mode")
+        .and_then(|s| {
+            s.call(SetModeRequest {
+                mode: MachineState::MODE_JOG,
+            })
+        })
+        .expect("set_mode");
+    assert!(r.accepted, "{}", r.message);
+    let jog = c.service::<Jog>("jog").expect("jog client");
+    let ask = |direction: i8, increment: f64| {
+        jog.call(JogRequest {
+            axis: "X".into(),
+            direction,
+            feed: 3000.0,
+            increment,
+        })
+        .expect("jog answered")
+    };
+    let x_switch = |c: &CellClient| c.axes.as_ref().map_or(0, |a| a.axes[0].overtravel);
+    let alarm_40 = |c: &CellClient| {
+        c.alarms
+            .as_ref()
+            .is_some_and(|a| a.alarms.iter().any(|x| x.number == 40))
+    };
+    let t0 = Instant::now();
+    while !alarm_40(&c) {
+        let _ = ask(1, 0.0);
+        std::thread::sleep(Duration::from_millis(50));
+        c.poll();
+        assert!(
+            t0.elapsed() < Duration::from_secs(20),
+            "no overtravel alarm"
+        );
+    }
+    let t1 = Instant::now();
+    while x_switch(&c) != 1 {
+        c.poll();
+        assert!(
+            t1.elapsed() < Duration::from_secs(5),
+            "axes do not show the switch"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let r = ask(-1, 1.0);
+    println!("jog during the alarm: {}", r.message);
+    assert!(!r.accepted && r.message.contains("reset"), "{}", r.message);
+    assert!(c.reset().expect("reset").accepted);
+    std::thread::sleep(Duration::from_millis(300));
+    c.poll();
+    let r = ask(1, 0.5);
+    println!("X+ on the switch after reset: {}", r.message);
+    assert!(
+        !r.accepted && r.message.contains("overtravel"),
+        "{}",
+        r.message
+    );
+    let r = ask(-1, 2.0);
+    assert!(r.accepted, "{}", r.message);
+    let t2 = Instant::now();
+    while x_switch(&c) != 0 {
+        c.poll();
+        assert!(t2.elapsed() < Duration::from_secs(5), "still on the switch");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    c.poll();
+    let x = c
+        .axes
+        .as_ref()
+        .map_or(f64::NAN, |a| a.axes[0].actual_position);
+    println!("off the switch at X {x:.3}");
+    assert!(x < 220.0, "{x}");
+    assert!(ask(1, 0.5).accepted);
+    drop(jog);
+    drop(c);
+    let (_, failed) = cell.stop();
+    assert!(failed.is_empty(), "nodes failed: {failed:?}");
+}

@@ -71,6 +71,7 @@ ros_message! {
         actual_position: f64,
         following_error: f64,
         homed: bool,
+        overtravel: i8,
     }
 }
 

@@ -253,6 +253,13 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         while let Ok(Some(a)) = axes_sub.take() {
             let commanded: Vec<f64> = a.axes.iter().map(|x| x.commanded_position).collect();
             core.axes(&commanded);
+            core.overtravel_axes(
+                a.axes
+                    .iter()
+                    .filter(|x| x.overtravel != 0)
+                    .map(|x| (x.name.clone(), x.overtravel))
+                    .collect(),
+            );
             core.unreferenced_axes(
                 a.axes
                     .iter()

@@ -219,6 +219,8 @@ pub struct RunCore {
     position_kept: Option<ProgramPosition>,
     /// Axes motion reports not referenced (incremental encoders after power-on, D68).
     unreferenced: Vec<String>,
+    /// Axes on an overtravel switch, with the side (+1, -1; D70).
+    overtravel: Vec<(String, i8)>,
 }
 
 impl RunCore {
@@ -249,7 +251,14 @@ impl RunCore {
             base,
             position_kept: None,
             unreferenced: Vec::new(),
+            overtravel: Vec::new(),
         }
+    }
+
+    /// The axes motion reports on an overtravel switch (`Axis.overtravel`): a jog toward the
+    /// switch is refused (D70).
+    pub fn overtravel_axes(&mut self, axes: Vec<(String, i8)>) {
+        self.overtravel = axes;
     }
 
     /// The axes motion reports without a reference point yet (`AxisState.homed` false): no
@@ -547,6 +556,20 @@ impl RunCore {
         let j = cnc_msgs::jog::JogText::parse(text)?;
         if !self.base.axes.iter().any(|a| a.to_string() == j.axis) {
             return Err(format!("jog refused: no axis {}", j.axis));
+        }
+        if self.status.state == MotionStatus::STATE_ALARM {
+            return Err("jog refused: motion alarm (reset first)".into());
+        }
+        if let Some((_, side)) = self
+            .overtravel
+            .iter()
+            .find(|(a, side)| *a == j.axis && *side == j.direction)
+        {
+            return Err(format!(
+                "jog refused: {} is on its {} overtravel switch: jog it the other way",
+                j.axis,
+                if *side > 0 { "+" } else { "−" }
+            ));
         }
         self.stop_command_id += 1;
         self.effects.push(Effect::ToMotion(ProgramCommand {

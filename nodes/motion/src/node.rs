@@ -41,8 +41,15 @@ enum Report {
     Late(Option<f64>),
     /// Commanded and actual slide positions.
     /// Commanded, actual and drive setpoint positions (machine coordinates), whether machine
-    /// lock holds them, and a bit per referenced axis.
-    Axes([f64; MAX_AXES], [f64; MAX_AXES], [f64; MAX_AXES], bool, u32),
+    /// lock holds them, a bit per referenced axis, and the overtravel switches (+, −).
+    Axes(
+        [f64; MAX_AXES],
+        [f64; MAX_AXES],
+        [f64; MAX_AXES],
+        bool,
+        u32,
+        (u32, u32),
+    ),
     Alarm(u32, String, u32),
     Stats(ServoStats),
 }
@@ -167,7 +174,7 @@ fn dds_loop(
                     0,
                 )),
                 Ok(Report::Late(None)) => alarms.clear(alarm::SERVO_LATE),
-                Ok(Report::Axes(commanded, actual, setpoint, machine_lock, referenced)) => {
+                Ok(Report::Axes(commanded, actual, setpoint, machine_lock, referenced, limits)) => {
                     let axes = axes
                         .iter()
                         .enumerate()
@@ -179,6 +186,8 @@ fn dds_loop(
                                 actual_position: act,
                                 following_error: setpoint[i] / a.scale() - act,
                                 homed: referenced & (1 << i) != 0,
+                                overtravel: i8::from(limits.0 & (1 << i) != 0)
+                                    - i8::from(limits.1 & (1 << i) != 0),
                             }
                         })
                         .collect();
@@ -481,7 +490,10 @@ fn servo_loop(
                 .iter()
                 .enumerate()
                 .fold(0u32, |bits, (i, r)| bits | (u32::from(*r) << i));
-            let _ = reports.send(Report::Axes(commanded, machine, drive, locked, referenced));
+            let limits = overtravel;
+            let _ = reports.send(Report::Axes(
+                commanded, machine, drive, locked, referenced, limits,
+            ));
         }
         if seq.is_multiple_of(250) {
             let _ = reports.send(Report::Stats(stats.message(mcfg.period)));

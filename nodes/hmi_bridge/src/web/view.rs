@@ -337,6 +337,7 @@ mod tests {
             actual_position: p,
             following_error: 0.0,
             homed: true,
+            overtravel: 0,
         };
         AxisState {
             axes: vec![axis("X", x), axis("Z", z)],
