@@ -714,7 +714,14 @@ impl RunCore {
                 p.program, p.line
             ));
         }
-        Ok((p.program.clone(), p.block, p.kept_at_start.clone()))
+        // The file may have been edited by hand: only kept variables, only numbers.
+        let kept = p
+            .kept_at_start
+            .iter()
+            .filter(|(n, v)| Memory::is_kept(**n) && v.is_finite())
+            .map(|(&n, &v)| (n, v))
+            .collect();
+        Ok((p.program.clone(), p.block, kept))
     }
 
     /// Feeds motion while credit lasts, notes completion and feed hold. Returns whether it
