@@ -8,6 +8,7 @@ use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
 use cnc_motion::{Block, Motion, MotionConfig, RunState};
+use cnc_msgs::msg::MachineState;
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{f, g, x, y, FImage, GImage, SignalTable, XImage, YImage};
 use cnc_plc::memory::Retained;
@@ -462,4 +463,49 @@ fn machine_lock_and_aux_lock_run_a_program_without_moving_the_machine() {
     assert!(!r.gi.get(g::BDT1) && !r.nc().get(f::MBDT));
     press(&mut r, x::KEY_BLOCK_SKIP);
     assert!(r.gi.get(g::BDT1) && r.nc().get(f::MBDT));
+}
+
+/// Issue 28, jog through the PLC's G signals (D71): the standard ladder turns the jog keys
+/// X19.4 +X and X19.5 −X into G100.0 and G102.0. In JOG mode, +X held for half a second moves
+/// X at the key jog feed and stops at the release; in HANDWHEEL mode each press of −X moves
+/// one step of 0.001 mm; in AUTO the keys move nothing.
+#[test]
+fn the_jog_keys_drive_the_axes_through_the_ladder_in_jog_and_handwheel_modes() {
+    let mut r = powered("M30\n");
+    let x = |r: &Rig| r.sim.position()[0] / 0.5;
+    let start = x(&r);
+    // AUTO: nothing moves.
+    r.sim.devices.inputs.set(x::KEY_JOG_PLUS_X, true);
+    r.run_until(0.3, |_| false);
+    r.sim.devices.inputs.set(x::KEY_JOG_PLUS_X, false);
+    r.run_until(0.1, |_| false);
+    assert!((x(&r) - start).abs() < 1e-9, "moved in AUTO");
+    // JOG: held half a second.
+    r.motion.set_mode(MachineState::MODE_JOG);
+    r.run_until(0.05, |_| false);
+    assert!(r.nc().get(f::MJ), "F3.2 MJ in JOG mode");
+    r.sim.devices.inputs.set(x::KEY_JOG_PLUS_X, true);
+    r.run_until(0.5, |_| false);
+    assert!(r.gi.get(g::jog_plus(0)), "G100.0 from the key");
+    r.sim.devices.inputs.set(x::KEY_JOG_PLUS_X, false);
+    r.run_until(0.3, |_| false);
+    let held = x(&r) - start;
+    println!("+X held 0.5 s in JOG mode: {held:.3} mm");
+    // 1000 mm/min for 0.5 s, less the PLC's scan on press and release.
+    assert!((7.0..9.0).contains(&held), "{held}");
+    let after = x(&r);
+    r.run_until(0.3, |_| false);
+    assert!(
+        (x(&r) - after).abs() < 1e-6,
+        "still moving after the release"
+    );
+    // HANDWHEEL: three presses of −X, three steps of 0.001.
+    r.motion.set_mode(MachineState::MODE_HANDWHEEL);
+    for _ in 0..3 {
+        press(&mut r, x::KEY_JOG_MINUS_X);
+        r.run_until(0.1, |_| false);
+    }
+    let steps = x(&r) - after;
+    println!("three -X presses in HANDWHEEL mode: {steps:.4} mm");
+    assert!((steps + 0.003).abs() < 1e-6, "{steps}");
 }

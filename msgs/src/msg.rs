@@ -279,6 +279,7 @@ ros_message! {
             REFERENCE_RETURN: u8 = 14,
             JOG: u8 = 15,
             MOTION_JOG: u8 = 16,
+            MOTION_MODE: u8 = 17,
         }
         id: u64,
         command: u8,

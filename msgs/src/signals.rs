@@ -178,6 +178,9 @@ pub mod f {
     /// Automatic mode (the only mode of the cell's NC so far).
     pub const MCYC: Bit = bit(3, 5);
     pub const MSBK: Bit = bit(4, 3);
+    /// JOG mode selected (F3.2 MJ) and HANDWHEEL mode selected (F3.1 MH).
+    pub const MJ: Bit = bit(3, 2);
+    pub const MH: Bit = bit(3, 1);
     /// Machine lock in effect (the axes do not move; `000` App.2 F4.1).
     pub const MMLK: Bit = bit(4, 1);
     /// Auxiliary function lock in effect (M, S, T not output; F4.4).
@@ -209,6 +212,19 @@ pub mod f {
 /// G signals the NC reads (`000` App.2, inventory §9.5).
 pub mod g {
     use super::{bit, Bit};
+    /// +J of axis `k` (0–5: X, Y, Z, A, B, C): jog key (`000` App.2 G100).
+    pub const fn jog_plus(k: usize) -> Bit {
+        bit(100, k as u8)
+    }
+    /// −J of axis `k` (G102).
+    pub const fn jog_minus(k: usize) -> Bit {
+        bit(102, k as u8)
+    }
+    /// Manual rapid traverse (G19.7 RT).
+    pub const RT: Bit = bit(19, 7);
+    /// Step multiplier MP1/MP2 (G19.4, G19.5): ×1, ×10, ×100, ×1000 of 0.001 mm.
+    pub const MP1: Bit = bit(19, 4);
+    pub const MP2: Bit = bit(19, 5);
     /// Completion of the M/S/T function.
     pub const FIN: Bit = bit(4, 3);
     /// Auxiliary function lock: M, S and T are not output, M00/M01/M02/M30 still are
@@ -297,6 +313,11 @@ pub mod x {
     pub const KEY_AUX_LOCK: Bit = bit(19, 1);
     pub const KEY_DRY_RUN: Bit = bit(19, 2);
     pub const KEY_BLOCK_SKIP: Bit = bit(19, 3);
+    /// Jog keys +X, −X, +Z, −Z (the cell's own byte X19, as the proving keys; D71).
+    pub const KEY_JOG_PLUS_X: Bit = bit(19, 4);
+    pub const KEY_JOG_MINUS_X: Bit = bit(19, 5);
+    pub const KEY_JOG_PLUS_Z: Bit = bit(19, 6);
+    pub const KEY_JOG_MINUS_Z: Bit = bit(19, 7);
 }
 
 /// Outputs of the standard lathe (`000` §19.1.6, inventory §9.3).

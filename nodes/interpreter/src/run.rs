@@ -588,6 +588,14 @@ impl RunCore {
                     Err("mode change refused: a program is running (stop it first)".into())
                 } else {
                     self.mode = m;
+                    // Motion acts on the PLC's jog keys in JOG and HANDWHEEL modes (D71).
+                    self.stop_command_id += 1;
+                    self.effects.push(Effect::ToMotion(ProgramCommand {
+                        id: self.stop_command_id,
+                        command: ProgramCommand::MOTION_MODE,
+                        program: String::new(),
+                        text: m.to_string(),
+                    }));
                     Ok(format!("mode {}", MachineState::mode_name_of(m)))
                 }
             }

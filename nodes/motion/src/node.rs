@@ -33,6 +33,8 @@ enum Input {
     Command(u8),
     /// Axis index, direction (+1, -1, 0 stops), feed mm/min, increment mm (0: continuous).
     Jog(usize, i8, f64, f64),
+    /// The mode the interpreter accepted.
+    Mode(u8),
 }
 
 enum Report {
@@ -144,6 +146,12 @@ fn dds_loop(
                 for number in std::mem::take(&mut raised) {
                     alarms.clear(number);
                 }
+            }
+            if c.command == ProgramCommand::MOTION_MODE {
+                if let Ok(m) = c.text.trim().parse::<u8>() {
+                    let _ = to_servo.send(Input::Mode(m));
+                }
+                continue;
             }
             if c.command == ProgramCommand::MOTION_JOG {
                 // The interpreter checked the mode; the values are checked again here.
@@ -374,6 +382,7 @@ fn servo_loop(
                         log::warn!("motion: {e}");
                     }
                 }
+                Input::Mode(m) => motion.set_mode(m),
                 Input::Command(_) => {}
             }
         }

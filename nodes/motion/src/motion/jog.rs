@@ -4,7 +4,22 @@
 //! that disappears (a lost connection, a crashed robot program) stops the axis within that
 //! time and its deceleration.
 
+use cnc_msgs::msg::MachineState;
+use cnc_msgs::signals::{g, GImage, SignalTable};
+
 use super::{Motion, RunState};
+
+/// The feed of the PLC's jog keys, mm/min (display units; D71).
+pub const KEY_JOG_FEED: f64 = 1000.0;
+
+/// The one key pressed among `plus` and `minus` (bits by axis index), if exactly one is.
+fn one_key(plus: u32, minus: u32) -> Option<(usize, bool)> {
+    match (plus.count_ones(), minus.count_ones()) {
+        (1, 0) => Some((plus.trailing_zeros() as usize, true)),
+        (0, 1) => Some((minus.trailing_zeros() as usize, false)),
+        _ => None,
+    }
+}
 
 /// How long one continuous jog request holds the axis moving: 100 ms at 4 ms, so that with
 /// the deceleration, the drive lag and a request's way through the cell the axis stands
@@ -157,5 +172,59 @@ impl Motion {
             return;
         }
         self.jog = Some(j);
+    }
+
+    /// The mode the interpreter accepted: the PLC's jog keys act in JOG and HANDWHEEL only,
+    /// and a key jog stops when the mode changes.
+    pub fn set_mode(&mut self, mode: u8) {
+        self.mode = mode;
+        if self.key_jog {
+            self.jog_stop();
+            self.key_jog = false;
+        }
+    }
+
+    /// The PLC's jog keys (G100 +J, G102 −J; D71). In JOG mode one key held jogs its axis at
+    /// [`KEY_JOG_FEED`] (with G19.7 RT at the rapid rate and its override), and its release
+    /// stops it; in HANDWHEEL mode each press moves one step of 0.001 mm times the multiplier
+    /// (G19.4 MP1, G19.5 MP2: ×1, ×10, ×100, ×1000). Two keys at once move nothing.
+    pub(super) fn key_jogs(&mut self, plc: &GImage) {
+        let (mut plus, mut minus) = (0u32, 0u32);
+        for (i, a) in self.cfg.axes.iter().enumerate() {
+            if let Some(k) = "XYZABC".find(a.name.as_str()) {
+                plus |= u32::from(plc.get(g::jog_plus(k))) << i;
+                minus |= u32::from(plc.get(g::jog_minus(k))) << i;
+            }
+        }
+        let (was_plus, was_minus) = self.jog_keys;
+        self.jog_keys = (plus, minus);
+        match self.mode {
+            MachineState::MODE_JOG => match one_key(plus, minus) {
+                Some((i, positive)) => {
+                    let a = &self.cfg.axes[i];
+                    let feed = if plc.get(g::RT) {
+                        a.max_velocity / a.scale() * self.panel.rapid_override
+                    } else {
+                        KEY_JOG_FEED
+                    };
+                    if feed > 0.0 && self.jog(i, positive, feed, None).is_ok() {
+                        self.key_jog = true;
+                    }
+                }
+                None if self.key_jog => {
+                    self.jog_stop();
+                    self.key_jog = false;
+                }
+                None => {}
+            },
+            MachineState::MODE_HANDWHEEL => {
+                if let Some((i, positive)) = one_key(plus & !was_plus, minus & !was_minus) {
+                    let times =
+                        10f64.powi(i32::from(plc.get(g::MP1)) + 2 * i32::from(plc.get(g::MP2)));
+                    let _ = self.jog(i, positive, KEY_JOG_FEED, Some(0.001 * times));
+                }
+            }
+            _ => {}
+        }
     }
 }

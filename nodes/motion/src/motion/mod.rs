@@ -10,6 +10,7 @@
 use std::collections::VecDeque;
 use std::f64::consts::TAU;
 
+use cnc_msgs::msg::MachineState;
 use cnc_msgs::signals::{f, g, FImage, GImage, SignalTable};
 
 use crate::block::{Aux, Block, Command};
@@ -162,6 +163,13 @@ pub struct Motion {
     jog: Option<jog::Jog>,
     /// Overtravel switches pressed, bits per axis: (+, −).
     overtravel: (u32, u32),
+    /// The mode the interpreter accepted (`MachineState::MODE_*`): the PLC's jog keys act in
+    /// JOG and HANDWHEEL only.
+    mode: u8,
+    /// The PLC's jog keys of the last tick (+J bits, −J bits by axis index).
+    jog_keys: (u32, u32),
+    /// The jog in progress was started by the PLC's keys (their release stops it).
+    key_jog: bool,
 }
 
 impl Motion {
@@ -186,6 +194,9 @@ impl Motion {
             reference_inputs: ReferenceInputs::default(),
             jog: None,
             overtravel: (0, 0),
+            mode: 0,
+            jog_keys: (0, 0),
+            key_jog: false,
             thread,
             encoder: Encoder::default(),
             panel: Panel::default(),
@@ -499,6 +510,7 @@ impl Motion {
             self.planner.reset(self.commanded_point());
         }
         let dt = self.cfg.period;
+        self.key_jogs(plc);
         if self.reference.is_some() && !self.alarm {
             self.reference_tick(dt);
             self.update_f();
@@ -703,6 +715,8 @@ impl Motion {
             matches!(self.active, Some((_, Active::Thread { .. }))),
         );
         fi.set(f::MCYC, true);
+        fi.set(f::MJ, self.mode == MachineState::MODE_JOG);
+        fi.set(f::MH, self.mode == MachineState::MODE_HANDWHEEL);
         fi.set(f::MSBK, self.panel.single_block);
         fi.set(f::DRUR, self.panel.dry_run);
         fi.set(f::MMLK, self.locked);
