@@ -551,8 +551,11 @@ fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
         last_request.duration_since(t0).as_secs_f64()
     );
     assert!(moved > 15.0 && moved < 25.0, "{moved}");
+    // The 200 ms bound is asserted on the simulated clock (the rig test above). Here, on the
+    // wall clock of a machine that may be busy, the figure is printed, and only a stop that
+    // does not come within half a second fails: a loaded CI measured 200 ms once.
     assert!(
-        stop_ms <= 200.0,
+        stop_ms <= 500.0,
         "stood {stop_ms:.0} ms after the last request"
     );
 
