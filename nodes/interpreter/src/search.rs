@@ -172,7 +172,8 @@ impl Collected {
         let r = approach.retract_axis.min(here.len().saturating_sub(1));
         if let Some(t) = self.loaded {
             // A mill changes tools with the tool axis at its change position.
-            if let Some(h) = approach.tool_change_at.filter(|h| here.get(r) != Some(h)) {
+            let elsewhere = |h: &f64| here.get(r).is_some_and(|x| x != h);
+            if let Some(h) = approach.tool_change_at.filter(elsewhere) {
                 here[r] = h;
                 push(Command::Rapid { end: here.clone() });
             }

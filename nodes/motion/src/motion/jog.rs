@@ -190,8 +190,8 @@ impl Motion {
     /// (G19.4 MP1, G19.5 MP2: ×1, ×10, ×100, ×1000). Two keys at once move nothing.
     pub(super) fn key_jogs(&mut self, plc: &GImage) {
         let (mut plus, mut minus) = (0u32, 0u32);
-        for (i, a) in self.cfg.axes.iter().enumerate() {
-            if let Some(k) = "XYZABC".find(a.name.as_str()) {
+        for (i, k) in self.signal_axis.iter().enumerate() {
+            if let Some(k) = *k {
                 plus |= u32::from(plc.get(g::jog_plus(k))) << i;
                 minus |= u32::from(plc.get(g::jog_minus(k))) << i;
             }

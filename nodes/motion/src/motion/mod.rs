@@ -170,6 +170,9 @@ pub struct Motion {
     jog_keys: (u32, u32),
     /// The jog in progress was started by the PLC's keys (their release stops it).
     key_jog: bool,
+    /// Per axis, its place in the PLC's per-axis signals (X, Y, Z, A, B, C: 0–5), found once
+    /// from its letter so that the tick does not search for it.
+    signal_axis: Vec<Option<usize>>,
 }
 
 impl Motion {
@@ -186,6 +189,11 @@ impl Motion {
         }
         let thread = ThreadChain::new(cfg.lookahead.max(1), cfg.planner().limits);
         let referenced = cfg.axes.iter().map(|a| a.reference.is_none()).collect();
+        let signal_axis = cfg
+            .axes
+            .iter()
+            .map(|a| "XYZABC".find(a.name.as_str()).filter(|_| a.name.len() == 1))
+            .collect();
         Motion {
             referenced,
             shift: vec![0.0; n],
@@ -197,6 +205,7 @@ impl Motion {
             mode: 0,
             jog_keys: (0, 0),
             key_jog: false,
+            signal_axis,
             thread,
             encoder: Encoder::default(),
             panel: Panel::default(),
@@ -692,8 +701,8 @@ impl Motion {
             ))
         );
         let hold = self.state() == RunState::Hold;
-        for (a, r) in self.cfg.axes.iter().zip(&self.referenced) {
-            if let Some(k) = "XYZABC".find(a.name.as_str()) {
+        for (k, r) in self.signal_axis.iter().zip(&self.referenced) {
+            if let Some(k) = *k {
                 self.f.set(f::zp(k), *r);
             }
         }
