@@ -52,13 +52,7 @@ struct Rig {
 
 impl Rig {
     fn new(cfg: &LaunchConfig) -> Rig {
-        let power_on: Vec<f64> = cfg
-            .machine
-            .axes
-            .iter()
-            .map(|a| a.power_on() * a.scale())
-            .collect();
-        let mut sim = SimLathe::new(sim_config(cfg), &power_on);
+        let mut sim = SimLathe::new(sim_config(cfg), &cfg.power_on_slide());
         let feedback = sim.step(&ServoSetpoint::default(), &YImage::default(), 0.0);
         let n = cfg.machine.axes.len();
         let motion = Motion::new(MotionConfig::from_launch(cfg), &feedback.position[..n]);

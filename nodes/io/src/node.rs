@@ -124,13 +124,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let outputs = shm.receiver::<YImage>(channel::Y_IMAGE, false)?;
     let x_out = shm.sender::<XImage>(channel::X_IMAGE, false)?;
     let period = cfg.servo.period_ms / 1000.0;
-    let power_on: Vec<f64> = cfg
-        .machine
-        .axes
-        .iter()
-        .map(|a| a.power_on() * a.scale())
-        .collect();
-    let mut sim = SimLathe::new(sim_config(&cfg), &power_on);
+    let mut sim = SimLathe::new(sim_config(&cfg), &cfg.power_on_slide());
     let mut y = YImage::default();
     // Report the power-on position before motion starts.
     let idle = ServoSetpoint::default();

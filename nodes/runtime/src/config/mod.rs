@@ -60,6 +60,15 @@ impl LaunchConfig {
             .collect()
     }
 
+    /// Where the simulated slides stand at power-on, slide travel ([`AxisEntry::power_on`]).
+    pub fn power_on_slide(&self) -> Vec<f64> {
+        self.machine
+            .axes
+            .iter()
+            .map(|a| a.power_on() * a.scale())
+            .collect()
+    }
+
     /// The axis address letters in machine order, e.g. `['X', 'Z']`.
     pub fn axis_letters(&self) -> Vec<char> {
         self.machine.axes.iter().map(AxisEntry::letter).collect()
