@@ -230,9 +230,7 @@ fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() 
     use cnc::cell::Cell;
     use cnc::client::CellClient;
     use cnc_msgs::msg::MachineState;
-    use cnc_msgs::srv::{SetMode, SetModeRequest};
     use cnc_runtime::config::ReferenceEntry;
-    use ros2_client::ServiceMapping;
     use std::time::{Duration, Instant};
 
     let mut cfg = common::sim_lathe(78);
@@ -248,15 +246,7 @@ fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() 
     }
     let home = cfg.home();
     let cell = Cell::start(&cfg).expect("cell starts");
-    let mut c = CellClient::new(
-        &cfg.network,
-        "lathe1",
-        "supervisor",
-        ServiceMapping::Enhanced,
-    )
-    .expect("client")
-    .with_timeout(Duration::from_secs(10));
-    c.wait_ready(Duration::from_secs(30)).expect("ready");
+    let mut c = common::ready_client(&cfg, "supervisor", Duration::from_secs(30));
     let part = "O0001\nG00 X150 Z50\nS600 M03\nG01 X140 Z40 F2000\nG00 X180 Z80\nM05\nM30\n";
     assert!(c.load_program("part.nc", part).expect("load").accepted);
     let wait_axes =
@@ -283,14 +273,7 @@ fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() 
     assert!(!r.accepted && r.message.contains("224"), "{}", r.message);
 
     // HOME mode, cycle start: the reference return.
-    let mode = |c: &mut CellClient, mode: u8| {
-        let r = c
-            .service::<SetMode>("set_mode")
-            .and_then(|s| s.call(SetModeRequest { mode }))
-            .expect("set_mode");
-        assert!(r.accepted, "{}", r.message);
-    };
-    mode(&mut c, MachineState::MODE_HOME);
+    common::set_mode(&mut c, MachineState::MODE_HOME);
     let t0 = Instant::now();
     let r = c.start_program("").expect("start");
     assert!(r.accepted, "{}", r.message);
@@ -313,7 +296,7 @@ fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() 
     }
 
     // AUTO: the part runs.
-    mode(&mut c, MachineState::MODE_AUTO);
+    common::set_mode(&mut c, MachineState::MODE_AUTO);
     let r = c.start_program("part.nc").expect("start");
     assert!(r.accepted, "{}", r.message);
     let t0 = Instant::now();
@@ -448,20 +431,12 @@ fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
     use cnc::cell::Cell;
     use cnc::client::CellClient;
     use cnc_msgs::msg::MachineState;
-    use cnc_msgs::srv::{Jog, JogRequest, SetMode, SetModeRequest};
-    use ros2_client::ServiceMapping;
+    use cnc_msgs::srv::{Jog, JogRequest};
     use std::time::{Duration, Instant};
 
     let cfg = common::sim_lathe(79);
     let cell = Cell::start(&cfg).expect("cell starts");
-    let mut watch = CellClient::new(
-        &cfg.network,
-        "lathe1",
-        "jog_watch",
-        ServiceMapping::Enhanced,
-    )
-    .expect("client");
-    watch.wait_ready(Duration::from_secs(30)).expect("ready");
+    let mut watch = common::ready_client(&cfg, "jog_watch", Duration::from_secs(30));
     let x = |c: &CellClient| {
         c.axes
             .as_ref()
@@ -473,10 +448,7 @@ fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
         feed,
         increment,
     };
-    let mut robot = CellClient::new(&cfg.network, "lathe1", "robot", ServiceMapping::Enhanced)
-        .expect("robot client")
-        .with_timeout(Duration::from_secs(5));
-    robot.wait_ready(Duration::from_secs(30)).expect("ready");
+    let mut robot = common::ready_client(&cfg, "robot", Duration::from_secs(30));
     let robot_jog = robot.service::<Jog>("jog").expect("jog client");
     let jog = |client: &cnc::client::ServiceClient<Jog>, direction, feed, increment| {
         client
@@ -486,15 +458,7 @@ fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
     // The service is discovered once; the first call may wait for it.
     let r = jog(&robot_jog, 1, 1200.0, 0.0);
     assert!(!r.accepted && r.message.contains("AUTO"), "{}", r.message);
-    let r = robot
-        .service::<SetMode>("set_mode")
-        .and_then(|s| {
-            s.call(SetModeRequest {
-                mode: MachineState::MODE_JOG,
-            })
-        })
-        .expect("set_mode");
-    assert!(r.accepted, "{}", r.message);
+    common::set_mode(&mut robot, MachineState::MODE_JOG);
 
     // Held for one second: a request every 50 ms.
     watch.poll();
@@ -628,26 +592,14 @@ fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way
     use cnc::cell::Cell;
     use cnc::client::CellClient;
     use cnc_msgs::msg::MachineState;
-    use cnc_msgs::srv::{Jog, JogRequest, SetMode, SetModeRequest};
-    use ros2_client::ServiceMapping;
+    use cnc_msgs::srv::{Jog, JogRequest};
     use std::time::{Duration, Instant};
 
     let mut cfg = common::sim_lathe(80);
     cfg.machine.axes[0].overtravel = Some([-5.0, 220.0]);
     let cell = Cell::start(&cfg).expect("cell starts");
-    let mut c = CellClient::new(&cfg.network, "lathe1", "robot", ServiceMapping::Enhanced)
-        .expect("client")
-        .with_timeout(Duration::from_secs(5));
-    c.wait_ready(Duration::from_secs(30)).expect("ready");
-    let r = c
-        .service::<SetMode>("set_mode")
-        .and_then(|s| {
-            s.call(SetModeRequest {
-                mode: MachineState::MODE_JOG,
-            })
-        })
-        .expect("set_mode");
-    assert!(r.accepted, "{}", r.message);
+    let mut c = common::ready_client(&cfg, "robot", Duration::from_secs(30));
+    common::set_mode(&mut c, MachineState::MODE_JOG);
     let jog = c.service::<Jog>("jog").expect("jog client");
     let ask = |direction: i8, increment: f64| {
         jog.call(JogRequest {

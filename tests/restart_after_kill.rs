@@ -12,15 +12,11 @@ mod common;
 
 use cnc::client::CellClient;
 use cnc_interpreter::position::ProgramPosition;
-use cnc_msgs::action::{RunProgramFeedback, RunProgramGoal, RunProgramResult};
+use cnc_msgs::action::RunProgramGoal;
 use cnc_msgs::msg::{MachineState, SpindleState};
-use cnc_runtime::dds::{qos, RosNode};
+use cnc_runtime::dds::RosNode;
 use cnc_runtime::LaunchConfig;
-use ros2_client::action::ActionClientQosPolicies;
 use ros2_client::action_msgs::GoalStatusEnum;
-use ros2_client::{ActionTypeName, Name, ServiceMapping};
-
-type Client = ros2_client::ActionClient<RunProgramGoal, RunProgramResult, RunProgramFeedback>;
 
 const DOMAIN: u16 = 77;
 /// Three roughing passes at F600 (about 8 s of cutting), spindle and coolant on.
@@ -31,38 +27,6 @@ G00 Z2\nX54\nG01 Z-20\nX58\nG00 Z2\nX50\nG01 Z-15\nX56\nG00 X100 Z50\nM09\nM05\n
 const KILL_LINE: u32 = 11;
 /// The line of `M05`: from it on, the spindle stops.
 const M05_LINE: u32 = 19;
-
-fn action_client(ros: &mut RosNode) -> Client {
-    let q = qos::services();
-    let policies = ActionClientQosPolicies {
-        goal_service: q.clone(),
-        result_service: q.clone(),
-        cancel_service: q.clone(),
-        feedback_subscription: qos::events(100),
-        status_subscription: qos::state(),
-    };
-    ros.node
-        .create_action_client(
-            ServiceMapping::Enhanced,
-            &Name::new("/lathe1", "run_program").expect("name"),
-            &ActionTypeName::new("cnc_msgs", "RunProgram"),
-            policies,
-        )
-        .expect("action client")
-}
-
-fn client(cfg: &LaunchConfig) -> CellClient {
-    let mut c = CellClient::new(
-        &cfg.network,
-        "lathe1",
-        "supervisor",
-        ServiceMapping::Enhanced,
-    )
-    .expect("client")
-    .with_timeout(Duration::from_secs(10));
-    c.wait_ready(Duration::from_secs(60)).expect("cell ready");
-    c
-}
 
 /// Polls until `done` says so, or panics with `what` after `timeout`.
 fn wait_for(
@@ -105,7 +69,7 @@ fn a_part_killed_mid_run_is_restarted_at_its_block_and_completes_at_the_same_pos
 
     // The uninterrupted part: where it ends.
     let mut cell = common::KillOnDrop(common::cnc_run(&config, &log));
-    let mut c = client(&cfg);
+    let mut c = common::ready_client(&cfg, "supervisor", Duration::from_secs(60));
     assert!(c.load_program("restart.nc", PART).expect("load").accepted);
     assert!(c.start_program("restart.nc").expect("start").accepted);
     wait_for(&mut c, Duration::from_secs(60), "the whole part", |c| {
@@ -155,10 +119,10 @@ fn a_part_killed_mid_run_is_restarted_at_its_block_and_completes_at_the_same_pos
 
     // The restart: the machine comes up where the simulator starts, not where the tool was.
     let mut cell = common::KillOnDrop(common::cnc_run(&config, &log));
-    let mut c = client(&cfg);
+    let mut c = common::ready_client(&cfg, "supervisor", Duration::from_secs(60));
     println!("after the restart the axes stand at {:?}", actual(&c));
     let mut supervisor = RosNode::new(&cfg.network, "cell", "restart_supervisor").expect("node");
-    let action = action_client(&mut supervisor);
+    let action = common::run_program_client(&mut supervisor);
     std::thread::sleep(Duration::from_secs(2)); // discovery of the action's services
     let (req, id) = action
         .send_goal(RunProgramGoal {

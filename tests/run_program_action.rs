@@ -12,37 +12,17 @@ use cnc::cell::Cell;
 use cnc::client::CellClient;
 use cnc_msgs::action::{RunProgramFeedback, RunProgramGoal, RunProgramResult};
 use cnc_msgs::msg::{MachineState, ProgramEvent};
-use cnc_runtime::dds::{qos, RosNode};
+use cnc_runtime::dds::RosNode;
 use cnc_runtime::topics;
-use ros2_client::action::ActionClientQosPolicies;
 use ros2_client::action_msgs::{CancelGoalResponseEnum, GoalStatusEnum};
-use ros2_client::{ActionTypeName, Name, ServiceMapping};
+use ros2_client::ServiceMapping;
 
-type Client = ros2_client::ActionClient<RunProgramGoal, RunProgramResult, RunProgramFeedback>;
+use common::RunProgramClient as Client;
 
 const SHORT: &str =
     "O0001\nG00 X60 Z5\nS600 M03\nG01 X40 Z0 F900\nZ-20\nG02 X50 Z-25 R5\nG01 X56 Z-30\nM05\nM30\n";
 /// One slow cut: a minute at F300.
 const LONG: &str = "O0002\nG00 X60 Z5\nS500 M03\nG01 X50 F300\nZ-300\nM05\nM30\n";
-
-fn action_client(ros: &mut RosNode) -> Client {
-    let q = qos::services();
-    let policies = ActionClientQosPolicies {
-        goal_service: q.clone(),
-        result_service: q.clone(),
-        cancel_service: q.clone(),
-        feedback_subscription: qos::events(100),
-        status_subscription: qos::state(),
-    };
-    ros.node
-        .create_action_client(
-            ServiceMapping::Enhanced,
-            &Name::new("/lathe1", "run_program").unwrap(),
-            &ActionTypeName::new("cnc_msgs", "RunProgram"),
-            policies,
-        )
-        .unwrap()
-}
 
 /// Sends a goal and waits for its acceptance.
 fn send(client: &Client, goal: RunProgramGoal) -> (ros2_client::action::GoalId, bool) {
@@ -117,7 +97,7 @@ fn run_program_reports_every_block_and_a_cancel_stops_the_machine_ready_for_the_
                 .history(ros2_client::qos::History::KeepLast { depth: 10_000 }),
         )
         .unwrap();
-    let client = action_client(&mut supervisor);
+    let client = common::run_program_client(&mut supervisor);
     std::thread::sleep(Duration::from_secs(2)); // discovery of the action's services
 
     // Refused goals change nothing, and each says why through GetResult (issue 26: the

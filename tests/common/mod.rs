@@ -157,3 +157,63 @@ impl Auditor {
         seen
     }
 }
+
+/// A client of the machine `lathe1` under the node name `name` (10 s per call), once the
+/// machine reports a state other than WAIT, within `wait`.
+#[allow(dead_code)]
+pub fn ready_client(
+    cfg: &LaunchConfig,
+    name: &str,
+    wait: std::time::Duration,
+) -> cnc::client::CellClient {
+    let mut c = cnc::client::CellClient::new(
+        &cfg.network,
+        "lathe1",
+        name,
+        ros2_client::ServiceMapping::Enhanced,
+    )
+    .expect("client")
+    .with_timeout(std::time::Duration::from_secs(10));
+    c.wait_ready(wait).expect("the machine ready");
+    c
+}
+
+/// Turns the mode switch through the `set_mode` service; a refusal fails the test.
+#[allow(dead_code)]
+pub fn set_mode(c: &mut cnc::client::CellClient, mode: u8) {
+    let r = c
+        .service::<cnc_msgs::srv::SetMode>("set_mode")
+        .and_then(|s| s.call(cnc_msgs::srv::SetModeRequest { mode }))
+        .expect("set_mode answered");
+    assert!(r.accepted, "mode {mode}: {}", r.message);
+}
+
+/// The `RunProgram` action's client, as a cell supervisor makes it.
+#[allow(dead_code)]
+pub type RunProgramClient = ros2_client::ActionClient<
+    cnc_msgs::action::RunProgramGoal,
+    cnc_msgs::action::RunProgramResult,
+    cnc_msgs::action::RunProgramFeedback,
+>;
+
+/// The `RunProgram` action client of `lathe1` on `ros`'s participant.
+#[allow(dead_code)]
+pub fn run_program_client(ros: &mut cnc_runtime::dds::RosNode) -> RunProgramClient {
+    use cnc_runtime::dds::qos;
+    let q = qos::services();
+    let policies = ros2_client::action::ActionClientQosPolicies {
+        goal_service: q.clone(),
+        result_service: q.clone(),
+        cancel_service: q.clone(),
+        feedback_subscription: qos::events(100),
+        status_subscription: qos::state(),
+    };
+    ros.node
+        .create_action_client(
+            ros2_client::ServiceMapping::Enhanced,
+            &ros2_client::Name::new("/lathe1", "run_program").expect("name"),
+            &ros2_client::ActionTypeName::new("cnc_msgs", "RunProgram"),
+            policies,
+        )
+        .expect("action client")
+}
