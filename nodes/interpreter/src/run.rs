@@ -361,13 +361,7 @@ impl RunCore {
         if let Some(r) = self.run.as_mut() {
             if !r.failed {
                 r.failed = true;
-                self.stop_command_id += 1;
-                self.effects.push(Effect::ToMotion(ProgramCommand {
-                    id: self.stop_command_id,
-                    command: ProgramCommand::CYCLE_STOP,
-                    program: String::new(),
-                    text: String::new(),
-                }));
+                self.send_motion(ProgramCommand::CYCLE_STOP, "");
             }
         }
         self.stop_execution();
@@ -528,13 +522,7 @@ impl RunCore {
         if self.running() {
             return Err("a program is running".into());
         }
-        self.stop_command_id += 1;
-        self.effects.push(Effect::ToMotion(ProgramCommand {
-            id: self.stop_command_id,
-            command: ProgramCommand::REFERENCE_RETURN,
-            program: String::new(),
-            text: String::new(),
-        }));
+        self.send_motion(ProgramCommand::REFERENCE_RETURN, "");
         Ok("reference return started".into())
     }
 
@@ -571,13 +559,7 @@ impl RunCore {
                 if *side > 0 { "+" } else { "−" }
             ));
         }
-        self.stop_command_id += 1;
-        self.effects.push(Effect::ToMotion(ProgramCommand {
-            id: self.stop_command_id,
-            command: ProgramCommand::MOTION_JOG,
-            program: String::new(),
-            text: j.to_text(),
-        }));
+        self.send_motion(ProgramCommand::MOTION_JOG, &j.to_text());
         Ok(format!("jog {}", j.to_text()))
     }
 
@@ -589,13 +571,7 @@ impl RunCore {
                 } else {
                     self.mode = m;
                     // Motion acts on the PLC's jog keys in JOG and HANDWHEEL modes (D71).
-                    self.stop_command_id += 1;
-                    self.effects.push(Effect::ToMotion(ProgramCommand {
-                        id: self.stop_command_id,
-                        command: ProgramCommand::MOTION_MODE,
-                        program: String::new(),
-                        text: m.to_string(),
-                    }));
+                    self.send_motion(ProgramCommand::MOTION_MODE, &m.to_string());
                     Ok(format!("mode {}", MachineState::mode_name_of(m)))
                 }
             }
@@ -814,6 +790,17 @@ impl RunCore {
         }
         self.keep_position();
         busy
+    }
+
+    /// Sends motion `command` with `text` (numbered in the interpreter's own series).
+    fn send_motion(&mut self, command: u8, text: &str) {
+        self.stop_command_id += 1;
+        self.effects.push(Effect::ToMotion(ProgramCommand {
+            id: self.stop_command_id,
+            command,
+            program: String::new(),
+            text: text.into(),
+        }));
     }
 
     /// Notes where the program is, if the state shows one worth keeping: with the block in

@@ -8,23 +8,13 @@
 use super::{alarm, Motion, MAX_AXES};
 
 /// What the encoders report in one servo period (the shell passes the drives' feedback).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ReferenceInputs {
     /// Bit per axis: deceleration dog pressed.
     pub dog: u32,
     /// Bit per axis: index mark passed, at `marker_position` (encoder count, mm).
     pub marker: u32,
     pub marker_position: [f64; MAX_AXES],
-}
-
-impl Default for ReferenceInputs {
-    fn default() -> Self {
-        ReferenceInputs {
-            dog: 0,
-            marker: 0,
-            marker_position: [0.0; MAX_AXES],
-        }
-    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
