@@ -14,7 +14,7 @@ use cnc_io::node::sim_config;
 use cnc_io::SimLathe;
 use cnc_motion::motion::ReferenceInputs;
 use cnc_motion::{Block, Command, Motion, MotionConfig, MotionEvent, RunState};
-use cnc_msgs::servo::{ServoSetpoint, MAX_AXES};
+use cnc_msgs::servo::ServoSetpoint;
 use cnc_msgs::signals::{f, GImage, SignalTable, YImage};
 use cnc_runtime::LaunchConfig;
 
@@ -218,7 +218,6 @@ fn a_missing_dog_ends_the_reference_return_on_the_overtravel_switch_or_within_th
         assert_eq!(rig.alarms, [alarm], "switches {switches:?}");
         assert_eq!(rig.motion.referenced(), &[false, false]);
     }
-    assert_eq!(MAX_AXES, 8);
 }
 
 /// The same through the whole cell on DDS (runs in scripts/test.sh's network namespace): a
