@@ -669,3 +669,87 @@ fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way
     let (_, failed) = cell.stop();
     assert!(failed.is_empty(), "nodes failed: {failed:?}");
 }
+
+/// Issue 28 end to end, the handwheel through the cell (D72): the external handwheel's
+/// switches and the wheel's detents come over `sim/input` (as a networked pendant would, each
+/// through the bridge's authority and audit), the io node's drives report the wheel's counter
+/// with every feedback, the standard ladder turns the switches into G18 HS1 and G19 MP1, and
+/// the motion node moves X 0.01 mm of diameter a detent at ×10, as `axes` shows.
+#[test]
+fn the_cell_moves_the_axis_the_handwheel_selects_by_its_detents() {
+    use cnc::cell::Cell;
+    use cnc::client::CellClient;
+    use cnc_msgs::msg::{MachineState, SimInput};
+    use cnc_runtime::dds::RosNode;
+    use cnc_runtime::topics;
+    use std::time::{Duration, Instant};
+
+    let cfg = common::sim_lathe(81);
+    let cell = Cell::start(&cfg).expect("cell starts");
+    let mut c = common::ready_client(&cfg, "robot", Duration::from_secs(30));
+    common::set_mode(&mut c, MachineState::MODE_HANDWHEEL);
+    let mut panel = RosNode::new(&cfg.network, "lathe1", "pendant").expect("pendant node");
+    let keys = panel
+        .dds_publisher::<SimInput>(&topics::SIM_INPUT)
+        .expect("sim/input publisher");
+    let x_actual = |c: &CellClient| c.axes.as_ref().map(|a| a.axes[0].actual_position);
+    // Stands: two samples 200 ms apart agree.
+    let settled = |c: &mut CellClient| {
+        let mut last = None;
+        loop {
+            std::thread::sleep(Duration::from_millis(200));
+            c.poll();
+            let now = x_actual(c);
+            if now.is_some() && now == last {
+                return now.unwrap_or(f64::NAN);
+            }
+            last = now;
+        }
+    };
+    let detent = |clockwise: bool| {
+        keys.publish(SimInput {
+            input: SimInput::HANDWHEEL_DETENT,
+            value: clockwise,
+        })
+        .expect("detent sent");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let switches = || {
+        for input in [SimInput::HANDWHEEL_SELECT_X, SimInput::HANDWHEEL_X10] {
+            keys.publish(SimInput { input, value: true })
+                .expect("switch sent");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let start = settled(&mut c);
+    // What is sent before the pendant's writer is matched is lost: set the switches and turn
+    // a detent until X moves.
+    let t0 = Instant::now();
+    while settled(&mut c) == start {
+        switches();
+        detent(true);
+        assert!(
+            t0.elapsed() < Duration::from_secs(20),
+            "X never moved; alarms {:?}, state {:?}",
+            c.alarms,
+            c.state
+        );
+    }
+    let from = settled(&mut c);
+    for _ in 0..20 {
+        detent(true);
+    }
+    for _ in 0..5 {
+        detent(false);
+    }
+    let to = settled(&mut c);
+    println!(
+        "handwheel through the cell: X from {from:.4} to {to:.4} for 20 detents + and 5 − at ×10"
+    );
+    assert!(((to - from) - 0.15).abs() < 1e-6, "{from} → {to}");
+    drop(keys);
+    drop(panel);
+    drop(c);
+    let (_, failed) = cell.stop();
+    assert!(failed.is_empty(), "nodes failed: {failed:?}");
+}

@@ -35,18 +35,18 @@ struct Rig {
     started: bool,
 }
 
-fn config() -> LaunchConfig {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/launch_configs/sim_lathe.yaml"
-    ))
-    .unwrap();
-    LaunchConfig::from_yaml(&text).unwrap()
+/// A launch config of `launch_configs/` (`sim_lathe`, `sim_mill`).
+fn config(name: &str) -> LaunchConfig {
+    let path = format!("{}/launch_configs/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+    LaunchConfig::from_yaml(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 impl Rig {
     fn new(program: &str, retained: Option<&Retained>) -> Rig {
-        let cfg = config();
+        Rig::on(config("sim_lathe"), program, retained)
+    }
+
+    fn on(cfg: LaunchConfig, program: &str, retained: Option<&Retained>) -> Rig {
         let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
         let dialect = Dialect::from_name(&cfg.machine.dialect).unwrap();
         let interp = Interpreter::with_library(dialect, program, setup, Library::new());
@@ -98,6 +98,7 @@ impl Rig {
         self.motion.plc_signals(&self.gi);
         self.motion
             .spindle_feedback(self.fb.spindle_rpm, self.fb.spindle_angle_deg);
+        self.motion.handwheel_input(self.fb.handwheel_count);
         let mut sp = ServoSetpoint {
             axis_count: self.n as u32,
             ..Default::default()
@@ -508,4 +509,176 @@ fn the_jog_keys_drive_the_axes_through_the_ladder_in_jog_and_handwheel_modes() {
     let steps = x(&r) - after;
     println!("three -X presses in HANDWHEEL mode: {steps:.4} mm");
     assert!((steps + 0.003).abs() < 1e-6, "{steps}");
+}
+
+/// Turns the simulated handwheel `detents` every servo period for `ticks` periods.
+fn turn(r: &mut Rig, detents: i32, ticks: usize) {
+    for _ in 0..ticks {
+        r.sim.turn_handwheel(detents);
+        r.tick();
+    }
+}
+
+/// Sets the external handwheel's switches (X2.1 X, X6.0 Z; X2.2 ×10, X2.3 ×100) and lets the
+/// ladder scan them.
+fn handwheel_switches(r: &mut Rig, axis: Option<cnc_msgs::signals::Bit>, times: u32) {
+    for b in [x::HANDWHEEL_SELECT_X, x::HANDWHEEL_SELECT_Z] {
+        r.sim.devices.inputs.set(b, Some(b) == axis);
+    }
+    r.sim.devices.inputs.set(x::HANDWHEEL_X10, times == 10);
+    r.sim.devices.inputs.set(x::HANDWHEEL_X100, times == 100);
+    r.run_until(SCAN * 3.0, |_| false);
+}
+
+/// Issue 28, the handwheel through the standard ladder (D72): the external handwheel's axis
+/// switch (X2.1 X, X6.0 Z) and multiplier switch (X2.2 ×10, X2.3 ×100) reach the NC as G18
+/// HS1 and G19 MP1/MP2 and are confirmed on F208/F209; in HANDWHEEL mode each detent of the
+/// wheel (four counts of the drives' bus counter) moves the selected axis 0.001 mm × the
+/// multiplier, either way; nothing moves in another mode or with no axis selected; and a wheel
+/// spun faster than the axis may follow (6,000 mm/min) moves it at that speed and no more than
+/// 0.1 s of it behind the wheel, so it stands soon after the wheel does.
+#[test]
+fn the_handwheel_moves_the_selected_axis_by_its_detents_times_the_multiplier() {
+    let mut r = powered("M30\n");
+    // Slide to display units: X is a diameter.
+    let shown = |r: &Rig| [r.sim.position()[0] / 0.5, r.sim.position()[1]];
+    let start = shown(&r);
+    // AUTO with X selected, then HANDWHEEL with no axis: the wheel moves nothing.
+    handwheel_switches(&mut r, Some(x::HANDWHEEL_SELECT_X), 1);
+    turn(&mut r, 1, 50);
+    // (The feedback of the last period of turning reaches the NC in the next.)
+    r.run_until(0.02, |_| false);
+    r.motion.set_mode(MachineState::MODE_HANDWHEEL);
+    handwheel_switches(&mut r, None, 1);
+    assert_eq!(r.nc().bytes[f::HANDWHEEL_AXIS], 0, "F208: no axis");
+    turn(&mut r, 1, 50);
+    r.run_until(0.2, |_| false);
+    assert_eq!(
+        shown(&r),
+        start,
+        "moved without an axis or outside HANDWHEEL mode"
+    );
+
+    // X ×1: 100 detents at 250 a second, 0.100 mm of diameter.
+    handwheel_switches(&mut r, Some(x::HANDWHEEL_SELECT_X), 1);
+    assert!(r.gi.get(g::HS1A) && !r.gi.get(g::HS1B), "G18: HS1 code 1");
+    assert_eq!(r.nc().bytes[f::HANDWHEEL_AXIS], 1, "F208 confirms X");
+    assert!(r.nc().get(f::HANDWHEEL_X1));
+    turn(&mut r, 1, 100);
+    r.run_until(0.3, |_| false);
+    let x1 = shown(&r)[0] - start[0];
+    // ×10 the other way: 30 detents, −0.300 mm.
+    handwheel_switches(&mut r, Some(x::HANDWHEEL_SELECT_X), 10);
+    assert!(r.gi.get(g::MP1) && r.nc().get(f::HANDWHEEL_X10));
+    turn(&mut r, -1, 30);
+    r.run_until(0.3, |_| false);
+    let x10 = shown(&r)[0] - start[0] - x1;
+    // Z ×100: a detent every 20 ms, ten of them, 1 mm.
+    handwheel_switches(&mut r, Some(x::HANDWHEEL_SELECT_Z), 100);
+    assert!(r.gi.get(g::HS1A) && r.gi.get(g::HS1B), "G18: HS1 code 3");
+    assert_eq!(r.nc().bytes[f::HANDWHEEL_AXIS], 3, "F208 confirms Z");
+    assert!(r.gi.get(g::MP2) && r.nc().get(f::HANDWHEEL_X100));
+    for _ in 0..10 {
+        turn(&mut r, 1, 1);
+        turn(&mut r, 0, 4);
+    }
+    r.run_until(0.3, |_| false);
+    let z100 = shown(&r)[1] - start[1];
+    println!("handwheel: X ×1 +100 detents {x1:.4} mm, X ×10 −30 detents {x10:.4} mm, Z ×100 +10 detents {z100:.4} mm");
+    assert!((x1 - 0.1).abs() < 1e-6, "{x1}");
+    assert!((x10 + 0.3).abs() < 1e-6, "{x10}");
+    assert!((z100 - 1.0).abs() < 1e-6, "{z100}");
+
+    // Spun far too fast: 50 detents a period for 80 ms at ×100 asks for 100 mm of −Z.
+    let z0 = r.sim.position()[1];
+    let mut fastest: f64 = 0.0;
+    let mut last = z0;
+    let mut speed = |r: &Rig| {
+        let z = r.sim.position()[1];
+        fastest = fastest.max((z - last).abs() / DT);
+        last = z;
+    };
+    for _ in 0..20 {
+        r.sim.turn_handwheel(-50);
+        r.tick();
+        speed(&r);
+    }
+    let mut still = 0;
+    let mut stood_after = None;
+    for k in 0..250 {
+        r.tick();
+        speed(&r);
+        still = if r.motion.handwheel_moving() {
+            0
+        } else {
+            still + 1
+        };
+        if still == 1 && stood_after.is_none() {
+            stood_after = Some((k + 1) as f64 * DT);
+        }
+    }
+    let moved = z0 - r.sim.position()[1];
+    let stood_after = stood_after.expect("the axis never stood");
+    println!(
+        "spun 100 mm in 80 ms: moved {moved:.2} mm, fastest {:.0} mm/min, stood {:.0} ms after the wheel",
+        fastest * 60.0,
+        stood_after * 1000.0
+    );
+    assert!((5.0..20.0).contains(&moved), "{moved}");
+    assert!(fastest * 60.0 <= 6000.0 * 1.01, "{fastest}");
+    assert!(stood_after <= 0.3, "{stood_after}");
+
+    // A counter that jumps (a broken cable, a glitch) is not a hand: nothing moves.
+    let before = shown(&r);
+    turn(&mut r, 1_000_000, 1);
+    r.run_until(0.2, |_| false);
+    assert_eq!(shown(&r), before, "a jump of the counter moved the axis");
+    // JOG mode: the wheel moves nothing.
+    r.motion.set_mode(MachineState::MODE_JOG);
+    turn(&mut r, 1, 50);
+    r.run_until(0.2, |_| false);
+    assert_eq!(shown(&r), before);
+}
+
+/// Issue 28, the mill's Z-axis lock (`003` part 2 §2.1.2; D73): the cell's Z-axis lock key
+/// (X9.0) toggles G108.2 through the standard ladder; a program runs with X and Y moving and
+/// Z's drive held where it stood, while Z's displayed position follows the program. Released
+/// at rest, Z's position is where the slide stands again.
+#[test]
+fn the_z_axis_lock_holds_z_while_the_program_moves_x_and_y() {
+    let mut r = Rig::on(
+        config("sim_mill"),
+        "O0001\nG90 G00 X10. Y10.\nZ-5.\nG01 Z-20. F600.\nX40. Y30.\nG00 Z50.\nM30\n",
+        None,
+    );
+    r.run_until(0.1, |_| false);
+    press(&mut r, x::KEY_Z_AXIS_LOCK);
+    assert!(r.gi.get(g::axis_lock(2)), "G108.2 from the key");
+    assert_eq!(r.motion.locked_axes(), 0b100, "Z alone is held");
+    assert!(!r.nc().get(f::MMLK), "not the whole machine's lock");
+    let z0 = r.sim.position()[2];
+    let start = r.motion.commanded_display();
+    r.started = true;
+    let mut z_moved = false;
+    let ok = r.run_until(30.0, |r| {
+        z_moved |= r.sim.position()[2] != z0;
+        r.program_done()
+    });
+    assert!(ok, "the program ran to its end; events {:?}", r.events);
+    r.run_until(0.2, |_| false);
+    assert!(!z_moved, "Z moved under the Z-axis lock");
+    let slides = r.sim.position();
+    assert!(
+        (slides[0] - 40.0).abs() < 1e-6 && (slides[1] - 30.0).abs() < 1e-6,
+        "X and Y moved: {slides:?}"
+    );
+    assert_eq!(
+        r.motion.commanded_display()[2],
+        50.0,
+        "Z's position followed"
+    );
+    // Released at rest: Z's position is the slide's again.
+    press(&mut r, x::KEY_Z_AXIS_LOCK);
+    assert_eq!(r.motion.locked_axes(), 0);
+    assert_eq!(r.motion.commanded_display()[2], start[2]);
 }

@@ -72,6 +72,7 @@ ros_message! {
         following_error: f64,
         homed: bool,
         overtravel: i8,
+        locked: bool,
     }
 }
 
@@ -316,7 +317,13 @@ ros_message! {
             MACHINE_LOCK_KEY: u8 = 13,
             AUX_LOCK_KEY: u8 = 14,
             DRY_RUN_KEY: u8 = 15,
-            BLOCK_SKIP_KEY: u8 = 16
+            BLOCK_SKIP_KEY: u8 = 16,
+            HANDWHEEL_SELECT_X: u8 = 17,
+            HANDWHEEL_SELECT_Z: u8 = 18,
+            HANDWHEEL_X10: u8 = 19,
+            HANDWHEEL_X100: u8 = 20,
+            Z_AXIS_LOCK_KEY: u8 = 21,
+            HANDWHEEL_DETENT: u8 = 22
         }
         input: u8,
         value: bool,

@@ -60,6 +60,9 @@ pub struct ServoFeedback {
     /// as bus servo drives report them).
     pub overtravel_plus: u32,
     pub overtravel_minus: u32,
+    /// The handwheel's (manual pulse generator's) counter: its A/B pulses counted four per
+    /// detent (the encoder interface's 4× quadrature, `000` §1.3), wrapping.
+    pub handwheel_count: i32,
 }
 
 impl Default for ServoFeedback {
@@ -77,6 +80,7 @@ impl Default for ServoFeedback {
             marker_position: [0.0; MAX_AXES],
             overtravel_plus: 0,
             overtravel_minus: 0,
+            handwheel_count: 0,
         }
     }
 }

@@ -187,6 +187,12 @@ pub mod f {
     pub const MAFL: Bit = bit(4, 4);
     /// Block skip in effect (F4.0).
     pub const MBDT: Bit = bit(4, 0);
+    /// The handwheel's axis as the NC took it (F208: the HS1 code, 1 X … 6 C, 0 none; D72).
+    pub const HANDWHEEL_AXIS: usize = 208;
+    /// The handwheel's multiplier in effect: ×1, ×10, ×100 (F209.1, F209.2, F209.3).
+    pub const HANDWHEEL_X1: Bit = bit(209, 1);
+    pub const HANDWHEEL_X10: Bit = bit(209, 2);
+    pub const HANDWHEEL_X100: Bit = bit(209, 3);
     /// Reference return in progress (`000` App.2 F4.5).
     pub const MREF: Bit = bit(4, 5);
     /// Reference return complete of axis `k` (0–5: X, Y, Z, A, B, C; F94.0–F94.5): the
@@ -222,9 +228,25 @@ pub mod g {
     }
     /// Manual rapid traverse (G19.7 RT).
     pub const RT: Bit = bit(19, 7);
-    /// Step multiplier MP1/MP2 (G19.4, G19.5): ×1, ×10, ×100, ×1000 of 0.001 mm.
-    pub const MP1: Bit = bit(19, 4);
-    pub const MP2: Bit = bit(19, 5);
+    /// Step and handwheel multiplier MP1/MP2 (G19.0, G19.1): ×1, ×10 (MP1), ×100 (MP2),
+    /// ×1000 (both; a handwheel takes it as ×100) of 0.001 mm (decisions D72).
+    pub const MP1: Bit = bit(19, 0);
+    pub const MP2: Bit = bit(19, 1);
+    /// The external handwheel's multiplier EXMP1/EXMP2 (G19.4, G19.5): named by the manual
+    /// without a meaning of their own; the NC reads MP1/MP2, the ladder chooses what drives
+    /// them (the manual's GB02.2 choice between panel and external selectors; D72).
+    pub const EXMP1: Bit = bit(19, 4);
+    pub const EXMP2: Bit = bit(19, 5);
+    /// Handwheel 1 axis select HS1A–HS1C (G18.0–G18.2): a binary code, 1 X, 2 Y, 3 Z, 4 A,
+    /// 5 B, 6 C; 0 no axis.
+    pub const HS1A: Bit = bit(18, 0);
+    pub const HS1B: Bit = bit(18, 1);
+    pub const HS1C: Bit = bit(18, 2);
+    /// Machine lock of axis `k` alone (0–5: X, Y, Z, A, B, C; G108, FANUC's each-axis lock;
+    /// the mill's Z-axis lock is G108.2; decisions D73).
+    pub const fn axis_lock(k: usize) -> Bit {
+        bit(108, k as u8)
+    }
     /// Completion of the M/S/T function.
     pub const FIN: Bit = bit(4, 3);
     /// Auxiliary function lock: M, S and T are not output, M00/M01/M02/M30 still are
@@ -290,6 +312,15 @@ pub mod x {
     pub const COOLANT_PRESSURE: Bit = bit(4, 6);
     /// Lubrication pressure / level good.
     pub const LUBE_OK: Bit = bit(4, 7);
+    /// The external handwheel's switches on XJ3 (`000` §19.4.2.4): axis select X (X2.1),
+    /// Y (X2.0), Z (X6.0), and multiplier ×10 (X2.2), ×100 (X2.3); neither is ×1.
+    pub const HANDWHEEL_SELECT_X: Bit = bit(2, 1);
+    pub const HANDWHEEL_SELECT_Y: Bit = bit(2, 0);
+    pub const HANDWHEEL_SELECT_Z: Bit = bit(6, 0);
+    pub const HANDWHEEL_X10: Bit = bit(2, 2);
+    pub const HANDWHEEL_X100: Bit = bit(2, 3);
+    /// The mill panel's Z-axis lock key (the cell's; `003` part 2 §2.1.2; decisions D73).
+    pub const KEY_Z_AXIS_LOCK: Bit = bit(9, 0);
     /// Robot: clear of the work area.
     pub const ROBOT_CLEAR: Bit = bit(8, 0);
     pub const ROBOT_CHUCK_OPEN: Bit = bit(8, 1);

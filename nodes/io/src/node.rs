@@ -67,6 +67,11 @@ fn input_bit(input: u8) -> Option<Bit> {
         SimInput::AUX_LOCK_KEY => x::KEY_AUX_LOCK,
         SimInput::DRY_RUN_KEY => x::KEY_DRY_RUN,
         SimInput::BLOCK_SKIP_KEY => x::KEY_BLOCK_SKIP,
+        SimInput::HANDWHEEL_SELECT_X => x::HANDWHEEL_SELECT_X,
+        SimInput::HANDWHEEL_SELECT_Z => x::HANDWHEEL_SELECT_Z,
+        SimInput::HANDWHEEL_X10 => x::HANDWHEEL_X10,
+        SimInput::HANDWHEEL_X100 => x::HANDWHEEL_X100,
+        SimInput::Z_AXIS_LOCK_KEY => x::KEY_Z_AXIS_LOCK,
         _ => return None,
     })
 }
@@ -79,6 +84,7 @@ pub fn apply_input(sim: &mut SimLathe, input: &SimInput) -> bool {
         SimInput::TURRET_STUCK => d.turret_stuck = input.value,
         SimInput::AIR_LOST => d.air_lost = input.value,
         SimInput::DOOR_FORCED_OPEN => d.door_forced_open = input.value,
+        SimInput::HANDWHEEL_DETENT => sim.turn_handwheel(if input.value { 1 } else { -1 }),
         other => match input_bit(other) {
             Some(bit) => d.inputs.set(bit, input.value),
             None => return false,

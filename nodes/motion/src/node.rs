@@ -42,13 +42,13 @@ enum Report {
     /// A tick later than the warning limit (its interval, µs), or the warning cleared.
     Late(Option<f64>),
     /// Commanded and actual slide positions.
-    /// Commanded, actual and drive setpoint positions (machine coordinates), whether machine
-    /// lock holds them, a bit per referenced axis, and the overtravel switches (+, −).
+    /// Commanded, actual and drive setpoint positions (machine coordinates), a bit per axis
+    /// a lock holds, a bit per referenced axis, and the overtravel switches (+, −).
     Axes(
         [f64; MAX_AXES],
         [f64; MAX_AXES],
         [f64; MAX_AXES],
-        bool,
+        u32,
         u32,
         (u32, u32),
     ),
@@ -182,7 +182,8 @@ fn dds_loop(
                     0,
                 )),
                 Ok(Report::Late(None)) => alarms.clear(alarm::SERVO_LATE),
-                Ok(Report::Axes(commanded, actual, setpoint, machine_lock, referenced, limits)) => {
+                Ok(Report::Axes(commanded, actual, setpoint, locked, referenced, limits)) => {
+                    let n = axes.len();
                     let axes = axes
                         .iter()
                         .enumerate()
@@ -196,6 +197,7 @@ fn dds_loop(
                                 homed: referenced & (1 << i) != 0,
                                 overtravel: i8::from(limits.0 & (1 << i) != 0)
                                     - i8::from(limits.1 & (1 << i) != 0),
+                                locked: locked & (1 << i) != 0,
                             }
                         })
                         .collect();
@@ -204,7 +206,7 @@ fn dds_loop(
                         AxisState {
                             stamp: stamp(),
                             axes,
-                            machine_lock,
+                            machine_lock: n > 0 && locked == (1u32 << n) - 1,
                         },
                     );
                 }
@@ -296,6 +298,8 @@ fn servo_loop(
     let mut reference = ReferenceInputs::default();
     // The drives' overtravel switches of the latest feedback (+, −).
     let mut overtravel = (first.overtravel_plus, first.overtravel_minus);
+    // The handwheel's counter of the latest feedback.
+    let mut handwheel = first.handwheel_count;
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
     let mut g = GImage::default();
@@ -408,6 +412,7 @@ fn servo_loop(
         motion.reference_inputs(reference);
         reference.marker = 0;
         motion.overtravel_inputs(overtravel.0, overtravel.1);
+        motion.handwheel_input(handwheel);
         // What the drives get; under machine lock it is not the commanded position.
         let mut setpoint = [0.0; MAX_AXES];
         setpoint[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
@@ -434,6 +439,7 @@ fn servo_loop(
             spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
             reference.dog = fb.reference_dog;
             overtravel = (fb.overtravel_plus, fb.overtravel_minus);
+            handwheel = fb.handwheel_count;
             if fb.marker != 0 {
                 reference.marker |= fb.marker;
                 for i in 0..n {
@@ -493,7 +499,7 @@ fn servo_loop(
             machine[..n].copy_from_slice(motion.actual());
             let mut drive = [0.0; MAX_AXES];
             drive[..n].copy_from_slice(motion.setpoint());
-            let locked = motion.machine_locked();
+            let locked = motion.locked_axes();
             let referenced = motion
                 .referenced()
                 .iter()

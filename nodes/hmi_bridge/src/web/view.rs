@@ -338,6 +338,7 @@ mod tests {
             following_error: 0.0,
             homed: true,
             overtravel: 0,
+            locked: false,
         };
         AxisState {
             axes: vec![axis("X", x), axis("Z", z)],

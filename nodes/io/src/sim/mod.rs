@@ -92,6 +92,8 @@ pub struct SimLathe {
     x_seq: u64,
     /// Overtravel switches pressed at the last step (bits per axis), for the PLC's inputs.
     overtravel: (u32, u32),
+    /// The handwheel's counter, four counts a detent (the encoder interface's 4× quadrature).
+    handwheel_count: i32,
 }
 
 impl SimLathe {
@@ -118,7 +120,14 @@ impl SimLathe {
             emergency_stop: false,
             x_seq: 0,
             overtravel: (0, 0),
+            handwheel_count: 0,
         }
+    }
+
+    /// Turns the handwheel by `detents` (clockwise positive): its counter, as the next
+    /// feedback reports it, moves four counts a detent.
+    pub fn turn_handwheel(&mut self, detents: i32) {
+        self.handwheel_count = self.handwheel_count.wrapping_add(detents.wrapping_mul(4));
     }
 
     pub fn set_emergency_stop(&mut self, pressed: bool) {
@@ -184,6 +193,7 @@ impl SimLathe {
             axis_count: n as u32,
             spindle_rpm: self.spindle_rpm,
             spindle_angle_deg: self.spindle_angle,
+            handwheel_count: self.handwheel_count,
             ..ServoFeedback::default()
         };
         for (i, was) in before.iter().enumerate().take(n) {

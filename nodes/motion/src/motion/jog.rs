@@ -79,6 +79,9 @@ impl Motion {
             }
             return Err("jog refused: an axis is moving".into());
         }
+        if self.handwheel.moving() {
+            return Err("jog refused: the handwheel is moving an axis".into());
+        }
         if self.active.is_some() || !self.queue.is_empty() || self.reference.is_some() {
             return Err("jog refused: a program or a reference return is moving the axes".into());
         }
@@ -187,7 +190,7 @@ impl Motion {
     /// The PLC's jog keys (G100 +J, G102 −J; D71). In JOG mode one key held jogs its axis at
     /// [`KEY_JOG_FEED`] (with G19.7 RT at the rapid rate and its override), and its release
     /// stops it; in HANDWHEEL mode each press moves one step of 0.001 mm times the multiplier
-    /// (G19.4 MP1, G19.5 MP2: ×1, ×10, ×100, ×1000). Two keys at once move nothing.
+    /// (G19.0 MP1, G19.1 MP2: ×1, ×10, ×100, ×1000). Two keys at once move nothing.
     pub(super) fn key_jogs(&mut self, plc: &GImage) {
         let (mut plus, mut minus) = (0u32, 0u32);
         for (i, k) in self.signal_axis.iter().enumerate() {

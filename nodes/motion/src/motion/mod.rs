@@ -25,6 +25,7 @@ pub use crate::alarm;
 pub use panel::Panel;
 
 mod activate;
+pub mod handwheel;
 pub mod jog;
 mod overtravel;
 mod panel;
@@ -106,8 +107,9 @@ pub struct Motion {
     /// The setpoint the drives get: the commanded position, or under machine lock where the
     /// slides stood when the lock was taken.
     drive: Vec<f64>,
-    /// Machine lock in effect (the switch is taken at rest only).
-    locked: bool,
+    /// The axes machine lock holds, a bit per axis: all of them under machine lock, some
+    /// under an axis lock (the mill's Z-axis lock); the switches are taken at rest only.
+    locked: u32,
     /// Last actual slide position per axis.
     actual: Vec<f64>,
     feed_hold: bool,
@@ -161,6 +163,7 @@ pub struct Motion {
     reference: Option<reference::ReferenceReturn>,
     reference_inputs: ReferenceInputs,
     jog: Option<jog::Jog>,
+    handwheel: handwheel::Handwheel,
     /// Overtravel switches pressed, bits per axis: (+, −).
     overtravel: (u32, u32),
     /// The mode the interpreter accepted (`MachineState::MODE_*`): the PLC's jog keys act in
@@ -201,6 +204,7 @@ impl Motion {
             reference: None,
             reference_inputs: ReferenceInputs::default(),
             jog: None,
+            handwheel: handwheel::Handwheel::default(),
             overtravel: (0, 0),
             mode: 0,
             jog_keys: (0, 0),
@@ -223,7 +227,7 @@ impl Motion {
             active: None,
             actual: commanded.clone(),
             drive: commanded.clone(),
-            locked: false,
+            locked: 0,
             commanded,
             feed_hold: false,
             cycle_stop: false,
@@ -369,6 +373,7 @@ impl Motion {
         self.clear_strobe();
         self.reference = None;
         self.jog = None;
+        self.handwheel.stop();
         self.commanded.clone_from(&self.actual);
         let here = self.commanded_point();
         self.planner.reset(here);
@@ -396,9 +401,16 @@ impl Motion {
     pub fn setpoint(&self) -> &[f64] {
         &self.drive
     }
-    /// Whether machine lock holds the drives.
+    /// Whether machine lock holds every axis's drive.
     pub fn machine_locked(&self) -> bool {
+        self.locked == self.all_axes()
+    }
+    /// The axes whose drives a lock holds, a bit per axis.
+    pub fn locked_axes(&self) -> u32 {
         self.locked
+    }
+    fn all_axes(&self) -> u32 {
+        (1u32 << self.cfg.axes.len()) - 1
     }
     pub fn f_image(&self) -> &FImage {
         &self.f
@@ -418,6 +430,7 @@ impl Motion {
             || !self.queue.is_empty()
             || self.reference.is_some()
             || self.jog.is_some()
+            || self.handwheel.moving()
         {
             RunState::Running
         } else {
@@ -471,6 +484,9 @@ impl Motion {
     /// [`Motion::tick`] in machine coordinates: `actual` is what the encoders count, the
     /// drive setpoint is left in `self.drive`.
     fn tick_machine(&mut self, actual: Option<&[f64]>, plc: &GImage) {
+        // Detents turned while the machine cannot take them (servo off, emergency stop) are
+        // dropped with this period.
+        let detents = self.take_detents();
         if let Some(a) = actual {
             for ((dst, src), s) in self.actual.iter_mut().zip(a).zip(&self.shift) {
                 *dst = *src + *s;
@@ -493,6 +509,7 @@ impl Motion {
             // Setpoints stay where they were; the drives are disabled (see `servo_enabled`).
             self.reference = None;
             self.jog = None;
+            self.handwheel.stop();
             self.update_f();
             self.drive_setpoint();
             return;
@@ -508,6 +525,7 @@ impl Motion {
                 self.block_stop = false;
                 self.reference = None;
                 self.jog = None;
+                self.handwheel.stop();
             }
             self.commanded.clone_from(&self.actual);
             self.update_f();
@@ -520,6 +538,7 @@ impl Motion {
         }
         let dt = self.cfg.period;
         self.key_jogs(plc);
+        self.handwheel_detents(plc, detents);
         if self.reference.is_some() && !self.alarm {
             self.reference_tick(dt);
             self.update_f();
@@ -528,6 +547,12 @@ impl Motion {
         }
         if self.jog.is_some() && !self.alarm {
             self.jog_tick(dt);
+            self.update_f();
+            self.drive_setpoint();
+            return;
+        }
+        if self.handwheel.moving() && !self.alarm {
+            self.handwheel_tick(dt);
             self.update_f();
             self.drive_setpoint();
             return;
@@ -678,6 +703,7 @@ impl Motion {
         self.active = None;
         self.reference = None;
         self.jog = None;
+        self.handwheel.stop();
         let here = self.commanded_point();
         self.planner.reset(here);
         self.clear_strobe();
@@ -707,6 +733,7 @@ impl Motion {
             }
         }
         self.f.set(f::MREF, self.reference.is_some());
+        let all_locked = self.machine_locked();
         let fi = &mut self.f;
         fi.set(f::OP, running);
         fi.set(f::STL, running && !hold);
@@ -728,7 +755,7 @@ impl Motion {
         fi.set(f::MH, self.mode == MachineState::MODE_HANDWHEEL);
         fi.set(f::MSBK, self.panel.single_block);
         fi.set(f::DRUR, self.panel.dry_run);
-        fi.set(f::MMLK, self.locked);
+        fi.set(f::MMLK, all_locked);
         fi.set(f::MAFL, self.panel.aux_lock);
         fi.set(f::MBDT, self.panel.block_skip);
         fi.set(f::RST, self.reset_ticks > 0);

@@ -19,6 +19,9 @@ pub struct Panel {
     /// Machine lock: the program runs and its positions count, the drives are held where the
     /// slides stand. Taken and released with the machine at rest (decisions D66).
     pub machine_lock: bool,
+    /// Each-axis machine lock (G108), a bit per axis index: the mill's Z-axis lock holds Z
+    /// alone (decisions D73).
+    pub axis_lock: u32,
     /// Auxiliary function lock: M, S and T complete without reaching the PLC, except M00,
     /// M01, M02 and M30.
     pub aux_lock: bool,
@@ -36,6 +39,7 @@ impl Default for Panel {
             dry_run: false,
             optional_stop: false,
             machine_lock: false,
+            axis_lock: 0,
             aux_lock: false,
             block_skip: false,
         }
@@ -69,6 +73,9 @@ impl Motion {
             dry_run: plc.get(g::DRN),
             optional_stop: plc.get(g::MOPS),
             machine_lock: plc.get(g::MLK),
+            axis_lock: self.signal_axis.iter().enumerate().fold(0, |bits, (i, k)| {
+                bits | u32::from(k.is_some_and(|k| plc.get(g::axis_lock(k)))) << i
+            }),
             aux_lock: plc.get(g::AFL),
             block_skip: plc.get(g::BDT1),
         });
@@ -87,21 +94,34 @@ impl Motion {
     /// (the interpreter takes its next start from there).
     pub(super) fn take_machine_lock(&mut self) {
         let at_rest = self.active.is_none() && self.queue.is_empty();
-        if !at_rest || self.panel.machine_lock == self.locked {
+        let all = if self.panel.machine_lock {
+            self.all_axes()
+        } else {
+            0
+        };
+        let wanted = (all | self.panel.axis_lock) & self.all_axes();
+        if !at_rest || wanted == self.locked {
             return;
         }
-        self.locked = self.panel.machine_lock;
-        if !self.locked {
-            self.commanded.clone_from(&self.drive);
+        let released = self.locked & !wanted;
+        self.locked = wanted;
+        if released != 0 {
+            for i in 0..self.commanded.len() {
+                if released & (1 << i) != 0 {
+                    self.commanded[i] = self.drive[i];
+                }
+            }
             let here = self.commanded_point();
             self.planner.reset(here);
         }
     }
 
-    /// What the drives get this tick: the commanded position, unless machine lock holds them.
+    /// What the drives get this tick: the commanded position, except on axes a lock holds.
     pub(super) fn drive_setpoint(&mut self) -> &[f64] {
-        if !self.locked {
-            self.drive.clone_from(&self.commanded);
+        for (i, (d, c)) in self.drive.iter_mut().zip(&self.commanded).enumerate() {
+            if self.locked & (1 << i) == 0 {
+                *d = *c;
+            }
         }
         &self.drive
     }
@@ -110,15 +130,13 @@ impl Motion {
     /// not the program's.
     pub(super) fn in_position(&self) -> bool {
         // Under machine lock the slides stand at the held setpoint, not at the program's.
-        let target = if self.locked {
-            &self.drive
-        } else {
-            &self.commanded
-        };
-        self.cfg
-            .axes
-            .iter()
-            .enumerate()
-            .all(|(i, a)| (self.actual[i] - target[i]).abs() <= a.in_position)
+        self.cfg.axes.iter().enumerate().all(|(i, a)| {
+            let target = if self.locked & (1 << i) != 0 {
+                self.drive[i]
+            } else {
+                self.commanded[i]
+            };
+            (self.actual[i] - target).abs() <= a.in_position
+        })
     }
 }
