@@ -682,3 +682,52 @@ fn the_z_axis_lock_holds_z_while_the_program_moves_x_and_y() {
     assert_eq!(r.motion.locked_axes(), 0);
     assert_eq!(r.motion.commanded_display()[2], start[2]);
 }
+
+/// Issue 28, the handwheel trial run (`000` §13.3; D74): the trial key (X9.1) toggles G19.6
+/// through the standard ladder; in AUTO the program then stands while the wheel stands, moves
+/// as fast as the wheel turns clockwise (a detent 0.001 mm × the multiplier of path), never
+/// faster than its F, and stops when the wheel stops. Off again, the program runs on at F.
+#[test]
+fn in_the_handwheel_trial_run_the_program_moves_as_fast_as_the_wheel_turns() {
+    let mut r = Rig::new("O0001\nG98 G01 Z40 F600\nM30\n", None);
+    r.run_until(0.1, |_| false);
+    press(&mut r, x::KEY_HANDWHEEL_TRIAL);
+    assert!(r.gi.get(g::HANDWHEEL_TRIAL), "G19.6 from the key");
+    assert!(r.motion.handwheel_trial(), "in effect in AUTO");
+    let z = |r: &Rig| r.motion.commanded_display()[1];
+    let z0 = z(&r);
+    r.started = true;
+    r.run_until(1.0, |_| false);
+    assert_eq!(z(&r), z0, "moved with the wheel standing");
+    // ×1, 250 detents a second: 0.25 mm/s.
+    handwheel_switches(&mut r, None, 1);
+    turn(&mut r, 1, 250);
+    let a = z(&r);
+    turn(&mut r, 1, 250);
+    let slow = a - z(&r);
+    // ×100, 250 detents a second asks for 25 mm/s; F600 is 10 mm/s.
+    handwheel_switches(&mut r, None, 100);
+    turn(&mut r, 1, 250);
+    let b = z(&r);
+    turn(&mut r, 1, 250);
+    let capped = b - z(&r);
+    // The wheel stops: so does the program.
+    r.run_until(0.3, |_| false);
+    let stopped = z(&r);
+    r.run_until(0.5, |_| false);
+    println!(
+        "trial run: ×1 at 250 detents/s {slow:.3} mm/s; ×100 {capped:.2} mm/s (F600 is 10); \
+         stood at Z {stopped:.3}"
+    );
+    assert!((slow - 0.25).abs() < 0.01, "{slow}");
+    assert!((capped - 10.0).abs() < 0.05, "{capped}");
+    assert_eq!(z(&r), stopped, "went on after the wheel stopped");
+    // Backwards turns do not run the program.
+    turn(&mut r, -1, 250);
+    assert_eq!(z(&r), stopped, "ran on a counter-clockwise turn");
+    // The key again: the program runs on at F to its end.
+    press(&mut r, x::KEY_HANDWHEEL_TRIAL);
+    assert!(!r.motion.handwheel_trial());
+    assert!(r.run_until(10.0, |r| r.program_done()), "{:?}", r.events);
+    assert!((z(&r) - 40.0).abs() < 1e-9);
+}

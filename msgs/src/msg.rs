@@ -323,7 +323,8 @@ ros_message! {
             HANDWHEEL_X10: u8 = 19,
             HANDWHEEL_X100: u8 = 20,
             Z_AXIS_LOCK_KEY: u8 = 21,
-            HANDWHEEL_DETENT: u8 = 22
+            HANDWHEEL_DETENT: u8 = 22,
+            HANDWHEEL_TRIAL_KEY: u8 = 23
         }
         input: u8,
         value: bool,

@@ -237,6 +237,9 @@ pub mod g {
     /// them (the manual's GB02.2 choice between panel and external selectors; D72).
     pub const EXMP1: Bit = bit(19, 4);
     pub const EXMP2: Bit = bit(19, 5);
+    /// Handwheel trial run (G19.6, a free bit of the handwheel's byte: the manual gives the
+    /// key no signal): in AUTO the program runs as fast as the handwheel turns (D74).
+    pub const HANDWHEEL_TRIAL: Bit = bit(19, 6);
     /// Handwheel 1 axis select HS1A–HS1C (G18.0–G18.2): a binary code, 1 X, 2 Y, 3 Z, 4 A,
     /// 5 B, 6 C; 0 no axis.
     pub const HS1A: Bit = bit(18, 0);
@@ -319,6 +322,8 @@ pub mod x {
     pub const HANDWHEEL_SELECT_Z: Bit = bit(6, 0);
     pub const HANDWHEEL_X10: Bit = bit(2, 2);
     pub const HANDWHEEL_X100: Bit = bit(2, 3);
+    /// The handwheel-trial key (the cell's; `000` §13.3 "手轮试切/手轮倍率"; D74).
+    pub const KEY_HANDWHEEL_TRIAL: Bit = bit(9, 1);
     /// The mill panel's Z-axis lock key (the cell's; `003` part 2 §2.1.2; decisions D73).
     pub const KEY_Z_AXIS_LOCK: Bit = bit(9, 0);
     /// Robot: clear of the work area.

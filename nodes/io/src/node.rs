@@ -72,6 +72,7 @@ fn input_bit(input: u8) -> Option<Bit> {
         SimInput::HANDWHEEL_X10 => x::HANDWHEEL_X10,
         SimInput::HANDWHEEL_X100 => x::HANDWHEEL_X100,
         SimInput::Z_AXIS_LOCK_KEY => x::KEY_Z_AXIS_LOCK,
+        SimInput::HANDWHEEL_TRIAL_KEY => x::KEY_HANDWHEEL_TRIAL,
         _ => return None,
     })
 }

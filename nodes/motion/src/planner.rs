@@ -384,10 +384,13 @@ impl Planner {
 
     /// One servo tick: moves along the path and writes the new position into `out`. Finished
     /// blocks go to `done`. Returns true when the window is empty and the tool at rest.
+    /// `feed_scale` is the feed override; `speed_cap` a path speed no block exceeds (the
+    /// handwheel trial run's; infinite otherwise).
     pub fn step(
         &mut self,
         hold: bool,
         feed_scale: f64,
+        speed_cap: f64,
         done: &mut Vec<Done>,
         out: &mut Point,
     ) -> bool {
@@ -417,7 +420,7 @@ impl Planner {
         let mut k = 1;
         while k < self.segs.len() && dist <= horizon {
             let p = &self.segs[k];
-            let entry = p.entry.min(p.feed * feed_scale);
+            let entry = p.entry.min(p.feed * feed_scale).min(speed_cap);
             if entry < lowest {
                 lowest = entry;
                 self.ahead.push(Ahead {
@@ -438,7 +441,7 @@ impl Planner {
             });
         }
         let lim = Limits {
-            velocity: front.vmax.min(front.feed * feed_scale),
+            velocity: front.vmax.min(front.feed * feed_scale).min(speed_cap),
             acceleration: front.accel,
             jerk,
         };

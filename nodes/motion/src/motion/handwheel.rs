@@ -4,6 +4,10 @@
 //! 0.001 mm × 1, 10 or 100 (G19 MP1/MP2). The axis follows the wheel at up to
 //! [`HANDWHEEL_MAX_FEED`]; what it cannot follow within [`MAX_LAG_S`] is dropped, so the axis
 //! stands soon after the wheel does, however fast it was turned.
+//!
+//! In the handwheel trial run (`000` §13.3; D74) the wheel drives the program instead: in
+//! AUTO with the trial switch on, the path moves as fast as the wheel turns clockwise (a
+//! detent is 0.001 mm × the multiplier of path), never faster than programmed.
 
 use cnc_msgs::msg::MachineState;
 use cnc_msgs::signals::{f, g, GImage, SignalTable};
@@ -22,6 +26,33 @@ const COUNTS_PER_DETENT: i32 = 4;
 /// More counts than this in one servo period is not a hand (250 revolutions a second at
 /// 4 ms): an encoder fault, and the jump is dropped.
 const MAX_COUNTS_PER_PERIOD: i32 = 400;
+
+/// Periods over which the trial run measures the wheel's speed (100 ms at 4 ms).
+const TRIAL_WINDOW: usize = 25;
+
+/// The handwheel trial run: the wheel's speed of the last [`TRIAL_WINDOW`] periods as the
+/// path's speed limit.
+#[derive(Debug, Clone, Default)]
+pub(super) struct TrialRun {
+    /// Clockwise detents of the last periods, a ring.
+    detents: [i32; TRIAL_WINDOW],
+    next: usize,
+    /// In effect: the switch on in AUTO.
+    on: bool,
+    /// The wheel's speed, mm of path a second.
+    speed: f64,
+}
+
+impl TrialRun {
+    /// The path speed no block may exceed: the wheel's in a trial run, none otherwise.
+    pub(super) fn speed_cap(&self) -> f64 {
+        if self.on {
+            self.speed
+        } else {
+            f64::INFINITY
+        }
+    }
+}
 
 /// The wheel's counter and the move it gives.
 #[derive(Debug, Clone, Default)]
@@ -109,6 +140,16 @@ impl Motion {
         d
     }
 
+    /// The trial run's wheel speed from this period's `detents` (G19.6, AUTO mode; D74).
+    pub(super) fn trial_run(&mut self, plc: &GImage, detents: i32, dt: f64) {
+        let t = &mut self.trial;
+        t.on = plc.get(g::HANDWHEEL_TRIAL) && self.mode == MachineState::MODE_AUTO;
+        t.detents[t.next] = if t.on { detents.max(0) } else { 0 };
+        t.next = (t.next + 1) % TRIAL_WINDOW;
+        let turned: i32 = t.detents.iter().sum();
+        t.speed = f64::from(turned) * 0.001 * multiplier(plc) / (TRIAL_WINDOW as f64 * dt);
+    }
+
     /// The axis and multiplier the PLC selects, confirmed on F208/F209; in HANDWHEEL mode,
     /// with nothing else moving the axes, `detents` move the selected axis.
     pub(super) fn handwheel_detents(&mut self, plc: &GImage, detents: i32) {
@@ -170,6 +211,11 @@ impl Motion {
     fn handwheel_speed(&self, axis: usize) -> f64 {
         let a = &self.cfg.axes[axis];
         (HANDWHEEL_MAX_FEED * a.scale() / 60.0).min(a.max_velocity / 60.0)
+    }
+
+    /// Whether the handwheel trial run is in effect (its switch on, in AUTO).
+    pub fn handwheel_trial(&self) -> bool {
+        self.trial.on
     }
 
     /// Whether the handwheel moves an axis.

@@ -164,6 +164,7 @@ pub struct Motion {
     reference_inputs: ReferenceInputs,
     jog: Option<jog::Jog>,
     handwheel: handwheel::Handwheel,
+    trial: handwheel::TrialRun,
     /// Overtravel switches pressed, bits per axis: (+, −).
     overtravel: (u32, u32),
     /// The mode the interpreter accepted (`MachineState::MODE_*`): the PLC's jog keys act in
@@ -205,6 +206,7 @@ impl Motion {
             reference_inputs: ReferenceInputs::default(),
             jog: None,
             handwheel: handwheel::Handwheel::default(),
+            trial: handwheel::TrialRun::default(),
             overtravel: (0, 0),
             mode: 0,
             jog_keys: (0, 0),
@@ -487,6 +489,7 @@ impl Motion {
         // Detents turned while the machine cannot take them (servo off, emergency stop) are
         // dropped with this period.
         let detents = self.take_detents();
+        self.trial_run(plc, detents, self.cfg.period);
         if let Some(a) = actual {
             for ((dst, src), s) in self.actual.iter_mut().zip(a).zip(&self.shift) {
                 *dst = *src + *s;
@@ -802,9 +805,13 @@ impl Motion {
             Active::Path => {
                 let mut out = [0.0; MAX_AXES];
                 self.finished.clear();
-                let end =
-                    self.planner
-                        .step(hold, self.panel.feed_override, &mut self.finished, &mut out);
+                let end = self.planner.step(
+                    hold,
+                    self.panel.feed_override,
+                    self.trial.speed_cap(),
+                    &mut self.finished,
+                    &mut out,
+                );
                 self.commanded[..n].copy_from_slice(&out[..n]);
                 for &seq in &self.finished {
                     self.done_seq = self.done_seq.max(seq);
@@ -820,7 +827,8 @@ impl Motion {
                 for (i, ax) in axes.iter_mut().enumerate().take(n) {
                     if ax.travelled < ax.length {
                         let limits = Limits {
-                            velocity: lim.velocity[i] * self.panel.rapid_override,
+                            velocity: (lim.velocity[i] * self.panel.rapid_override)
+                                .min(self.trial.speed_cap()),
                             acceleration: lim.acceleration[i],
                             jerk: lim.jerk[i],
                         };
