@@ -468,7 +468,8 @@ fn machine_lock_and_aux_lock_run_a_program_without_moving_the_machine() {
 
 /// Issue 28, jog through the PLC's G signals (D71): the standard ladder turns the jog keys
 /// X19.4 +X and X19.5 −X into G100.0 and G102.0. In JOG mode, +X held for half a second moves
-/// X at the key jog feed and stops at the release; in HANDWHEEL mode each press of −X moves
+/// X at the key jog feed and stops at the release, and half as far with the feed override
+/// switch at 50 %; in HANDWHEEL mode each press of −X moves
 /// one step of 0.001 mm; in AUTO the keys move nothing.
 #[test]
 fn the_jog_keys_drive_the_axes_through_the_ladder_in_jog_and_handwheel_modes() {
@@ -500,6 +501,18 @@ fn the_jog_keys_drive_the_axes_through_the_ladder_in_jog_and_handwheel_modes() {
         (x(&r) - after).abs() < 1e-6,
         "still moving after the release"
     );
+    // The feed override switch at 50 % (X16 → G12): the same half second moves half as far.
+    r.sim.devices.inputs.bytes[x::FEED_OVERRIDE_SWITCH as usize] = 50;
+    let before = x(&r);
+    r.sim.devices.inputs.set(x::KEY_JOG_PLUS_X, true);
+    r.run_until(0.5, |_| false);
+    r.sim.devices.inputs.set(x::KEY_JOG_PLUS_X, false);
+    r.run_until(0.3, |_| false);
+    let half = x(&r) - before;
+    println!("+X held 0.5 s at 50 % feed override: {half:.3} mm");
+    assert!((half / held - 0.5).abs() < 0.03, "{half} against {held}");
+    r.sim.devices.inputs.bytes[x::FEED_OVERRIDE_SWITCH as usize] = 100;
+    let after = x(&r);
     // HANDWHEEL: three presses of −X, three steps of 0.001.
     r.motion.set_mode(MachineState::MODE_HANDWHEEL);
     for _ in 0..3 {
