@@ -2,7 +2,9 @@
 
 use std::time::{Duration, Instant};
 
-use cnc_msgs::msg::{ActiveAlarms, AxisState, MachineState, PartCount, ServoStats, SpindleState};
+use cnc_msgs::msg::{
+    ActiveAlarms, AxisState, MachineState, PartCount, RobotHandshake, ServoStats, SpindleState,
+};
 use cnc_msgs::srv::*;
 use cnc_runtime::config::NetworkConfig;
 use cnc_runtime::dds::{qos, RosNode};
@@ -31,12 +33,15 @@ pub struct CellClient {
     alarms_sub: Subscription<ActiveAlarms>,
     axes_sub: Subscription<AxisState>,
     stats_sub: Subscription<ServoStats>,
+    handshake_sub: Subscription<RobotHandshake>,
     pub state: Option<MachineState>,
     pub spindle: Option<SpindleState>,
     pub part_count: Option<PartCount>,
     pub alarms: Option<ActiveAlarms>,
     pub axes: Option<AxisState>,
     pub servo_stats: Option<ServoStats>,
+    /// The machine's side of the robot handshake.
+    pub handshake: Option<RobotHandshake>,
 }
 
 fn client<S: RosService>(
@@ -87,6 +92,7 @@ impl CellClient {
             alarms_sub: ros.dds_subscription(&topics::ALARMS)?,
             axes_sub: ros.dds_subscription(&topics::AXES)?,
             stats_sub: ros.dds_subscription(&topics::SERVO_STATS)?,
+            handshake_sub: ros.dds_subscription(&topics::ROBOT_HANDSHAKE)?,
             ros,
             mapping,
             namespace: ns.into(),
@@ -97,6 +103,7 @@ impl CellClient {
             alarms: None,
             axes: None,
             servo_stats: None,
+            handshake: None,
         })
     }
 
@@ -149,6 +156,9 @@ impl CellClient {
         }
         while let Ok(Some((m, _))) = self.stats_sub.take() {
             self.servo_stats = Some(m);
+        }
+        while let Ok(Some((m, _))) = self.handshake_sub.take() {
+            self.handshake = Some(m);
         }
         states
     }

@@ -5,4 +5,6 @@ pub mod bench_paths;
 pub mod cell;
 pub mod client;
 pub mod machines;
+pub mod robot;
+pub mod robot_node;
 pub mod simulate;
