@@ -8,21 +8,12 @@
 
 use std::net::IpAddr;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 mod common;
 
-use cnc::client::CellClient;
-use cnc::robot::Robot;
-use cnc_msgs::msg::{MachineState, RobotHandshake};
 use cnc_runtime::config::NetworkConfig;
-use cnc_runtime::dds::{qos, RosNode};
-use cnc_runtime::topics;
-use ros2_client::qos::History;
-use ros2_client::ServiceMapping;
 
 const DOMAIN: u16 = 83;
-const PART: &str = "O0001\nG98 G97 S500 M03\nG00 X100 Z5\nG01 Z-10 F1500\nG00 X150 Z50\nM05\nM30\n";
 
 fn ip(args: &[&str]) {
     let out = Command::new("ip").args(args).output().expect("ip runs");
@@ -133,84 +124,11 @@ fn a_robot_on_the_cell_host_tends_two_lathes_on_their_own_hosts() {
             .expect("cnc runs on its host");
         lathes.push(common::KillOnDrop(child));
     }
-    let net = cell_network();
-    let client = |ns: &str, who: &str| {
-        let mut c = CellClient::new(&net, ns, who, ServiceMapping::Enhanced)
-            .expect("client")
-            .with_timeout(Duration::from_secs(20));
-        c.wait_ready(Duration::from_secs(60))
-            .unwrap_or_else(|e| panic!("{ns} across the bridge: {e}"));
-        c
-    };
-    let mut observers: Vec<RosNode> = names
-        .iter()
-        .map(|ns| RosNode::new(&net, ns, "observer").expect("observer"))
-        .collect();
-    let watch: Vec<_> = observers
-        .iter_mut()
-        .map(|o| {
-            o.dds_subscription_with_qos::<RobotHandshake>(
-                &topics::ROBOT_HANDSHAKE,
-                qos::state().history(History::KeepLast { depth: 10_000 }),
-            )
-            .expect("handshake reader")
-        })
-        .collect();
-    let mut supervisor: Vec<CellClient> = names.iter().map(|ns| client(ns, "supervisor")).collect();
-    for s in supervisor.iter_mut() {
-        let r = s.load_program("part.nc", PART).expect("load");
-        assert!(r.accepted, "{}", r.message);
-        let r = s.start_program("part.nc").expect("start");
-        assert!(r.accepted, "{}", r.message);
-    }
-    let mut arm: Vec<CellClient> = names.iter().map(|ns| client(ns, "robot")).collect();
-    let mut robot = Robot::new(2, 1.0, 2);
-    let t0 = Instant::now();
-    let done = cnc::robot_node::tend(&mut arm, &mut robot, t0 + Duration::from_secs(240));
-    println!(
-        "robot across hosts: {:?} after {:.1} s",
-        robot.machines,
-        t0.elapsed().as_secs_f64()
-    );
-    done.expect("the robot loaded its parts");
-    for (ns, s) in names.iter().zip(supervisor.iter_mut()) {
-        let t = Instant::now();
-        loop {
-            s.poll();
-            let counted = s.part_count.as_ref().map_or(0, |p| p.count);
-            let ended = s
-                .state
-                .as_ref()
-                .is_some_and(|m| m.execution == MachineState::PROGRAM_COMPLETED);
-            if counted == 3 && ended {
-                println!("{ns}: 3 parts counted by the machine");
-                break;
-            }
-            assert!(
-                t.elapsed() < Duration::from_secs(30),
-                "{ns}: count {counted}"
-            );
-            std::thread::sleep(Duration::from_millis(20));
-        }
-    }
-    let mut inside = 0;
-    for (ns, w) in names.iter().zip(&watch) {
-        while let Ok(Some((h, _))) = w.take() {
-            if !h.robot_clear {
-                inside += 1;
-                assert!(
-                    h.door_open && !h.spindle_turning && !h.emergency_stop && !h.cycle_active,
-                    "{ns}: the robot inside an unsafe machine: {h:?}"
-                );
-            }
-        }
-    }
-    println!("samples with the robot inside: {inside}, all safe");
+    let inside = common::robot_tends(&cell_network(), &names, 2);
     assert!(
         inside >= 4,
         "the observer saw the robot inside {inside} times"
     );
-    drop((arm, supervisor, watch, observers));
     drop(lathes);
     drop(hosts);
     let _ = std::fs::remove_dir_all(&dir);
