@@ -117,22 +117,40 @@ impl CellClient {
     /// Waits until the machine reports a state other than WAIT (the interpreter knows where the
     /// axes are, so a cycle start can be accepted).
     pub fn wait_ready(&mut self, timeout: Duration) -> Result<(), String> {
-        let deadline = Instant::now() + timeout;
-        while Instant::now() < deadline {
-            self.poll();
-            if self
-                .state
+        let ready = |c: &CellClient| {
+            c.state
                 .as_ref()
                 .is_some_and(|s| s.execution != MachineState::WAIT)
-            {
-                return Ok(());
+        };
+        if self.wait_until(timeout, ready).0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "the machine did not become ready within {} s",
+                timeout.as_secs()
+            ))
+        }
+    }
+
+    /// Polls the state topics until `done` holds or `timeout` passes: whether it held, and
+    /// every machine state seen on the way, in order.
+    pub fn wait_until(
+        &mut self,
+        timeout: Duration,
+        mut done: impl FnMut(&CellClient) -> bool,
+    ) -> (bool, Vec<MachineState>) {
+        let deadline = Instant::now() + timeout;
+        let mut seen = Vec::new();
+        loop {
+            seen.extend(self.poll());
+            if done(self) {
+                return (true, seen);
+            }
+            if Instant::now() >= deadline {
+                return (false, seen);
             }
             std::thread::sleep(Duration::from_millis(5));
         }
-        Err(format!(
-            "the machine did not become ready within {} s",
-            timeout.as_secs()
-        ))
     }
 
     /// Takes every new sample of the state topics; returns the machine states seen, in order.

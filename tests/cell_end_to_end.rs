@@ -2,7 +2,7 @@
 //! as the supervisor. Run by `scripts/test.sh` inside a network namespace with only loopback.
 //! Each test uses its own DDS domain and so its own iceoryx2 instance.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
 
@@ -21,24 +21,6 @@ fn supervisor(cfg: &LaunchConfig, mapping: ServiceMapping) -> CellClient {
     CellClient::new(&cfg.network, "lathe1", "test_supervisor", mapping).unwrap()
 }
 
-/// Polls until `done` holds or the timeout passes; returns every machine state seen.
-fn wait_for(
-    client: &mut CellClient,
-    timeout: Duration,
-    mut done: impl FnMut(&CellClient) -> bool,
-) -> (bool, Vec<MachineState>) {
-    let t0 = Instant::now();
-    let mut seen = vec![];
-    while t0.elapsed() < timeout {
-        seen.extend(client.poll());
-        if done(client) {
-            return (true, seen);
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    (false, seen)
-}
-
 const PROGRAM: &str = "O0001\nG00 X60 Z5\nS600 M03\nG01 X40 Z0 F600\nZ-20\nG02 X50 Z-25 R5\nG01 X56.789 Z-30.123\nM05\nM30\n";
 
 #[test]
@@ -46,7 +28,7 @@ fn program_runs_through_ros2_services_and_the_part_is_counted() {
     let cfg = config(41);
     let cell = Cell::start(&cfg).unwrap();
     let mut client = supervisor(&cfg, ServiceMapping::Enhanced);
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(20), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(20), |c| {
         c.part_count.is_some() && c.state.is_some() && c.axes.is_some()
     });
     assert!(ok, "state topics never arrived");
@@ -57,7 +39,7 @@ fn program_runs_through_ros2_services_and_the_part_is_counted() {
     let r = client.start_program("part1.nc").unwrap();
     assert!(r.accepted, "{}", r.message);
     let mut max_rpm_while_cutting: f64 = 0.0;
-    let (ok, seen) = wait_for(&mut client, Duration::from_secs(60), |c| {
+    let (ok, seen) = client.wait_until(Duration::from_secs(60), |c| {
         if let (Some(s), Some(sp)) = (&c.state, &c.spindle) {
             if s.execution == MachineState::ACTIVE && (4..=6).contains(&s.line) {
                 max_rpm_while_cutting = max_rpm_while_cutting.max(sp.actual_rpm);
@@ -89,7 +71,7 @@ fn program_runs_through_ros2_services_and_the_part_is_counted() {
         "spindle {max_rpm_while_cutting} rpm while cutting"
     );
     // Final position: X56.789 Z-30.123 within 1 µm, after the drives settle.
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(5), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(5), |c| {
         c.axes.as_ref().is_some_and(|a| {
             (a.axes[0].actual_position - 56.789).abs() < 0.001
                 && (a.axes[1].actual_position + 30.123).abs() < 0.001
@@ -113,7 +95,7 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
     let cfg = config(42);
     let cell = Cell::start(&cfg).unwrap();
     let mut client = supervisor(&cfg, ServiceMapping::Cyclone);
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(20), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(20), |c| {
         c.axes.is_some() && c.alarms.is_some()
     });
     assert!(ok);
@@ -122,7 +104,7 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
     let bad = "G00 X150 Z50\nG01 Z40 F3000\nG77 X10\nG01 X0 Z-100\nM30\n";
     assert!(client.load_program("bad.nc", bad).unwrap().accepted);
     assert!(client.start_program("bad.nc").unwrap().accepted);
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(30), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(30), |c| {
         c.alarms.as_ref().is_some_and(|a| !a.alarms.is_empty())
     });
     assert!(ok, "no alarm");
@@ -137,7 +119,7 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
         (7, 3, "interpreter", "bad.nc")
     );
     assert!(alarm.text.contains("G77"), "{}", alarm.text);
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(10), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
         c.state
             .as_ref()
             .is_some_and(|s| s.execution == MachineState::STOPPED && s.alarm_active)
@@ -161,7 +143,7 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
     // Start is refused while the alarm is active; after reset a good program runs.
     assert!(!client.start_program("bad.nc").unwrap().accepted);
     assert!(client.reset().unwrap().accepted);
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(10), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
         c.alarms.as_ref().is_some_and(|a| a.alarms.is_empty())
     });
     assert!(ok, "alarm not cleared by reset");
@@ -173,7 +155,7 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
             .accepted
     );
     assert!(client.start_program("arc.nc").unwrap().accepted);
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(30), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(30), |c| {
         c.alarms
             .as_ref()
             .is_some_and(|a| a.alarms.iter().any(|x| x.number == 11 && x.line == 2))
@@ -187,7 +169,7 @@ fn bad_program_raises_an_alarm_with_its_line_and_reset_recovers() {
             .accepted
     );
     assert!(client.start_program("good.nc").unwrap().accepted);
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(30), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(30), |c| {
         c.part_count.as_ref().is_some_and(|p| p.count == 1)
     });
     assert!(
@@ -212,7 +194,7 @@ fn a_malformed_plc_program_is_refused_and_the_running_one_keeps_the_machine() {
     client.wait_ready(Duration::from_secs(20)).unwrap();
     // The machine builder saves a program with a write to an input on line 4.
     std::fs::write(&file, "RD X1.0\nWRT G8.4\nRD X0.0\nWRT X0.1\nEND1\nEND2\n").unwrap();
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(10), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
         c.alarms
             .as_ref()
             .is_some_and(|a| a.alarms.iter().any(|x| x.number == 1091))
@@ -233,7 +215,7 @@ fn a_malformed_plc_program_is_refused_and_the_running_one_keeps_the_machine() {
     assert!(client.load_program("p.nc", program).unwrap().accepted);
     assert!(client.start_program("p.nc").unwrap().accepted);
     let mut max_rpm: f64 = 0.0;
-    let (ok, _) = wait_for(&mut client, Duration::from_secs(30), |c| {
+    let (ok, _) = client.wait_until(Duration::from_secs(30), |c| {
         if let Some(sp) = &c.spindle {
             max_rpm = max_rpm.max(sp.actual_rpm);
         }

@@ -93,9 +93,7 @@ fn cell_network() -> NetworkConfig {
 #[test]
 fn a_robot_on_the_cell_host_tends_two_lathes_on_their_own_hosts() {
     let hosts = Hosts::new(2);
-    let dir = std::env::temp_dir().join(format!("cnc_cell_hosts_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("dir");
+    let dir = common::fresh_dir("cnc_cell_hosts");
     let names = ["lathe1", "lathe2"];
     let mut lathes = Vec::new();
     for (k, (ns, host)) in names.iter().zip(&hosts.hosts).enumerate() {

@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use cnc::cell::Cell;
 use cnc::client::CellClient;
@@ -12,17 +12,9 @@ use cnc_msgs::msg::{MachineState, ToolOffset, WorkOffset};
 use cnc_msgs::srv::*;
 use ros2_client::ServiceMapping;
 
-/// Polls until `done` holds, or fails with `what`.
+/// Polls until `done` holds, or fails with `what` after 30 s.
 fn wait(client: &mut CellClient, what: &str, done: impl Fn(&CellClient) -> bool) {
-    let t0 = Instant::now();
-    while t0.elapsed() < Duration::from_secs(30) {
-        client.poll();
-        if done(client) {
-            return;
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    panic!("timed out waiting for {what}");
+    common::wait(client, Duration::from_secs(30), what, done);
 }
 
 fn execution(c: &CellClient) -> u8 {

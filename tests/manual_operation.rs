@@ -250,19 +250,9 @@ fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() 
     assert!(c.load_program("part.nc", part).expect("load").accepted);
     let wait_axes =
         |c: &mut CellClient, what: &str, ok: &dyn Fn(&cnc_msgs::msg::AxisState) -> bool| {
-            let t0 = Instant::now();
-            loop {
-                c.poll();
-                if c.axes.as_ref().is_some_and(ok) {
-                    return;
-                }
-                assert!(
-                    t0.elapsed() < Duration::from_secs(90),
-                    "{what}: {:?}",
-                    c.axes
-                );
-                std::thread::sleep(Duration::from_millis(10));
-            }
+            common::wait(c, Duration::from_secs(90), what, |c| {
+                c.axes.as_ref().is_some_and(ok)
+            })
         };
     wait_axes(&mut c, "axes state", &|a| a.axes.iter().all(|x| !x.homed));
 
@@ -298,22 +288,11 @@ fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() 
     common::set_mode(&mut c, MachineState::MODE_AUTO);
     let r = c.start_program("part.nc").expect("start");
     assert!(r.accepted, "{}", r.message);
-    let t0 = Instant::now();
-    loop {
-        c.poll();
-        if c.state
+    common::wait(&mut c, Duration::from_secs(60), "part", |c| {
+        c.state
             .as_ref()
             .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
-        {
-            break;
-        }
-        assert!(
-            t0.elapsed() < Duration::from_secs(60),
-            "part: {:?}",
-            c.state
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    });
     std::thread::sleep(Duration::from_millis(300));
     c.poll();
     let end: Vec<f64> = c
@@ -625,15 +604,12 @@ fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way
             "no overtravel alarm"
         );
     }
-    let t1 = Instant::now();
-    while x_switch(&c) != 1 {
-        c.poll();
-        assert!(
-            t1.elapsed() < Duration::from_secs(5),
-            "axes do not show the switch"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    common::wait(
+        &mut c,
+        Duration::from_secs(5),
+        "axes do not show the switch",
+        |c| x_switch(c) == 1,
+    );
     let r = ask(-1, 1.0);
     println!("jog during the alarm: {}", r.message);
     assert!(!r.accepted && r.message.contains("reset"), "{}", r.message);
@@ -649,12 +625,9 @@ fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way
     );
     let r = ask(-1, 2.0);
     assert!(r.accepted, "{}", r.message);
-    let t2 = Instant::now();
-    while x_switch(&c) != 0 {
-        c.poll();
-        assert!(t2.elapsed() < Duration::from_secs(5), "still on the switch");
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    common::wait(&mut c, Duration::from_secs(5), "still on the switch", |c| {
+        x_switch(c) == 0
+    });
     std::thread::sleep(Duration::from_millis(300));
     c.poll();
     let x = c

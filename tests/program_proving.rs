@@ -18,14 +18,9 @@ use ros2_client::ServiceMapping;
 const PROGRAM: &str =
     "O0001\nG98 G00 X60 Z5\nS600 M03\nM08\nG01 X40 Z0 F900\nZ-20\nG02 X50 Z-25 R5\nG00 X150 Z50\nM09\nM05\nM30\n";
 
-/// Polls until `done` holds; fails after `timeout`.
-fn wait(client: &mut CellClient, what: &str, mut done: impl FnMut(&CellClient) -> bool) {
-    let t0 = Instant::now();
-    while !done(client) {
-        client.poll();
-        assert!(t0.elapsed() < Duration::from_secs(30), "{what}");
-        std::thread::sleep(Duration::from_millis(5));
-    }
+/// Polls until `done` holds; fails after 30 s.
+fn wait(client: &mut CellClient, what: &str, done: impl FnMut(&CellClient) -> bool) {
+    common::wait(client, Duration::from_secs(30), what, done);
 }
 
 fn locked(c: &CellClient) -> Option<bool> {

@@ -28,24 +28,6 @@ const KILL_LINE: u32 = 11;
 /// The line of `M05`: from it on, the spindle stops.
 const M05_LINE: u32 = 19;
 
-/// Polls until `done` says so, or panics with `what` after `timeout`.
-fn wait_for(
-    c: &mut CellClient,
-    timeout: Duration,
-    what: &str,
-    mut done: impl FnMut(&CellClient) -> bool,
-) {
-    let t0 = Instant::now();
-    loop {
-        c.poll();
-        if done(c) {
-            return;
-        }
-        assert!(t0.elapsed() < timeout, "{what}: state {:?}", c.state);
-        std::thread::sleep(Duration::from_millis(5));
-    }
-}
-
 fn actual(c: &CellClient) -> Vec<f64> {
     c.axes
         .as_ref()
@@ -59,9 +41,7 @@ fn execution(c: &CellClient) -> u8 {
 
 #[test]
 fn a_part_killed_mid_run_is_restarted_at_its_block_and_completes_at_the_same_position() {
-    let dir = std::env::temp_dir().join(format!("cnc_restart_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let dir = common::fresh_dir("cnc_restart");
     let config = common::sim_lathe_file(&dir, "restart_lathe.yaml", DOMAIN, |_| {});
     let cfg = LaunchConfig::load(&config).expect("config");
     let position_file = cfg.machine.position_file.clone().expect("position file");
@@ -72,7 +52,7 @@ fn a_part_killed_mid_run_is_restarted_at_its_block_and_completes_at_the_same_pos
     let mut c = common::ready_client(&cfg, "supervisor", Duration::from_secs(60));
     assert!(c.load_program("restart.nc", PART).expect("load").accepted);
     assert!(c.start_program("restart.nc").expect("start").accepted);
-    wait_for(&mut c, Duration::from_secs(60), "the whole part", |c| {
+    common::wait(&mut c, Duration::from_secs(60), "the whole part", |c| {
         execution(c) == MachineState::PROGRAM_COMPLETED
     });
     std::thread::sleep(Duration::from_millis(200));
@@ -83,18 +63,18 @@ fn a_part_killed_mid_run_is_restarted_at_its_block_and_completes_at_the_same_pos
     // The same part again, killed on its second or third pass.
     assert!(c.start_program("restart.nc").expect("start").accepted);
     // The state shows the last run's line until motion takes the new run's first block.
-    wait_for(&mut c, Duration::from_secs(60), "the new run", |c| {
+    common::wait(&mut c, Duration::from_secs(60), "the new run", |c| {
         c.state
             .as_ref()
             .is_some_and(|s| s.execution == MachineState::ACTIVE && s.line < KILL_LINE)
     });
-    wait_for(&mut c, Duration::from_secs(60), "the second pass", |c| {
+    common::wait(&mut c, Duration::from_secs(60), "the second pass", |c| {
         c.state
             .as_ref()
             .is_some_and(|s| s.execution == MachineState::ACTIVE && s.line >= KILL_LINE)
     });
     let t_cut = Instant::now();
-    wait_for(&mut c, Duration::from_secs(5), "in the cut", |_| {
+    common::wait(&mut c, Duration::from_secs(5), "in the cut", |_| {
         t_cut.elapsed() >= Duration::from_secs(1)
     });
     let seen = c.state.as_ref().map_or(0, |s| s.line);

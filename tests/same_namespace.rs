@@ -17,9 +17,7 @@ const PART: &str = "O0001\nG00 X60 Z5\nS600 M03\nG01 X50 F3000\nZ-5\nG00 X60\nM0
 
 #[test]
 fn a_second_controller_with_the_same_namespace_is_refused_and_the_first_runs_on() {
-    let dir = std::env::temp_dir().join(format!("cnc_same_ns_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
+    let dir = common::fresh_dir("cnc_same_ns");
     let config = common::sim_lathe_file(&dir, "lathe.yaml", DOMAIN, |_| {});
     let cfg = LaunchConfig::load(&config).expect("config");
     let mut first = common::KillOnDrop(common::cnc_run(&config, &dir.join("first.log")));

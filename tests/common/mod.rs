@@ -218,6 +218,28 @@ pub fn run_program_client(ros: &mut cnc_runtime::dds::RosNode) -> RunProgramClie
         .expect("action client")
 }
 
+/// Polls `client` until `done` holds; fails the test with `what` and the machine's state
+/// after `timeout`.
+#[allow(dead_code)]
+pub fn wait(
+    client: &mut cnc::client::CellClient,
+    timeout: std::time::Duration,
+    what: &str,
+    done: impl FnMut(&cnc::client::CellClient) -> bool,
+) {
+    let (ok, _) = client.wait_until(timeout, done);
+    assert!(ok, "{what}: state {:?}", client.state);
+}
+
+/// An empty folder `name` in the temp directory, for one test's files.
+#[allow(dead_code)]
+pub fn fresh_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("{name}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
 /// A part program short enough for the robot tests: spindle on, one cut, M30.
 #[allow(dead_code)]
 pub const SHORT_PART: &str =
@@ -281,24 +303,18 @@ pub fn robot_tends(
     done.expect("the robot loaded its parts");
     assert!(robot.machines.iter().all(|m| m.parts == parts_each));
     for (ns, s) in names.iter().zip(supervisor.iter_mut()) {
-        let t = Instant::now();
-        loop {
-            s.poll();
-            let counted = s.part_count.as_ref().map_or(0, |p| p.count);
-            let ended = s
-                .state
-                .as_ref()
-                .is_some_and(|m| m.execution == MachineState::PROGRAM_COMPLETED);
-            if counted == 1 + parts_each && ended {
-                println!("{ns}: {counted} parts counted by the machine");
-                break;
-            }
-            assert!(
-                t.elapsed() < Duration::from_secs(30),
-                "{ns}: count {counted}"
-            );
-            std::thread::sleep(Duration::from_millis(20));
-        }
+        wait(
+            s,
+            Duration::from_secs(30),
+            &format!("{ns}: its parts counted"),
+            |s| {
+                s.part_count.as_ref().map_or(0, |p| p.count) == 1 + parts_each
+                    && s.state
+                        .as_ref()
+                        .is_some_and(|m| m.execution == MachineState::PROGRAM_COMPLETED)
+            },
+        );
+        println!("{ns}: {} parts counted by the machine", 1 + parts_each);
     }
     let mut inside = 0;
     for (ns, w) in names.iter().zip(&watch) {
