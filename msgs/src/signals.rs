@@ -229,14 +229,11 @@ pub mod g {
     /// Manual rapid traverse (G19.7 RT).
     pub const RT: Bit = bit(19, 7);
     /// Step and handwheel multiplier MP1/MP2 (G19.0, G19.1): ×1, ×10 (MP1), ×100 (MP2),
-    /// ×1000 (both; a handwheel takes it as ×100) of 0.001 mm (decisions D72).
+    /// ×1000 (both; a handwheel takes it as ×100) of 0.001 mm (decisions D72). The manual
+    /// also names EXMP1/EXMP2 (G19.4, G19.5) for the external handwheel; the NC reads MP1/MP2
+    /// only, and the ladder chooses what drives them (the manual's GB02.2).
     pub const MP1: Bit = bit(19, 0);
     pub const MP2: Bit = bit(19, 1);
-    /// The external handwheel's multiplier EXMP1/EXMP2 (G19.4, G19.5): named by the manual
-    /// without a meaning of their own; the NC reads MP1/MP2, the ladder chooses what drives
-    /// them (the manual's GB02.2 choice between panel and external selectors; D72).
-    pub const EXMP1: Bit = bit(19, 4);
-    pub const EXMP2: Bit = bit(19, 5);
     /// Handwheel trial run (G19.6, a free bit of the handwheel's byte: the manual gives the
     /// key no signal): in AUTO the program runs as fast as the handwheel turns (D74).
     pub const HANDWHEEL_TRIAL: Bit = bit(19, 6);
@@ -315,10 +312,10 @@ pub mod x {
     pub const COOLANT_PRESSURE: Bit = bit(4, 6);
     /// Lubrication pressure / level good.
     pub const LUBE_OK: Bit = bit(4, 7);
-    /// The external handwheel's switches on XJ3 (`000` §19.4.2.4): axis select X (X2.1),
-    /// Y (X2.0), Z (X6.0), and multiplier ×10 (X2.2), ×100 (X2.3); neither is ×1.
+    /// The external handwheel's switches on XJ3 (`000` §19.4.2.4) the simulated lathe has:
+    /// axis select X (X2.1), Z (X6.0), and multiplier ×10 (X2.2), ×100 (X2.3); neither is ×1.
+    /// (Y's, X2.0, is wired by the standard ladder for a machine that has Y.)
     pub const HANDWHEEL_SELECT_X: Bit = bit(2, 1);
-    pub const HANDWHEEL_SELECT_Y: Bit = bit(2, 0);
     pub const HANDWHEEL_SELECT_Z: Bit = bit(6, 0);
     pub const HANDWHEEL_X10: Bit = bit(2, 2);
     pub const HANDWHEEL_X100: Bit = bit(2, 3);

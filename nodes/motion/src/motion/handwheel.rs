@@ -164,12 +164,7 @@ impl Motion {
                 .iter()
                 .position(|s| *s == Some(usize::from(k)))
         });
-        let busy = self.active.is_some()
-            || !self.queue.is_empty()
-            || self.reference.is_some()
-            || self.jog.is_some()
-            || self.alarm
-            || self.servo_off;
+        let busy = self.axes_driven() || self.alarm || self.servo_off;
         let Some(axis) = axis.filter(|_| detents != 0 && !busy) else {
             return;
         };

@@ -428,16 +428,20 @@ impl Motion {
             || self.feed_hold && (self.active.is_some() || !self.queue.is_empty())
         {
             RunState::Hold
-        } else if self.active.is_some()
-            || !self.queue.is_empty()
-            || self.reference.is_some()
-            || self.jog.is_some()
-            || self.handwheel.moving()
-        {
+        } else if self.axes_driven() || self.handwheel.moving() {
             RunState::Running
         } else {
             RunState::Idle
         }
+    }
+
+    /// A program, a reference return or a jog drives the axes (the handwheel aside: it takes
+    /// more detents while it moves one).
+    pub(super) fn axes_driven(&self) -> bool {
+        self.active.is_some()
+            || !self.queue.is_empty()
+            || self.reference.is_some()
+            || self.jog.is_some()
     }
 
     /// Whether the active block is a feed move (line, arc or thread) rather than a rapid,

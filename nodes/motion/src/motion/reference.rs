@@ -68,8 +68,7 @@ impl Motion {
     /// Starts the reference return of every axis with an incremental encoder, in the
     /// config's order. Refused while a program runs or the machine is stopped by an alarm.
     pub fn reference_return(&mut self) -> Result<String, String> {
-        let manual = self.jog.is_some() || self.handwheel.moving();
-        if self.active.is_some() || !self.queue.is_empty() || self.reference.is_some() || manual {
+        if self.axes_driven() || self.handwheel.moving() {
             return Err("reference return refused: the axes are moving".into());
         }
         if self.alarm || self.emergency_stop || self.servo_off {
