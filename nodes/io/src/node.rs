@@ -194,3 +194,42 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The panel's keys and the handwheel's switches from `sim/input` reach the PLC's X image;
+    /// a detent turns the wheel's counter four counts either way; an unknown input is refused.
+    #[test]
+    fn the_simulated_panel_and_handwheel_inputs_reach_the_machine() {
+        let text = include_str!("../../../launch_configs/sim_lathe.yaml");
+        let cfg = LaunchConfig::from_yaml(text).expect("sim_lathe.yaml");
+        let mut sim = SimLathe::new(sim_config(&cfg), &cfg.power_on_slide());
+        let input = |input, value| SimInput { input, value };
+        for (key, bit) in [
+            (SimInput::HANDWHEEL_SELECT_X, x::HANDWHEEL_SELECT_X),
+            (SimInput::HANDWHEEL_SELECT_Z, x::HANDWHEEL_SELECT_Z),
+            (SimInput::HANDWHEEL_X10, x::HANDWHEEL_X10),
+            (SimInput::HANDWHEEL_X100, x::HANDWHEEL_X100),
+            (SimInput::Z_AXIS_LOCK_KEY, x::KEY_Z_AXIS_LOCK),
+            (SimInput::HANDWHEEL_TRIAL_KEY, x::KEY_HANDWHEEL_TRIAL),
+        ] {
+            assert!(apply_input(&mut sim, &input(key, true)));
+            let y = YImage::default();
+            assert!(sim.x_image(&y).get(bit), "input {key}");
+            assert!(apply_input(&mut sim, &input(key, false)));
+            assert!(!sim.x_image(&y).get(bit), "input {key} released");
+        }
+        let count = |sim: &mut SimLathe| {
+            sim.step(&ServoSetpoint::default(), &YImage::default(), 0.0)
+                .handwheel_count
+        };
+        let before = count(&mut sim);
+        apply_input(&mut sim, &input(SimInput::HANDWHEEL_DETENT, true));
+        apply_input(&mut sim, &input(SimInput::HANDWHEEL_DETENT, true));
+        apply_input(&mut sim, &input(SimInput::HANDWHEEL_DETENT, false));
+        assert_eq!(count(&mut sim) - before, 4);
+        assert!(!apply_input(&mut sim, &input(200, true)));
+    }
+}
