@@ -24,8 +24,11 @@ pub enum Phase {
     },
     /// Inside: clamps the blank.
     Clamp,
-    /// Reports itself clear of the work area.
-    Leave,
+    /// Reports itself clear of the work area; `retreat`: it had to leave before the blank
+    /// was clamped.
+    Leave {
+        retreat: bool,
+    },
     CloseDoor,
     Start,
     /// The cycle it started: `seen` once the machine shows it running.
@@ -106,8 +109,8 @@ impl Robot {
         if let Some(i) = self.inside {
             let h = handshakes.get(i)?.as_ref()?;
             let m = &mut self.machines[i];
-            if !safe_inside(h) && m.phase != Phase::Leave {
-                m.phase = Phase::Leave;
+            if !safe_inside(h) && !matches!(m.phase, Phase::Leave { .. }) {
+                m.phase = Phase::Leave { retreat: true };
                 m.refusals
                     .push((Rq::CLEAR, "left the machine: no longer safe inside".into()));
             }
@@ -118,7 +121,7 @@ impl Robot {
                     Some((i, Rq::CHUCK_CLAMP))
                 }
                 Phase::Clamp => Some((i, Rq::CHUCK_CLAMP)),
-                Phase::Leave => Some((i, Rq::CLEAR)),
+                Phase::Leave { .. } => Some((i, Rq::CLEAR)),
                 _ => None,
             };
         }
@@ -187,14 +190,10 @@ impl Robot {
                     until: now + self.swap_seconds,
                 }
             }
-            (Rq::CHUCK_CLAMP, Phase::Clamp) => m.phase = Phase::Leave,
-            (Rq::CLEAR, Phase::Leave) => {
+            (Rq::CHUCK_CLAMP, Phase::Clamp) => m.phase = Phase::Leave { retreat: false },
+            (Rq::CLEAR, Phase::Leave { retreat }) => {
                 self.inside = None;
                 // A retreat before the blank was clamped leaves the machine to an operator.
-                let retreat = m
-                    .refusals
-                    .last()
-                    .is_some_and(|(c, why)| *c == Rq::CLEAR && why.starts_with("left"));
                 m.phase = if retreat {
                     Phase::Retreated
                 } else {
