@@ -183,41 +183,71 @@ impl CellClient {
 
     pub fn load_program(&mut self, name: &str, text: &str) -> Result<LoadProgramResponse, String> {
         call(
+            &self.ros.node,
             self.timeout,
             &self.load,
             LoadProgramRequest {
                 name: name.into(),
                 text: text.into(),
             },
+            Copies::Allowed,
         )
     }
     pub fn start_program(&mut self, name: &str) -> Result<StartProgramResponse, String> {
         call(
+            &self.ros.node,
             self.timeout,
             &self.start,
             StartProgramRequest { name: name.into() },
+            Copies::Never,
         )
     }
     pub fn stop(&mut self, mode: u8) -> Result<StopResponse, String> {
-        call(self.timeout, &self.stop, StopRequest { mode })
+        call(
+            &self.ros.node,
+            self.timeout,
+            &self.stop,
+            StopRequest { mode },
+            Copies::Allowed,
+        )
     }
     pub fn reset(&mut self) -> Result<ResetResponse, String> {
-        call(self.timeout, &self.reset, ResetRequest::default())
+        call(
+            &self.ros.node,
+            self.timeout,
+            &self.reset,
+            ResetRequest::default(),
+            Copies::Allowed,
+        )
     }
 
     /// A robot handshake request (`RobotRequestRequest::DOOR_OPEN` …).
     pub fn robot_request(&mut self, request: u8) -> Result<RobotRequestResponse, String> {
-        call(self.timeout, &self.robot, RobotRequestRequest { request })
+        call(
+            &self.ros.node,
+            self.timeout,
+            &self.robot,
+            RobotRequestRequest { request },
+            Copies::Never,
+        )
     }
 
     pub fn list_programs(&mut self) -> Result<ListProgramsResponse, String> {
-        call(self.timeout, &self.list, ListProgramsRequest::default())
+        call(
+            &self.ros.node,
+            self.timeout,
+            &self.list,
+            ListProgramsRequest::default(),
+            Copies::Allowed,
+        )
     }
     pub fn delete_program(&mut self, name: &str) -> Result<DeleteProgramResponse, String> {
         call(
+            &self.ros.node,
             self.timeout,
             &self.delete,
             DeleteProgramRequest { name: name.into() },
+            Copies::Never,
         )
     }
 
@@ -228,6 +258,7 @@ impl CellClient {
         rapid_percent: u8,
     ) -> Result<SetOverridesResponse, String> {
         call(
+            &self.ros.node,
             self.timeout,
             &self.overrides,
             SetOverridesRequest {
@@ -235,6 +266,7 @@ impl CellClient {
                 spindle_percent,
                 rapid_percent,
             },
+            Copies::Allowed,
         )
     }
 
@@ -245,10 +277,14 @@ impl CellClient {
     /// A client of any other service of the cell (`set_mode`, `mdi`, `get_offsets`,
     /// `set_tool_offset`, `set_work_offset`, `get_parameters`, `set_parameter`,
     /// `acknowledge_alarm`), on this client's node and mapping.
+    /// Waits (at most this client's timeout) until the service's server is matched.
     pub fn service<S: RosService>(&mut self, service: &str) -> Result<ServiceClient<S>, String> {
         let ns = self.namespace.clone();
+        let client = client::<S>(&mut self.ros, self.mapping, &ns, service)?;
+        wait_for_server(&self.ros.node, &client, self.timeout)
+            .map_err(|e| format!("{service}: {e}"))?;
         Ok(ServiceClient {
-            client: client::<S>(&mut self.ros, self.mapping, &ns, service)?,
+            client,
             timeout: self.timeout,
         })
     }
@@ -261,23 +297,78 @@ pub struct ServiceClient<S: RosService> {
 }
 
 impl<S: RosService> ServiceClient<S> {
+    /// Sends the request once (its server was matched when this client was made) and waits for
+    /// the reply.
     pub fn call(&self, request: S::Request) -> Result<S::Response, String> {
-        call(self.timeout, &self.client, request)
+        exchange(self.timeout, &self.client, request, Copies::Never)
     }
 }
 
-/// Calls a service. A request sent before discovery has matched the server is lost, so it is
-/// repeated every second (at most 3 copies); the first reply to any copy is the answer.
+/// Whether a lost reply may be made good by sending the request again: only for requests whose
+/// second execution changes nothing (a copy of an increment jog or of a cycle start would move the
+/// machine twice).
+#[derive(Clone, Copy, PartialEq)]
+enum Copies {
+    Allowed,
+    Never,
+}
+
+/// Waits until this node has matched the service's server (its request reader and its reply
+/// writer), at most `timeout`. A request written before that match would be lost.
+fn wait_for_server<Req: ros2_client::Message + 'static, Resp: ros2_client::Message + 'static>(
+    node: &ros2_client::Node,
+    client: &Client<Req, Resp>,
+    timeout: Duration,
+) -> Result<(), String> {
+    let matched = smol::block_on(smol::future::or(
+        async {
+            client.wait_for_service(node).await;
+            true
+        },
+        async {
+            smol::Timer::after(timeout).await;
+            false
+        },
+    ));
+    if matched {
+        Ok(())
+    } else {
+        Err(format!(
+            "no server of the service found within {} s",
+            timeout.as_secs()
+        ))
+    }
+}
+
+/// Calls a service once its server is matched, so the request is not lost in discovery; the
+/// reply is awaited until `timeout`. Where `copies` allows, the request is sent again every 2 s
+/// without a reply (at most 3 copies), the first reply to any copy being the answer.
 fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
+    node: &ros2_client::Node,
     timeout: Duration,
     client: &Client<Req, Resp>,
     req: Req,
+    copies: Copies,
+) -> Result<Resp, String> {
+    wait_for_server(node, client, timeout)?;
+    exchange(timeout, client, req, copies)
+}
+
+/// Sends the request and waits at most `timeout` for its reply; see [`call`].
+fn exchange<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message + 'static>(
+    timeout: Duration,
+    client: &Client<Req, Resp>,
+    req: Req,
+    copies: Copies,
 ) -> Result<Resp, String> {
     let deadline = Instant::now() + timeout;
     let mut ids = Vec::new();
     let mut last_send: Option<Instant> = None;
     while Instant::now() < deadline {
-        if ids.len() < 3 && last_send.is_none_or(|t| t.elapsed() > Duration::from_secs(1)) {
+        let again = copies == Copies::Allowed
+            && ids.len() < 3
+            && last_send.is_some_and(|t| t.elapsed() > Duration::from_secs(2));
+        if last_send.is_none() || again {
             ids.push(
                 client
                     .send_request(req.clone())
@@ -292,5 +383,8 @@ fn call<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Message 
         }
         std::thread::sleep(Duration::from_millis(2));
     }
-    Err("no reply from the cell within 20 s".into())
+    Err(format!(
+        "no reply from the cell within {} s",
+        timeout.as_secs()
+    ))
 }
