@@ -40,7 +40,7 @@ fn main() -> Result<(), String> {
     }
     let mut robot = Robot::new(arm.len(), 2.0, parts);
     let deadline = Instant::now() + Duration::from_secs(24 * 3600);
-    cnc::robot_node::tend(&mut arm, &mut robot, deadline)?;
+    cnc::robot_node::tend(&mut arm, &mut robot, None, deadline)?;
     for (ns, m) in machines.iter().zip(&robot.machines) {
         println!("{ns}: {} parts loaded, {:?}", m.parts, m.phase);
     }

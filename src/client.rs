@@ -42,6 +42,9 @@ pub struct CellClient {
     pub servo_stats: Option<ServoStats>,
     /// The machine's side of the robot handshake.
     pub handshake: Option<RobotHandshake>,
+    /// When a sample of any state topic last came (`axes` comes 25 times a second): how a
+    /// supervisor knows the machine is still there.
+    pub heard_at: Option<Instant>,
 }
 
 fn client<S: RosService>(
@@ -104,6 +107,7 @@ impl CellClient {
             axes: None,
             servo_stats: None,
             handshake: None,
+            heard_at: None,
         })
     }
 
@@ -156,27 +160,37 @@ impl CellClient {
     /// Takes every new sample of the state topics; returns the machine states seen, in order.
     pub fn poll(&mut self) -> Vec<MachineState> {
         let mut states = Vec::new();
+        let mut heard = false;
         while let Ok(Some((m, _))) = self.machine.take() {
             states.push(m.clone());
             self.state = Some(m);
         }
         while let Ok(Some((m, _))) = self.spindle_sub.take() {
             self.spindle = Some(m);
+            heard = true;
         }
         while let Ok(Some((m, _))) = self.parts.take() {
             self.part_count = Some(m);
+            heard = true;
         }
         while let Ok(Some((m, _))) = self.alarms_sub.take() {
             self.alarms = Some(m);
+            heard = true;
         }
         while let Ok(Some((m, _))) = self.axes_sub.take() {
             self.axes = Some(m);
+            heard = true;
         }
         while let Ok(Some((m, _))) = self.stats_sub.take() {
             self.servo_stats = Some(m);
+            heard = true;
         }
         while let Ok(Some((m, _))) = self.handshake_sub.take() {
             self.handshake = Some(m);
+            heard = true;
+        }
+        if heard || !states.is_empty() {
+            self.heard_at = Some(Instant::now());
         }
         states
     }
@@ -272,6 +286,16 @@ impl CellClient {
 
     pub fn node(&self) -> &RosNode {
         &self.ros
+    }
+
+    /// This client's node, to follow more of the machine's topics.
+    pub fn node_mut(&mut self) -> &mut RosNode {
+        &mut self.ros
+    }
+
+    /// The machine's namespace.
+    pub fn namespace(&self) -> &str {
+        &self.namespace
     }
 
     /// A client of any other service of the cell (`set_mode`, `mdi`, `get_offsets`,

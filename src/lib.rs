@@ -8,3 +8,5 @@ pub mod machines;
 pub mod robot;
 pub mod robot_node;
 pub mod simulate;
+pub mod supervisor;
+pub mod supervisor_node;

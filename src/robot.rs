@@ -61,7 +61,10 @@ pub struct Robot {
     /// The machine it served last: the next is looked for after it, so no machine starves.
     last: usize,
     swap_seconds: f64,
-    parts_each: u32,
+    /// Parts to load into each machine.
+    wanted: Vec<u32>,
+    /// Machines the cell lets the robot serve now (its supervisor's word; all by default).
+    allowed: Vec<bool>,
 }
 
 /// Whether a robot may enter the machine (or stay inside it).
@@ -73,21 +76,38 @@ impl Robot {
     /// A robot for `machines` machines that swaps a part in `swap_seconds` and loads
     /// `parts_each` parts into each.
     pub fn new(machines: usize, swap_seconds: f64, parts_each: u32) -> Robot {
-        let tended = Tended {
-            phase: if parts_each == 0 {
-                Phase::Done
-            } else {
-                Phase::WaitReady
-            },
-            parts: 0,
-            refusals: Vec::new(),
-        };
+        Robot::with_parts(swap_seconds, &vec![parts_each; machines])
+    }
+
+    /// A robot that loads `parts[i]` parts into machine `i`.
+    pub fn with_parts(swap_seconds: f64, parts: &[u32]) -> Robot {
+        let machines = parts
+            .iter()
+            .map(|&p| Tended {
+                phase: if p == 0 {
+                    Phase::Done
+                } else {
+                    Phase::WaitReady
+                },
+                parts: 0,
+                refusals: Vec::new(),
+            })
+            .collect();
         Robot {
-            machines: vec![tended; machines],
+            machines,
             inside: None,
-            last: machines.saturating_sub(1),
+            last: parts.len().saturating_sub(1),
             swap_seconds: swap_seconds.max(0.0),
-            parts_each,
+            wanted: parts.to_vec(),
+            allowed: vec![true; parts.len()],
+        }
+    }
+
+    /// Lets the robot serve machine `i` or not (a supervisor's pause, an unreachable machine).
+    /// A machine it is inside it finishes with: leaving a part loose would be worse.
+    pub fn allow(&mut self, i: usize, allowed: bool) {
+        if let Some(a) = self.allowed.get_mut(i) {
+            *a = allowed;
         }
     }
 
@@ -152,7 +172,7 @@ impl Robot {
                         // or a reset is not; the robot waits for whoever clears the machine
                         // and runs it to its end, and serves the others meanwhile.
                         m.parts += 1;
-                        m.phase = if m.parts >= self.parts_each {
+                        m.phase = if m.parts >= self.wanted.get(i).copied().unwrap_or(0) {
                             Phase::Done
                         } else {
                             Phase::WaitReady
@@ -162,7 +182,8 @@ impl Robot {
                 }
                 _ => None,
             };
-            if let Some(code) = ask {
+            let allowed = self.allowed.get(i).copied().unwrap_or(false);
+            if let (Some(code), true) = (ask, allowed) {
                 self.last = i;
                 return Some((i, code));
             }
@@ -369,5 +390,23 @@ mod tests {
         r.answered(i, code, false, "robot not clear refused: test", 0.0);
         assert_eq!(r.machines[0].refusals.len(), 1);
         assert_eq!(r.next(&[Some(finished())], 0.1), Some((0, Rq::NOT_CLEAR)));
+    }
+
+    #[test]
+    fn a_machine_the_cell_holds_back_is_not_entered_and_the_other_is_served() {
+        let mut r = Robot::with_parts(0.3, &[1, 1]);
+        r.allow(1, false);
+        let both = [Some(finished()), Some(finished())];
+        let mut t = 0.0;
+        let asked = drive(&mut r, &both, &mut t, 40);
+        assert!(asked.iter().all(|a| a.0 == 0), "{asked:?}");
+        assert!(asked.contains(&(0, Rq::CYCLE_START)));
+        // Allowed again, it is served.
+        r.allow(1, true);
+        assert_eq!(r.next(&both, t), Some((1, Rq::NOT_CLEAR)));
+        // Each machine its own number of parts.
+        let r = Robot::with_parts(0.3, &[0, 2]);
+        assert_eq!(r.machines[0].phase, Phase::Done);
+        assert_eq!(r.machines[1].phase, Phase::WaitReady);
     }
 }

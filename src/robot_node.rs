@@ -1,22 +1,94 @@
 //! The robot's shell: the [`Robot`] core against machines over ROS 2, through their public
-//! interface only (`robot_handshake`, `robot_request`), with the wall clock for the swap.
+//! interface only (`robot_handshake`, `robot_request`), with the wall clock for the swap. In a
+//! cell with a supervisor it follows `/cell/state` and serves only the machines the supervisor
+//! has producing: not one that is paused, unreachable or done.
 
 use std::time::{Duration, Instant};
 
-use cnc_msgs::msg::RobotHandshake;
+use cnc_msgs::msg::{CellMachine, CellState, RobotHandshake};
+use cnc_runtime::config::NetworkConfig;
+use cnc_runtime::dds::RosNode;
+use ros2_client::dds::Subscription;
 
 use crate::client::CellClient;
 use crate::robot::Robot;
+use crate::supervisor_node::{CELL_NAMESPACE, CELL_STATE};
 
-/// Tends `machines` (one client each, in the robot's order) until the robot has its parts or
-/// `deadline` passes. Each request waits for the machine to answer it done or refused.
+/// The supervisor's state topic, as the robot follows it.
+pub struct CellWatch {
+    _node: RosNode,
+    state: Subscription<CellState>,
+    /// The supervisor's last state.
+    pub last: Option<CellState>,
+}
+
+impl CellWatch {
+    pub fn new(net: &NetworkConfig, who: &str) -> Result<CellWatch, String> {
+        let mut node = RosNode::new(net, CELL_NAMESPACE, who)?;
+        let state = node.dds_subscription(&CELL_STATE)?;
+        Ok(CellWatch {
+            _node: node,
+            state,
+            last: None,
+        })
+    }
+
+    /// Takes the new states; whether the supervisor has one.
+    pub fn poll(&mut self) -> bool {
+        while let Ok(Some((s, _))) = self.state.take() {
+            self.last = Some(s);
+        }
+        self.last.is_some()
+    }
+
+    /// Whether the supervisor has machine `name` producing.
+    pub fn producing(&self, name: &str) -> bool {
+        self.last.as_ref().is_some_and(|s| {
+            s.machines
+                .iter()
+                .any(|m| m.name == name && m.status == CellMachine::PRODUCING)
+        })
+    }
+
+    /// Whether the supervisor's order is complete.
+    pub fn complete(&self) -> bool {
+        self.last.as_ref().is_some_and(|s| s.complete)
+    }
+}
+
+/// One request the robot made.
+#[derive(Debug, Clone)]
+pub struct Asked {
+    pub at: Instant,
+    pub machine: usize,
+    /// The `RobotRequest` code.
+    pub code: u8,
+    pub accepted: bool,
+}
+
+/// Tends `machines` (one client each, in the robot's order) until the robot has its parts, the
+/// supervisor followed through `cell` says its order is complete, or `deadline` passes. Each
+/// request waits for the machine to answer it done or refused. Returns the requests made.
 pub fn tend(
     machines: &mut [CellClient],
     robot: &mut Robot,
+    mut cell: Option<&mut CellWatch>,
     deadline: Instant,
-) -> Result<(), String> {
+) -> Result<Vec<Asked>, String> {
     let t0 = Instant::now();
-    while !robot.finished() {
+    let mut asked = Vec::new();
+    loop {
+        if let Some(w) = cell.as_deref_mut() {
+            w.poll();
+            if w.complete() {
+                return Ok(asked);
+            }
+            for (i, c) in machines.iter().enumerate() {
+                robot.allow(i, w.producing(c.namespace()));
+            }
+        } else if robot.finished() {
+            return Ok(asked);
+        }
         if Instant::now() > deadline {
             return Err(format!(
                 "the robot did not finish in time: {:?}",
@@ -33,10 +105,17 @@ pub fn tend(
                 let Some(c) = machines.get_mut(i) else {
                     return Err(format!("no machine {i}"));
                 };
+                let at = Instant::now();
                 let (accepted, message) = match c.robot_request(code) {
                     Ok(r) => (r.accepted, r.message),
                     Err(e) => (false, e),
                 };
+                asked.push(Asked {
+                    at,
+                    machine: i,
+                    code,
+                    accepted,
+                });
                 robot.answered(i, code, accepted, &message, t0.elapsed().as_secs_f64());
                 if !accepted {
                     std::thread::sleep(Duration::from_millis(200));
@@ -45,5 +124,4 @@ pub fn tend(
             None => std::thread::sleep(Duration::from_millis(20)),
         }
     }
-    Ok(())
 }

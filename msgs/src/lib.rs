@@ -27,6 +27,8 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("AlarmEvent", include_str!("../msg/AlarmEvent.msg")),
     ("Axis", include_str!("../msg/Axis.msg")),
     ("AxisState", include_str!("../msg/AxisState.msg")),
+    ("CellMachine", include_str!("../msg/CellMachine.msg")),
+    ("CellState", include_str!("../msg/CellState.msg")),
     ("CommandEvent", include_str!("../msg/CommandEvent.msg")),
     ("CommandResult", include_str!("../msg/CommandResult.msg")),
     ("MachineState", include_str!("../msg/MachineState.msg")),

@@ -391,6 +391,39 @@ ros_message! {
 }
 
 ros_message! {
+    /// One machine of the cell as the cell supervisor sees it.
+    pub struct CellMachine("cnc_msgs/msg/CellMachine") {
+        consts {
+            WAITING: u8 = 0,
+            PRODUCING: u8 = 1,
+            PAUSED: u8 = 2,
+            UNREACHABLE: u8 = 3,
+            DONE: u8 = 4,
+        }
+        name: String,
+        status: u8,
+        reason: String,
+        program: String,
+        target: u32,
+        count: u32,
+        counter_at_start: u32,
+        cycle_times: Vec<f64>,
+        silent_seconds: f64,
+    }
+}
+
+ros_message! {
+    /// The cell supervisor's view of its work order.
+    pub struct CellState("cnc_msgs/msg/CellState") {
+        consts {}
+        stamp: Time,
+        order: String,
+        complete: bool,
+        machines: Vec<CellMachine>,
+    }
+}
+
+ros_message! {
     /// The machine's side of the robot handshake.
     pub struct RobotHandshake("cnc_msgs/msg/RobotHandshake") {
         consts {}

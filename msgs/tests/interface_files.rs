@@ -128,6 +128,8 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<CommandEvent>("CommandEvent.msg");
     check_msg::<ProgramEvent>("ProgramEvent.msg");
     check_msg::<RobotHandshake>("RobotHandshake.msg");
+    check_msg::<CellMachine>("CellMachine.msg");
+    check_msg::<CellState>("CellState.msg");
     check_msg::<Overrides>("Overrides.msg");
     check_msg::<ToolOffset>("ToolOffset.msg");
     check_msg::<WorkOffset>("WorkOffset.msg");
@@ -202,6 +204,8 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "CommandEvent",
         "ProgramEvent",
         "RobotHandshake",
+        "CellMachine",
+        "CellState",
         "RobotRequest",
         "ListPrograms",
         "DeleteProgram",

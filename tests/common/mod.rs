@@ -5,6 +5,10 @@ use std::process::{Child, Command, Stdio};
 
 use cnc_runtime::LaunchConfig;
 
+pub mod cell_run;
+#[allow(unused_imports)]
+pub use cell_run::robot_tends;
+
 /// `launch_configs/sim_lathe.yaml` for a cell run as its own process (`cnc run`), written as
 /// `name` into `dir`, where its kept files go too (the config's paths are relative to it): DDS
 /// `domain`, no recorder, no web panel, no alarms for servo lateness; `edit` changes more.
@@ -244,90 +248,3 @@ pub fn fresh_dir(name: &str) -> PathBuf {
 #[allow(dead_code)]
 pub const SHORT_PART: &str =
     "O0001\nG98 G97 S500 M03\nG00 X100 Z5\nG01 Z-10 F1500\nG00 X150 Z50\nM05\nM30\n";
-
-/// Issue 29's judge of a robot cell: on `net`, a supervisor's client loads [`SHORT_PART`] into
-/// each machine of `names` and runs its first part; one robot arm then loads `parts_each`
-/// more into each; every machine must count them all (1 + `parts_each`), and an observer that
-/// is not the robot reads every `robot_handshake` sample: whenever a machine's PLC sees the
-/// robot inside, its door is open, its spindle stands, no cycle runs and no emergency stop is
-/// pressed. Returns how many such samples it saw.
-#[allow(dead_code)]
-pub fn robot_tends(
-    net: &cnc_runtime::config::NetworkConfig,
-    names: &[&str],
-    parts_each: u32,
-) -> usize {
-    use cnc::client::CellClient;
-    use cnc_msgs::msg::{MachineState, RobotHandshake};
-    use cnc_runtime::dds::{qos, RosNode};
-    use std::time::{Duration, Instant};
-
-    let client = |ns: &str, who: &str| {
-        let mut c = CellClient::new(net, ns, who, ros2_client::ServiceMapping::Enhanced)
-            .expect("client")
-            .with_timeout(Duration::from_secs(20));
-        c.wait_ready(Duration::from_secs(60))
-            .unwrap_or_else(|e| panic!("{ns}: {e}"));
-        c
-    };
-    let mut observers: Vec<RosNode> = names
-        .iter()
-        .map(|ns| RosNode::new(net, ns, "observer").expect("observer"))
-        .collect();
-    let watch: Vec<_> = observers
-        .iter_mut()
-        .map(|o| {
-            o.dds_subscription_with_qos::<RobotHandshake>(
-                &cnc_runtime::topics::ROBOT_HANDSHAKE,
-                qos::state().history(ros2_client::qos::History::KeepLast { depth: 10_000 }),
-            )
-            .expect("handshake reader")
-        })
-        .collect();
-    let mut supervisor: Vec<CellClient> = names.iter().map(|ns| client(ns, "supervisor")).collect();
-    for s in supervisor.iter_mut() {
-        let r = s.load_program("part.nc", SHORT_PART).expect("load");
-        assert!(r.accepted, "{}", r.message);
-        let r = s.start_program("part.nc").expect("start");
-        assert!(r.accepted, "{}", r.message);
-    }
-    let mut arm: Vec<CellClient> = names.iter().map(|ns| client(ns, "robot")).collect();
-    let mut robot = cnc::robot::Robot::new(names.len(), 1.0, parts_each);
-    let t0 = Instant::now();
-    let done = cnc::robot_node::tend(&mut arm, &mut robot, t0 + Duration::from_secs(240));
-    println!(
-        "robot: {:?} after {:.1} s",
-        robot.machines,
-        t0.elapsed().as_secs_f64()
-    );
-    done.expect("the robot loaded its parts");
-    assert!(robot.machines.iter().all(|m| m.parts == parts_each));
-    for (ns, s) in names.iter().zip(supervisor.iter_mut()) {
-        wait(
-            s,
-            Duration::from_secs(30),
-            &format!("{ns}: its parts counted"),
-            |s| {
-                s.part_count.as_ref().map_or(0, |p| p.count) == 1 + parts_each
-                    && s.state
-                        .as_ref()
-                        .is_some_and(|m| m.execution == MachineState::PROGRAM_COMPLETED)
-            },
-        );
-        println!("{ns}: {} parts counted by the machine", 1 + parts_each);
-    }
-    let mut inside = 0;
-    for (ns, w) in names.iter().zip(&watch) {
-        while let Ok(Some((h, _))) = w.take() {
-            if !h.robot_clear {
-                inside += 1;
-                assert!(
-                    h.door_open && !h.spindle_turning && !h.emergency_stop && !h.cycle_active,
-                    "{ns}: the robot inside an unsafe machine: {h:?}"
-                );
-            }
-        }
-    }
-    println!("samples with the robot inside: {inside}, all safe");
-    inside
-}
