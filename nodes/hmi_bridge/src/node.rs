@@ -174,7 +174,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
         None
     } else {
         let axes = cfg.machine.axes.iter().map(|a| a.name.clone()).collect();
-        match WebHmi::start(&cfg.hmi, axes, cfg.diameter_axes()) {
+        match WebHmi::start(&cfg.hmi, &cfg.machine.namespace, axes, cfg.diameter_axes()) {
             Ok(w) => Some(w),
             Err(e) => {
                 log::error!("hmi_bridge: {e}; the web HMI is not served");

@@ -309,6 +309,21 @@ $("acknowledge").onclick = () => send({ op: "acknowledge" });
 $("param_set").onclick = () => send({ op: "set_parameter", name: $("param_name").value, value: $("param_value").value });
 $("param_filter").oninput = showParameters;
 
+// A machine of a cell offers the other machines' panels: choosing one opens it.
+function showCell(cell) {
+  const panels = (cell && cell.panels) || [];
+  $("machine_pick").hidden = panels.length === 0;
+  const select = $("machine_select");
+  select.replaceChildren(...panels.map((p) => {
+    const o = document.createElement("option");
+    o.value = p.url;
+    o.textContent = p.name;
+    o.selected = p.name === cell.machine;
+    return o;
+  }));
+  select.onchange = () => { window.location.href = select.value; };
+}
+
 // On the network the panel needs a login (the server says so at /session); on the machine's
 // own screen (loopback) it does not.
 async function start() {
@@ -316,6 +331,7 @@ async function start() {
   try { session = await (await fetch("/session")).json(); } catch (_) { setTimeout(start, 1000); return; }
   $("operator").hidden = !session.operator;
   $("operator_name").textContent = session.operator || "";
+  showCell(session.cell);
   if (session.required && !session.operator) {
     document.querySelector("main").hidden = true;
     $("login").hidden = false;

@@ -172,6 +172,8 @@ pub struct Gate {
     origins: Vec<String>,
     lifetime: Duration,
     sessions: Mutex<BTreeMap<String, (String, Instant)>>,
+    /// What `/session` also tells the page: the machine and the cell's other panels.
+    pub cell: serde_json::Value,
 }
 
 impl Gate {
@@ -197,6 +199,7 @@ impl Gate {
             origins,
             lifetime,
             sessions: Mutex::new(BTreeMap::new()),
+            cell: serde_json::Value::Null,
         }
     }
 

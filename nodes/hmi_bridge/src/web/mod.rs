@@ -54,8 +54,10 @@ pub struct WebHmi {
 }
 
 impl WebHmi {
+    /// The panel of machine `machine`.
     pub fn start(
         hmi: &cnc_runtime::config::HmiConfig,
+        machine: &str,
         axes: Vec<String>,
         diameter: Vec<bool>,
     ) -> Result<WebHmi, String> {
@@ -66,8 +68,11 @@ impl WebHmi {
         };
         let lifetime = Duration::from_secs(hmi.session_seconds.max(1));
         let origins = hmi.web_origins.clone();
+        let cell = serde_json::json!({"machine": machine, "panels": hmi.cell_panels});
         let server = WebServer::start(&hmi.web_address, move |bound| {
-            login::Gate::new(bound, operators, origins, lifetime)
+            let mut gate = login::Gate::new(bound, operators, origins, lifetime);
+            gate.cell = cell;
+            gate
         })?;
         log::info!("web HMI on http://{}/", server.address);
         Ok(WebHmi {

@@ -321,7 +321,11 @@ fn serve(
             );
         }
         ("GET", "/session") => {
-            let body = serde_json::json!({"required": gate.required, "operator": operator});
+            let body = serde_json::json!({
+                "required": gate.required,
+                "operator": operator,
+                "cell": gate.cell,
+            });
             return respond(
                 &mut stream,
                 "200 OK",

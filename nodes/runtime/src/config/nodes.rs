@@ -74,6 +74,19 @@ pub struct HmiConfig {
     /// panel on an unspecified address (`0.0.0.0`) must name them.
     #[serde(default)]
     pub web_origins: Vec<String>,
+    /// The panels of the cell's machines (this one among them), offered by the panel's
+    /// machine selector; empty: no selector.
+    #[serde(default)]
+    pub cell_panels: Vec<CellPanel>,
+}
+
+/// One machine's web panel in the cell.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+pub struct CellPanel {
+    /// The machine's namespace, `lathe2`.
+    pub name: String,
+    /// Its panel, `http://127.0.0.1:8081/`.
+    pub url: String,
 }
 
 fn default_operators_file() -> Option<std::path::PathBuf> {
@@ -100,6 +113,7 @@ impl Default for HmiConfig {
             operators_file: default_operators_file(),
             session_seconds: default_session_seconds(),
             web_origins: Vec::new(),
+            cell_panels: Vec::new(),
         }
     }
 }
