@@ -3,6 +3,7 @@
 
 pub mod bench_paths;
 pub mod cell;
+pub mod cell_launch;
 pub mod client;
 pub mod machines;
 pub mod robot;

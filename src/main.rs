@@ -2,7 +2,8 @@
 //!
 //! `cnc run [CONFIG]` runs until Ctrl-C; with `--program FILE --cycles N` it loads and runs the
 //! program N times through the cell's own ROS 2 services and exits 0 when done, 1 on any alarm.
-//! With no arguments it runs the built-in simulated lathe with the demo part, looping. Where no
+//! With no arguments it runs the built-in simulated lathe with the demo part, looping.
+//! `cnc run <cell launch file>` runs a whole cell: its machines, robot and supervisor. Where no
 //! config is named, the built-in lathe is used ([`cnc::machines`]).
 
 use std::path::{Path, PathBuf};
@@ -30,7 +31,8 @@ enum Verb {
     /// Start every node of the cell in this process.
     Run {
         /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill); default:
-        /// the built-in sim_lathe.
+        /// the built-in sim_lathe. A cell launch file (`launch_configs/cell_two_lathes.yaml`)
+        /// runs all its machines, the robot and the cell supervisor until its order is done.
         #[arg(value_name = "CONFIG")]
         config_file: Option<PathBuf>,
         /// The same as CONFIG.
@@ -533,6 +535,12 @@ fn read_named_program(path: &Path) -> Result<NamedProgram, String> {
 }
 
 fn run(config: Option<&Path>, program: Option<NamedProgram>, cycles: u32) -> Result<(), String> {
+    if let Some(path) = config.filter(|p| cnc::cell_launch::is_cell_file(p)) {
+        if program.is_some() {
+            return Err("a cell launch file runs its work order: no --program".into());
+        }
+        return run_cell(path);
+    }
     let (cfg, described) = machines::load(config, None)?;
     install_signal_handlers();
     let domain = cfg.network.effective_domain_id()?;
@@ -559,6 +567,155 @@ fn run(config: Option<&Path>, program: Option<NamedProgram>, cycles: u32) -> Res
     } else {
         Err("a node failed".into())
     }
+}
+
+/// Runs a whole cell from its launch file: every machine, the cell supervisor and the robot
+/// in this process, until the work order is complete (exit 0), Ctrl-C, or a node fails. The
+/// terminal shows the supervisor's view whenever it changes.
+fn run_cell(path: &Path) -> Result<(), String> {
+    use cnc::robot_node::CellWatch;
+    let launch = cnc::cell_launch::load(path)?;
+    install_signal_handlers();
+    let mut cells = Vec::new();
+    for cfg in &launch.machines {
+        match Cell::start(cfg) {
+            Ok(c) => cells.push(c),
+            Err(e) => {
+                for c in cells {
+                    c.stop();
+                }
+                return Err(format!("{}: {e}", cfg.machine.namespace));
+            }
+        }
+        let web = match cfg.hmi.web_address.as_str() {
+            "" => "no web panel".to_string(),
+            a => format!("web panel http://{a}/"),
+        };
+        println!(
+            "machine '{}' running: DDS domain {} on {:?}, {web}",
+            cfg.machine.namespace,
+            cfg.network.effective_domain_id()?,
+            cfg.network.interfaces
+        );
+    }
+    let net = launch.machines[0].network.clone();
+    let names: Vec<String> = launch
+        .order
+        .lines
+        .iter()
+        .map(|l| l.machine.clone())
+        .collect();
+    let (order, options) = (launch.order, launch.supervisor);
+    println!(
+        "work order '{}': {} parts of {} on each of {}",
+        order.name,
+        order.lines[0].parts,
+        order.lines[0].program,
+        names.join(", ")
+    );
+    // The supervisor starts each machine's first part; the robot loads the others.
+    let parts: Vec<u32> = order
+        .lines
+        .iter()
+        .map(|l| l.parts.saturating_sub(1))
+        .collect();
+    let supervisor = {
+        let net = net.clone();
+        std::thread::spawn(move || cnc::supervisor_node::supervise(&net, order, &options, &STOP))
+    };
+    let robot_net = net.clone();
+    let swap = launch.swap_seconds;
+    let robot_names = names.clone();
+    std::thread::spawn(move || {
+        let run = || -> Result<(), String> {
+            let mut arm = Vec::new();
+            for ns in &robot_names {
+                let mut c = CellClient::new(&robot_net, ns, "robot", ServiceMapping::Enhanced)?
+                    .with_timeout(Duration::from_secs(5));
+                c.wait_ready(Duration::from_secs(60))?;
+                arm.push(c);
+            }
+            let mut watch = CellWatch::new(&robot_net, "robot")?;
+            let mut robot = cnc::robot::Robot::with_parts(swap, &parts);
+            let forever = Instant::now() + Duration::from_secs(365 * 24 * 3600);
+            cnc::robot_node::tend(&mut arm, &mut robot, Some(&mut watch), forever).map(|_| ())
+        };
+        if let Err(e) = run() {
+            eprintln!("cnc: robot: {e}");
+        }
+    });
+    let mut watch = CellWatch::new(&net, "cnc_cli")?;
+    let mut shown = String::new();
+    let outcome = loop {
+        if STOP.load(Ordering::SeqCst) {
+            break Ok(());
+        }
+        if let Some(node) = cells.iter().find_map(|c| c.failed_node()) {
+            break Err(format!("node {node} stopped"));
+        }
+        watch.poll();
+        if let Some(s) = &watch.last {
+            let line = cell_line(s);
+            if line != shown {
+                println!("{line}");
+                shown = line;
+            }
+            if s.complete {
+                println!("work order '{}' complete", s.order);
+                break Ok(());
+            }
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    STOP.store(true, Ordering::SeqCst);
+    let finished = supervisor
+        .join()
+        .map_err(|_| "the supervisor panicked".to_string())
+        .and_then(|r| r);
+    if let Ok((_, Some(bag))) = &finished {
+        println!("supervisor's audit bag: {}", bag.display());
+    }
+    let mut errors = Vec::new();
+    for c in cells {
+        errors.extend(c.stop().1);
+    }
+    for e in &errors {
+        eprintln!("cnc: {e}");
+    }
+    outcome?;
+    finished?;
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err("a node failed".into())
+    }
+}
+
+/// One line of the supervisor's view: each machine's status, parts and last cycle time.
+fn cell_line(s: &cnc_msgs::msg::CellState) -> String {
+    s.machines
+        .iter()
+        .map(|m| {
+            let last = m
+                .cycle_times
+                .last()
+                .map_or(String::new(), |t| format!(", last cycle {t:.2} s"));
+            let why = match m.status {
+                cnc_msgs::msg::CellMachine::PAUSED | cnc_msgs::msg::CellMachine::UNREACHABLE => {
+                    format!(" ({})", m.reason)
+                }
+                _ => String::new(),
+            };
+            format!(
+                "{} {}{why}: {}/{} parts{last}",
+                m.name,
+                cnc::supervisor::status_name(m.status),
+                m.count,
+                m.target
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(" | ")
 }
 
 /// Loads and runs the program for the requested cycles, printing progress; or just waits.
