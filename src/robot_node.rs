@@ -20,7 +20,13 @@ pub struct CellWatch {
     state: Subscription<CellState>,
     /// The supervisor's last state.
     pub last: Option<CellState>,
+    /// When it came.
+    heard_at: Option<Instant>,
 }
+
+/// The supervisor publishes its state at least once a second; a robot that has heard nothing
+/// for this long takes no machine (the supervisor is gone, or the robot's link to it).
+const SUPERVISOR_SILENCE: Duration = Duration::from_secs(5);
 
 impl CellWatch {
     pub fn new(net: &NetworkConfig, who: &str) -> Result<CellWatch, String> {
@@ -30,6 +36,7 @@ impl CellWatch {
             _node: node,
             state,
             last: None,
+            heard_at: None,
         })
     }
 
@@ -37,23 +44,32 @@ impl CellWatch {
     pub fn poll(&mut self) -> bool {
         while let Ok(Some((s, _))) = self.state.take() {
             self.last = Some(s);
+            self.heard_at = Some(Instant::now());
         }
         self.last.is_some()
     }
 
-    /// Whether the supervisor has machine `name` producing.
+    /// Whether the supervisor, heard lately, has machine `name` producing.
     pub fn producing(&self, name: &str) -> bool {
-        self.last.as_ref().is_some_and(|s| {
-            s.machines
-                .iter()
-                .any(|m| m.name == name && m.status == CellMachine::PRODUCING)
-        })
+        let silence = self.heard_at.map(|t| t.elapsed());
+        serves(self.last.as_ref(), silence, name)
     }
 
     /// Whether the supervisor's order is complete.
     pub fn complete(&self) -> bool {
         self.last.as_ref().is_some_and(|s| s.complete)
     }
+}
+
+/// Whether the robot may serve machine `name`, from the supervisor's last state and how long
+/// ago it came.
+fn serves(last: Option<&CellState>, silence: Option<Duration>, name: &str) -> bool {
+    silence.is_some_and(|d| d < SUPERVISOR_SILENCE)
+        && last.is_some_and(|s| {
+            s.machines
+                .iter()
+                .any(|m| m.name == name && m.status == CellMachine::PRODUCING)
+        })
 }
 
 /// One request the robot made.
@@ -123,5 +139,40 @@ pub fn tend(
             }
             None => std::thread::sleep(Duration::from_millis(20)),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_a_machine_a_supervisor_heard_lately_has_producing_is_served() {
+        let state = CellState {
+            machines: vec![
+                CellMachine {
+                    name: "lathe1".into(),
+                    status: CellMachine::PRODUCING,
+                    ..CellMachine::default()
+                },
+                CellMachine {
+                    name: "lathe2".into(),
+                    status: CellMachine::UNREACHABLE,
+                    ..CellMachine::default()
+                },
+            ],
+            ..CellState::default()
+        };
+        let now = Some(Duration::from_millis(100));
+        assert!(serves(Some(&state), now, "lathe1"));
+        assert!(!serves(Some(&state), now, "lathe2"));
+        assert!(!serves(Some(&state), now, "lathe3"));
+        assert!(!serves(None, now, "lathe1"));
+        assert!(!serves(Some(&state), None, "lathe1"));
+        assert!(!serves(
+            Some(&state),
+            Some(Duration::from_secs(6)),
+            "lathe1"
+        ));
     }
 }
