@@ -627,20 +627,9 @@ fn run_cell(path: &Path) -> Result<(), String> {
     let swap = launch.swap_seconds;
     let robot_names = names.clone();
     std::thread::spawn(move || {
-        let run = || -> Result<(), String> {
-            let mut arm = Vec::new();
-            for ns in &robot_names {
-                let mut c = CellClient::new(&robot_net, ns, "robot", ServiceMapping::Enhanced)?
-                    .with_timeout(Duration::from_secs(5));
-                c.wait_ready(Duration::from_secs(60))?;
-                arm.push(c);
-            }
-            let mut watch = CellWatch::new(&robot_net, "robot")?;
-            let mut robot = cnc::robot::Robot::with_parts(swap, &parts);
-            let forever = Instant::now() + Duration::from_secs(365 * 24 * 3600);
-            cnc::robot_node::tend(&mut arm, &mut robot, Some(&mut watch), forever).map(|_| ())
-        };
-        if let Err(e) = run() {
+        let forever = Instant::now() + Duration::from_secs(365 * 24 * 3600);
+        let served = cnc::robot_node::serve_cell(&robot_net, &robot_names, &parts, swap, forever);
+        if let Err(e) = served {
             eprintln!("cnc: robot: {e}");
         }
     });

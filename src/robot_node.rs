@@ -61,6 +61,31 @@ impl CellWatch {
     }
 }
 
+/// A robot in a cell with a supervisor: connects to the machines `names` on `net` (each given
+/// a minute to become ready), loads `parts[i]` parts into machine `i` (a swap takes
+/// `swap_seconds`) while the supervisor lets it, until the supervisor's order is complete or
+/// `deadline` passes. Returns the robot and the requests it made.
+pub fn serve_cell(
+    net: &NetworkConfig,
+    names: &[String],
+    parts: &[u32],
+    swap_seconds: f64,
+    deadline: Instant,
+) -> Result<(Robot, Vec<Asked>), String> {
+    let mut arm = Vec::new();
+    for ns in names {
+        let mut c = CellClient::new(net, ns, "robot", ros2_client::ServiceMapping::Enhanced)?
+            .with_timeout(Duration::from_secs(5));
+        c.wait_ready(Duration::from_secs(60))
+            .map_err(|e| format!("{ns}: {e}"))?;
+        arm.push(c);
+    }
+    let mut watch = CellWatch::new(net, "robot")?;
+    let mut robot = Robot::with_parts(swap_seconds, parts);
+    let asked = tend(&mut arm, &mut robot, Some(&mut watch), deadline)?;
+    Ok((robot, asked))
+}
+
 /// Whether the robot may serve machine `name`, from the supervisor's last state and how long
 /// ago it came.
 fn serves(last: Option<&CellState>, silence: Option<Duration>, name: &str) -> bool {

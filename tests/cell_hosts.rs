@@ -334,16 +334,7 @@ fn a_lathe_cut_off_for_10_s_finishes_its_cycle_and_is_taken_back_while_the_other
     // The audit bag: it verifies, and a reader nobody here wrote finds the decisions and the
     // machines' commands in it.
     let bag = out.bag.clone().expect("audit bag");
-    let verify = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["audit", "verify"])
-        .arg(&bag)
-        .output()
-        .expect("cnc audit verify");
-    println!(
-        "cnc audit verify: {}",
-        String::from_utf8_lossy(&verify.stdout).trim()
-    );
-    assert!(verify.status.success());
+    println!("cnc audit verify: {}", common::cell_run::audit_verify(&bag));
     let lines = read_cell_bag(&bag);
     let has = |topic: &str, what: &str| {
         lines

@@ -11,7 +11,6 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use cnc::client::CellClient;
 use cnc::robot::Robot;
 use cnc::robot_node::{Asked, CellWatch};
 use cnc::supervisor::{Order, OrderLine};
@@ -107,22 +106,11 @@ impl CellRun {
         let robot = {
             let net = net.clone();
             let names: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+            // The supervisor starts each first part; the robot loads the others.
+            let each = vec![parts.saturating_sub(1); names.len()];
+            let deadline = Instant::now() + Duration::from_secs(300);
             std::thread::spawn(move || {
-                let mut arm = Vec::new();
-                for ns in &names {
-                    let mut c =
-                        CellClient::new(&net, ns, "robot", ros2_client::ServiceMapping::Enhanced)?
-                            .with_timeout(Duration::from_secs(5));
-                    c.wait_ready(Duration::from_secs(60))?;
-                    arm.push(c);
-                }
-                let mut watch = CellWatch::new(&net, "robot")?;
-                // The supervisor starts each first part; the robot loads the others.
-                let mut robot = Robot::with_parts(1.0, &vec![parts.saturating_sub(1); names.len()]);
-                let deadline = Instant::now() + Duration::from_secs(300);
-                let asked =
-                    cnc::robot_node::tend(&mut arm, &mut robot, Some(&mut watch), deadline)?;
-                Ok((robot, asked))
+                cnc::robot_node::serve_cell(&net, &names, &each, 1.0, deadline)
             })
         };
         CellRun {
@@ -245,6 +233,18 @@ impl Outcome {
             );
         }
     }
+}
+
+/// `cnc audit verify` on a bag: its verdict; fails the test unless the chain is intact.
+pub fn audit_verify(bag: &std::path::Path) -> String {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["audit", "verify"])
+        .arg(bag)
+        .output()
+        .expect("cnc audit verify runs");
+    let verdict = String::from_utf8_lossy(&out.stdout).trim().to_string();
+    assert!(out.status.success(), "{verdict}");
+    verdict
 }
 
 /// A whole run on `net` without faults: `parts_each` parts per machine after the first the
