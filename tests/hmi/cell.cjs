@@ -3,24 +3,15 @@
 // shows lathe2 chosen and its parts counting up while the robot tends it.
 // Usage: node cell.cjs <lathe1 panel url> <lathe2 panel url>. Exits 1 with the reason on a failure.
 "use strict";
-const { chromium } = require(process.env.PLAYWRIGHT_CORE || "playwright-core");
+const { fail, launch } = require("./browser.cjs");
 const [first, second] = process.argv.slice(2);
-
-function fail(why) {
-  console.error(`FAIL: ${why}`);
-  process.exit(1);
-}
 
 async function machines(page) {
   return page.$$eval("#machine_select option", (os) => os.map((o) => `${o.textContent}${o.selected ? "*" : ""}`));
 }
 
 (async () => {
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
-    args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-  });
+  const browser = await launch();
   const page = await browser.newPage();
   page.on("pageerror", (e) => fail(`page error: ${e.message}`));
   await page.goto(first);

@@ -4,20 +4,11 @@
 // goes out (as a command event naming the operator, checked by tests/web_login.rs).
 // Usage: node login.cjs <url> <operator> <password>. Exits 1 with the reason on a failure.
 "use strict";
-const { chromium } = require(process.env.PLAYWRIGHT_CORE || "playwright-core");
+const { fail, launch } = require("./browser.cjs");
 const [url, operator, password] = process.argv.slice(2);
 
-function fail(why) {
-  console.error(`FAIL: ${why}`);
-  process.exit(1);
-}
-
 (async () => {
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
-    args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-  });
+  const browser = await launch();
   const page = await browser.newPage();
   page.on("pageerror", (e) => fail(`page error: ${e.message}`));
   await page.goto(url);

@@ -5,7 +5,7 @@
 // Usage: node panel.cjs <url> <screenshot.png>; PLAYWRIGHT_CORE names the module. Exits 1 with
 // the reason when something is not as it should be.
 "use strict";
-const { chromium } = require(process.env.PLAYWRIGHT_CORE || "playwright-core");
+const { fail, launch } = require("./browser.cjs");
 const [url, screenshot] = process.argv.slice(2);
 
 const PROGRAM = [
@@ -20,11 +20,6 @@ const PROGRAM = [
   "M05",
   "M30",
 ].join("\n");
-
-function fail(why) {
-  console.error(`FAIL: ${why}`);
-  process.exit(1);
-}
 
 let page = null;
 
@@ -43,11 +38,7 @@ async function waitFor(what, check, seconds) {
 }
 
 (async () => {
-  const browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
-    args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-      "--disable-background-networking", "--disable-component-update", "--disable-sync"],
-  });
+  const browser = await launch();
   page = await browser.newPage({ viewport: { width: 1400, height: 1100 } });
   page.on("pageerror", (e) => fail(`page error: ${e.message}`));
   await page.goto(url);
