@@ -9,6 +9,7 @@ use crate::gtc2e::Gtc2e;
 use crate::huaxing::Huaxing;
 use crate::iso::IsoLathe;
 use crate::mill::Mill;
+use crate::sinumerik::{self, Sinumerik};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Dialect {
@@ -20,6 +21,8 @@ pub enum Dialect {
     IsoLathe,
     /// The FANUC 0-M mill (`003`).
     FanucMill,
+    /// The SINUMERIK 802D sl mill (`001`).
+    Sinumerik802d,
 }
 
 /// A running front end, as the interpreter drives it.
@@ -51,19 +54,26 @@ fn m_status<D: Family>(x10: u32) -> Option<CodeStatus> {
 }
 
 impl Dialect {
-    pub const ALL: [Dialect; 4] = [
+    pub const ALL: [Dialect; 5] = [
         Dialect::HuaxingLathe,
         Dialect::Gtc2eLathe,
         Dialect::IsoLathe,
         Dialect::FanucMill,
+        Dialect::Sinumerik802d,
     ];
 
     /// A lathe's dialect: X in diameter, the Z-X plane.
     pub fn is_lathe(self) -> bool {
-        self != Dialect::FanucMill
+        !matches!(self, Dialect::FanucMill | Dialect::Sinumerik802d)
     }
 
+    /// A dialect by its name; `sinumerik` is short for `sinumerik-802d`.
     pub fn from_name(name: &str) -> Option<Dialect> {
+        let name = if name == "sinumerik" {
+            "sinumerik-802d"
+        } else {
+            name
+        };
         Dialect::ALL.into_iter().find(|d| d.name() == name)
     }
 
@@ -73,6 +83,7 @@ impl Dialect {
             Dialect::Gtc2eLathe => "gtc2e-lathe",
             Dialect::IsoLathe => "iso-lathe",
             Dialect::FanucMill => "fanuc-mill",
+            Dialect::Sinumerik802d => "sinumerik-802d",
         }
     }
 
@@ -83,6 +94,7 @@ impl Dialect {
             Dialect::Gtc2eLathe => Box::new(Fanuc::<Gtc2e>::new(text, setup, library)),
             Dialect::IsoLathe => Box::new(Fanuc::<IsoLathe>::new(text, setup, library)),
             Dialect::FanucMill => Box::new(Fanuc::<Mill>::new(text, setup, library)),
+            Dialect::Sinumerik802d => Box::new(Sinumerik::new(text, setup, library)),
         }
     }
 
@@ -93,6 +105,7 @@ impl Dialect {
             Dialect::Gtc2eLathe => Gtc2e::alarm(f),
             Dialect::IsoLathe => IsoLathe::alarm(f),
             Dialect::FanucMill => Mill::alarm(f),
+            Dialect::Sinumerik802d => sinumerik::alarms::alarm(f),
         }
     }
 
@@ -103,6 +116,9 @@ impl Dialect {
             Dialect::Gtc2eLathe => g_status::<Gtc2e>(x10),
             Dialect::IsoLathe => g_status::<IsoLathe>(x10),
             Dialect::FanucMill => g_status::<Mill>(x10),
+            Dialect::Sinumerik802d => (x10.is_multiple_of(10)
+                && sinumerik::exec_g_group(x10 / 10).is_some())
+            .then_some(CodeStatus::Built),
         }
     }
 
@@ -113,6 +129,9 @@ impl Dialect {
             Dialect::Gtc2eLathe => m_status::<Gtc2e>(x10),
             Dialect::IsoLathe => m_status::<IsoLathe>(x10),
             Dialect::FanucMill => m_status::<Mill>(x10),
+            Dialect::Sinumerik802d => {
+                (x10.is_multiple_of(10) && x10 <= 990).then_some(CodeStatus::Built)
+            }
         }
     }
 
@@ -123,6 +142,7 @@ impl Dialect {
             Dialect::Gtc2eLathe => Fanuc::<Gtc2e>::line_errors(text),
             Dialect::IsoLathe => Fanuc::<IsoLathe>::line_errors(text),
             Dialect::FanucMill => Fanuc::<Mill>::line_errors(text),
+            Dialect::Sinumerik802d => sinumerik::line_errors(text),
         }
     }
 

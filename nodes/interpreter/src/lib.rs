@@ -3,7 +3,8 @@
 //! The dialect-free core is its own crate, `cnc_interpreter_core`: machine state, transforms,
 //! program flow, path filters, the canonical command stream. This crate holds the front ends
 //! that read the dialects and lower them onto the core: the FANUC family base ([`fanuc`]) and
-//! its dialects [`huaxing`], [`gtc2e`], [`iso`] and [`mill`], named in one place
+//! its dialects [`huaxing`], [`gtc2e`], [`iso`] and [`mill`], and the SINUMERIK 802D's own
+//! front end [`sinumerik`], named in one place
 //! ([`dialect`]). Around them: the public [`interpreter`], program libraries ([`library`]),
 //! the program run ([`run`]) and where it is ([`position`]), [`trace`] (the stream as text for checks and golden files) and
 //! [`node`] (the ROS 2 shell).
@@ -23,6 +24,7 @@ pub mod position;
 pub mod run;
 pub mod search;
 pub mod setup;
+pub mod sinumerik;
 pub mod trace;
 
 pub use cnc_interpreter_core::{canon, geometry, rough, Aux, Canon, Command, Library};

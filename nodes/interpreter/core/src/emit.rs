@@ -86,6 +86,9 @@ impl Core {
                 0.0
             }
         };
+        if matches!(kind, MoveKind::Arc { .. }) {
+            self.arc_under_frame()?;
+        }
         self.spindle_for(end);
         let m = self.to_machine(end);
         // The machine position becomes `m`; the command takes `m` itself (no copy per move).
@@ -96,6 +99,9 @@ impl Core {
             MoveKind::Arc { center, ccw, .. } => {
                 // Axes outside the plane keep the end's value (a helix's centre is at its end).
                 let c = self.to_machine(&self.with_point(end, center));
+                // A mirroring frame turns the circle the other way (checked before the
+                // position changed: see `arc_under_frame`).
+                let ccw = ccw != self.arc_under_frame()?;
                 let plane = self
                     .plane_axes()
                     .ok()
@@ -116,6 +122,25 @@ impl Core {
         };
         self.push(command);
         Ok(())
+    }
+
+    /// Whether the frame mirrors the working plane (an arc then turns the other way); an
+    /// alarm when the frame would make a circle of the plane an ellipse or tilt it.
+    pub fn arc_under_frame(&self) -> Result<bool, ProgramError> {
+        if self.frame.is_identity() {
+            return Ok(false);
+        }
+        let (h, v) = self.plane_axes()?;
+        self.frame
+            .plane_similarity(h, v)
+            .map(|(_, mirrored)| mirrored)
+            .ok_or_else(|| {
+                self.fault(
+                    Fault::ArcRadius,
+                    "a circle under this frame is no circle in the plane: both plane axes \
+                     need the same scale factor, and a rotation must stay in the plane",
+                )
+            })
     }
 
     /// A feed a cutting move can use: above 0 and within the control's range.

@@ -247,6 +247,39 @@ impl Core {
             )
         })?;
         let name = name.to_string();
+        self.push_level(name, text, count, locals);
+        Ok(())
+    }
+
+    /// Runs the library program called `name` `count` times as a called program with the
+    /// given locals (`None`: the caller's).
+    pub fn call_named(
+        &mut self,
+        name: &str,
+        count: u32,
+        locals: Option<Vec<Value>>,
+    ) -> Result<(), ProgramError> {
+        if self.levels.len() > self.rules.max_call_depth {
+            return Err(self.fault(
+                Fault::CallDepth,
+                format!(
+                    "programs nested deeper than {} levels",
+                    self.rules.max_call_depth + 1
+                ),
+            ));
+        }
+        let (file, text) = self.library.get_named(name).ok_or_else(|| {
+            self.fault(
+                Fault::UndefinedSubprogram,
+                format!("program {name} does not exist"),
+            )
+        })?;
+        let file = file.to_string();
+        self.push_level(file, text, count, locals);
+        Ok(())
+    }
+
+    fn push_level(&mut self, name: String, text: Arc<str>, count: u32, locals: Option<Vec<Value>>) {
         self.levels.push(CallLevel {
             text,
             name,
@@ -256,7 +289,6 @@ impl Core {
             locals,
             loops: Vec::new(),
         });
-        Ok(())
     }
 
     /// A return: from a called program to its caller (or to its top for a further repeat);

@@ -79,6 +79,12 @@ pub struct Setup {
     /// Numbers without a decimal point are millimetres (`Some(true)`, calculator type) or
     /// least input increments (`Some(false)`); `None`: as the control's manual says.
     pub calculator_decimal_point: Option<bool>,
+    /// A T word only preselects the tool and M6 changes it (a machine datum); else T
+    /// changes the tool at once.
+    pub tool_change_with_m6: bool,
+    /// The tool in the spindle when the program starts, as the last program or the operator
+    /// left it (0: none); a control that keeps it across power-off starts with it.
+    pub active_tool: u32,
     /// How far a roughing contour may leave its start or turn back before it is refused,
     /// mm (a machine parameter; 0.05 unless set).
     pub contour_tolerance: f64,
@@ -113,6 +119,8 @@ impl Setup {
             tool_change_macro: None,
             calculator_decimal_point: None,
             contour_tolerance: 0.05,
+            tool_change_with_m6: false,
+            active_tool: 0,
         }
     }
 }

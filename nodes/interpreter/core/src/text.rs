@@ -80,6 +80,8 @@ pub fn find_number(text: &str, from: Pos, n: u32) -> Option<Pos> {
 #[derive(Debug, Clone, Default)]
 pub struct Library {
     programs: HashMap<u32, (String, Arc<str>)>,
+    /// Programs called by name (upper case), for controls whose programs have names.
+    named: HashMap<String, (String, Arc<str>)>,
 }
 
 impl Library {
@@ -99,12 +101,26 @@ impl Library {
             .map(|(n, t)| (n.as_str(), t.clone()))
     }
 
+    /// Adds a program under its name (case is not distinguished); the first one wins.
+    pub fn insert_named(&mut self, name: &str, file: &str, text: &str) {
+        self.named
+            .entry(name.to_ascii_uppercase())
+            .or_insert_with(|| (file.to_string(), Arc::from(text)));
+    }
+
+    /// The program called `name` (any case): what errors call it, and its text.
+    pub fn get_named(&self, name: &str) -> Option<(&str, Arc<str>)> {
+        self.named
+            .get(&name.to_ascii_uppercase())
+            .map(|(n, t)| (n.as_str(), t.clone()))
+    }
+
     pub fn len(&self) -> usize {
-        self.programs.len()
+        self.programs.len() + self.named.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.programs.is_empty()
+        self.programs.is_empty() && self.named.is_empty()
     }
 }
 

@@ -6,74 +6,56 @@
 //! ```
 //!
 //! - the work offset of the active work system (off for a front end whose work offsets are
-//!   shifts of their own);
+//!   shifts of their own, and for [`NO_WORK_OFFSET`]);
 //! - shifts set from the program (setting the current point's coordinates, cumulative offset
 //!   groups);
 //! - a local system inside the work system;
-//! - a general [`Frame`]: mirror, scale, rotation in the working plane, translation (identity
-//!   unless a front end sets one);
+//! - a programmable [`Frame`]: any composition of translations, rotations, scalings and
+//!   mirrorings (identity unless a front end sets one);
 //! - the tool offset (geometry plus wear, or a tool length along its axis).
 //!
 //! With the identity frame each axis is a sum, computed in this order; the inverse gives the
 //! work position shown to the program.
 
-/// A general frame: each axis is mirrored, then scaled, then the working plane's two axes are
-/// rotated, then every axis is translated.
+/// The work system index that selects no work offset (a control's "settable offset off").
+pub const NO_WORK_OFFSET: u8 = u8::MAX;
+
+/// A programmable frame: the affine map `p ↦ L·p + t`, its linear part `L` (row-major,
+/// n×n) a product of rotations, scalings and mirrorings. Each additive instruction acts in
+/// the coordinates the frame already defines (post-multiplies), so a translation after a
+/// scaling is scaled and one after a rotation runs along the rotated axes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
-    /// Added last, per axis.
+    n: usize,
+    linear: Vec<f64>,
+    inverse: Vec<f64>,
     pub translation: Vec<f64>,
-    /// Degrees, counter-clockwise from the first plane axis toward the second.
-    pub rotation: f64,
-    /// The plane the rotation turns in, as axis indices (horizontal, vertical).
-    pub rotation_plane: Option<(usize, usize)>,
-    /// Per axis; 1 is none.
-    pub scale: Vec<f64>,
-    /// Per axis: the sign of the axis is reversed.
-    pub mirror: Vec<bool>,
 }
 
 impl Frame {
     /// The identity frame of `n` axes.
     pub fn identity(n: usize) -> Frame {
+        let eye = identity_matrix(n);
         Frame {
+            n,
+            linear: eye.clone(),
+            inverse: eye,
             translation: vec![0.0; n],
-            rotation: 0.0,
-            rotation_plane: None,
-            scale: vec![1.0; n],
-            mirror: vec![false; n],
         }
     }
 
     pub fn is_identity(&self) -> bool {
-        self.rotation == 0.0
-            && self.translation.iter().all(|&t| t == 0.0)
-            && self.scale.iter().all(|&s| s == 1.0)
-            && !self.mirror.iter().any(|&m| m)
+        self.translation.iter().all(|&t| t == 0.0) && self.linear == identity_matrix(self.n)
+    }
+
+    /// `L[row][col]`.
+    pub fn linear(&self, row: usize, col: usize) -> f64 {
+        self.linear[row * self.n + col]
     }
 
     /// The frame applied to the point `p`.
     pub fn apply(&self, p: &[f64]) -> Vec<f64> {
-        let mut q: Vec<f64> = p
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| {
-                let v = if self.mirror.get(i) == Some(&true) {
-                    -v
-                } else {
-                    v
-                };
-                v * self.scale.get(i).copied().unwrap_or(1.0)
-            })
-            .collect();
-        if let (Some((h, v)), true) = (self.rotation_plane, self.rotation != 0.0) {
-            if h < q.len() && v < q.len() {
-                let (s, c) = self.rotation.to_radians().sin_cos();
-                let (a, b) = (q[h], q[v]);
-                q[h] = a * c - b * s;
-                q[v] = a * s + b * c;
-            }
-        }
+        let mut q = mul(&self.linear, self.n, p);
         for (x, t) in q.iter_mut().zip(&self.translation) {
             *x += t;
         }
@@ -82,30 +64,126 @@ impl Frame {
 
     /// The point the frame maps to `q`.
     pub fn invert(&self, q: &[f64]) -> Vec<f64> {
-        let mut p: Vec<f64> = q
+        let d: Vec<f64> = q
             .iter()
             .enumerate()
             .map(|(i, &v)| v - self.translation.get(i).copied().unwrap_or(0.0))
             .collect();
-        if let (Some((h, v)), true) = (self.rotation_plane, self.rotation != 0.0) {
-            if h < p.len() && v < p.len() {
-                let (s, c) = self.rotation.to_radians().sin_cos();
-                let (a, b) = (p[h], p[v]);
-                p[h] = a * c + b * s;
-                p[v] = -a * s + b * c;
-            }
-        }
-        for (i, x) in p.iter_mut().enumerate() {
-            let s = self.scale.get(i).copied().unwrap_or(1.0);
-            if s != 0.0 {
-                *x /= s;
-            }
-            if self.mirror.get(i) == Some(&true) {
-                *x = -*x;
-            }
-        }
-        p
+        mul(&self.inverse, self.n, &d)
     }
+
+    /// A translation by `v`, in the frame's own coordinates.
+    pub fn translate(&mut self, v: &[f64]) {
+        let d = mul(&self.linear, self.n, v);
+        for (t, x) in self.translation.iter_mut().zip(d) {
+            *t += x;
+        }
+    }
+
+    /// A rotation by `degrees` counter-clockwise from axis `h` toward axis `v`, about the
+    /// frame's origin.
+    pub fn rotate(&mut self, h: usize, v: usize, degrees: f64) {
+        let (s, c) = degrees.to_radians().sin_cos();
+        let mut r = identity_matrix(self.n);
+        let n = self.n;
+        if h >= n || v >= n || h == v {
+            return;
+        }
+        r[h * n + h] = c;
+        r[h * n + v] = -s;
+        r[v * n + h] = s;
+        r[v * n + v] = c;
+        let mut ri = identity_matrix(n);
+        ri[h * n + h] = c;
+        ri[h * n + v] = s;
+        ri[v * n + h] = -s;
+        ri[v * n + v] = c;
+        self.compose(&r, &ri);
+    }
+
+    /// Per-axis factors (negative mirrors); a factor of 0 is refused by the caller.
+    pub fn scale(&mut self, factors: &[f64]) {
+        let n = self.n;
+        let mut s = identity_matrix(n);
+        let mut si = identity_matrix(n);
+        for (i, &f) in factors.iter().enumerate().take(n) {
+            if f != 0.0 && f.is_finite() {
+                s[i * n + i] = f;
+                si[i * n + i] = 1.0 / f;
+            }
+        }
+        self.compose(&s, &si);
+    }
+
+    /// How the frame maps the plane of axes `h`, `v`: `Some((factor, mirrored))` when it maps
+    /// the plane onto itself as a similarity (circles stay circles of radius × factor,
+    /// turning the other way when mirrored) and leaves the plane's axes out of the others;
+    /// `None` when circles in the plane would not stay circles in it.
+    pub fn plane_similarity(&self, h: usize, v: usize) -> Option<(f64, bool)> {
+        let n = self.n;
+        if h >= n || v >= n {
+            return None;
+        }
+        for k in (0..n).filter(|&k| k != h && k != v) {
+            let leaks = [
+                self.linear(h, k),
+                self.linear(v, k),
+                self.linear(k, h),
+                self.linear(k, v),
+            ];
+            if leaks.iter().any(|x| x.abs() > 1e-12) {
+                return None;
+            }
+        }
+        let (a, b, c, d) = (
+            self.linear(h, h),
+            self.linear(h, v),
+            self.linear(v, h),
+            self.linear(v, v),
+        );
+        let det = a * d - b * c;
+        // Columns orthogonal and of equal length.
+        let len_h = a.hypot(c);
+        let len_v = b.hypot(d);
+        let ok = (a * b + c * d).abs() <= 1e-9 * len_h * len_v.max(1e-12)
+            && (len_h - len_v).abs() <= 1e-9 * len_h.max(len_v)
+            && det.abs() > 1e-12;
+        ok.then_some((len_h, det < 0.0))
+    }
+
+    /// `self ∘ m`, with `mi` the inverse of `m`.
+    fn compose(&mut self, m: &[f64], mi: &[f64]) {
+        self.linear = matmul(&self.linear, m, self.n);
+        self.inverse = matmul(mi, &self.inverse, self.n);
+    }
+}
+
+fn identity_matrix(n: usize) -> Vec<f64> {
+    let mut m = vec![0.0; n * n];
+    for i in 0..n {
+        m[i * n + i] = 1.0;
+    }
+    m
+}
+
+fn mul(m: &[f64], n: usize, p: &[f64]) -> Vec<f64> {
+    (0..n)
+        .map(|r| {
+            (0..n)
+                .map(|c| m[r * n + c] * p.get(c).copied().unwrap_or(0.0))
+                .sum()
+        })
+        .collect()
+}
+
+fn matmul(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n * n];
+    for r in 0..n {
+        for c in 0..n {
+            out[r * n + c] = (0..n).map(|k| a[r * n + k] * b[k * n + c]).sum();
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -122,14 +200,12 @@ mod tests {
     }
 
     #[test]
-    fn a_frame_mirrors_scales_rotates_and_translates_and_inverts() {
+    fn a_frame_translates_rotates_scales_and_mirrors_in_its_own_coordinates_and_inverts() {
         let mut f = Frame::identity(3);
-        f.mirror[0] = true;
-        f.scale[1] = 2.0;
-        f.rotation = 90.0;
-        f.rotation_plane = Some((0, 1));
-        f.translation = vec![10.0, 20.0, 30.0];
-        // (1, 1, 5) → mirror (−1, 1, 5) → scale (−1, 2, 5) → rotate 90° (−2, −1, 5) → +T.
+        f.translate(&[10.0, 20.0, 30.0]);
+        f.rotate(0, 1, 90.0);
+        f.scale(&[-1.0, 2.0, 1.0]);
+        // (1, 1, 5) → mirror/scale (−1, 2, 5) → rotate 90° (−2, −1, 5) → +T.
         let q = f.apply(&[1.0, 1.0, 5.0]);
         for (a, b) in q.iter().zip([8.0, 19.0, 35.0]) {
             assert!((a - b).abs() < 1e-12, "{q:?}");
@@ -139,5 +215,32 @@ mod tests {
             assert!((a - b).abs() < 1e-12, "{back:?}");
         }
         assert!(!f.is_identity());
+        // A translation now runs along the frame's axes, scaled: X+1 of the frame is −Y×1.
+        let mut g = f.clone();
+        g.translate(&[1.0, 0.0, 0.0]);
+        let d: Vec<f64> = g
+            .translation
+            .iter()
+            .zip(&f.translation)
+            .map(|(a, b)| a - b)
+            .collect();
+        assert!((d[0]).abs() < 1e-12 && (d[1] + 1.0).abs() < 1e-12, "{d:?}");
+    }
+
+    #[test]
+    fn circles_stay_circles_only_under_similarities_of_their_plane() {
+        let mut f = Frame::identity(3);
+        f.rotate(0, 1, 30.0);
+        f.scale(&[2.0, 2.0, 1.0]);
+        assert_eq!(f.plane_similarity(0, 1).map(|s| s.1), Some(false));
+        assert!((f.plane_similarity(0, 1).unwrap().0 - 2.0).abs() < 1e-12);
+        f.scale(&[-1.0, 1.0, 1.0]);
+        assert_eq!(f.plane_similarity(0, 1).map(|s| s.1), Some(true));
+        // Unequal factors: an ellipse.
+        let mut e = Frame::identity(3);
+        e.scale(&[2.0, 1.0, 1.0]);
+        assert_eq!(e.plane_similarity(0, 1), None);
+        // A rotation in the XY plane tilts the ZX plane out of itself.
+        assert_eq!(f.plane_similarity(2, 0), None);
     }
 }

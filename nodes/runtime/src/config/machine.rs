@@ -140,7 +140,13 @@ pub fn work_offset_index(code: &str) -> Option<u8> {
 
 /// The program dialects a launch config may name (the interpreter's `Dialect::from_name`
 /// knows each; its tests check that).
-pub const DIALECTS: [&str; 4] = ["huaxing-lathe", "gtc2e-lathe", "iso-lathe", "fanuc-mill"];
+pub const DIALECTS: [&str; 5] = [
+    "huaxing-lathe",
+    "gtc2e-lathe",
+    "iso-lathe",
+    "fanuc-mill",
+    "sinumerik-802d",
+];
 
 /// One row of the offset page (`000` §5.2, `002` §3.7): geometry and wear (X as diameter),
 /// nose radius and imaginary tip direction 0–9.

@@ -1,0 +1,318 @@
+//! One 802D block as the parser reads it (`001` §9.1.2–§9.1.6, §9.9–§9.11): the skip mark,
+//! the block number (`N10`, main block `:50`), a label, then its items in the order written.
+//! What an item means (an address, a variable, a keyword, a program) is the executor's
+//! business; the parser only knows the shapes.
+
+use super::expr::{Expr, Parser};
+use super::lex::{strip_comment, tokens, Tok};
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Item {
+    /// `X20`, `G1`, `X-12`: an address letter with a number.
+    Word {
+        letter: char,
+        digits: String,
+        value: f64,
+    },
+    /// `NAME=value`, `NAME[i]=value`, `R10=value`, `I1=value`, `X=AC(5)`: an address given
+    /// an expression or a variable written; the executor tells which.
+    Assign {
+        name: String,
+        index: Vec<Expr>,
+        value: Expr,
+    },
+    /// A bare name: a keyword (`CIP`, `TRANS`, `STOPRE`) or a program to call (`LRAHMEN7`).
+    Name(String),
+    /// `NAME(arguments)`: `MSG(…)`, a cycle.
+    Call(String, Vec<Option<Expr>>),
+    /// `GOTOF label` / `GOTOB label`, under a condition when it came with `IF`.
+    Goto {
+        condition: Option<Expr>,
+        forward: bool,
+        target: String,
+    },
+    Def(Def),
+}
+
+/// `DEF type name[dims]=init, …` (§9.9.2).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Def {
+    pub ty: String,
+    /// STRING[n]: the longest string.
+    pub len: Option<usize>,
+    pub vars: Vec<DefVar>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct DefVar {
+    pub name: String,
+    pub dims: Vec<usize>,
+    pub init: Option<Expr>,
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Block {
+    pub skip: bool,
+    /// `N` or `:` number.
+    pub number: Option<u32>,
+    pub label: Option<String>,
+    pub items: Vec<Item>,
+}
+
+/// Parses one line; an error is the syntax alarm's text.
+pub fn parse(line: &str) -> Result<Block, String> {
+    let toks = tokens(strip_comment(line))?;
+    let mut p = Parser::new(&toks);
+    let mut b = Block {
+        skip: p.eat_op("/"),
+        ..Block::default()
+    };
+    match p.peek() {
+        Some(Tok::Word {
+            letter: 'N', value, ..
+        }) => {
+            b.number = Some(block_number(*value)?);
+            p.at += 1;
+        }
+        Some(Tok::Op(":")) => {
+            p.at += 1;
+            match p.take() {
+                Some(Tok::Num(v)) => b.number = Some(block_number(*v)?),
+                _ => return Err("a main block ':' needs its number".into()),
+            }
+        }
+        _ => {}
+    }
+    if let (Some(Tok::Name(n)), Some(Tok::Op(":"))) = (p.peek(), p.peek_at(1)) {
+        b.label = Some(n.clone());
+        p.at += 2;
+    }
+    while p.peek().is_some() {
+        let item = item(&mut p)?;
+        b.items.push(item);
+    }
+    Ok(b)
+}
+
+fn block_number(v: f64) -> Result<u32, String> {
+    if v.fract() != 0.0 || !(0.0..=99_999_999.0).contains(&v) {
+        return Err(format!("block number {v} is not 0…99999999"));
+    }
+    Ok(v as u32)
+}
+
+fn item(p: &mut Parser) -> Result<Item, String> {
+    let Some(t) = p.take() else {
+        return Err("block ends early".into());
+    };
+    match t {
+        Tok::Word {
+            letter,
+            digits,
+            value,
+        } => {
+            if p.eat_op("=") {
+                let expr = p.expr()?;
+                let (name, index) = if *letter == 'R' {
+                    ("R".to_string(), vec![Expr::Num(*value)])
+                } else {
+                    (format!("{letter}{digits}"), Vec::new())
+                };
+                Ok(Item::Assign {
+                    name,
+                    index,
+                    value: expr,
+                })
+            } else {
+                Ok(Item::Word {
+                    letter: *letter,
+                    digits: digits.clone(),
+                    value: *value,
+                })
+            }
+        }
+        Tok::Name(n) => name_item(p, n.clone()),
+        other => Err(format!("'{other}' cannot start a word")),
+    }
+}
+
+fn name_item(p: &mut Parser, n: String) -> Result<Item, String> {
+    match n.as_str() {
+        "DEF" => return def(p).map(Item::Def),
+        "IF" => {
+            let condition = p.expr()?;
+            let (forward, target) = goto(p)?;
+            return Ok(Item::Goto {
+                condition: Some(condition),
+                forward,
+                target,
+            });
+        }
+        "GOTOF" | "GOTOB" => {
+            p.at -= 1;
+            let (forward, target) = goto(p)?;
+            return Ok(Item::Goto {
+                condition: None,
+                forward,
+                target,
+            });
+        }
+        _ => {}
+    }
+    if p.eat_op("=") {
+        let value = p.expr()?;
+        return Ok(Item::Assign {
+            name: n,
+            index: Vec::new(),
+            value,
+        });
+    }
+    if p.is_op("[") {
+        let index = p.indexes()?;
+        p.expect_op("=")?;
+        let value = p.expr()?;
+        return Ok(Item::Assign {
+            name: n,
+            index,
+            value,
+        });
+    }
+    if p.is_op("(") {
+        let args = p.arguments()?;
+        return Ok(Item::Call(n, args));
+    }
+    // `X-12`, `X .5`: a one-letter address and its number with blanks or a sign between.
+    if n.len() == 1 {
+        let neg = p.is_op("-");
+        let sign = usize::from(neg || p.is_op("+"));
+        if let Some(Tok::Num(v)) = p.peek_at(sign) {
+            p.at += sign + 1;
+            let letter = n.chars().next().unwrap_or('?');
+            return Ok(Item::Word {
+                letter,
+                digits: String::new(),
+                value: if neg { -v } else { *v },
+            });
+        }
+    }
+    Ok(Item::Name(n))
+}
+
+fn goto(p: &mut Parser) -> Result<(bool, String), String> {
+    let forward = match p.take() {
+        Some(Tok::Name(g)) if g == "GOTOF" => true,
+        Some(Tok::Name(g)) if g == "GOTOB" => false,
+        _ => return Err("IF needs GOTOF or GOTOB and a jump target".into()),
+    };
+    let target = match p.take() {
+        Some(Tok::Name(l)) => l.clone(),
+        Some(Tok::Word {
+            letter: 'N',
+            digits,
+            ..
+        }) => format!("N{}", digits.trim_start_matches('0')),
+        _ => return Err("a jump needs its target: a label or a block number".into()),
+    };
+    Ok((forward, target))
+}
+
+fn def(p: &mut Parser) -> Result<Def, String> {
+    let ty = match p.take() {
+        Some(Tok::Name(t)) if ["BOOL", "CHAR", "INT", "REAL", "STRING"].contains(&t.as_str()) => {
+            t.clone()
+        }
+        _ => return Err("DEF needs a type: BOOL, CHAR, INT, REAL or STRING".into()),
+    };
+    let mut len = None;
+    if ty == "STRING" {
+        p.expect_op("[")?;
+        len = match p.take() {
+            Some(Tok::Num(v)) if *v >= 1.0 && v.fract() == 0.0 && *v <= 200.0 => Some(*v as usize),
+            _ => return Err("STRING[n] needs its length n".into()),
+        };
+        p.expect_op("]")?;
+    }
+    let mut vars = Vec::new();
+    loop {
+        let name = match p.take() {
+            Some(Tok::Name(n)) => n.clone(),
+            Some(t) => return Err(format!("'{t}' is no variable name (two letters first)")),
+            None => return Err("DEF needs a variable name".into()),
+        };
+        let mut dims = Vec::new();
+        if p.eat_op("[") {
+            loop {
+                match p.take() {
+                    Some(Tok::Num(v)) if *v >= 1.0 && v.fract() == 0.0 && *v <= 65_535.0 => {
+                        dims.push(*v as usize)
+                    }
+                    _ => return Err(format!("array {name} needs whole dimensions ≥ 1")),
+                }
+                if p.eat_op("]") {
+                    break;
+                }
+                p.expect_op(",")?;
+            }
+            if dims.len() > 2 {
+                return Err(format!("array {name}: at most two dimensions"));
+            }
+        }
+        let init = if p.eat_op("=") { Some(p.expr()?) } else { None };
+        vars.push(DefVar { name, dims, init });
+        if p.peek().is_none() {
+            return Ok(Def { ty, len, vars });
+        }
+        p.expect_op(",")?;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_labels_and_items() {
+        let b = parse("/N90 X118 Z180 ; skip").unwrap();
+        assert!(b.skip);
+        assert_eq!(b.number, Some(90));
+        assert_eq!(b.items.len(), 2);
+        let b = parse(":50 G54 F4.7").unwrap();
+        assert_eq!(b.number, Some(50));
+        let b = parse("N20 MA1: G0 Z=R2*COS (R1)+R5").unwrap();
+        assert_eq!(b.label.as_deref(), Some("MA1"));
+        assert!(matches!(&b.items[1], Item::Assign { name, .. } if name == "Z"));
+        let b = parse("N40 IF R4 > 0 GOTOB MA1").unwrap();
+        assert!(
+            matches!(&b.items[0], Item::Goto { forward: false, target, condition: Some(_) } if target == "MA1")
+        );
+        let b = parse("R[R0]=5 I1=40 X-12").unwrap();
+        assert!(
+            matches!(&b.items[0], Item::Assign { name, index, .. } if name == "R" && index.len() == 1)
+        );
+        assert!(matches!(&b.items[1], Item::Assign { name, .. } if name == "I1"));
+        assert_eq!(
+            b.items[2],
+            Item::Word {
+                letter: 'X',
+                digits: String::new(),
+                value: -12.0
+            }
+        );
+    }
+
+    #[test]
+    fn definitions() {
+        let b = parse("DEF INT PVAR1, PVAR2, PVAR3=12, PVAR4").unwrap();
+        let Item::Def(d) = &b.items[0] else { panic!() };
+        assert_eq!(d.vars.len(), 4);
+        assert!(d.vars[2].init.is_some());
+        let b = parse("DEF STRING[12] PVAR=\"Hallo\"").unwrap();
+        let Item::Def(d) = &b.items[0] else { panic!() };
+        assert_eq!(d.len, Some(12));
+        let b = parse("DEF REAL B[2,3]").unwrap();
+        let Item::Def(d) = &b.items[0] else { panic!() };
+        assert_eq!(d.vars[0].dims, [2, 3]);
+        assert!(parse("DEF FLOAT X1").is_err());
+        assert!(parse("DEF REAL A[0]").is_err());
+    }
+}

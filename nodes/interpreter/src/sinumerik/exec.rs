@@ -1,0 +1,592 @@
+//! One block in the control's order (`001` §9.1.6, §9.7; inventory §11.3): the items as
+//! written (definitions, variables, jumps' conditions), then the modal G functions, feed and
+//! speed, tool and cutting edge, the M functions output before the motion (M3/M4/M5 and the
+//! machine's own), the non-modal functions (dwell, frames, pole), radius compensation and
+//! the motion, then the stops and ends after it, the program call and the jump.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, SpindleDir};
+
+use super::block::{Block, Item};
+use super::expr::Expr;
+use super::{find_target, Motion, Sinumerik};
+
+/// How an axis value counts: the modal G90/G91, or `AC`/`IC`/`DC`/`ACP`/`ACN` for this word.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Modal,
+    Abs,
+    Inc,
+    /// DC/ACP/ACN: absolute on a rotary axis, by the shortest way or in one direction.
+    Rotary,
+}
+
+/// A block's addresses, sorted out of its items.
+#[derive(Debug, Default)]
+pub struct Words {
+    /// Machine axis index → value and how it counts.
+    pub axes: HashMap<usize, (f64, Mode)>,
+    /// Other addresses: `I`, `J`, `K`, `I1`, `CR`, `AR`, `AP`, `RP`, `TURN`, `RPL`, `F`,
+    /// `S`, `T`, `D`, `P`…
+    pub addr: HashMap<String, (f64, Mode)>,
+    pub g: Vec<u32>,
+    pub m: Vec<u32>,
+    /// Keywords in the order written (`CIP`, `TRANS`, `STOPRE`…).
+    pub keys: Vec<String>,
+    /// The program the block calls.
+    pub call: Option<String>,
+}
+
+impl Words {
+    pub fn has_g(&self, n: u32) -> bool {
+        self.g.contains(&n)
+    }
+    pub fn key(&self, k: &str) -> bool {
+        self.keys.iter().any(|x| x == k)
+    }
+    pub fn get(&self, a: &str) -> Option<f64> {
+        self.addr.get(a).map(|v| v.0)
+    }
+}
+
+/// Multi-letter addresses the control reads with `=` (§9.1.3, §9.1.6).
+const ADDRESSES: [&str; 17] = [
+    "CR", "AR", "AP", "RP", "TURN", "RPL", "I1", "J1", "K1", "SF", "CHF", "CHR", "RND", "RNDM",
+    "FRC", "FRCM", "ANG",
+];
+
+/// Keywords this front end runs.
+const KEYWORDS: [&str; 19] = [
+    "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
+    "STOPRE", "RET", "PROC", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
+];
+
+/// Keywords of the manual this controller does not run, each with the reason (the alarm says
+/// it; the coverage table lists them).
+pub const NOT_BUILT: [(&str, &str); 22] = [
+    (
+        "CFC",
+        "feed correction on compensated circles is not built: F acts on the cutter centre (CFTCP)",
+    ),
+    (
+        "SOFT",
+        "the acceleration profile is the machine's (motion profile), not switched by the program",
+    ),
+    (
+        "FFWON",
+        "feedforward is the drives' setting, not switched by the program",
+    ),
+    ("COMPCAD", "the compressor is not built"),
+    ("WALIMON", "working area limits G25/G26 are not built yet"),
+    ("G62", "corner deceleration is not built"),
+    ("G621", "corner deceleration is not built"),
+    ("STOPFIFO", "fast-block buffering is not built"),
+    ("STARTFIFO", "fast-block buffering is not built"),
+    ("MCALL", "modal calls are not built yet"),
+    ("EXTCALL", "external programs are not built"),
+    ("TRACYL", "the cylinder transformation is not built"),
+    ("TRAFOOF", "no transformation is built"),
+    ("TRAILON", "coupled motion is not built"),
+    ("TRAILOF", "coupled motion is not built"),
+    (
+        "MEAS",
+        "probing is not built: the simulated mill has no probe",
+    ),
+    (
+        "MEAW",
+        "probing is not built: the simulated mill has no probe",
+    ),
+    ("FXS", "travel to fixed stop is not built"),
+    ("SPOS", "spindle positioning is not built yet"),
+    ("OFFN", "the contour offset OFFN is not built yet"),
+    ("SETPIECE", "tool monitoring is not built"),
+    ("RESETMON", "tool monitoring is not built"),
+];
+
+/// A name the control reserves: an address or a keyword (no variable may take it).
+pub fn is_address(name: &str) -> bool {
+    ADDRESSES.contains(&name)
+        || KEYWORDS.contains(&name)
+        || NOT_BUILT.iter().any(|(k, _)| *k == name)
+        || [
+            "DEF", "IF", "GOTOF", "GOTOB", "MSG", "SET", "REP", "AC", "IC", "DC", "ACP", "ACN",
+        ]
+        .contains(&name)
+}
+
+/// The cycles of chapter 10: issue 24.
+fn is_cycle(name: &str) -> bool {
+    name.starts_with("CYCLE")
+        || [
+            "HOLES1", "HOLES2", "LONGHOLE", "SLOT1", "SLOT2", "POCKET3", "POCKET4",
+        ]
+        .contains(&name)
+}
+
+impl Sinumerik {
+    /// Runs one parsed block.
+    pub(super) fn run_block(&mut self, b: &Block, text: &Arc<str>) -> Result<(), ProgramError> {
+        let mut w = Words::default();
+        self.jump = None;
+        for item in &b.items {
+            if !matches!(item, Item::Def(_)) {
+                if let Some(d) = self.may_define.last_mut() {
+                    *d = false;
+                }
+            }
+            self.item(item, &mut w)?;
+        }
+        let from = self.core.queued();
+        self.modal(&w)?;
+        self.feed_and_speed(&w)?;
+        self.tool_words(&w)?;
+        self.m_before(&w)?;
+        let nonmodal = self.non_modal(&w)?;
+        if !nonmodal {
+            self.motion_block(&w)?;
+        }
+        if w.has_g(9) {
+            self.core.exact_stop_block(from);
+        }
+        self.m_after(&w)?;
+        if w.key("RET") {
+            self.return_from_program();
+        }
+        if let Some(name) = &w.call {
+            let count = match w.get("P") {
+                None => 1,
+                Some(p) if p.fract() == 0.0 && (1.0..=9999.0).contains(&p) => p as u32,
+                Some(p) => {
+                    return Err(self.fault(
+                        Fault::OutOfRange,
+                        format!(
+                            "P{} repeats a call 1…9999 times",
+                            cnc_interpreter_core::show(p)
+                        ),
+                    ))
+                }
+            };
+            self.core.call_named(name, count, None)?;
+            self.sync_scopes();
+        }
+        if let Some((forward, target)) = self.jump.take() {
+            let level = self.core.current();
+            let pos = find_target(text, self.core.block_start, level.pos, forward, &target)
+                .ok_or_else(|| {
+                    self.fault(
+                        Fault::TargetNotFound,
+                        format!(
+                            "jump target {target} not found {} in this program",
+                            if forward {
+                                "after this block"
+                            } else {
+                                "before this block"
+                            }
+                        ),
+                    )
+                })?;
+            self.core.level().pos = pos;
+        }
+        Ok(())
+    }
+
+    /// Sorts one item into the block's words, or runs it when it runs as written (a
+    /// definition, a variable, a jump's condition, a message).
+    fn item(&mut self, item: &Item, w: &mut Words) -> Result<(), ProgramError> {
+        match item {
+            Item::Def(d) => self.define(d)?,
+            Item::Goto {
+                condition,
+                forward,
+                target,
+            } => {
+                if self.jump.is_none() {
+                    let go = match condition {
+                        None => true,
+                        Some(c) => self.number(c)? != 0.0,
+                    };
+                    if go {
+                        self.jump = Some((*forward, target.clone()));
+                    }
+                }
+            }
+            Item::Assign { name, index, value } => {
+                let axis = self.axis_of(name);
+                if index.is_empty()
+                    && (axis.is_some()
+                        || ADDRESSES.contains(&name.as_str())
+                        || "FSTDIJKP".contains(name.as_str()) && name.len() == 1)
+                {
+                    let (v, mode) = self.address_value(name, value)?;
+                    self.put(w, name, v, mode, axis)?;
+                } else if NOT_BUILT.iter().any(|(k, _)| k == name) {
+                    self.not_built(name)?;
+                } else {
+                    self.write(name, index, value)?;
+                }
+            }
+            Item::Word {
+                letter,
+                digits,
+                value,
+            } => self.word(w, *letter, digits, *value)?,
+            Item::Name(n) => {
+                if KEYWORDS.contains(&n.as_str()) {
+                    w.keys.push(n.clone());
+                } else if NOT_BUILT.iter().any(|(k, _)| k == n) {
+                    self.not_built(n)?;
+                } else if is_cycle(n) || self.core.library.get_named(n).is_some() {
+                    self.program_call(w, n)?;
+                } else if n == "RET" {
+                    w.keys.push(n.clone());
+                } else {
+                    return Err(self.fault(
+                        Fault::NoSuchAddress,
+                        format!("{n} is not defined: no address, keyword, variable or program of this name"),
+                    ));
+                }
+            }
+            Item::Call(name, args) => self.call_item(name, args)?,
+        }
+        Ok(())
+    }
+
+    fn not_built(&self, name: &str) -> Result<(), ProgramError> {
+        let why = NOT_BUILT
+            .iter()
+            .find(|(k, _)| *k == name)
+            .map_or("not built", |(_, w)| w);
+        Err(self.fault(Fault::NotSupported, format!("{name}: {why}")))
+    }
+
+    fn program_call(&mut self, w: &mut Words, name: &str) -> Result<(), ProgramError> {
+        if is_cycle(name) {
+            return Err(self.fault(
+                Fault::NotSupported,
+                format!("{name}: the cycles of chapter 10 are not built yet"),
+            ));
+        }
+        if w.call.is_some() {
+            return Err(self.fault(Fault::Call, "one program call per block"));
+        }
+        w.call = Some(name.to_string());
+        Ok(())
+    }
+
+    fn call_item(&mut self, name: &str, args: &[Option<Expr>]) -> Result<(), ProgramError> {
+        if name == "MSG" {
+            let text = match args {
+                [] | [None] => String::new(),
+                [Some(e)] => self.value(e)?.text(),
+                _ => return Err(self.fault(Fault::MacroArgument, "MSG takes one text")),
+            };
+            // The display shows 65 characters (§9.1.6).
+            let shown: String = text.chars().take(65).collect();
+            self.messages.push((self.core.line, shown.clone()));
+            self.message = shown;
+            return Ok(());
+        }
+        if is_cycle(name) {
+            return Err(self.fault(
+                Fault::NotSupported,
+                format!("{name}: the cycles of chapter 10 are not built yet"),
+            ));
+        }
+        if NOT_BUILT.iter().any(|(k, _)| *k == name) {
+            return self.not_built(name);
+        }
+        Err(self.fault(
+            Fault::NoSuchAddress,
+            format!("{name}(…) is not defined: no function, cycle or procedure of this name"),
+        ))
+    }
+
+    /// The machine axis an address names: a channel axis (`X`) or a machine axis (`X1`).
+    fn axis_of(&self, name: &str) -> Option<usize> {
+        let mut c = name.chars();
+        let letter = c.next()?;
+        let rest: String = c.collect();
+        (rest.is_empty() || rest == "1")
+            .then(|| self.core.axis(letter))
+            .flatten()
+            .filter(|_| {
+                !"IJKFSTDP".contains(letter) || rest.is_empty() && self.core.axis(letter).is_some()
+            })
+    }
+
+    /// An address's expression: its value and `AC`/`IC`/`DC`/`ACP`/`ACN` when it has one.
+    fn address_value(&self, name: &str, value: &Expr) -> Result<(f64, Mode), ProgramError> {
+        if let Expr::Call(f, args) = value {
+            let mode = match f.as_str() {
+                "AC" => Some(Mode::Abs),
+                "IC" => Some(Mode::Inc),
+                "DC" | "ACP" | "ACN" => Some(Mode::Rotary),
+                _ => None,
+            };
+            if let Some(mode) = mode {
+                let [Some(arg)] = args.as_slice() else {
+                    return Err(self.fault(Fault::MacroArgument, format!("{name}={f}(value)")));
+                };
+                if mode == Mode::Rotary {
+                    return Err(self.fault(
+                        Fault::NotSupported,
+                        format!("{name}={f}(…): rotary positioning modes are not built yet"),
+                    ));
+                }
+                return Ok((self.number(arg)?, mode));
+            }
+        }
+        Ok((self.number(value)?, Mode::Modal))
+    }
+
+    fn put(
+        &self,
+        w: &mut Words,
+        name: &str,
+        v: f64,
+        mode: Mode,
+        axis: Option<usize>,
+    ) -> Result<(), ProgramError> {
+        if !v.is_finite() {
+            return Err(self.fault(Fault::OutOfRange, format!("{name}: value not finite")));
+        }
+        let dup = match axis {
+            Some(i) => w.axes.insert(i, (v, mode)).is_some(),
+            None => w.addr.insert(name.to_string(), (v, mode)).is_some(),
+        };
+        if dup {
+            return Err(self.fault(
+                Fault::RepeatedWord,
+                format!("address {name} programmed twice in one block"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn word(
+        &mut self,
+        w: &mut Words,
+        letter: char,
+        digits: &str,
+        value: f64,
+    ) -> Result<(), ProgramError> {
+        match letter {
+            'G' => {
+                if value.fract() != 0.0 || !(0.0..=1000.0).contains(&value) {
+                    return Err(
+                        self.fault(Fault::UndefinedCode, format!("G{value} does not exist"))
+                    );
+                }
+                w.g.push(value as u32);
+            }
+            'M' => {
+                if value.fract() != 0.0 || !(0.0..=99.0).contains(&value) {
+                    return Err(self.fault(Fault::OutOfRange, "M functions are 0…99"));
+                }
+                w.m.push(value as u32);
+            }
+            'L' => {
+                if digits.is_empty() || digits.len() > 7 || value.fract() != 0.0 {
+                    return Err(
+                        self.fault(Fault::DataFormat, "L needs 1–7 digits: a subprogram number")
+                    );
+                }
+                // Leading zeros are part of the name: L128, L0128 and L00128 differ (§9.11.1).
+                self.program_call(w, &format!("L{digits}"))?;
+            }
+            'N' => {
+                return Err(self.fault(Fault::DataFormat, "the block number N must start the block"))
+            }
+            'H' => {
+                return Err(self.fault(
+                    Fault::NotSupported,
+                    "H functions are not built: the PLC here takes M, S and T",
+                ))
+            }
+            'R' => {
+                return Err(self.fault(
+                    Fault::DataFormat,
+                    format!("R{digits} needs '=' and a value"),
+                ))
+            }
+            _ => {
+                let name = letter.to_string();
+                let axis = self
+                    .core
+                    .axis(letter)
+                    .filter(|_| !"IJKFSTDP".contains(letter));
+                if axis.is_none() && !"IJKFSTDP".contains(letter) {
+                    return Err(self.fault(
+                        Fault::NoSuchAddress,
+                        format!("{letter} is no address of this machine"),
+                    ));
+                }
+                self.put(w, &name, value, Mode::Modal, axis)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The modal G functions of the block, one per group (§9.1.6).
+    fn modal(&mut self, w: &Words) -> Result<(), ProgramError> {
+        let mut groups: HashMap<u8, u32> = HashMap::new();
+        for &g in &w.g {
+            let group = g_group(g).ok_or_else(|| {
+                self.fault(
+                    Fault::UndefinedCode,
+                    format!("G{g} is no G function of this control"),
+                )
+            })?;
+            if let Some(other) = groups.insert(group, g) {
+                return Err(self.fault(
+                    Fault::SameGroup,
+                    format!("G{other} and G{g} are of one group: one per block"),
+                ));
+            }
+            match g {
+                0 => self.motion = Motion::Rapid,
+                1 => self.motion = Motion::Line,
+                2 => self.motion = Motion::Cw,
+                3 => self.motion = Motion::Ccw,
+                17..=19 => self.set_plane(g as u8)?,
+                90 => self.absolute = true,
+                91 => self.absolute = false,
+                70 | 71 | 700 | 710 => {
+                    self.inch = g == 70 || g == 700;
+                    self.inch_feed = g == 700;
+                }
+                94 | 95 => {
+                    let per_rev = g == 95;
+                    if self.core.feed_per_rev != per_rev {
+                        self.core.feed_per_rev = per_rev;
+                        self.core.push(Command::FeedMode { per_rev });
+                    }
+                }
+                60 | 64 => {
+                    let exact = g == 60;
+                    if self.core.exact_stop_mode != exact {
+                        self.core.exact_stop_mode = exact;
+                        self.core.push(Command::PathMode { exact_stop: exact });
+                    }
+                }
+                500 => self.set_work_offset(None)?,
+                // G54–G59 are the 1st–6th settable offsets, G507–G554 the 7th–54th (§9.2.10).
+                54..=59 => self.set_work_offset(Some((g - 54) as u8))?,
+                507..=554 => self.set_work_offset(Some((g - 507 + 6) as u8))?,
+                _ => {}
+            }
+        }
+        for k in &w.keys {
+            match k.as_str() {
+                "CIP" => self.motion = Motion::Cip,
+                "CT" => self.motion = Motion::Ct,
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// F and S (§9.3.14, §9.4.1): F in G700 counts inches; S sets the speed.
+    fn feed_and_speed(&mut self, w: &Words) -> Result<(), ProgramError> {
+        let dwell = w.has_g(4);
+        if let Some(f) = w.get("F").filter(|_| !dwell) {
+            if f <= 0.0 {
+                return Err(self.fault(Fault::FeedRange, "F must be above 0 (0.001…99999.999)"));
+            }
+            self.core.feed = if self.inch_feed { f * 25.4 } else { f };
+        }
+        if let Some(s) = w.get("S").filter(|_| !dwell) {
+            if !(0.0..=99_999.999).contains(&s) {
+                return Err(self.fault(Fault::OutOfRange, "S is 0…99999.999 rpm"));
+            }
+            self.core.set_rpm(s);
+        }
+        Ok(())
+    }
+
+    /// M3/M4/M5, gear stages and the machine's own M functions, output before the motion
+    /// (§9.7); at most 5 M per block.
+    fn m_before(&mut self, w: &Words) -> Result<(), ProgramError> {
+        if w.m.len() > 5 {
+            return Err(self.fault(Fault::TooManyM, "more than 5 M functions in one block"));
+        }
+        for &m in &w.m {
+            match m {
+                0 | 1 | 2 | 17 | 30 | 6 => {}
+                3 => self.spindle(SpindleDir::Cw, 3),
+                4 => self.spindle(SpindleDir::Ccw, 4),
+                5 => self.spindle(SpindleDir::Stopped, 5),
+                _ => self.core.aux(Aux::M(m as i32)),
+            }
+        }
+        Ok(())
+    }
+
+    fn spindle(&mut self, dir: SpindleDir, code: i32) {
+        self.core.spindle = dir;
+        self.core.aux(Aux::M(code));
+    }
+
+    /// M0, M1 after the motion; M2/M30 end the program (in a called program M2 returns, as
+    /// M17 does, §9.11.1).
+    fn m_after(&mut self, w: &Words) -> Result<(), ProgramError> {
+        for &m in &w.m {
+            match m {
+                0 | 1 => self.core.aux(Aux::M(m as i32)),
+                2 | 30 | 17 => {
+                    if self.core.depth() > 1 {
+                        self.return_from_program();
+                    } else if m == 17 {
+                        return Err(self.fault(
+                            Fault::ReturnWithoutCall,
+                            "M17 ends a subprogram; the main program ends with M2 or M30",
+                        ));
+                    } else {
+                        self.core.saw_end = true;
+                        self.core.spindle = SpindleDir::Stopped;
+                        self.core.aux(Aux::M(m as i32));
+                        self.core.finish();
+                    }
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn return_from_program(&mut self) {
+        if self.core.depth() > 1 {
+            self.core.return_from_call();
+            self.sync_scopes();
+        } else {
+            self.core.saw_end = true;
+            self.core.finish();
+        }
+    }
+}
+
+/// The group of a numeric G function (§9.1.6; inventory §3.1), `None` when the control has
+/// no such G.
+pub fn g_group(g: u32) -> Option<u8> {
+    Some(match g {
+        0..=3 | 33 | 331 | 332 => 1,
+        4 | 63 | 74 | 75 | 147 | 148 | 247 | 248 | 347 | 348 => 2,
+        25 | 26 | 110..=112 => 3,
+        17..=19 => 6,
+        40..=42 => 7,
+        500 | 54..=59 | 507..=554 => 8,
+        53 | 153 => 9,
+        60 | 64 => 10,
+        9 => 11,
+        601 | 602 => 12,
+        70 | 71 | 700 | 710 => 13,
+        90 | 91 => 14,
+        94 | 95 => 15,
+        450 | 451 => 18,
+        340 | 341 => 44,
+        290 | 291 => 47,
+        _ => return None,
+    })
+}

@@ -1,0 +1,562 @@
+//! The SINUMERIK 802D sl mill (`001`), a front end of its own over the interpreter's core
+//! (issue 23): its language is not FANUC's. Follow a block: [`lex`] makes tokens, [`block`]
+//! parses them into items, [`Sinumerik::run_block`] (`exec.rs`) sorts the items into
+//! assignments, addresses and keywords and runs them in the control's order, [`motion`]
+//! computes lines, circles, helices and polar moves, [`frames`] the programmable frames and
+//! zero offsets, [`tool`] tools, cutting edges and radius compensation; [`vars`] holds the
+//! variables and [`alarms`] the alarm numbers.
+
+pub mod alarms;
+pub mod block;
+mod exec;
+pub use exec::g_group as exec_g_group;
+pub mod expr;
+mod frames;
+pub mod lex;
+mod motion;
+mod tool;
+pub mod vars;
+
+use std::sync::Arc;
+
+use cnc_interpreter_core::comp::Side;
+use cnc_interpreter_core::geometry::Pt;
+use cnc_interpreter_core::{
+    CompRules, Core, Fault, FrontEnd, Library, Plane, ProgramError, Rules, Setup, NO_WORK_OFFSET,
+};
+
+use self::expr::{eval, EvalError, Expr, Val};
+use self::vars::{PlcArea, Scope, Var, R_BASE, R_COUNT};
+
+/// Group 1: how the axes move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    Rapid,
+    Line,
+    Cw,
+    Ccw,
+    /// CIP: a circle through an intermediate point.
+    Cip,
+    /// CT: a circle tangent to the path before it.
+    Ct,
+}
+
+/// The 802D front end: the core plus the control's own modal state.
+pub struct Sinumerik {
+    pub core: Core,
+    motion: Motion,
+    /// G90 (else G91).
+    absolute: bool,
+    /// G70/G700: geometry in inches.
+    inch: bool,
+    /// G700: the feed too.
+    inch_feed: bool,
+    /// The pole of polar coordinates, in the plane's work coordinates (§9.2.5).
+    pole: Pt,
+    /// The last polar angle and radius (modal until the pole or plane changes).
+    polar: (f64, f64),
+    /// G17/G18/G19 as 17, 18, 19.
+    plane_code: u8,
+    /// Active tool T and cutting edge D (0: none).
+    tool: u32,
+    edge: u32,
+    /// A T word waiting for M6 (when the machine changes tools with M6).
+    preselected: Option<u32>,
+    /// G41/G42 asked for; started with the next move.
+    comp_side: Option<Side>,
+    /// The path's direction at the end of the last move in the plane (CT continues it).
+    tangent: Option<Pt>,
+    /// Each program level's own `DEF` variables, innermost last.
+    scopes: Vec<Scope>,
+    /// A program level may still define variables (nothing else has run in it yet).
+    may_define: Vec<bool>,
+    plc: PlcArea,
+    /// MSG: the message shown now, and every one shown with its line (§9.1.6).
+    pub message: String,
+    pub messages: Vec<(u32, String)>,
+    /// A jump the block asked for, done once its other words ran.
+    jump: Option<(bool, String)>,
+}
+
+/// The plane of G17, G18 or G19 (`001` §9.2.2).
+fn plane_of(code: u8) -> Plane {
+    let (h, v, normal) = match code {
+        18 => ('Z', 'X', 'Y'),
+        19 => ('Y', 'Z', 'X'),
+        _ => ('X', 'Y', 'Z'),
+    };
+    Plane {
+        h,
+        v,
+        normal: Some(normal),
+        missing: (
+            Fault::PlaneAxis,
+            "the plane names an axis this machine does not have",
+        ),
+    }
+}
+
+impl Sinumerik {
+    pub fn rules() -> Rules {
+        Rules {
+            alarms: alarms::alarm,
+            // F range 0.001…99 999.999 (§9.3.14).
+            max_feed: 99_999.999,
+            initial_feed: 0.0,
+            needs_end: None,
+            locals: 0,
+            work_offsets: true,
+            plane: plane_of(17),
+            comp: CompRules {
+                refuse_rapid: false,
+                name: "tool radius compensation",
+            },
+            // 8 program levels including the main program (§9.11.1).
+            max_call_depth: 7,
+        }
+    }
+
+    pub fn new(text: &str, setup: Setup, library: Library) -> Sinumerik {
+        let mut core = Core::new(Sinumerik::rules(), text, setup, library);
+        // G500 at program start: no settable zero offset (§9.1.6 table, `*`).
+        core.work_system = NO_WORK_OFFSET;
+        core.program_start = core.work_position();
+        // G60, exact stop, is the power-on path mode (§9.3.16).
+        core.exact_stop_mode = true;
+        core.push(cnc_interpreter_core::Command::PathMode { exact_stop: true });
+        // The tool the machine holds stays active, with its first edge (§9.6.2).
+        let tool = core.setup.active_tool;
+        let mut front = Sinumerik {
+            core,
+            motion: Motion::Line,
+            absolute: true,
+            inch: false,
+            inch_feed: false,
+            pole: Pt::new(0.0, 0.0),
+            polar: (0.0, 0.0),
+            plane_code: 17,
+            tool,
+            edge: u32::from(tool > 0),
+            preselected: None,
+            comp_side: None,
+            tangent: None,
+            scopes: vec![Scope::new()],
+            may_define: vec![true],
+            plc: PlcArea::default(),
+            message: String::new(),
+            messages: Vec::new(),
+            jump: None,
+        };
+        front.apply_length();
+        front
+    }
+
+    /// R parameter `n` as the program has left it.
+    pub fn r(&self, n: i64) -> f64 {
+        self.core.common.get(&(R_BASE + n)).copied().unwrap_or(0.0)
+    }
+
+    /// A `DEF` variable of the innermost program level (for checks).
+    pub fn variable(&self, name: &str) -> Option<&Var> {
+        self.scopes.last().and_then(|s| s.get(name))
+    }
+
+    /// The active tool and cutting edge.
+    pub fn tool_edge(&self) -> (u32, u32) {
+        (self.tool, self.edge)
+    }
+
+    pub fn fault(&self, f: Fault, text: impl Into<String>) -> ProgramError {
+        self.core.fault(f, text)
+    }
+
+    fn eval_error(&self, e: EvalError) -> ProgramError {
+        self.fault(e.fault, e.text)
+    }
+
+    // ------------------------------------------------------------------ variables
+
+    /// Keeps one scope per program level (a call pushes one, a return pops it, a repeat
+    /// of the same program starts it afresh).
+    fn sync_scopes(&mut self) {
+        let depth = self.core.depth();
+        self.scopes.truncate(depth);
+        self.may_define.truncate(depth);
+        while self.scopes.len() < depth {
+            self.scopes.push(Scope::new());
+            self.may_define.push(true);
+        }
+    }
+
+    /// The value of an expression.
+    pub fn value(&self, e: &Expr) -> Result<Val, ProgramError> {
+        eval(e, &|name, idx| self.read(name, idx)).map_err(|e| self.eval_error(e))
+    }
+
+    pub fn number(&self, e: &Expr) -> Result<f64, ProgramError> {
+        let v = self.value(e)?;
+        v.num().map_err(|e| self.eval_error(e))
+    }
+
+    fn r_index(idx: &[Val]) -> Result<i64, EvalError> {
+        let k = match idx {
+            [v] => v.num()?,
+            _ => return Err(EvalError::new(Fault::MacroVariable, "R needs one number")),
+        };
+        if k.fract() != 0.0 || k < 0.0 || k >= R_COUNT as f64 {
+            return Err(EvalError::new(
+                Fault::MacroVariable,
+                format!("R{} does not exist: R0…R299", cnc_interpreter_core::show(k)),
+            ));
+        }
+        Ok(k as i64)
+    }
+
+    /// Reads a variable (an R parameter, a `DEF` variable of this program, a system
+    /// variable).
+    fn read(&self, name: &str, idx: &[Val]) -> Result<Val, EvalError> {
+        if name == "R" {
+            let k = Sinumerik::r_index(idx)?;
+            return Ok(Val::Num(
+                self.core.common.get(&(R_BASE + k)).copied().unwrap_or(0.0),
+            ));
+        }
+        if let Some(var) = self.scopes.last().and_then(|s| s.get(name)) {
+            let at = var.slot(name, idx)?;
+            return Ok(var.values[at].clone());
+        }
+        if PlcArea::is_plc(name) {
+            return self.plc.read(name, idx).map(Val::Num);
+        }
+        self.system(name, idx).map(Val::Num)
+    }
+
+    /// The system variables the manual's programs read (§3.12 of the inventory).
+    fn system(&self, name: &str, idx: &[Val]) -> Result<f64, EvalError> {
+        let unknown = || {
+            EvalError::new(
+                Fault::NoSuchAddress,
+                format!("{name} is not defined (no variable, address or keyword of this name)"),
+            )
+        };
+        match name {
+            "$P_TOOLNO" => Ok(f64::from(self.tool)),
+            "$P_TOOL" => Ok(f64::from(self.edge)),
+            "$AA_IW" => {
+                let axis = match idx {
+                    [Val::Str(a)] => a.clone(),
+                    _ => return Err(EvalError::new(Fault::MacroVariable, "$AA_IW[axis]")),
+                };
+                let i = axis
+                    .chars()
+                    .next()
+                    .and_then(|c| self.core.axis(c))
+                    .filter(|_| axis.len() == 1)
+                    .ok_or_else(|| EvalError::new(Fault::AxisAddress, format!("no axis {axis}")))?;
+                Ok(self.core.work_position()[i])
+            }
+            _ => match counter_key(name) {
+                Some(k) => Ok(self.core.common.get(&k).copied().unwrap_or(0.0)),
+                None => Err(unknown()),
+            },
+        }
+    }
+
+    /// Writes a variable; `name` is no address (the caller checked).
+    fn write(&mut self, name: &str, idx: &[Expr], value: &Expr) -> Result<(), ProgramError> {
+        let idx: Vec<Val> = idx
+            .iter()
+            .map(|e| self.value(e))
+            .collect::<Result<_, _>>()?;
+        // SET(…) / REP(…): successive elements from the one named (§9.9.2).
+        if let Expr::Call(f, args) = value {
+            if f == "SET" || f == "REP" {
+                let mut vals = Vec::new();
+                for a in args {
+                    let a = a.as_ref().ok_or_else(|| {
+                        self.fault(Fault::MacroArgument, format!("{f}: empty value"))
+                    })?;
+                    vals.push(self.value(a)?);
+                }
+                return self.write_list(name, &idx, &vals, f == "REP");
+            }
+        }
+        let v = self.value(value)?;
+        self.write_one(name, &idx, v)
+    }
+
+    fn write_one(&mut self, name: &str, idx: &[Val], v: Val) -> Result<(), ProgramError> {
+        let r = self.write_value(name, idx, v);
+        r.map_err(|e| self.eval_error(e))
+    }
+
+    fn write_value(&mut self, name: &str, idx: &[Val], v: Val) -> Result<(), EvalError> {
+        if name == "R" {
+            let k = Sinumerik::r_index(idx)?;
+            let x = v.num()?;
+            if !x.is_finite() {
+                return Err(EvalError::new(Fault::OutOfRange, "R value not finite"));
+            }
+            self.core.common.insert(R_BASE + k, x);
+            return Ok(());
+        }
+        if let Some(var) = self.scopes.last_mut().and_then(|s| s.get_mut(name)) {
+            let at = var.slot(name, idx)?;
+            var.values[at] = var.coerce(name, v)?;
+            return Ok(());
+        }
+        if PlcArea::is_plc(name) {
+            return self.plc.write(name, idx, v.num()?);
+        }
+        if let Some(k) = counter_key(name).filter(|_| name.ends_with("_PARTS")) {
+            let x = v.num()?;
+            if x.fract() != 0.0 || !(0.0..=999_999_999.0).contains(&x) {
+                return Err(EvalError::new(
+                    Fault::OutOfRange,
+                    format!("{name}: 0…999999999"),
+                ));
+            }
+            self.core.common.insert(k, x);
+            return Ok(());
+        }
+        if name.starts_with('$') {
+            return Err(EvalError::new(
+                Fault::MacroReadOnly,
+                format!("{name} cannot be written from a program"),
+            ));
+        }
+        Err(EvalError::new(
+            Fault::NoSuchAddress,
+            format!("{name} is not defined (no variable, address or keyword of this name)"),
+        ))
+    }
+
+    /// SET/REP into an array (or R parameters from the one named on).
+    fn write_list(
+        &mut self,
+        name: &str,
+        idx: &[Val],
+        vals: &[Val],
+        rep: bool,
+    ) -> Result<(), ProgramError> {
+        if name == "R" {
+            let k = Sinumerik::r_index(idx).map_err(|e| self.eval_error(e))?;
+            for (j, v) in vals.iter().enumerate() {
+                self.write_one("R", &[Val::Num((k + j as i64) as f64)], v.clone())?;
+            }
+            return Ok(());
+        }
+        let Some(var) = self.scopes.last().and_then(|s| s.get(name)).cloned() else {
+            return Err(self.fault(
+                Fault::MacroVariable,
+                format!("SET/REP need an array: {name} is none"),
+            ));
+        };
+        let start = if idx.is_empty() {
+            0
+        } else {
+            var.slot(name, idx).map_err(|e| self.eval_error(e))?
+        };
+        let n = var.values.len();
+        let list: Vec<Val> = if rep {
+            let v = vals.first().cloned().unwrap_or(Val::Num(0.0));
+            vec![v; n - start]
+        } else {
+            if start + vals.len() > n {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!(
+                        "SET: {} values from element {start} overrun {name}[{n}]",
+                        vals.len()
+                    ),
+                ));
+            }
+            vals.to_vec()
+        };
+        let mut coerced = Vec::with_capacity(list.len());
+        for v in list {
+            coerced.push(var.coerce(name, v).map_err(|e| self.eval_error(e))?);
+        }
+        if let Some(var) = self.scopes.last_mut().and_then(|s| s.get_mut(name)) {
+            var.values[start..start + coerced.len()].clone_from_slice(&coerced);
+        }
+        Ok(())
+    }
+
+    /// `DEF`: new variables of this program, at its start only (§9.9.2).
+    fn define(&mut self, d: &block::Def) -> Result<(), ProgramError> {
+        if !self.may_define.last().copied().unwrap_or(false) {
+            return Err(self.fault(
+                Fault::Macro,
+                "DEF only at the start of a program, before its other blocks",
+            ));
+        }
+        for v in &d.vars {
+            if !name_ok(&v.name) || exec::is_address(&v.name) || self.core.axis_named(&v.name) {
+                return Err(self.fault(
+                    Fault::Macro,
+                    format!("{} cannot name a variable: 2–32 letters, digits or _, the first two letters, and no address or keyword", v.name),
+                ));
+            }
+            if self.scopes.last().is_some_and(|s| s.contains_key(&v.name)) {
+                return Err(self.fault(Fault::Macro, format!("{} is defined twice", v.name)));
+            }
+            let var = Var::new(&d.ty, d.len, &v.dims);
+            if let Some(s) = self.scopes.last_mut() {
+                s.insert(v.name.clone(), var);
+            }
+            if let Some(init) = &v.init {
+                self.write(&v.name, &[], init)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Where the part counters and timers of §9.12 live in the core's common store.
+fn counter_key(name: &str) -> Option<i64> {
+    let names = [
+        "$AC_TOTAL_PARTS",
+        "$AC_REQUIRED_PARTS",
+        "$AC_ACTUAL_PARTS",
+        "$AC_SPECIAL_PARTS",
+        "$AC_CUTTING_TIME",
+        "$AC_CYCLE_TIME",
+        "$AC_OPERATING_TIME",
+        "$AN_SETUP_TIME",
+        "$AN_POWERON_TIME",
+    ];
+    names
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| R_BASE + 1000 + i as i64)
+}
+
+/// A variable name: 2–32 characters, letters, digits or `_`, the first two letters or `_`
+/// (§9.9.2).
+fn name_ok(n: &str) -> bool {
+    let c: Vec<char> = n.chars().collect();
+    (2..=32).contains(&c.len())
+        && c[..2].iter().all(|c| c.is_ascii_alphabetic() || *c == '_')
+        && c.iter().all(|c| c.is_ascii_alphanumeric() || *c == '_')
+}
+
+trait AxisNamed {
+    fn axis_named(&self, name: &str) -> bool;
+}
+
+impl AxisNamed for Core {
+    fn axis_named(&self, name: &str) -> bool {
+        name.len() == 1 && name.chars().next().and_then(|c| self.axis(c)).is_some()
+    }
+}
+
+impl FrontEnd for Sinumerik {
+    fn core(&self) -> &Core {
+        &self.core
+    }
+    fn core_mut(&mut self) -> &mut Core {
+        &mut self.core
+    }
+    fn read_block(&mut self) -> Result<(), ProgramError> {
+        let Some((text, range)) = self.core.next_line() else {
+            // The end of a called program returns as M17 does; of the main program, ends it.
+            if self.core.depth() > 1 {
+                self.core.return_from_call();
+                self.sync_scopes();
+                return Ok(());
+            }
+            return self.core.end_of_main();
+        };
+        self.sync_scopes();
+        let line: &str = &text[range];
+        let trimmed = line.trim_start();
+        // Transfer headers (`%_N_NAME_MPF`) and empty lines are no blocks.
+        if trimmed.starts_with('%') || lex::strip_comment(trimmed).trim().is_empty() {
+            return Ok(());
+        }
+        let block = block::parse(line).map_err(|e| self.fault(Fault::DataFormat, e))?;
+        if block.skip && self.core.setup.block_skip {
+            return Ok(());
+        }
+        self.run_block(&block, &text)
+    }
+}
+
+/// The errors each line shows on its own (its syntax), without running it.
+pub fn line_errors(text: &str) -> Vec<ProgramError> {
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim_start();
+        if t.starts_with('%') {
+            continue;
+        }
+        if let Err(e) = block::parse(line) {
+            out.push(ProgramError::new(
+                alarms::alarm(Fault::DataFormat),
+                i as u32 + 1,
+                e,
+            ));
+        }
+    }
+    out
+}
+
+/// Finds the line a jump goes to: a label (`NAME:`) or a block number (`N100`), forward
+/// from the block after `from` to the end, or backward from `from` (the jumping block
+/// included) to the top (§9.10.2).
+fn find_target(
+    text: &Arc<str>,
+    from: cnc_interpreter_core::Pos,
+    after: cnc_interpreter_core::Pos,
+    forward: bool,
+    target: &str,
+) -> Option<cnc_interpreter_core::Pos> {
+    let mut pos = if forward {
+        after
+    } else {
+        cnc_interpreter_core::Pos::default()
+    };
+    let mut found = None;
+    while let Some((line, next)) = cnc_interpreter_core::read_line(text, pos) {
+        if !forward && pos.offset > from.offset {
+            break;
+        }
+        if block_is(line, target) {
+            if forward {
+                return Some(pos);
+            }
+            found = Some(pos);
+        }
+        pos = next;
+    }
+    found
+}
+
+/// The line carries label `target`, or block number `target` (`N100`).
+fn block_is(line: &str, target: &str) -> bool {
+    let toks = match lex::tokens(lex::strip_comment(line)) {
+        Ok(t) => t,
+        // A line that does not parse may still carry the label: read up to the colon.
+        Err(_) => match line.split_once(':') {
+            Some((head, _)) => lex::tokens(head).unwrap_or_default(),
+            None => return false,
+        },
+    };
+    let mut t = toks.iter().peekable();
+    if matches!(t.peek(), Some(lex::Tok::Op("/"))) {
+        t.next();
+    }
+    if let Some(lex::Tok::Word {
+        letter: 'N',
+        digits,
+        ..
+    }) = t.peek()
+    {
+        if target == format!("N{}", digits.trim_start_matches('0')) {
+            return true;
+        }
+        t.next();
+    }
+    matches!((t.next(), t.next()), (Some(lex::Tok::Name(n)), Some(lex::Tok::Op(":"))) if n == target)
+}

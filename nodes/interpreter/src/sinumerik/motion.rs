@@ -1,0 +1,488 @@
+//! Lines, circles, helices and polar moves (`001` §9.2.5, §9.3.1–§9.3.6, §9.3.22): the end
+//! point from the axis words (G90/G91, AC/IC, inches), or from the pole with AP/RP; a circle
+//! by centre (I/J/K from the start, or `=AC(…)`), by radius CR (negative: more than a
+//! semicircle), by opening angle AR with the centre or the end, by the pole (AP/RP), through an
+//! intermediate point (CIP) or tangent to the path before it (CT); TURN= full turns more for a
+//! helix.
+
+use std::f64::consts::TAU;
+
+use cnc_interpreter_core::geometry::{
+    arc_sweep, center_from_radius, check_center, three_point, ArcError, Pt,
+};
+use cnc_interpreter_core::{Command, Fault, MoveKind, ProgramError, NO_WORK_OFFSET};
+
+use super::exec::{Mode, Words};
+use super::{Motion, Sinumerik};
+
+/// The interpolation parameter of an axis: I for X, J for Y, K for Z.
+fn centre_letter(axis: char) -> Option<char> {
+    match axis {
+        'X' => Some('I'),
+        'Y' => Some('J'),
+        'Z' => Some('K'),
+        _ => None,
+    }
+}
+
+fn rotate(p: Pt, c: Pt, radians: f64) -> Pt {
+    let (s, co) = radians.sin_cos();
+    let (dz, dr) = (p.z - c.z, p.r - c.r);
+    Pt::new(c.z + dz * co - dr * s, c.r + dz * s + dr * co)
+}
+
+impl Sinumerik {
+    /// The non-modal instructions that take the block's words for themselves: dwell,
+    /// frames, pole; `true` when the block moves nothing else.
+    pub(super) fn non_modal(&mut self, w: &Words) -> Result<bool, ProgramError> {
+        for (g, why) in [
+            (33, "G33 thread cutting is not built yet for the mill"),
+            (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
+            (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
+            (63, "G63 tapping with a compensating chuck is not built yet"),
+            (74, "G74 reference point approach from the program is not built yet"),
+            (75, "G75 fixed point approach is not built yet"),
+            (25, "G25/G26 working area and spindle limits are not built yet"),
+            (26, "G25/G26 working area and spindle limits are not built yet"),
+            (147, "smooth approach and retraction (WAB) is not built"),
+            (148, "smooth approach and retraction (WAB) is not built"),
+            (247, "smooth approach and retraction (WAB) is not built"),
+            (248, "smooth approach and retraction (WAB) is not built"),
+            (347, "smooth approach and retraction (WAB) is not built"),
+            (348, "smooth approach and retraction (WAB) is not built"),
+            (291, "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill"),
+            (153, "G153 (suppressing the basic frame too) is not built: there is no basic frame"),
+        ] {
+            if w.has_g(g) {
+                return Err(self.fault(Fault::NotSupported, why));
+            }
+        }
+        for k in ["CHF", "CHR", "RND", "RNDM", "FRC", "FRCM", "ANG", "SF"] {
+            if w.addr.contains_key(k) {
+                return Err(self.fault(
+                    Fault::NotSupported,
+                    format!("{k}= is not built yet (contour elements, chamfers and roundings)"),
+                ));
+            }
+        }
+        if w.has_g(4) {
+            return self.dwell(w).map(|()| true);
+        }
+        if self.frame_instruction(w)? {
+            return Ok(true);
+        }
+        if let Some(g) = [110, 111, 112].into_iter().find(|&g| w.has_g(g)) {
+            self.set_pole(g, w)?;
+            return Ok(true);
+        }
+        Ok(false)
+    }
+
+    /// G4 F seconds or S spindle revolutions (§9.3.22); F and S stay as they were.
+    fn dwell(&mut self, w: &Words) -> Result<(), ProgramError> {
+        let seconds = match (w.get("F"), w.get("S")) {
+            (Some(f), None) => f,
+            (None, Some(s)) => {
+                if self.core.rpm <= 0.0 {
+                    return Err(
+                        self.fault(Fault::DwellTime, "G4 S needs a spindle speed programmed")
+                    );
+                }
+                s * 60.0 / self.core.rpm
+            }
+            _ => {
+                return Err(self.fault(Fault::DwellTime, "G4 needs F (seconds) or S (revolutions)"))
+            }
+        };
+        if !(0.001..=99_999.999).contains(&seconds) {
+            return Err(self.fault(Fault::DwellTime, "dwell outside 0.001…99999.999"));
+        }
+        self.core.push(Command::Dwell { seconds });
+        Ok(())
+    }
+
+    /// G110 (from the last position), G111 (from the work zero), G112 (from the last pole):
+    /// the pole, given in the plane's axes or polar (§9.2.5).
+    fn set_pole(&mut self, g: u32, w: &Words) -> Result<(), ProgramError> {
+        let (h, v) = self.core.plane_axes()?;
+        let base = match g {
+            110 => self.core.plane_point(&self.core.work_position())?,
+            111 => Pt::new(0.0, 0.0),
+            _ => self.pole,
+        };
+        let unit = self.unit();
+        let polar = w.addr.contains_key("AP") || w.addr.contains_key("RP");
+        self.pole = if polar {
+            let ap = w.get("AP").unwrap_or(0.0);
+            let rp = w.get("RP").unwrap_or(0.0) * unit;
+            let (s, c) = ap.to_radians().sin_cos();
+            Pt::new(base.z + rp * c, base.r + rp * s)
+        } else {
+            let get = |i: usize| w.axes.get(&i).map_or(0.0, |a| a.0 * unit);
+            Pt::new(base.z + get(h), base.r + get(v))
+        };
+        self.polar = (0.0, 0.0);
+        Ok(())
+    }
+
+    fn unit(&self) -> f64 {
+        if self.inch {
+            25.4
+        } else {
+            1.0
+        }
+    }
+
+    /// The block's move, if it has one.
+    pub(super) fn motion_block(&mut self, w: &Words) -> Result<(), ProgramError> {
+        let arc_words = ["I", "J", "K", "CR", "AR", "I1", "J1", "K1", "TURN"];
+        let polar = w.addr.contains_key("AP") || w.addr.contains_key("RP");
+        let moves =
+            !w.axes.is_empty() || polar || arc_words.iter().any(|k| w.addr.contains_key(*k));
+        if !moves {
+            return Ok(());
+        }
+        if w.has_g(53) {
+            return self.machine_coordinates(w);
+        }
+        let here = self.core.work_position();
+        let mut end = here.clone();
+        let unit = self.unit();
+        for (&i, &(v, mode)) in &w.axes {
+            let linear = "XYZUVW".contains(self.core.setup.axes[i]);
+            let v = if linear { v * unit } else { v };
+            let absolute = match mode {
+                Mode::Abs | Mode::Rotary => true,
+                Mode::Inc => false,
+                Mode::Modal => self.absolute,
+            };
+            end[i] = if absolute { v } else { here[i] + v };
+        }
+        let circle = matches!(self.motion, Motion::Cw | Motion::Ccw);
+        if polar {
+            let (ap, rp) = self.polar_words(w)?;
+            let (s, c) = ap.to_radians().sin_cos();
+            let p = Pt::new(self.pole.z + rp * c, self.pole.r + rp * s);
+            self.core.set_plane_point(&mut end, p);
+        }
+        self.start_compensation()?;
+        let a = self.core.plane_point(&here)?;
+        let b = self.core.plane_point(&end)?;
+        let feed = self.core.feed;
+        match self.motion {
+            Motion::Rapid | Motion::Line => {
+                if let Some(k) = arc_words.iter().find(|k| w.addr.contains_key(**k)) {
+                    return Err(self.fault(
+                        Fault::IllegalWord,
+                        format!("{k} belongs to a circle (G2/G3/CIP)"),
+                    ));
+                }
+                let kind = if self.motion == Motion::Rapid {
+                    MoveKind::Rapid
+                } else {
+                    MoveKind::Feed(feed)
+                };
+                self.core.emit(&end, kind)?;
+                if a.dist(b) > 1e-9 {
+                    let l = a.dist(b);
+                    self.tangent = Some(Pt::new((b.z - a.z) / l, (b.r - a.r) / l));
+                }
+            }
+            _ => {
+                let (c, ccw, end) = if circle {
+                    self.circle(w, a, end, polar)?
+                } else if self.motion == Motion::Cip {
+                    self.through_point(w, a, end, &here)?
+                } else {
+                    self.tangential(a, b, end)?
+                };
+                self.arc_to(&here, &end, c, ccw, w.get("TURN"), feed)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// AP/RP of the block, or the last ones; IC makes them incremental.
+    fn polar_words(&mut self, w: &Words) -> Result<(f64, f64), ProgramError> {
+        let mut ap = self.polar.0;
+        let mut rp = self.polar.1;
+        if let Some(&(v, mode)) = w.addr.get("AP") {
+            ap = if mode == Mode::Inc { ap + v } else { v };
+        }
+        if let Some(&(v, mode)) = w.addr.get("RP") {
+            let v = v * self.unit();
+            rp = if mode == Mode::Inc { rp + v } else { v };
+        }
+        if rp < 0.0 {
+            return Err(self.fault(Fault::OutOfRange, "RP= must not be negative"));
+        }
+        self.polar = (ap, rp);
+        Ok((ap, rp))
+    }
+
+    /// G2/G3: the centre and the end point from the block's words (§9.3.3).
+    fn circle(
+        &self,
+        w: &Words,
+        a: Pt,
+        mut end: Vec<f64>,
+        polar: bool,
+    ) -> Result<(Pt, bool, Vec<f64>), ProgramError> {
+        let ccw = self.motion == Motion::Ccw;
+        let (h, v) = self.core.plane_axes()?;
+        let letters = (
+            centre_letter(self.core.setup.axes[h]),
+            centre_letter(self.core.setup.axes[v]),
+        );
+        let unit = self.unit();
+        let centre_word = |l: Option<char>, start: f64| -> Option<f64> {
+            let (val, mode) = *w.addr.get(&l?.to_string())?;
+            Some(if mode == Mode::Abs {
+                val * unit
+            } else {
+                start + val * unit
+            })
+        };
+        let has_centre = [letters.0, letters.1]
+            .iter()
+            .flatten()
+            .any(|l| w.addr.contains_key(&l.to_string()));
+        let radius = w.get("CR").map(|r| r * unit);
+        let angle = w.get("AR");
+        let arc_err = |e: ArcError, what: &str| {
+            self.fault(
+                match e {
+                    ArcError::RadiusTooSmall => Fault::ArcRadius,
+                    _ => Fault::ArcEnd,
+                },
+                format!("error in the end point of the circle: {what}"),
+            )
+        };
+        if polar {
+            // The pole is the centre (§9.3.3).
+            if has_centre || radius.is_some() {
+                return Err(self.fault(
+                    Fault::ArcRAndIk,
+                    "a polar circle takes its centre from the pole",
+                ));
+            }
+            return Ok((self.pole, ccw, end));
+        }
+        let b = self.core.plane_point(&end)?;
+        let end_given = w.axes.contains_key(&h) || w.axes.contains_key(&v);
+        match (has_centre, radius, angle) {
+            (true, None, None) => {
+                let c = Pt::new(
+                    centre_word(letters.0, a.z).unwrap_or(a.z),
+                    centre_word(letters.1, a.r).unwrap_or(a.r),
+                );
+                let c = check_center(a, b, c).map_err(|e| arc_err(e, "start and end are not on one circle around the centre"))?;
+                Ok((c, ccw, end))
+            }
+            (false, Some(r), None) => {
+                if r.abs() < 0.01 {
+                    return Err(self.fault(Fault::ArcRadius, "CR= is 0.010…99999.999"));
+                }
+                let c = center_from_radius(a, b, r, ccw).map_err(|e| arc_err(e, "the radius does not reach the end, or the end is the start (a full circle needs its centre)"))?;
+                Ok((c, ccw, end))
+            }
+            (true, None, Some(ar)) => {
+                // Centre and opening angle: the end follows (§9.3.3).
+                let c = Pt::new(
+                    centre_word(letters.0, a.z).unwrap_or(a.z),
+                    centre_word(letters.1, a.r).unwrap_or(a.r),
+                );
+                self.check_angle(ar)?;
+                let turn = if ccw { ar } else { -ar }.to_radians();
+                let p = rotate(a, c, turn);
+                self.core.set_plane_point(&mut end, p);
+                Ok((c, ccw, end))
+            }
+            (false, None, Some(ar)) if end_given => {
+                self.check_angle(ar)?;
+                let half = a.dist(b) / 2.0;
+                let r = half / (ar.to_radians() / 2.0).sin();
+                // More than a semicircle: the centre on the other side.
+                let r = if ar > 180.0 { -r } else { r };
+                let c = center_from_radius(a, b, r, ccw).map_err(|e| arc_err(e, "AR with this end"))?;
+                Ok((c, ccw, end))
+            }
+            _ => Err(self.fault(
+                Fault::ArcRAndIk,
+                "a circle needs its centre (I/J/K), or CR=, or AR= with the centre or the end: one of them",
+            )),
+        }
+    }
+
+    fn check_angle(&self, ar: f64) -> Result<(), ProgramError> {
+        if !(0.00001..=359.99999).contains(&ar) {
+            return Err(self.fault(Fault::ArcRadius, "AR= is 0.00001…359.99999 degrees"));
+        }
+        Ok(())
+    }
+
+    /// CIP: the circle from the start through I1/J1/K1 to the end (§9.3.4); G90/G91 apply to
+    /// the intermediate point too.
+    fn through_point(
+        &self,
+        w: &Words,
+        a: Pt,
+        end: Vec<f64>,
+        here: &[f64],
+    ) -> Result<(Pt, bool, Vec<f64>), ProgramError> {
+        let (h, v) = self.core.plane_axes()?;
+        let unit = self.unit();
+        let coord = |i: usize| -> Result<f64, ProgramError> {
+            let l = centre_letter(self.core.setup.axes[i]).map(|c| format!("{c}1"));
+            let (val, mode) = l.and_then(|l| w.addr.get(&l).copied()).ok_or_else(|| {
+                self.fault(
+                    Fault::MissingWord,
+                    "CIP needs the intermediate point I1=/J1=/K1= in the plane",
+                )
+            })?;
+            let absolute = match mode {
+                Mode::Abs | Mode::Rotary => true,
+                Mode::Inc => false,
+                Mode::Modal => self.absolute,
+            };
+            Ok(if absolute {
+                val * unit
+            } else {
+                here[i] + val * unit
+            })
+        };
+        let m = Pt::new(coord(h)?, coord(v)?);
+        let b = self.core.plane_point(&end)?;
+        let (c, ccw) = three_point(a, m, b).map_err(|_| {
+            self.fault(
+                Fault::ThreePointArc,
+                "intermediate point of the circle incorrect: the three points are on a line",
+            )
+        })?;
+        Ok((c, ccw, end))
+    }
+
+    /// CT: the circle tangent to the path before it (§9.3.5).
+    fn tangential(
+        &self,
+        a: Pt,
+        b: Pt,
+        end: Vec<f64>,
+    ) -> Result<(Pt, bool, Vec<f64>), ProgramError> {
+        let t = self.tangent.ok_or_else(|| {
+            self.fault(
+                Fault::ArcEnd,
+                "CT needs a path element before it in this plane",
+            )
+        })?;
+        let (dz, dr) = (b.z - a.z, b.r - a.r);
+        let n = Pt::new(-t.r, t.z);
+        let nd = n.z * dz + n.r * dr;
+        if nd.abs() < 1e-9 {
+            return Err(self.fault(Fault::ArcEnd, "CT: the end lies on the tangent, no circle"));
+        }
+        let rho = (dz * dz + dr * dr) / (2.0 * nd);
+        Ok((Pt::new(a.z + rho * n.z, a.r + rho * n.r), nd > 0.0, end))
+    }
+
+    /// The arc (with TURN= full turns before it, a helix along the other axes) and the
+    /// tangent after it.
+    fn arc_to(
+        &mut self,
+        here: &[f64],
+        end: &[f64],
+        c: Pt,
+        ccw: bool,
+        turns: Option<f64>,
+        feed: f64,
+    ) -> Result<(), ProgramError> {
+        let a = self.core.plane_point(here)?;
+        let b = self.core.plane_point(end)?;
+        let turns = match turns {
+            None => 0,
+            Some(t) if t.fract() == 0.0 && (0.0..=999.0).contains(&t) => t as u32,
+            Some(_) => return Err(self.fault(Fault::OutOfRange, "TURN= is 0…999")),
+        };
+        let sweep = arc_sweep(a, b, c, ccw).abs();
+        let total = sweep + TAU * f64::from(turns);
+        let (hi, vi) = self.core.plane_axes()?;
+        for k in 1..=turns {
+            let share = TAU * f64::from(k) / total;
+            let p: Vec<f64> = (0..here.len())
+                .map(|i| {
+                    if i == hi || i == vi {
+                        here[i]
+                    } else {
+                        here[i] + (end[i] - here[i]) * share
+                    }
+                })
+                .collect();
+            self.core.emit(
+                &p,
+                MoveKind::Arc {
+                    center: c,
+                    ccw,
+                    feed,
+                },
+            )?;
+        }
+        self.core.emit(
+            end,
+            MoveKind::Arc {
+                center: c,
+                ccw,
+                feed,
+            },
+        )?;
+        let (dz, dr) = (b.z - c.z, b.r - c.r);
+        let l = dz.hypot(dr).max(1e-12);
+        self.tangent = Some(if ccw {
+            Pt::new(-dr / l, dz / l)
+        } else {
+            Pt::new(dr / l, -dz / l)
+        });
+        Ok(())
+    }
+
+    /// G53: this block's positions are machine positions (settable and programmable offsets
+    /// off; the tool length stays), §9.2.10.
+    fn machine_coordinates(&mut self, w: &Words) -> Result<(), ProgramError> {
+        if self.core.comp.is_some() {
+            return Err(self.fault(
+                Fault::CompInCycle,
+                "G53 while radius compensation is active",
+            ));
+        }
+        if !matches!(self.motion, Motion::Rapid | Motion::Line) {
+            return Err(self.fault(Fault::IllegalWord, "G53 takes straight moves"));
+        }
+        let saved = (
+            self.core.frame.clone(),
+            self.core.work_system,
+            std::mem::take(&mut self.core.shift),
+        );
+        let n = self.core.setup.axes.len();
+        self.core.shift = vec![0.0; n];
+        self.core.frame = cnc_interpreter_core::Frame::identity(n);
+        self.core.work_system = NO_WORK_OFFSET;
+        let here = self.core.work_position();
+        let mut end = here.clone();
+        let unit = self.unit();
+        for (&i, &(v, mode)) in &w.axes {
+            let absolute = mode != Mode::Inc && (mode != Mode::Modal || self.absolute);
+            end[i] = if absolute {
+                v * unit
+            } else {
+                here[i] + v * unit
+            };
+        }
+        let kind = if self.motion == Motion::Rapid {
+            MoveKind::Rapid
+        } else {
+            MoveKind::Feed(self.core.feed)
+        };
+        let r = self.core.emit(&end, kind);
+        (self.core.frame, self.core.work_system, self.core.shift) = saved;
+        r
+    }
+}

@@ -1,0 +1,163 @@
+//! Tools, cutting edges and radius compensation (`001` §9.6; inventory §3.7, §5.2–§5.3).
+//! T selects a tool and its edge D1; D1–D9 choose the edge, D0 none. An edge's offsets are
+//! the offset page's entry T×10+D (decision D80): its Z length (geometry plus wear) is the
+//! tool length along the axis normal to the plane (G17 Z, G18 Y, G19 X), its radius the
+//! cutter radius of G41/G42. Whether T changes the tool at once or only preselects it for M6
+//! is the machine's choice (`Setup::tool_change_with_m6`).
+
+use cnc_interpreter_core::comp::{Side, Startup};
+use cnc_interpreter_core::{Aux, Fault, ProgramError};
+
+use super::exec::Words;
+use super::{plane_of, Motion, Sinumerik};
+
+impl Sinumerik {
+    /// T, D, M6 and the G40/G41/G42 choice of the block.
+    pub(super) fn tool_words(&mut self, w: &Words) -> Result<(), ProgramError> {
+        if let Some(t) = w.get("T") {
+            if t.fract() != 0.0 || !(0.0..=32_000.0).contains(&t) {
+                return Err(self.fault(Fault::ToolNumber, "T is 0…32000"));
+            }
+            let t = t as u32;
+            self.core.aux(Aux::T(t as i32));
+            if self.core.setup.tool_change_with_m6 {
+                self.preselected = Some(t);
+            } else {
+                self.change_tool(t)?;
+            }
+        }
+        if w.m.contains(&6) {
+            self.core.aux(Aux::M(6));
+            if let Some(t) = self.preselected.take() {
+                self.change_tool(t)?;
+            }
+        }
+        if let Some(d) = w.get("D") {
+            if d.fract() != 0.0 || !(0.0..=9.0).contains(&d) {
+                return Err(self.fault(Fault::ToolNumber, "D is 0…9: a cutting edge of the tool"));
+            }
+            if d > 0.0 && self.tool == 0 {
+                return Err(self.fault(Fault::ToolNumber, "D without an active tool: T first"));
+            }
+            self.edge = d as u32;
+            self.apply_length();
+            if self.core.comp.is_some() {
+                return Err(self.fault(
+                    Fault::NotSupported,
+                    "a D change under radius compensation is not built yet: G40 first",
+                ));
+            }
+        }
+        for g in [40, 41, 42] {
+            if w.has_g(g) {
+                self.comp_side = match g {
+                    41 => Some(Side::Left),
+                    42 => Some(Side::Right),
+                    _ => None,
+                };
+                if g == 40 && self.core.comp.is_some() {
+                    self.core.comp_cancel = true;
+                }
+            }
+        }
+        if w.has_g(451) {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "G451 (intersection at outer corners) is not built: G450 transition circles",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The tool becomes active with its first edge (§9.6.2); T0 leaves none.
+    fn change_tool(&mut self, t: u32) -> Result<(), ProgramError> {
+        if self.core.comp.is_some() {
+            return Err(self.fault(
+                Fault::CompInCycle,
+                "tool change while radius compensation is active: G40 first",
+            ));
+        }
+        self.tool = t;
+        self.edge = u32::from(t > 0);
+        self.apply_length();
+        Ok(())
+    }
+
+    /// The active edge's entry on the offset page.
+    fn offset_entry(&self) -> Option<cnc_interpreter_core::ToolOffset> {
+        (self.tool > 0 && self.edge > 0)
+            .then(|| self.core.setup.offsets.tool(self.tool * 10 + self.edge))
+    }
+
+    /// Tool length along the plane's normal axis: taken up by the next move of that axis
+    /// (§9.6.3).
+    pub(super) fn apply_length(&mut self) {
+        let length = self.offset_entry().map_or(0.0, |o| o.z + o.wear_z);
+        for v in self.core.tool_offset.iter_mut() {
+            *v = 0.0;
+        }
+        if let Some(i) = self.core.plane_normal() {
+            self.core.tool_offset[i] = length;
+        }
+    }
+
+    /// G17/G18/G19: the plane, the length axis with it, and polar coordinates start over.
+    pub(super) fn set_plane(&mut self, code: u8) -> Result<(), ProgramError> {
+        if code == self.plane_code {
+            return Ok(());
+        }
+        if self.core.comp.is_some() {
+            return Err(self.fault(
+                Fault::CompPlane,
+                "the plane cannot change while radius compensation is active: G40 first",
+            ));
+        }
+        self.plane_code = code;
+        self.core.plane = plane_of(code);
+        self.polar = (0.0, 0.0);
+        self.tangent = None;
+        self.apply_length();
+        Ok(())
+    }
+
+    /// Starts radius compensation with the block's move, which must be a straight one
+    /// (§9.6.4): the move ends perpendicular to the next element's start.
+    pub(super) fn start_compensation(&mut self) -> Result<(), ProgramError> {
+        let Some(side) = self.comp_side else {
+            return Ok(());
+        };
+        if let Some(c) = &self.core.comp {
+            if c.side() != side {
+                return Err(self.fault(
+                    Fault::CompDirection,
+                    "a switch between G41 and G42 without G40 is not built: G40 first",
+                ));
+            }
+            return Ok(());
+        }
+        if !matches!(self.motion, Motion::Rapid | Motion::Line) {
+            return Err(self.fault(Fault::CompStartNotLine, "G41/G42 start in a G0 or G1 block"));
+        }
+        let entry = self.offset_entry().ok_or_else(|| {
+            self.fault(
+                Fault::CompRadiusZero,
+                "radius compensation without an active tool edge (T and D)",
+            )
+        })?;
+        let (h, v) = self.core.plane_axes()?;
+        let factor = match self.core.frame.plane_similarity(h, v) {
+            Some((f, _)) => f,
+            None if self.core.frame.is_identity() => 1.0,
+            None => {
+                return Err(self.fault(
+                    Fault::CompInCycle,
+                    "radius compensation under a frame that distorts the plane",
+                ))
+            }
+        };
+        // Compensation runs in the program's coordinates: the radius there is the tool's
+        // divided by the frame's scale, so the machine path keeps the tool's radius.
+        self.core
+            .start_comp(side, entry.radius / factor, 0, Startup::ToNextElement)
+    }
+}
