@@ -418,3 +418,21 @@ fn every_fixture_ends_or_stops_with_a_numbered_alarm() {
     }
     assert_eq!(n, 117);
 }
+
+/// Input that once could have crashed or made a zero circle: each an alarm on its line.
+#[test]
+fn malformed_circles_values_and_indexes_are_alarms() {
+    // A polar circle whose start is not on the pole's circle, and one around its own start.
+    let r = run("F100 G0 X10 Y0\nG111 X0 Y0\nG2 RP=5 AP=90\n");
+    assert_eq!(r.alarm(), (14040, 3));
+    let r = run("F100 G0 X10 Y0\nG111 X10 Y0\nG2 RP=0 AP=90\n");
+    assert_eq!(r.alarm(), (14040, 3));
+    // Centre and opening angle with the centre on the start.
+    let r = run("F100 G0 X10 Y0\nG2 I0 J0 AR=90\n");
+    assert_eq!(r.alarm(), (14040, 2));
+    // A value nested ten thousand deep, a PLC index beyond any offset.
+    let deep = format!("R1={}1{}\n", "(".repeat(10_000), ")".repeat(10_000));
+    assert_eq!(run(&deep).alarm(), (12080, 1));
+    let r = run("R1=$A_DBW[1EX30]\n");
+    assert_eq!(r.alarm(), (17020, 1));
+}

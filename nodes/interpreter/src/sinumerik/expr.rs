@@ -71,13 +71,22 @@ pub type Reader<'r> = dyn Fn(&str, &[Val]) -> Result<Val, EvalError> + 'r;
 pub struct Parser<'a> {
     pub toks: &'a [Tok],
     pub at: usize,
+    /// How deep the value being read nests (signs, parentheses, function arguments).
+    depth: usize,
 }
+
+/// Deepest nesting of one value: a line of a thousand `(` is an alarm, not a stack overflow.
+const MAX_NESTING: usize = 64;
 
 type PResult<T> = Result<T, String>;
 
 impl<'a> Parser<'a> {
     pub fn new(toks: &'a [Tok]) -> Parser<'a> {
-        Parser { toks, at: 0 }
+        Parser {
+            toks,
+            at: 0,
+            depth: 0,
+        }
     }
 
     pub fn peek(&self) -> Option<&'a Tok> {
@@ -166,7 +175,18 @@ impl<'a> Parser<'a> {
         }
     }
 
+    /// Every nesting passes here (a sign, or a primary's parentheses and arguments).
     fn unary(&mut self) -> PResult<Expr> {
+        if self.depth >= MAX_NESTING {
+            return Err(format!("a value nested deeper than {MAX_NESTING} levels"));
+        }
+        self.depth += 1;
+        let e = self.signed();
+        self.depth -= 1;
+        e
+    }
+
+    fn signed(&mut self) -> PResult<Expr> {
         if self.eat_op("-") {
             return Ok(Expr::Neg(Box::new(self.unary()?)));
         }
@@ -397,5 +417,12 @@ mod tests {
         let e = Parser::new(&toks).expr().unwrap();
         assert_eq!(eval(&e, &r).unwrap_err().fault, Fault::MacroArgument);
         assert!(Parser::new(&tokens("(1+2").unwrap()).expr().is_err());
+        let deep = format!("{}1{}", "(".repeat(10_000), ")".repeat(10_000));
+        assert!(Parser::new(&tokens(&deep).unwrap()).expr().is_err());
+        assert!(Parser::new(&tokens(&"-".repeat(10_000)).unwrap())
+            .expr()
+            .is_err());
+        let fine = format!("{}1{}", "(".repeat(40), ")".repeat(40));
+        assert!(Parser::new(&tokens(&fine).unwrap()).expr().is_ok());
     }
 }

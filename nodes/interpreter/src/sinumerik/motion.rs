@@ -8,7 +8,7 @@
 use std::f64::consts::TAU;
 
 use cnc_interpreter_core::geometry::{
-    arc_sweep, center_from_radius, check_center, three_point, ArcError, Pt,
+    arc_sweep, center_from_radius, check_center, three_point, ArcError, Pt, ARC_TOLERANCE,
 };
 use cnc_interpreter_core::{Command, Fault, MoveKind, ProgramError, NO_WORK_OFFSET};
 
@@ -266,7 +266,15 @@ impl Sinumerik {
                     "a polar circle takes its centre from the pole",
                 ));
             }
-            return Ok((self.pole, ccw, end));
+            // The start must lie on the circle the pole and RP make.
+            let b = self.core.plane_point(&end)?;
+            let c = check_center(a, b, self.pole).map_err(|e| {
+                arc_err(
+                    e,
+                    "the start is not on the circle of radius RP around the pole",
+                )
+            })?;
+            return Ok((c, ccw, end));
         }
         let b = self.core.plane_point(&end)?;
         let end_given = w.axes.contains_key(&h) || w.axes.contains_key(&v);
@@ -293,6 +301,9 @@ impl Sinumerik {
                     centre_word(letters.1, a.r).unwrap_or(a.r),
                 );
                 self.check_angle(ar)?;
+                if a.dist(c) < ARC_TOLERANCE {
+                    return Err(arc_err(ArcError::RadiusTooSmall, "the centre is the start"));
+                }
                 let turn = if ccw { ar } else { -ar }.to_radians();
                 let p = rotate(a, c, turn);
                 self.core.set_plane_point(&mut end, p);

@@ -149,7 +149,8 @@ impl PlcArea {
                 ))
             }
         };
-        if at.fract() != 0.0 || at < 0.0 || at as usize + w > PLC_BYTES {
+        // Compared as numbers: a huge index must not wrap when made an offset.
+        if at.fract() != 0.0 || at < 0.0 || at + w as f64 > PLC_BYTES as f64 {
             return Err(EvalError::new(
                 Fault::OutOfRange,
                 format!(
@@ -234,5 +235,7 @@ mod tests {
         assert_eq!(a.read("$A_DBR", &[Val::Num(8.0)]).unwrap(), 1.5);
         assert!(a.write("$A_DBD", &[Val::Num(510.0)], 1.0).is_err());
         assert!(a.write("$A_DBB", &[Val::Num(0.0)], 300.0).is_err());
+        assert!(a.read("$A_DBB", &[Val::Num(1e30)]).is_err());
+        assert!(a.read("$A_DBW", &[Val::Num(f64::MAX)]).is_err());
     }
 }
