@@ -116,9 +116,15 @@ impl Dialect {
             Dialect::Gtc2eLathe => g_status::<Gtc2e>(x10),
             Dialect::IsoLathe => g_status::<IsoLathe>(x10),
             Dialect::FanucMill => g_status::<Mill>(x10),
-            Dialect::Sinumerik802d => (x10.is_multiple_of(10)
-                && sinumerik::exec_g_group(x10 / 10).is_some())
-            .then_some(CodeStatus::Built),
+            Dialect::Sinumerik802d => {
+                let g = x10 / 10;
+                (x10.is_multiple_of(10) && sinumerik::g_group(g).is_some()).then(|| {
+                    match sinumerik::NOT_BUILT_G.iter().find(|(n, _)| *n == g) {
+                        Some((_, why)) => CodeStatus::Unsupported(why),
+                        None => CodeStatus::Built,
+                    }
+                })
+            }
         }
     }
 

@@ -436,3 +436,19 @@ fn malformed_circles_values_and_indexes_are_alarms() {
     let r = run("R1=$A_DBW[1EX30]\n");
     assert_eq!(r.alarm(), (17020, 1));
 }
+
+/// The code table tells the G functions that run from those refused with a reason, from the
+/// same table the front end refuses them by.
+#[test]
+fn the_code_table_marks_the_g_functions_not_built() {
+    use cnc_interpreter::dialect::CodeStatus;
+    use cnc_interpreter::Dialect;
+    let d = Dialect::Sinumerik802d;
+    assert_eq!(d.g_code(20), Some(CodeStatus::Built));
+    assert_eq!(d.g_code(5070), Some(CodeStatus::Built));
+    assert!(matches!(d.g_code(330), Some(CodeStatus::Unsupported(w)) if w.contains("G33")));
+    assert!(matches!(d.g_code(4510), Some(CodeStatus::Unsupported(_))));
+    assert_eq!(d.g_code(5060), None);
+    let r = run("G33 Z-10 K1\n");
+    assert_eq!(r.alarm(), (12140, 1));
+}

@@ -231,15 +231,7 @@ impl Core {
         locals: Option<Vec<Value>>,
         what: &str,
     ) -> Result<(), ProgramError> {
-        if self.levels.len() > self.rules.max_call_depth {
-            return Err(self.fault(
-                Fault::CallDepth,
-                format!(
-                    "subprograms nested deeper than {} levels",
-                    self.rules.max_call_depth
-                ),
-            ));
-        }
+        self.check_call_depth()?;
         let (name, text) = self.library.get(number).ok_or_else(|| {
             self.fault(
                 Fault::UndefinedSubprogram,
@@ -259,15 +251,7 @@ impl Core {
         count: u32,
         locals: Option<Vec<Value>>,
     ) -> Result<(), ProgramError> {
-        if self.levels.len() > self.rules.max_call_depth {
-            return Err(self.fault(
-                Fault::CallDepth,
-                format!(
-                    "programs nested deeper than {} levels",
-                    self.rules.max_call_depth + 1
-                ),
-            ));
-        }
+        self.check_call_depth()?;
         let (file, text) = self.library.get_named(name).ok_or_else(|| {
             self.fault(
                 Fault::UndefinedSubprogram,
@@ -276,6 +260,20 @@ impl Core {
         })?;
         let file = file.to_string();
         self.push_level(file, text, count, locals);
+        Ok(())
+    }
+
+    /// One more call level would nest deeper than the control allows.
+    fn check_call_depth(&self) -> Result<(), ProgramError> {
+        if self.levels.len() > self.rules.max_call_depth {
+            return Err(self.fault(
+                Fault::CallDepth,
+                format!(
+                    "subprograms nested deeper than {} levels",
+                    self.rules.max_call_depth
+                ),
+            ));
+        }
         Ok(())
     }
 

@@ -105,6 +105,28 @@ pub const NOT_BUILT: [(&str, &str); 22] = [
     ("RESETMON", "tool monitoring is not built"),
 ];
 
+/// G functions of the manual this controller does not run, each with the reason (the
+/// alarm 12140 says it; the code table lists them).
+pub const NOT_BUILT_G: [(u32, &str); 17] = [
+    (33, "G33 thread cutting is not built yet for the mill"),
+    (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
+    (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
+    (63, "G63 tapping with a compensating chuck is not built yet"),
+    (74, "G74 reference point approach from the program is not built yet"),
+    (75, "G75 fixed point approach is not built yet"),
+    (25, "G25/G26 working area and spindle limits are not built yet"),
+    (26, "G25/G26 working area and spindle limits are not built yet"),
+    (147, "smooth approach and retraction (WAB) is not built"),
+    (148, "smooth approach and retraction (WAB) is not built"),
+    (247, "smooth approach and retraction (WAB) is not built"),
+    (248, "smooth approach and retraction (WAB) is not built"),
+    (347, "smooth approach and retraction (WAB) is not built"),
+    (348, "smooth approach and retraction (WAB) is not built"),
+    (291, "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill"),
+    (153, "G153 (suppressing the basic frame too) is not built: there is no basic frame"),
+    (451, "G451 (intersection at outer corners) is not built: G450 transition circles"),
+];
+
 /// A name the control reserves: an address or a keyword (no variable may take it).
 pub fn is_address(name: &str) -> bool {
     ADDRESSES.contains(&name)
@@ -239,8 +261,6 @@ impl Sinumerik {
                     self.not_built(n)?;
                 } else if is_cycle(n) || self.core.library.get_named(n).is_some() {
                     self.program_call(w, n)?;
-                } else if n == "RET" {
-                    w.keys.push(n.clone());
                 } else {
                     return Err(self.fault(
                         Fault::NoSuchAddress,
@@ -284,8 +304,7 @@ impl Sinumerik {
             };
             // The display shows 65 characters (§9.1.6).
             let shown: String = text.chars().take(65).collect();
-            self.messages.push((self.core.line, shown.clone()));
-            self.message = shown;
+            self.messages.push((self.core.line, shown));
             return Ok(());
         }
         if is_cycle(name) {
@@ -307,13 +326,9 @@ impl Sinumerik {
     fn axis_of(&self, name: &str) -> Option<usize> {
         let mut c = name.chars();
         let letter = c.next()?;
-        let rest: String = c.collect();
-        (rest.is_empty() || rest == "1")
-            .then(|| self.core.axis(letter))
-            .flatten()
-            .filter(|_| {
-                !"IJKFSTDP".contains(letter) || rest.is_empty() && self.core.axis(letter).is_some()
-            })
+        let rest = c.as_str();
+        let axis_name = (rest.is_empty() || rest == "1") && !"IJKFSTDP".contains(letter);
+        self.core.axis(letter).filter(|_| axis_name)
     }
 
     /// An address's expression: its value and `AC`/`IC`/`DC`/`ACP`/`ACN` when it has one.
@@ -439,6 +454,9 @@ impl Sinumerik {
                     format!("G{g} is no G function of this control"),
                 )
             })?;
+            if let Some((_, why)) = NOT_BUILT_G.iter().find(|(n, _)| *n == g) {
+                return Err(self.fault(Fault::NotSupported, *why));
+            }
             if let Some(other) = groups.insert(group, g) {
                 return Err(self.fault(
                     Fault::SameGroup,
@@ -471,10 +489,10 @@ impl Sinumerik {
                         self.core.push(Command::PathMode { exact_stop: exact });
                     }
                 }
-                500 => self.set_work_offset(None)?,
+                500 => self.set_work_offset(None),
                 // G54–G59 are the 1st–6th settable offsets, G507–G554 the 7th–54th (§9.2.10).
-                54..=59 => self.set_work_offset(Some((g - 54) as u8))?,
-                507..=554 => self.set_work_offset(Some((g - 507 + 6) as u8))?,
+                54..=59 => self.set_work_offset(Some((g - 54) as u8)),
+                507..=554 => self.set_work_offset(Some((g - 507 + 6) as u8)),
                 _ => {}
             }
         }

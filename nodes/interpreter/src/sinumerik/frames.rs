@@ -17,9 +17,8 @@ const FRAMES: [&str; 8] = [
 
 impl Sinumerik {
     /// G500 (`None`) or a settable offset by index.
-    pub(super) fn set_work_offset(&mut self, index: Option<u8>) -> Result<(), ProgramError> {
+    pub(super) fn set_work_offset(&mut self, index: Option<u8>) {
         self.core.work_system = index.unwrap_or(NO_WORK_OFFSET);
-        Ok(())
     }
 
     /// The block's frame instruction, if it has one: its axis words are the instruction's

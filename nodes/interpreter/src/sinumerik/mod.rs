@@ -9,7 +9,7 @@
 pub mod alarms;
 pub mod block;
 mod exec;
-pub use exec::g_group as exec_g_group;
+pub use exec::{g_group, NOT_BUILT_G};
 pub mod expr;
 mod frames;
 pub mod lex;
@@ -71,8 +71,7 @@ pub struct Sinumerik {
     /// A program level may still define variables (nothing else has run in it yet).
     may_define: Vec<bool>,
     plc: PlcArea,
-    /// MSG: the message shown now, and every one shown with its line (§9.1.6).
-    pub message: String,
+    /// Every MSG text with its line (§9.1.6); the last one is shown (`MSG()` clears).
     pub messages: Vec<(u32, String)>,
     /// A jump the block asked for, done once its other words ran.
     jump: Option<(bool, String)>,
@@ -143,12 +142,16 @@ impl Sinumerik {
             scopes: vec![Scope::new()],
             may_define: vec![true],
             plc: PlcArea::default(),
-            message: String::new(),
             messages: Vec::new(),
             jump: None,
         };
         front.apply_length();
         front
+    }
+
+    /// The message shown now: the last MSG's text.
+    pub fn message(&self) -> &str {
+        self.messages.last().map_or("", |m| m.1.as_str())
     }
 
     /// R parameter `n` as the program has left it.

@@ -35,28 +35,6 @@ impl Sinumerik {
     /// The non-modal instructions that take the block's words for themselves: dwell,
     /// frames, pole; `true` when the block moves nothing else.
     pub(super) fn non_modal(&mut self, w: &Words) -> Result<bool, ProgramError> {
-        for (g, why) in [
-            (33, "G33 thread cutting is not built yet for the mill"),
-            (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
-            (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
-            (63, "G63 tapping with a compensating chuck is not built yet"),
-            (74, "G74 reference point approach from the program is not built yet"),
-            (75, "G75 fixed point approach is not built yet"),
-            (25, "G25/G26 working area and spindle limits are not built yet"),
-            (26, "G25/G26 working area and spindle limits are not built yet"),
-            (147, "smooth approach and retraction (WAB) is not built"),
-            (148, "smooth approach and retraction (WAB) is not built"),
-            (247, "smooth approach and retraction (WAB) is not built"),
-            (248, "smooth approach and retraction (WAB) is not built"),
-            (347, "smooth approach and retraction (WAB) is not built"),
-            (348, "smooth approach and retraction (WAB) is not built"),
-            (291, "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill"),
-            (153, "G153 (suppressing the basic frame too) is not built: there is no basic frame"),
-        ] {
-            if w.has_g(g) {
-                return Err(self.fault(Fault::NotSupported, why));
-            }
-        }
         for k in ["CHF", "CHR", "RND", "RNDM", "FRC", "FRCM", "ANG", "SF"] {
             if w.addr.contains_key(k) {
                 return Err(self.fault(

@@ -60,12 +60,6 @@ impl Sinumerik {
                 }
             }
         }
-        if w.has_g(451) {
-            return Err(self.fault(
-                Fault::NotSupported,
-                "G451 (intersection at outer corners) is not built: G450 transition circles",
-            ));
-        }
         Ok(())
     }
 
