@@ -326,6 +326,14 @@ impl<S: RosService> ServiceClient<S> {
     pub fn call(&self, request: S::Request) -> Result<S::Response, String> {
         exchange(self.timeout, &self.client, request, Copies::Never)
     }
+
+    /// As [`ServiceClient::call`] for a request that only reads (`get_offsets`,
+    /// `get_parameters`): without a reply it is sent again (D77). Just after a server starts,
+    /// the client can match it before the server has matched the client's reply reader, and
+    /// the first reply is lost.
+    pub fn query(&self, request: S::Request) -> Result<S::Response, String> {
+        exchange(self.timeout, &self.client, request, Copies::Allowed)
+    }
 }
 
 /// Whether a lost reply may be made good by sending the request again: only for requests whose

@@ -79,7 +79,7 @@ fn read_back(client: &mut CellClient, memory_file: &Path) -> Kept {
     let kept_200 = memory["kept"][200].as_f64().unwrap_or(0.0);
     let offsets = client
         .service::<GetOffsets>("get_offsets")
-        .and_then(|s| s.call(GetOffsetsRequest::default()))
+        .and_then(|s| s.query(GetOffsetsRequest::default()))
         .expect("get_offsets");
     let wear_x = offsets
         .tools
@@ -89,7 +89,7 @@ fn read_back(client: &mut CellClient, memory_file: &Path) -> Kept {
     let params = client
         .service::<GetParameters>("get_parameters")
         .and_then(|s| {
-            s.call(GetParametersRequest {
+            s.query(GetParametersRequest {
                 prefix: "servo.lookahead".into(),
             })
         })
@@ -161,7 +161,8 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
 
     for round in 0..=KILLS {
         let t_start = Instant::now();
-        let mut cell = common::cnc_run(&config, &log);
+        // Killed if the test fails before the round's own kill: no cell outlives the test.
+        let mut cell = common::KillOnDrop(common::cnc_run(&config, &log));
         let mut client = CellClient::new(
             &cfg.network,
             "lathe1",
@@ -246,8 +247,8 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
         }
         seen_count = kept.count;
         if round == KILLS {
-            let _ = cell.kill();
-            let _ = cell.wait();
+            let _ = cell.0.kill();
+            let _ = cell.0.wait();
             break;
         }
 
@@ -261,7 +262,7 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
         let mut end_kill: Option<Instant> = None;
         let killed = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
         let killer = kill_at.map(|at| {
-            let pid = cell.id();
+            let pid = cell.0.id();
             let killed = killed.clone();
             std::thread::spawn(move || {
                 std::thread::sleep(at);
@@ -335,14 +336,14 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
                 }
                 if end_kill.is_some_and(|t| Instant::now() >= t) && alive() {
                     // SAFETY: kill(2) with a pid this test spawned and has not yet waited for.
-                    unsafe { libc::kill(cell.id() as i32, libc::SIGKILL) };
+                    unsafe { libc::kill(cell.0.id() as i32, libc::SIGKILL) };
                     killed.store(true, std::sync::atomic::Ordering::SeqCst);
                 }
             }
             if round == 0 && seen_count > kept.count {
                 break;
             }
-            if let Ok(Some(_)) = cell.try_wait() {
+            if let Ok(Some(_)) = cell.0.try_wait() {
                 break;
             }
             assert!(
@@ -352,9 +353,9 @@ fn kill_9_at_fifty_random_moments_loses_nothing_the_supervisor_was_told() {
             std::thread::sleep(Duration::from_millis(2));
         }
         if round == 0 {
-            let _ = cell.kill();
+            let _ = cell.0.kill();
         }
-        let _ = cell.wait();
+        let _ = cell.0.wait();
         if let Some(k) = killer {
             let _ = k.join();
         }

@@ -80,7 +80,7 @@ fn mode_mdi_offsets_parameters_and_alarms_are_served_to_the_cell() {
     assert_eq!(c.state.as_ref().unwrap().mode, MachineState::MODE_MDI);
 
     // The offset pages.
-    let page = offsets.call(GetOffsetsRequest::default()).unwrap();
+    let page = offsets.query(GetOffsetsRequest::default()).unwrap();
     assert!(page.accepted, "{}", page.message);
     let t1 = page.tools.iter().find(|t| t.number == 1).expect("tool 1");
     assert_eq!((t1.radius, t1.tip), (0.4, 3));
@@ -150,7 +150,7 @@ fn mode_mdi_offsets_parameters_and_alarms_are_served_to_the_cell() {
         let r = work.call(SetWorkOffsetRequest { offset }).unwrap();
         assert!(!r.accepted && r.message.contains(why), "{}", r.message);
     }
-    let page = offsets.call(GetOffsetsRequest::default()).unwrap();
+    let page = offsets.query(GetOffsetsRequest::default()).unwrap();
     assert_eq!(page.tools.iter().find(|t| t.number == 5), Some(&row));
     assert_eq!(page.work[0].values, [0.0, -100.0], "G54 X kept, Z set");
     // The written G54 moves the next cut: Z0 of the program is machine Z -100.
@@ -164,7 +164,7 @@ fn mode_mdi_offsets_parameters_and_alarms_are_served_to_the_cell() {
     let name = "machine.axes.X.max_velocity";
     let read = |prefix: &str| {
         get_parameters
-            .call(GetParametersRequest {
+            .query(GetParametersRequest {
                 prefix: prefix.into(),
             })
             .unwrap()
