@@ -1,6 +1,6 @@
 //! Which launch config `cnc` uses: a file the user names, or a machine built into the binary.
 //!
-//! The repository's `launch_configs/sim_lathe.yaml` and `sim_mill.yaml` and the demo part are
+//! The repository's `launch_configs/sim_lathe.yaml`, `sim_mill.yaml` and `sim_mill_802d.yaml` and the demo part are
 //! embedded at build time, so an installed `cnc` (`cargo install --path .`) runs the demo cell,
 //! checks and simulates programs from any folder. A built-in machine has no file to take its
 //! relative paths (kept memory, parameters, recordings) from; they are taken from its data
@@ -13,12 +13,16 @@ use std::path::{Path, PathBuf};
 use cnc_runtime::LaunchConfig;
 
 /// The built-in machines by name: the launch configs of the repository, as they were built.
-pub const BUILT_IN: [(&str, &str); 2] = [
+pub const BUILT_IN: [(&str, &str); 3] = [
     (
         "sim_lathe",
         include_str!("../launch_configs/sim_lathe.yaml"),
     ),
     ("sim_mill", include_str!("../launch_configs/sim_mill.yaml")),
+    (
+        "sim_mill_802d",
+        include_str!("../launch_configs/sim_mill_802d.yaml"),
+    ),
 ];
 
 /// The machine `cnc` uses when no config is named.
@@ -154,7 +158,7 @@ mod tests {
         );
         let e = source(Some(Path::new("no_such.yaml"))).unwrap_err();
         assert!(
-            e.contains("no_such.yaml") && e.contains("sim_lathe, sim_mill"),
+            e.contains("no_such.yaml") && e.contains("sim_lathe, sim_mill, sim_mill_802d"),
             "{e}"
         );
     }

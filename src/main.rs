@@ -30,7 +30,7 @@ struct Cli {
 enum Verb {
     /// Start every node of the cell in this process.
     Run {
-        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill); default:
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d); default:
         /// the built-in sim_lathe. A cell launch file (`launch_configs/cell_two_lathes.yaml`)
         /// runs all its machines, the robot and the cell supervisor until its order is done.
         #[arg(value_name = "CONFIG")]
@@ -49,7 +49,7 @@ enum Verb {
     /// other hosts), until Ctrl-C or SIGTERM.
     Node {
         node: NodeName,
-        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill); default:
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d); default:
         /// the built-in sim_lathe.
         #[arg(value_name = "CONFIG")]
         config_file: Option<PathBuf>,
@@ -101,7 +101,7 @@ enum Verb {
     Operator {
         #[command(subcommand)]
         action: OperatorVerb,
-        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill); default:
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d); default:
         /// the built-in sim_lathe.
         #[arg(long, global = true)]
         config: Option<PathBuf>,
@@ -116,7 +116,7 @@ enum Verb {
     Replay {
         bag: PathBuf,
         /// The launch config whose network section (domain, interfaces) is used: a file, or a
-        /// built-in machine (sim_lathe, sim_mill); default: the built-in sim_lathe.
+        /// built-in machine (sim_lathe, sim_mill, sim_mill_802d); default: the built-in sim_lathe.
         #[arg(long)]
         config: Option<PathBuf>,
         #[arg(long)]
@@ -159,7 +159,7 @@ enum AuditVerb {
 struct ProgramArgs {
     program: PathBuf,
     /// The launch config that describes the machine: a file, or a built-in machine
-    /// (sim_lathe, sim_mill); default: the built-in sim_lathe.
+    /// (sim_lathe, sim_mill, sim_mill_802d); default: the built-in sim_lathe.
     #[arg(long, visible_alias = "launch")]
     config: Option<PathBuf>,
     /// The program's dialect; default: the config's.

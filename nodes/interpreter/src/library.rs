@@ -91,20 +91,34 @@ pub fn load_dir(dir: &Path) -> std::io::Result<(Library, Vec<String>)> {
             skipped.push(format!("{}: not UTF-8 text", path.display()));
             continue;
         };
-        let number = declared_number(&text).or_else(|| file_number(&path));
         let name = path
             .file_name()
             .and_then(|n| n.to_str())
             .unwrap_or("?")
             .to_string();
-        match number {
-            // The first file wins; a later one with the same number is reported.
-            Some(n) if lib.get(n).is_none() => lib.insert(n, &name, &text),
-            Some(n) => skipped.push(format!("{name}: O{n:04} already taken")),
-            None => {}
+        if let Err(taken) = add_program(&mut lib, &name, &text) {
+            skipped.push(taken);
         }
     }
     Ok((lib, skipped))
+}
+
+/// Adds one stored program to `lib`: by its program number (the `O` number on its first line
+/// or in its file name), and by its name, the file name without its extension (`L10.SPF` is
+/// called as `L10`, `RAHMEN7.SPF` as `RAHMEN7`: the programs of controls that call by
+/// name). The first program of a number or name wins; a later one with a taken number is
+/// the error.
+pub fn add_program(lib: &mut Library, file_name: &str, text: &str) -> Result<(), String> {
+    let path = Path::new(file_name);
+    if let Some(stem) = path.file_stem().and_then(|s| s.to_str()) {
+        lib.insert_named(stem, file_name, text);
+    }
+    match declared_number(text).or_else(|| file_number(path)) {
+        Some(n) if lib.get(n).is_none() => lib.insert(n, file_name, text),
+        Some(n) => return Err(format!("{file_name}: O{n:04} already taken")),
+        None => {}
+    }
+    Ok(())
 }
 
 #[cfg(test)]

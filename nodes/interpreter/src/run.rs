@@ -921,18 +921,13 @@ fn mdi_refusal(mode: u8, running: bool, text: &str) -> Option<String> {
     }
 }
 
-/// Program memory as a subprogram library: every stored program with an O number on its first
-/// line or in its name (`O0010`, `O0010.nc`).
+/// Program memory as a subprogram library: every stored program by its O number (on its first
+/// line or in its name, `O0010`, `O0010.nc`) and by its name (`L10.SPF` as `L10`).
 fn library(programs: &BTreeMap<String, String>) -> Library {
     let mut lib = Library::new();
     for (name, text) in programs {
-        let number = crate::library::declared_number(text)
-            .or_else(|| crate::library::file_number(std::path::Path::new(name)));
-        if let Some(n) = number {
-            if lib.get(n).is_none() {
-                lib.insert(n, name, text);
-            }
-        }
+        // A second program of a taken number stays callable by name only.
+        let _ = crate::library::add_program(&mut lib, name, text);
     }
     lib
 }

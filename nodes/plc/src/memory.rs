@@ -193,9 +193,39 @@ pub struct Retained {
     pub counter_presets: BTreeMap<u16, i64>,
 }
 
+impl Retained {
+    /// The kept memory of a machine's first power-up (no memory file yet): the keep relays
+    /// the machine builder sets on (`K1.1`, a setting the ladder reads), all else zero.
+    pub fn first_power_up(keep_relays: &[String]) -> Result<Retained, String> {
+        let mut k = vec![0u8; Space::K.size()];
+        for text in keep_relays {
+            match crate::address::parse(text)? {
+                crate::address::Address::Bit(b) if b.byte.space == Space::K => {
+                    k[usize::from(b.byte.index)] |= 1 << b.bit;
+                }
+                _ => return Err(format!("{text}: not a keep relay bit (K0.0–K19.7)")),
+            }
+        }
+        Ok(Retained {
+            k,
+            ..Retained::default()
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_first_power_up_sets_the_builders_keep_relays_and_refuses_other_addresses() {
+        let r = Retained::first_power_up(&["K1.1".into(), "k2.0".into()]).expect("keep relays");
+        assert_eq!((r.k[1], r.k[2], r.k[0]), (0b10, 0b1, 0));
+        assert!(r.d.is_empty() && r.timer_presets.is_empty());
+        for bad in ["R1.1", "K1", "K20.0", "K1.8", "x"] {
+            assert!(Retained::first_power_up(&[bad.into()]).is_err(), "{bad}");
+        }
+    }
 
     #[test]
     fn retains_tells_a_change_of_what_is_kept_and_only_that() {

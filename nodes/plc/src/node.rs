@@ -67,6 +67,12 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     })?;
     let memory_file = cfg.plc.memory_file.clone();
     let mut saved = load_retained(memory_file.as_deref());
+    if saved.is_none() && !cfg.plc.keep_relays.is_empty() {
+        saved = Some(
+            Retained::first_power_up(&cfg.plc.keep_relays)
+                .map_err(|e| format!("plc.keep_relays: {e}"))?,
+        );
+    }
     let mut plc = Plc::new(program, saved.as_ref(), cfg.plc.level2_divisions as usize);
     plc.set_spindle_limit(cfg.limits.spindle_max_rpm);
     let mut program_mtime = program_path.as_deref().and_then(modified);

@@ -324,6 +324,10 @@ pub struct PlcConfig {
     /// Keep relays, data registers and timer/counter presets (the PLC parameter page).
     #[serde(default)]
     pub memory_file: Option<std::path::PathBuf>,
+    /// Keep relays the machine builder turns on at the first power-up, while there is no
+    /// memory file yet (`[K1.1]`: M02 counts a part); afterwards the kept memory rules.
+    #[serde(default)]
+    pub keep_relays: Vec<String>,
 }
 
 fn default_level2_divisions() -> u32 {
@@ -341,6 +345,7 @@ impl Default for PlcConfig {
             level2_divisions: default_level2_divisions(),
             program: None,
             memory_file: None,
+            keep_relays: Vec::new(),
         }
     }
 }

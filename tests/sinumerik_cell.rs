@@ -1,0 +1,129 @@
+//! Issue 23, must-show 4: the 802D mill (`launch_configs/sim_mill_802d.yaml`) in the cell over
+//! real DDS and iceoryx2. A supervisor node loads the manual's radius compensation example
+//! (`../shared/fixtures/001/061`, as printed, header comments and all) and a subprogram it
+//! calls by name, starts it through the ROS 2 services, and reads the machine's topics: the
+//! program completes without alarm, the part is counted at its M2 (D82), and the axes stand
+//! where the manual's program ends. Run by `scripts/test.sh` inside a network namespace.
+
+use std::time::Duration;
+
+use cnc::cell::Cell;
+use cnc::client::CellClient;
+use cnc_msgs::msg::MachineState;
+use cnc_runtime::LaunchConfig;
+use ros2_client::ServiceMapping;
+
+const DOMAIN: u16 = 88;
+
+/// The 802D mill in this test's DDS domain, with no kept memory (so the PLC comes up as at
+/// its first power-up, with the builder's keep relays), no recorder, no web panel and no
+/// alarms for servo lateness (timing is not what this test tests).
+fn config() -> LaunchConfig {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/launch_configs/sim_mill_802d.yaml"
+    );
+    let text = std::fs::read_to_string(path).expect("sim_mill_802d.yaml");
+    let mut cfg = LaunchConfig::from_yaml(&text).expect("sim_mill_802d.yaml parses");
+    cfg.network.domain_id = Some(DOMAIN);
+    cfg.plc.memory_file = None;
+    cfg.machine.memory_file = None;
+    cfg.machine.position_file = None;
+    cfg.machine.parameter_file = None;
+    cfg.machine.program_directory = None;
+    cfg.recorder.enabled = false;
+    cfg.hmi.web_address = String::new();
+    cfg.servo.late_warning_ms = Some(60_000.0);
+    cfg.servo.late_alarm_ticks = u32::MAX;
+    cfg
+}
+
+fn fixture_061() -> String {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
+    let path = std::fs::read_dir(dir)
+        .expect("fixtures 001")
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .find(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with("061"))
+        })
+        .expect("fixture 061");
+    std::fs::read_to_string(path).expect("fixture text")
+}
+
+#[test]
+fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() {
+    let cfg = config();
+    // T1 D1 as the launch config sets it: the test's expectations follow from it.
+    let edge = cfg
+        .machine
+        .tools
+        .get(&11)
+        .expect("T1 D1 in sim_mill_802d.yaml");
+    let length = edge.z;
+    let cell = Cell::start(&cfg).expect("the cell starts");
+    let mut client = CellClient::new(
+        &cfg.network,
+        "mill2",
+        "test_supervisor",
+        ServiceMapping::Enhanced,
+    )
+    .expect("supervisor node");
+    let (ok, _) = client.wait_until(Duration::from_secs(30), |c| {
+        c.part_count.is_some() && c.state.is_some() && c.axes.is_some()
+    });
+    assert!(ok, "state topics never arrived");
+    client.wait_ready(Duration::from_secs(30)).expect("ready");
+    assert_eq!(client.part_count.as_ref().map(|p| p.count), Some(0));
+
+    // The manual's program, and a main program that calls it as a subprogram by name
+    // (`RAHMEN.SPF`, 802D naming; its last block's M2 made M17, the subprogram's return).
+    let text = fixture_061();
+    assert!(text.contains("N130 G0 Z50 M2"), "061's last block");
+    let contour = text.replace("N130 G0 Z50 M2", "N130 G0 Z50 M17");
+    assert!(
+        client
+            .load_program("RAHMEN.SPF", &contour)
+            .unwrap()
+            .accepted
+    );
+    let main = "; the cell's job: the manual's contour as a subprogram\n\
+                N10 G17 G90 G500\n\
+                N20 RAHMEN\n\
+                N30 G0 X5 Y60 Z50\n\
+                N40 M2\n";
+    assert!(client.load_program("JOB.MPF", main).unwrap().accepted);
+    let r = client.start_program("JOB.MPF").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let (ok, seen) = client.wait_until(Duration::from_secs(120), |c| {
+        c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+            && c.part_count.as_ref().is_some_and(|p| p.count == 1)
+    });
+    let names: Vec<&str> = seen.iter().map(|s| s.execution_name.as_str()).collect();
+    assert!(
+        ok,
+        "did not complete and count; states {names:?}, alarms {:?}",
+        client.alarms
+    );
+    assert!(names.contains(&"ACTIVE"), "{names:?}");
+    assert!(
+        client.alarms.as_ref().is_some_and(|a| a.alarms.is_empty()),
+        "alarms {:?}",
+        client.alarms
+    );
+    // The manual's end: X5 Y60 Z50 with T1 D1's length along Z (G17), machine coordinates.
+    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
+        c.axes.as_ref().is_some_and(|a| {
+            let at = |i: usize| a.axes[i].actual_position;
+            (at(0) - 5.0).abs() < 0.001
+                && (at(1) - 60.0).abs() < 0.001
+                && (at(2) - (50.0 + length)).abs() < 0.001
+        })
+    });
+    assert!(ok, "final position {:?}", client.axes);
+    let (_, errors) = cell.stop();
+    assert!(errors.is_empty(), "{errors:?}");
+}
