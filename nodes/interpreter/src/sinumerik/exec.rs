@@ -4,7 +4,7 @@
 //! machine's own), the non-modal functions (dwell, frames, pole), radius compensation and
 //! the motion, then the stops and ends after it, the program call and the jump.
 
-use std::collections::HashMap;
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, SpindleDir};
@@ -27,10 +27,10 @@ pub enum Mode {
 #[derive(Debug, Default)]
 pub struct Words {
     /// Machine axis index → value and how it counts.
-    pub axes: HashMap<usize, (f64, Mode)>,
+    pub axes: BTreeMap<usize, (f64, Mode)>,
     /// Other addresses: `I`, `J`, `K`, `I1`, `CR`, `AR`, `AP`, `RP`, `TURN`, `RPL`, `F`,
     /// `S`, `T`, `D`, `P`…
-    pub addr: HashMap<String, (f64, Mode)>,
+    pub addr: BTreeMap<String, (f64, Mode)>,
     pub g: Vec<u32>,
     pub m: Vec<u32>,
     /// Keywords in the order written (`CIP`, `TRANS`, `STOPRE`…).
@@ -446,7 +446,7 @@ impl Sinumerik {
 
     /// The modal G functions of the block, one per group (§9.1.6).
     fn modal(&mut self, w: &Words) -> Result<(), ProgramError> {
-        let mut groups: HashMap<u8, u32> = HashMap::new();
+        let mut groups: BTreeMap<u8, u32> = BTreeMap::new();
         for &g in &w.g {
             let group = g_group(g).ok_or_else(|| {
                 self.fault(
