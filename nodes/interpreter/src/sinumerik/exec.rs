@@ -65,7 +65,7 @@ const KEYWORDS: [&str; 19] = [
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 22] = [
+pub const NOT_BUILT: [(&str, &str); 20] = [
     (
         "CFC",
         "feed correction on compensated circles is not built: F acts on the cutter centre (CFTCP)",
@@ -80,8 +80,6 @@ pub const NOT_BUILT: [(&str, &str); 22] = [
     ),
     ("COMPCAD", "the compressor is not built"),
     ("WALIMON", "working area limits G25/G26 are not built yet"),
-    ("G62", "corner deceleration is not built"),
-    ("G621", "corner deceleration is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
     ("MCALL", "modal calls are not built yet"),
@@ -107,7 +105,7 @@ pub const NOT_BUILT: [(&str, &str); 22] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 17] = [
+pub const NOT_BUILT_G: [(u32, &str); 19] = [
     (33, "G33 thread cutting is not built yet for the mill"),
     (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
     (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
@@ -125,6 +123,8 @@ pub const NOT_BUILT_G: [(u32, &str); 17] = [
     (291, "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill"),
     (153, "G153 (suppressing the basic frame too) is not built: there is no basic frame"),
     (451, "G451 (intersection at outer corners) is not built: G450 transition circles"),
+    (62, "corner deceleration G62/G621 is not built"),
+    (621, "corner deceleration G62/G621 is not built"),
 ];
 
 /// A name the control reserves: an address or a keyword (no variable may take it).
@@ -605,6 +605,8 @@ pub fn g_group(g: u32) -> Option<u8> {
         450 | 451 => 18,
         340 | 341 => 44,
         290 | 291 => 47,
+        // Corner deceleration: the manual lists no group; SINUMERIK's is 57.
+        62 | 621 => 57,
         _ => return None,
     })
 }

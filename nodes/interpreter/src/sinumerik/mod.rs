@@ -9,7 +9,7 @@
 pub mod alarms;
 pub mod block;
 mod exec;
-pub use exec::{g_group, NOT_BUILT_G};
+pub use exec::{g_group, NOT_BUILT, NOT_BUILT_G};
 pub mod expr;
 mod frames;
 pub mod lex;

@@ -1,0 +1,151 @@
+//! Issue 23, must-show 2: the 802D instructions the coverage table
+//! (`docs/sinumerik_802d.md`) lists as running without a fixture that asserts them, each
+//! asserted here on what it emits; and every instruction the table lists as not built,
+//! asserted to stop with alarm 12140 and its reason.
+
+use cnc_interpreter::sinumerik::{Sinumerik, NOT_BUILT, NOT_BUILT_G};
+use cnc_interpreter::{Aux, Command, Library, Setup};
+use cnc_interpreter_core::{next_command, ProgramError};
+
+fn mill() -> Setup {
+    Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3])
+}
+
+fn run(text: &str) -> (Vec<Command>, Option<ProgramError>) {
+    let mut front = Sinumerik::new(text, mill(), Library::new());
+    let mut out = Vec::new();
+    loop {
+        match next_command(&mut front) {
+            Ok(Some(c)) => out.push(c.command),
+            Ok(None) => return (out, None),
+            Err(e) => return (out, Some(e)),
+        }
+    }
+}
+
+fn ok(text: &str) -> Vec<Command> {
+    let (out, e) = run(text);
+    assert!(e.is_none(), "{e:?}\n{text}");
+    out
+}
+
+fn ends(out: &[Command]) -> Vec<Vec<f64>> {
+    out.iter()
+        .filter_map(|c| c.end().map(<[f64]>::to_vec))
+        .collect()
+}
+
+fn near(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6)
+}
+
+#[test]
+fn g4_dwells_by_seconds_and_keeps_f() {
+    let out = ok("G1 X1 F100\nG4 F2.5\nX2\n");
+    assert!(out.contains(&Command::Dwell { seconds: 2.5 }), "{out:?}");
+    // F2.5 of G4 is no feed: the next move still runs at F100.
+    let last_feed = out.iter().rev().find_map(|c| match c {
+        Command::Linear { feed, .. } => Some(*feed),
+        _ => None,
+    });
+    assert_eq!(last_feed, Some(100.0), "{out:?}");
+}
+
+#[test]
+fn g94_g95_switch_the_feed_unit_and_g60_g64_g9_the_path_mode() {
+    let out = ok("G95 G1 X1 F0.2\nG94 X2 F300\nG64 X3\nG9 X4\nX5\n");
+    assert!(out.contains(&Command::FeedMode { per_rev: true }));
+    assert!(out.contains(&Command::FeedMode { per_rev: false }));
+    let modes: Vec<bool> = out
+        .iter()
+        .filter_map(|c| match c {
+            Command::PathMode { exact_stop } => Some(*exact_stop),
+            _ => None,
+        })
+        .collect();
+    // G60 at power-on, G64, then G9 for its block only (exact stop, then blending again).
+    assert_eq!(modes.first(), Some(&true), "{modes:?}");
+    assert!(
+        modes.windows(3).any(|w| w == [false, true, false]),
+        "{modes:?}"
+    );
+}
+
+#[test]
+fn g70_inch_geometry_and_g700_inch_feed() {
+    let out = ok("G70 G1 X1 F100\nG700 X2 F10\nG71 X3\n");
+    let e = ends(&out);
+    assert!(
+        near(&e[0], &[25.4, 0.0, 0.0]) && near(&e[1], &[50.8, 0.0, 0.0]),
+        "{e:?}"
+    );
+    assert!(near(&e[2], &[3.0, 0.0, 0.0]));
+    let feeds: Vec<f64> = out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Linear { feed, .. } => Some(*feed),
+            _ => None,
+        })
+        .collect();
+    // G70: F stays mm/min; G700: F10 in/min is 254 mm/min.
+    assert!(
+        (feeds[0] - 100.0).abs() < 1e-9 && (feeds[1] - 254.0).abs() < 1e-9,
+        "{feeds:?}"
+    );
+}
+
+#[test]
+fn poles_g110_g111_g112_and_polar_moves() {
+    let out = ok("G0 X10 Y10\nG111 X20 Y0\nG1 AP=90 RP=5 F100\nG110 AP=0 RP=10\nG1 AP=180 RP=10\n");
+    let e = ends(&out);
+    assert!(near(&e[1], &[20.0, 5.0, 0.0]), "{e:?}");
+    // G110: the pole 10 along X from the last point (20,5): (30,5); AP=180 RP=10 → (20,5).
+    assert!(near(&e[2], &[20.0, 5.0, 0.0]), "{e:?}");
+}
+
+#[test]
+fn ct_continues_tangentially_and_cip_passes_its_point() {
+    let out = ok("G1 X0 Y0 F100\nX10\nCT X20 Y10\nG1 X0 Y0\nCIP X20 Y0 I1=10 J1=10\n");
+    let arcs: Vec<(Vec<f64>, bool)> = out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Arc {
+                center, clockwise, ..
+            } => Some((center.clone(), *clockwise)),
+            _ => None,
+        })
+        .collect();
+    // Tangent to +X at (10,0) and ending at (20,10): the quarter about (10,10), CCW.
+    assert!(
+        near(&arcs[0].0, &[10.0, 10.0, 0.0]) && !arcs[0].1,
+        "{arcs:?}"
+    );
+    // Through (10,10) from (0,0) to (20,0): the upper half about (10,0), clockwise.
+    assert!(near(&arcs[1].0, &[10.0, 0.0, 0.0]) && arcs[1].1, "{arcs:?}");
+}
+
+#[test]
+fn spindle_words_go_out_before_the_move_and_m2_ends() {
+    let out = ok("S800 M3 G1 X5 F100\nM5\nM2\n");
+    let s = out.iter().position(|c| *c == Command::Aux(Aux::S(800.0)));
+    let m3 = out.iter().position(|c| *c == Command::Aux(Aux::M(3)));
+    let mv = out.iter().position(|c| c.end().is_some());
+    assert!(s < mv && m3 < mv && s.is_some() && m3.is_some(), "{out:?}");
+    assert_eq!(out.last(), Some(&Command::ProgramEnd));
+}
+
+#[test]
+fn every_instruction_not_built_stops_with_12140_and_its_reason() {
+    for (name, reason) in NOT_BUILT {
+        let (_, e) = run(&format!("G0 X1\n{name}\n"));
+        let e = e.unwrap_or_else(|| panic!("{name} ran"));
+        assert_eq!((e.number, e.line), (12140, 2), "{name}: {e}");
+        assert!(e.text.contains(reason), "{name}: {e}");
+    }
+    for (g, reason) in NOT_BUILT_G {
+        let (_, e) = run(&format!("G0 X1\nG{g} X1\n"));
+        let e = e.unwrap_or_else(|| panic!("G{g} ran"));
+        assert_eq!((e.number, e.line), (12140, 2), "G{g}: {e}");
+        assert!(e.text.contains(reason), "G{g}: {e}");
+    }
+}
