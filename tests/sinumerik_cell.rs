@@ -10,33 +10,11 @@ use std::time::Duration;
 use cnc::cell::Cell;
 use cnc::client::CellClient;
 use cnc_msgs::msg::MachineState;
-use cnc_runtime::LaunchConfig;
 use ros2_client::ServiceMapping;
 
-const DOMAIN: u16 = 88;
+mod common;
 
-/// The 802D mill in this test's DDS domain, with no kept memory (so the PLC comes up as at
-/// its first power-up, with the builder's keep relays), no recorder, no web panel and no
-/// alarms for servo lateness (timing is not what this test tests).
-fn config() -> LaunchConfig {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/launch_configs/sim_mill_802d.yaml"
-    );
-    let text = std::fs::read_to_string(path).expect("sim_mill_802d.yaml");
-    let mut cfg = LaunchConfig::from_yaml(&text).expect("sim_mill_802d.yaml parses");
-    cfg.network.domain_id = Some(DOMAIN);
-    cfg.plc.memory_file = None;
-    cfg.machine.memory_file = None;
-    cfg.machine.position_file = None;
-    cfg.machine.parameter_file = None;
-    cfg.machine.program_directory = None;
-    cfg.recorder.enabled = false;
-    cfg.hmi.web_address = String::new();
-    cfg.servo.late_warning_ms = Some(60_000.0);
-    cfg.servo.late_alarm_ticks = u32::MAX;
-    cfg
-}
+const DOMAIN: u16 = 88;
 
 fn fixture_061() -> String {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
@@ -54,7 +32,9 @@ fn fixture_061() -> String {
 
 #[test]
 fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() {
-    let cfg = config();
+    // No kept memory: the PLC comes up as at its first power-up, with the builder's keep
+    // relays (K1.1, D82).
+    let cfg = common::machine("sim_mill_802d", DOMAIN);
     // T1 D1 as the launch config sets it: the test's expectations follow from it.
     let edge = cfg
         .machine

@@ -57,14 +57,21 @@ impl Drop for KillOnDrop {
     }
 }
 
-/// `launch_configs/sim_lathe.yaml` in DDS `domain` (one per test, so tests never hear each
-/// other), with no kept memory (part count, variables, position and programs start empty) and no parameter file and no recorder
-/// (`tests/recording.rs` tests that), and no alarms for servo lateness.
+/// `launch_configs/sim_lathe.yaml` for one test: see [`machine`].
 #[allow(dead_code)]
 pub fn sim_lathe(domain: u16) -> LaunchConfig {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/launch_configs/sim_lathe.yaml");
-    let text = std::fs::read_to_string(path).expect("sim_lathe.yaml");
-    let mut cfg = LaunchConfig::from_yaml(&text).expect("sim_lathe.yaml parses");
+    machine("sim_lathe", domain)
+}
+
+/// `launch_configs/<name>.yaml` in DDS `domain` (one per test, so tests never hear each
+/// other), with no kept memory (part count, variables, position and programs start empty; the
+/// PLC comes up as at its first power-up), no parameter file, no recorder
+/// (`tests/recording.rs` tests that), no web panel and no alarms for servo lateness.
+#[allow(dead_code)]
+pub fn machine(name: &str, domain: u16) -> LaunchConfig {
+    let path = format!("{}/launch_configs/{name}.yaml", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).expect("the launch config");
+    let mut cfg = LaunchConfig::from_yaml(&text).expect("the launch config parses");
     cfg.network.domain_id = Some(domain);
     cfg.plc.memory_file = None;
     cfg.machine.memory_file = None;

@@ -126,6 +126,20 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_stored_program_is_found_by_number_and_by_name() {
+        let mut lib = Library::new();
+        assert!(add_program(&mut lib, "L10.SPF", "G1 X1\nM17\n").is_ok());
+        assert!(add_program(&mut lib, "O2011.nc", "O2011\nM99\n").is_ok());
+        assert_eq!(lib.get_named("l10").map(|(f, _)| f), Some("L10.SPF"));
+        assert_eq!(lib.get(2011).map(|(f, _)| f), Some("O2011.nc"));
+        // `L0010` is another program than `L10`; a taken number is the error, the name stays.
+        assert!(lib.get_named("L0010").is_none());
+        let taken = add_program(&mut lib, "SECOND.nc", "O2011\nM99\n");
+        assert_eq!(taken, Err("SECOND.nc: O2011 already taken".to_string()));
+        assert_eq!(lib.get_named("SECOND").map(|(f, _)| f), Some("SECOND.nc"));
+    }
+
+    #[test]
     fn program_numbers_and_tapes() {
         assert_eq!(declared_number("\n O0010 ;x\nN1"), Some(10));
         // A tape: main program, then two subprograms; `%` and the program heads delimit them.

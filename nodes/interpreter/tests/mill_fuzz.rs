@@ -4,7 +4,6 @@
 //! The run is deterministic (fixed seed), so a failure names a program that can be rerun.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::mpsc;
 use std::time::Duration;
 
 use cnc_interpreter::interpreter::check_limited;
@@ -12,7 +11,6 @@ use cnc_interpreter::{Command, Dialect, Library, Setup};
 
 #[path = "support/mutate.rs"]
 mod mutate;
-use mutate::Rng;
 
 /// Mutants made of each seed program (`MILL_FUZZ_MUTANTS` and `MILL_FUZZ_SEED` change the
 /// run for a longer search by hand).
@@ -140,45 +138,19 @@ fn mutated_mill_programs_end_in_commands_or_an_alarm() {
         .collect();
     seeds.sort();
     assert!(seeds.len() >= 40, "{} seed programs", seeds.len());
-    let (tx, rx) = mpsc::channel::<Result<(usize, usize), String>>();
-    std::thread::spawn(move || {
-        let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<u64>().ok());
-        let mut rng = Rng(env("MILL_FUZZ_SEED").unwrap_or(0x5eed_cafe_f00d_0001) | 1);
-        let mutants = env("MILL_FUZZ_MUTANTS").map_or(MUTANTS, |n| n as usize);
-        let (mut alarms, mut runs) = (0, 0);
-        for (name, seed) in &seeds {
-            for _ in 0..mutants {
-                let text = mutate::mutate(seed, TOKENS, &mut rng);
-                // Tell the watcher which program runs, so a hang names it.
-                let _ = tx.send(Err(format!("running a mutant of {name}:\n{text}")));
-                match examine(&text) {
-                    Ok(alarm) => alarms += usize::from(alarm),
-                    Err(problem) => {
-                        let _ = tx.send(Err(format!(
-                            "FAIL {problem} for a mutant of {name}:\n{text}"
-                        )));
-                        return;
-                    }
-                }
-                runs += 1;
-            }
-        }
-        let _ = tx.send(Ok((runs, alarms)));
-    });
-    let start = std::time::Instant::now();
-    let mut last = String::new();
-    loop {
-        let left = DEADLINE.saturating_sub(start.elapsed());
-        match rx.recv_timeout(left) {
-            Ok(Ok((runs, alarms))) => {
-                println!("{runs} mutants, {alarms} ended in an alarm, none panicked or hung");
-                // The mutations must reach the alarms, and leave many programs runnable.
-                assert!(alarms > runs / 10 && alarms < runs, "{alarms} of {runs}");
-                return;
-            }
-            Ok(Err(msg)) if msg.starts_with("FAIL") => panic!("{msg}"),
-            Ok(Err(msg)) => last = msg,
-            Err(_) => panic!("no answer within {DEADLINE:?}; last: {last}"),
-        }
+    let (runs, alarms) = mutate::Search {
+        seeds,
+        tokens: TOKENS,
+        mutants: MUTANTS,
+        seed: 0x5eed_cafe_f00d_0001,
+        env: "MILL_FUZZ",
+        extra: None,
+        examine,
+        deadline: DEADLINE,
+        stack_bytes: 2 << 20,
     }
+    .run();
+    println!("{runs} mutants, {alarms} ended in an alarm, none panicked or hung");
+    // The mutations must reach the alarms, and leave many programs runnable.
+    assert!(alarms > runs / 10 && alarms < runs, "{alarms} of {runs}");
 }

@@ -10,7 +10,6 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
-use std::sync::mpsc;
 use std::time::Duration;
 
 use cnc_interpreter::interpreter::check_limited;
@@ -207,9 +206,12 @@ fn examine(text: &str) -> Result<bool, String> {
     }
 }
 
-/// A mutant with arbitrary bytes (any UTF-8 character, control characters) over the
-/// G-code alphabet's mutations.
+/// One mutant in five also gets arbitrary bytes (any UTF-8 character, control characters)
+/// over the G-code alphabet's mutations.
 fn with_foreign_bytes(text: String, rng: &mut Rng) -> String {
+    if rng.below(5) != 0 {
+        return text;
+    }
     let mut chars: Vec<char> = text.chars().collect();
     for _ in 0..rng.below(3) {
         let at = rng.below(chars.len() + 1);
@@ -262,51 +264,19 @@ fn mutated_802d_fixtures_end_in_commands_or_an_alarm_with_program_and_block() {
         2 * 117,
         "the manual's 117 example programs, two forms each"
     );
-    let (tx, rx) = mpsc::channel::<Result<(usize, usize), String>>();
-    std::thread::Builder::new()
-        .stack_size(16 << 20)
-        .spawn(move || {
-            let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<u64>().ok());
-            let mut rng = Rng(env("SINUMERIK_FUZZ_SEED").unwrap_or(0x802d_5eed_0001) | 1);
-            let mutants = env("SINUMERIK_FUZZ_MUTANTS").map_or(MUTANTS, |n| n as usize);
-            let (mut alarms, mut runs) = (0, 0);
-            for (name, seed) in &seeds {
-                for k in 0..mutants {
-                    let mut text = mutate::mutate(seed, TOKENS, &mut rng);
-                    if k % 5 == 0 {
-                        text = with_foreign_bytes(text, &mut rng);
-                    }
-                    // Tell the watcher which program runs, so a hang names it.
-                    let _ = tx.send(Err(format!("running a mutant of {name}:\n{text}")));
-                    match examine(&text) {
-                        Ok(alarm) => alarms += usize::from(alarm),
-                        Err(problem) => {
-                            let _ = tx.send(Err(format!(
-                                "FAIL {problem} for a mutant of {name}:\n{text}"
-                            )));
-                            return;
-                        }
-                    }
-                    runs += 1;
-                }
-            }
-            let _ = tx.send(Ok((runs, alarms)));
-        })
-        .expect("fuzz thread");
-    let start = std::time::Instant::now();
-    let mut last = String::new();
-    loop {
-        let left = DEADLINE.saturating_sub(start.elapsed());
-        match rx.recv_timeout(left) {
-            Ok(Ok((runs, alarms))) => {
-                println!("{runs} mutants, {alarms} ended in an alarm, none panicked or hung");
-                // The mutations must reach the alarms, and leave programs runnable.
-                assert!(alarms > runs / 10 && alarms < runs, "{alarms} of {runs}");
-                return;
-            }
-            Ok(Err(msg)) if msg.starts_with("FAIL") => panic!("{msg}"),
-            Ok(Err(msg)) => last = msg,
-            Err(_) => panic!("no answer within {DEADLINE:?}; last: {last}"),
-        }
+    let (runs, alarms) = mutate::Search {
+        seeds,
+        tokens: TOKENS,
+        mutants: MUTANTS,
+        seed: 0x802d_5eed_0001,
+        env: "SINUMERIK_FUZZ",
+        extra: Some(with_foreign_bytes),
+        examine,
+        deadline: DEADLINE,
+        stack_bytes: 16 << 20,
     }
+    .run();
+    println!("{runs} mutants, {alarms} ended in an alarm, none panicked or hung");
+    // The mutations must reach the alarms, and leave programs runnable.
+    assert!(alarms > runs / 10 && alarms < runs, "{alarms} of {runs}");
 }
