@@ -3,64 +3,76 @@
 //! What an item means (an address, a variable, a keyword, a program) is the executor's
 //! business; the parser only knows the shapes.
 
+use std::borrow::Cow;
+
 use super::expr::{Expr, Parser};
 use super::lex::{strip_comment, tokens, Tok};
 
+/// An item of a block; names and digits borrow from the line.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Item {
+pub enum Item<'s> {
     /// `X20`, `G1`, `X-12`: an address letter with a number.
     Word {
         letter: char,
-        digits: String,
+        digits: &'s str,
         value: f64,
     },
-    /// `NAME=value`, `NAME[i]=value`, `R10=value`, `I1=value`, `X=AC(5)`: an address given
-    /// an expression or a variable written; the executor tells which.
+    /// `R10=value`: an arithmetic parameter by its number.
+    Param {
+        number: f64,
+        value: Expr<'s>,
+    },
+    /// `NAME=value`, `NAME[i]=value`, `I1=value`, `X=AC(5)`: an address given an expression
+    /// or a variable written; the executor tells which.
     Assign {
-        name: String,
-        index: Vec<Expr>,
-        value: Expr,
+        name: Cow<'s, str>,
+        index: Vec<Expr<'s>>,
+        value: Expr<'s>,
     },
     /// A bare name: a keyword (`CIP`, `TRANS`, `STOPRE`) or a program to call (`LRAHMEN7`).
-    Name(String),
+    Name(Cow<'s, str>),
     /// `NAME(arguments)`: `MSG(…)`, a cycle.
-    Call(String, Vec<Option<Expr>>),
+    Call(Cow<'s, str>, Vec<Option<Expr<'s>>>),
     /// `GOTOF label` / `GOTOB label`, under a condition when it came with `IF`.
     Goto {
-        condition: Option<Expr>,
+        condition: Option<Expr<'s>>,
         forward: bool,
-        target: String,
+        target: Cow<'s, str>,
     },
-    Def(Def),
+    Def(Def<'s>),
 }
 
 /// `DEF type name[dims]=init, …` (§9.9.2).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Def {
-    pub ty: String,
+pub struct Def<'s> {
+    /// BOOL, CHAR, INT, REAL or STRING.
+    pub ty: &'static str,
     /// STRING[n]: the longest string.
     pub len: Option<usize>,
-    pub vars: Vec<DefVar>,
+    pub vars: Vec<DefVar<'s>>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
-pub struct DefVar {
-    pub name: String,
+pub struct DefVar<'s> {
+    pub name: Cow<'s, str>,
     pub dims: Vec<usize>,
-    pub init: Option<Expr>,
+    pub init: Option<Expr<'s>>,
 }
 
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct Block {
+pub struct Block<'s> {
     pub skip: bool,
     /// `N` or `:` number.
     pub number: Option<u32>,
-    pub label: Option<String>,
-    pub items: Vec<Item>,
+    pub label: Option<Cow<'s, str>>,
+    pub items: Vec<Item<'s>>,
 }
 
+/// The data types of `DEF` (§9.9.2).
+const TYPES: [&str; 5] = ["BOOL", "CHAR", "INT", "REAL", "STRING"];
+
 /// Parses one line; an error is the syntax alarm's text.
-pub fn parse(line: &str) -> Result<Block, String> {
+pub fn parse(line: &str) -> Result<Block<'_>, String> {
     let toks = tokens(strip_comment(line))?;
     let mut p = Parser::new(&toks);
     let mut b = Block {
@@ -101,7 +113,7 @@ fn block_number(v: f64) -> Result<u32, String> {
     Ok(v as u32)
 }
 
-fn item(p: &mut Parser) -> Result<Item, String> {
+fn item<'s>(p: &mut Parser<'_, 's>) -> Result<Item<'s>, String> {
     let Some(t) = p.take() else {
         return Err("block ends early".into());
     };
@@ -113,20 +125,21 @@ fn item(p: &mut Parser) -> Result<Item, String> {
         } => {
             if p.eat_op("=") {
                 let expr = p.expr()?;
-                let (name, index) = if *letter == 'R' {
-                    ("R".to_string(), vec![Expr::Num(*value)])
-                } else {
-                    (format!("{letter}{digits}"), Vec::new())
-                };
+                if *letter == 'R' {
+                    return Ok(Item::Param {
+                        number: *value,
+                        value: expr,
+                    });
+                }
                 Ok(Item::Assign {
-                    name,
-                    index,
+                    name: Cow::Owned(format!("{letter}{digits}")),
+                    index: Vec::new(),
                     value: expr,
                 })
             } else {
                 Ok(Item::Word {
                     letter: *letter,
-                    digits: digits.clone(),
+                    digits,
                     value: *value,
                 })
             }
@@ -136,8 +149,8 @@ fn item(p: &mut Parser) -> Result<Item, String> {
     }
 }
 
-fn name_item(p: &mut Parser, n: String) -> Result<Item, String> {
-    match n.as_str() {
+fn name_item<'s>(p: &mut Parser<'_, 's>, n: Cow<'s, str>) -> Result<Item<'s>, String> {
+    match n.as_ref() {
         "DEF" => return def(p).map(Item::Def),
         "IF" => {
             let condition = p.expr()?;
@@ -190,7 +203,7 @@ fn name_item(p: &mut Parser, n: String) -> Result<Item, String> {
             let letter = n.chars().next().unwrap_or('?');
             return Ok(Item::Word {
                 letter,
-                digits: String::new(),
+                digits: "",
                 value: if neg { -v } else { *v },
             });
         }
@@ -198,7 +211,7 @@ fn name_item(p: &mut Parser, n: String) -> Result<Item, String> {
     Ok(Item::Name(n))
 }
 
-fn goto(p: &mut Parser) -> Result<(bool, String), String> {
+fn goto<'s>(p: &mut Parser<'_, 's>) -> Result<(bool, Cow<'s, str>), String> {
     let forward = match p.take() {
         Some(Tok::Name(g)) if g == "GOTOF" => true,
         Some(Tok::Name(g)) if g == "GOTOB" => false,
@@ -210,19 +223,18 @@ fn goto(p: &mut Parser) -> Result<(bool, String), String> {
             letter: 'N',
             digits,
             ..
-        }) => format!("N{}", digits.trim_start_matches('0')),
+        }) => Cow::Owned(format!("N{}", digits.trim_start_matches('0'))),
         _ => return Err("a jump needs its target: a label or a block number".into()),
     };
     Ok((forward, target))
 }
 
-fn def(p: &mut Parser) -> Result<Def, String> {
+fn def<'s>(p: &mut Parser<'_, 's>) -> Result<Def<'s>, String> {
     let ty = match p.take() {
-        Some(Tok::Name(t)) if ["BOOL", "CHAR", "INT", "REAL", "STRING"].contains(&t.as_str()) => {
-            t.clone()
-        }
-        _ => return Err("DEF needs a type: BOOL, CHAR, INT, REAL or STRING".into()),
-    };
+        Some(Tok::Name(t)) => TYPES.iter().copied().find(|ty| *ty == t.as_ref()),
+        _ => None,
+    }
+    .ok_or("DEF needs a type: BOOL, CHAR, INT, REAL or STRING")?;
     let mut len = None;
     if ty == "STRING" {
         p.expect_op("[")?;
@@ -294,10 +306,12 @@ mod tests {
             b.items[2],
             Item::Word {
                 letter: 'X',
-                digits: String::new(),
+                digits: "",
                 value: -12.0
             }
         );
+        let b = parse("R12=R[R0]+1").unwrap();
+        assert!(matches!(&b.items[0], Item::Param { number, .. } if *number == 12.0));
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! machine's own), the non-modal functions (dwell, frames, pole), radius compensation and
 //! the motion, then the stops and ends after it, the program call and the jump.
 
-use std::collections::BTreeMap;
+use std::borrow::Borrow;
 use std::sync::Arc;
 
 use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, SpindleDir};
@@ -23,28 +23,83 @@ pub enum Mode {
     Rotary,
 }
 
+/// A block's few addresses in key order: a list kept from block to block, so sorting a
+/// block's words allocates nothing once the first blocks have run.
+#[derive(Debug)]
+pub struct AddrMap<K>(Vec<(K, (f64, Mode))>);
+
+impl<K> Default for AddrMap<K> {
+    fn default() -> Self {
+        AddrMap(Vec::new())
+    }
+}
+
+impl<K: Ord + Copy> AddrMap<K> {
+    /// Sets `k`; the value it had, if any (an address written twice).
+    pub fn insert(&mut self, k: K, v: (f64, Mode)) -> Option<(f64, Mode)> {
+        match self.0.binary_search_by(|(x, _)| x.cmp(&k)) {
+            Ok(i) => Some(std::mem::replace(&mut self.0[i].1, v)),
+            Err(i) => {
+                self.0.insert(i, (k, v));
+                None
+            }
+        }
+    }
+    pub fn get<Q: Ord + ?Sized>(&self, k: &Q) -> Option<&(f64, Mode)>
+    where
+        K: Borrow<Q>,
+    {
+        self.0
+            .binary_search_by(|(x, _)| x.borrow().cmp(k))
+            .ok()
+            .map(|i| &self.0[i].1)
+    }
+    pub fn contains_key<Q: Ord + ?Sized>(&self, k: &Q) -> bool
+    where
+        K: Borrow<Q>,
+    {
+        self.get(k).is_some()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+    pub fn iter(&self) -> impl Iterator<Item = (&K, &(f64, Mode))> {
+        self.0.iter().map(|(k, v)| (k, v))
+    }
+}
+
 /// A block's addresses, sorted out of its items.
 #[derive(Debug, Default)]
 pub struct Words {
     /// Machine axis index → value and how it counts.
-    pub axes: BTreeMap<usize, (f64, Mode)>,
+    pub axes: AddrMap<usize>,
     /// Other addresses: `I`, `J`, `K`, `I1`, `CR`, `AR`, `AP`, `RP`, `TURN`, `RPL`, `F`,
     /// `S`, `T`, `D`, `P`…
-    pub addr: BTreeMap<String, (f64, Mode)>,
+    pub addr: AddrMap<&'static str>,
     pub g: Vec<u32>,
     pub m: Vec<u32>,
     /// Keywords in the order written (`CIP`, `TRANS`, `STOPRE`…).
-    pub keys: Vec<String>,
+    pub keys: Vec<&'static str>,
     /// The program the block calls.
     pub call: Option<String>,
 }
 
 impl Words {
+    /// Empty for the next block, its lists' room kept.
+    fn clear(&mut self) {
+        self.axes.0.clear();
+        self.addr.0.clear();
+        self.g.clear();
+        self.m.clear();
+        self.keys.clear();
+        self.call = None;
+    }
+
     pub fn has_g(&self, n: u32) -> bool {
         self.g.contains(&n)
     }
     pub fn key(&self, k: &str) -> bool {
-        self.keys.iter().any(|x| x == k)
+        self.keys.contains(&k)
     }
     pub fn get(&self, a: &str) -> Option<f64> {
         self.addr.get(a).map(|v| v.0)
@@ -62,6 +117,19 @@ const KEYWORDS: [&str; 19] = [
     "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
     "STOPRE", "RET", "PROC", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
 ];
+
+const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
+
+/// An address's name as a constant: one letter or one of [`ADDRESSES`].
+fn address_name(name: &str) -> Option<&'static str> {
+    match name.as_bytes() {
+        [c] if c.is_ascii_uppercase() => {
+            let i = usize::from(c - b'A');
+            Some(&LETTERS[i..=i])
+        }
+        _ => ADDRESSES.iter().copied().find(|a| *a == name),
+    }
+}
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
@@ -150,7 +218,15 @@ fn is_cycle(name: &str) -> bool {
 impl Sinumerik {
     /// Runs one parsed block.
     pub(super) fn run_block(&mut self, b: &Block, text: &Arc<str>) -> Result<(), ProgramError> {
-        let mut w = Words::default();
+        let mut w = std::mem::take(&mut self.words);
+        w.clear();
+        let done = self.run_words(b, &mut w, text);
+        self.words = w;
+        done
+    }
+
+    /// The block's items, then its words in the control's order.
+    fn run_words(&mut self, b: &Block, w: &mut Words, text: &Arc<str>) -> Result<(), ProgramError> {
         self.jump = None;
         for item in &b.items {
             if !matches!(item, Item::Def(_)) {
@@ -158,21 +234,21 @@ impl Sinumerik {
                     *d = false;
                 }
             }
-            self.item(item, &mut w)?;
+            self.item(item, w)?;
         }
         let from = self.core.queued();
-        self.modal(&w)?;
-        self.feed_and_speed(&w)?;
-        self.tool_words(&w)?;
-        self.m_before(&w)?;
-        let nonmodal = self.non_modal(&w)?;
+        self.modal(w)?;
+        self.feed_and_speed(w)?;
+        self.tool_words(w)?;
+        self.m_before(w)?;
+        let nonmodal = self.non_modal(w)?;
         if !nonmodal {
-            self.motion_block(&w)?;
+            self.motion_block(w)?;
         }
         if w.has_g(9) {
             self.core.exact_stop_block(from);
         }
-        self.m_after(&w)?;
+        self.m_after(w)?;
         if w.key("RET") {
             self.return_from_program();
         }
@@ -230,16 +306,17 @@ impl Sinumerik {
                         Some(c) => self.number(c)? != 0.0,
                     };
                     if go {
-                        self.jump = Some((*forward, target.clone()));
+                        self.jump = Some((*forward, target.to_string()));
                     }
                 }
             }
+            Item::Param { number, value } => self.write_param(*number, value)?,
             Item::Assign { name, index, value } => {
                 let axis = self.axis_of(name);
                 if index.is_empty()
                     && (axis.is_some()
-                        || ADDRESSES.contains(&name.as_str())
-                        || "FSTDIJKP".contains(name.as_str()) && name.len() == 1)
+                        || ADDRESSES.contains(&name.as_ref())
+                        || "FSTDIJKP".contains(name.as_ref()) && name.len() == 1)
                 {
                     let (v, mode) = self.address_value(name, value)?;
                     self.put(w, name, v, mode, axis)?;
@@ -255,8 +332,8 @@ impl Sinumerik {
                 value,
             } => self.word(w, *letter, digits, *value)?,
             Item::Name(n) => {
-                if KEYWORDS.contains(&n.as_str()) {
-                    w.keys.push(n.clone());
+                if let Some(k) = KEYWORDS.iter().find(|k| **k == n.as_ref()) {
+                    w.keys.push(k);
                 } else if NOT_BUILT.iter().any(|(k, _)| k == n) {
                     self.not_built(n)?;
                 } else if is_cycle(n) || self.core.library.get_named(n).is_some() {
@@ -334,7 +411,7 @@ impl Sinumerik {
     /// An address's expression: its value and `AC`/`IC`/`DC`/`ACP`/`ACN` when it has one.
     fn address_value(&self, name: &str, value: &Expr) -> Result<(f64, Mode), ProgramError> {
         if let Expr::Call(f, args) = value {
-            let mode = match f.as_str() {
+            let mode = match f.as_ref() {
                 "AC" => Some(Mode::Abs),
                 "IC" => Some(Mode::Inc),
                 "DC" | "ACP" | "ACN" => Some(Mode::Rotary),
@@ -367,9 +444,12 @@ impl Sinumerik {
         if !v.is_finite() {
             return Err(self.fault(Fault::OutOfRange, format!("{name}: value not finite")));
         }
-        let dup = match axis {
-            Some(i) => w.axes.insert(i, (v, mode)).is_some(),
-            None => w.addr.insert(name.to_string(), (v, mode)).is_some(),
+        let dup = match (axis, address_name(name)) {
+            (Some(i), _) => w.axes.insert(i, (v, mode)).is_some(),
+            (None, Some(a)) => w.addr.insert(a, (v, mode)).is_some(),
+            (None, None) => {
+                return Err(self.fault(Fault::NoSuchAddress, format!("{name} is no address")))
+            }
         };
         if dup {
             return Err(self.fault(
@@ -427,7 +507,8 @@ impl Sinumerik {
                 ))
             }
             _ => {
-                let name = letter.to_string();
+                let mut buf = [0; 4];
+                let name: &str = letter.encode_utf8(&mut buf);
                 let axis = self
                     .core
                     .axis(letter)
@@ -438,7 +519,7 @@ impl Sinumerik {
                         format!("{letter} is no address of this machine"),
                     ));
                 }
-                self.put(w, &name, value, Mode::Modal, axis)?;
+                self.put(w, name, value, Mode::Modal, axis)?;
             }
         }
         Ok(())
@@ -446,8 +527,7 @@ impl Sinumerik {
 
     /// The modal G functions of the block, one per group (§9.1.6).
     fn modal(&mut self, w: &Words) -> Result<(), ProgramError> {
-        let mut groups: BTreeMap<u8, u32> = BTreeMap::new();
-        for &g in &w.g {
+        for (at, &g) in w.g.iter().enumerate() {
             let group = g_group(g).ok_or_else(|| {
                 self.fault(
                     Fault::UndefinedCode,
@@ -457,7 +537,8 @@ impl Sinumerik {
             if let Some((_, why)) = NOT_BUILT_G.iter().find(|(n, _)| *n == g) {
                 return Err(self.fault(Fault::NotSupported, *why));
             }
-            if let Some(other) = groups.insert(group, g) {
+            let same = w.g[..at].iter().find(|o| g_group(**o) == Some(group));
+            if let Some(other) = same {
                 return Err(self.fault(
                     Fault::SameGroup,
                     format!("G{other} and G{g} are of one group: one per block"),
@@ -497,7 +578,7 @@ impl Sinumerik {
             }
         }
         for k in &w.keys {
-            match k.as_str() {
+            match *k {
                 "CIP" => self.motion = Motion::Cip,
                 "CT" => self.motion = Motion::Ct,
                 _ => {}

@@ -4,6 +4,8 @@
 //! `<<` joining strings and numbers. The parser turns tokens into an [`Expr`]; evaluation asks
 //! the front end for the variables' values.
 
+use std::borrow::Cow;
+
 use cnc_interpreter_core::Fault;
 
 use super::lex::Tok;
@@ -50,26 +52,29 @@ impl EvalError {
     }
 }
 
+/// A value as written; names borrow from the block's line.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Expr {
+pub enum Expr<'s> {
     Num(f64),
-    Str(String),
-    /// A variable: `R` with an index for arithmetic parameters (`R12`, `R[R0]`), a user or
-    /// system variable with its indexes (`PVAR5[2]`, `$AA_IW[X]`).
-    Var(String, Vec<Expr>),
+    Str(&'s str),
+    /// An arithmetic parameter by its number (`R12`).
+    R(f64),
+    /// A variable: `R` with a computed index (`R[R0]`), a user or system variable with its
+    /// indexes (`PVAR5[2]`, `$AA_IW[X]`).
+    Var(Cow<'s, str>, Vec<Expr<'s>>),
     /// An axis name as an index (`$AA_IW[X]`, `FXS[Z1]`).
-    Axis(String),
-    Neg(Box<Expr>),
-    Bin(&'static str, Box<Expr>, Box<Expr>),
-    Call(String, Vec<Option<Expr>>),
+    Axis(Cow<'s, str>),
+    Neg(Box<Expr<'s>>),
+    Bin(&'static str, Box<Expr<'s>>, Box<Expr<'s>>),
+    Call(Cow<'s, str>, Vec<Option<Expr<'s>>>),
 }
 
 /// How evaluation reads a variable: its name and evaluated indexes.
 pub type Reader<'r> = dyn Fn(&str, &[Val]) -> Result<Val, EvalError> + 'r;
 
 /// A parser over one block's tokens.
-pub struct Parser<'a> {
-    pub toks: &'a [Tok],
+pub struct Parser<'a, 's> {
+    pub toks: &'a [Tok<'s>],
     pub at: usize,
     /// How deep the value being read nests (signs, parentheses, function arguments).
     depth: usize,
@@ -80,8 +85,8 @@ const MAX_NESTING: usize = 64;
 
 type PResult<T> = Result<T, String>;
 
-impl<'a> Parser<'a> {
-    pub fn new(toks: &'a [Tok]) -> Parser<'a> {
+impl<'a, 's> Parser<'a, 's> {
+    pub fn new(toks: &'a [Tok<'s>]) -> Parser<'a, 's> {
         Parser {
             toks,
             at: 0,
@@ -89,15 +94,15 @@ impl<'a> Parser<'a> {
         }
     }
 
-    pub fn peek(&self) -> Option<&'a Tok> {
+    pub fn peek(&self) -> Option<&'a Tok<'s>> {
         self.toks.get(self.at)
     }
 
-    pub fn peek_at(&self, k: usize) -> Option<&'a Tok> {
+    pub fn peek_at(&self, k: usize) -> Option<&'a Tok<'s>> {
         self.toks.get(self.at + k)
     }
 
-    pub fn take(&mut self) -> Option<&'a Tok> {
+    pub fn take(&mut self) -> Option<&'a Tok<'s>> {
         let t = self.toks.get(self.at);
         self.at += usize::from(t.is_some());
         t
@@ -125,7 +130,7 @@ impl<'a> Parser<'a> {
     }
 
     /// An expression, comparisons and `<<` included.
-    pub fn expr(&mut self) -> PResult<Expr> {
+    pub fn expr(&mut self) -> PResult<Expr<'s>> {
         let mut left = self.comparison()?;
         while self.eat_op("<<") {
             let right = self.comparison()?;
@@ -134,7 +139,7 @@ impl<'a> Parser<'a> {
         Ok(left)
     }
 
-    fn comparison(&mut self) -> PResult<Expr> {
+    fn comparison(&mut self) -> PResult<Expr<'s>> {
         let left = self.sum()?;
         for op in ["==", "<>", "<=", ">=", "<", ">"] {
             if self.eat_op(op) {
@@ -145,7 +150,7 @@ impl<'a> Parser<'a> {
         Ok(left)
     }
 
-    fn sum(&mut self) -> PResult<Expr> {
+    fn sum(&mut self) -> PResult<Expr<'s>> {
         let mut left = self.term()?;
         loop {
             let op = if self.eat_op("+") {
@@ -160,7 +165,7 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn term(&mut self) -> PResult<Expr> {
+    fn term(&mut self) -> PResult<Expr<'s>> {
         let mut left = self.unary()?;
         loop {
             let op = if self.eat_op("*") {
@@ -176,7 +181,7 @@ impl<'a> Parser<'a> {
     }
 
     /// Every nesting passes here (a sign, or a primary's parentheses and arguments).
-    fn unary(&mut self) -> PResult<Expr> {
+    fn unary(&mut self) -> PResult<Expr<'s>> {
         if self.depth >= MAX_NESTING {
             return Err(format!("a value nested deeper than {MAX_NESTING} levels"));
         }
@@ -186,7 +191,7 @@ impl<'a> Parser<'a> {
         e
     }
 
-    fn signed(&mut self) -> PResult<Expr> {
+    fn signed(&mut self) -> PResult<Expr<'s>> {
         if self.eat_op("-") {
             return Ok(Expr::Neg(Box::new(self.unary()?)));
         }
@@ -196,10 +201,10 @@ impl<'a> Parser<'a> {
         self.primary()
     }
 
-    fn primary(&mut self) -> PResult<Expr> {
+    fn primary(&mut self) -> PResult<Expr<'s>> {
         match self.take() {
             Some(Tok::Num(v)) => Ok(Expr::Num(*v)),
-            Some(Tok::Str(s)) => Ok(Expr::Str(s.clone())),
+            Some(Tok::Str(s)) => Ok(Expr::Str(s)),
             Some(Tok::Op("(")) => {
                 let e = self.expr()?;
                 self.expect_op(")")?;
@@ -210,7 +215,7 @@ impl<'a> Parser<'a> {
                 value,
                 digits,
                 ..
-            }) if !digits.is_empty() => Ok(Expr::Var("R".into(), vec![Expr::Num(*value)])),
+            }) if !digits.is_empty() => Ok(Expr::R(*value)),
             Some(Tok::Name(n)) if n == "TRUE" => Ok(Expr::Num(1.0)),
             Some(Tok::Name(n)) if n == "FALSE" => Ok(Expr::Num(0.0)),
             Some(Tok::Name(n)) => {
@@ -231,7 +236,7 @@ impl<'a> Parser<'a> {
     }
 
     /// `( a, , c )`: arguments, each may be left out.
-    pub fn arguments(&mut self) -> PResult<Vec<Option<Expr>>> {
+    pub fn arguments(&mut self) -> PResult<Vec<Option<Expr<'s>>>> {
         self.expect_op("(")?;
         let mut args = Vec::new();
         if self.eat_op(")") {
@@ -251,7 +256,7 @@ impl<'a> Parser<'a> {
     }
 
     /// `[ i ]` or `[ i, j ]`; an axis name may be an index.
-    pub fn indexes(&mut self) -> PResult<Vec<Expr>> {
+    pub fn indexes(&mut self) -> PResult<Vec<Expr<'s>>> {
         self.expect_op("[")?;
         let mut idx = Vec::new();
         loop {
@@ -260,7 +265,7 @@ impl<'a> Parser<'a> {
                 (Some(Tok::Word { letter, digits, .. }), Some(Tok::Op("]" | ",")))
                     if *letter != 'R' =>
                 {
-                    Some(format!("{letter}{digits}"))
+                    Some(Cow::Owned(format!("{letter}{digits}")))
                 }
                 _ => None,
             };
@@ -283,12 +288,19 @@ impl<'a> Parser<'a> {
 pub fn eval(e: &Expr, var: &Reader) -> Result<Val, EvalError> {
     Ok(match e {
         Expr::Num(v) => Val::Num(*v),
-        Expr::Str(s) => Val::Str(s.clone()),
-        Expr::Axis(a) => Val::Str(a.clone()),
-        Expr::Var(name, idx) => {
-            let idx: Vec<Val> = idx.iter().map(|i| eval(i, var)).collect::<Result<_, _>>()?;
-            var(name, &idx)?
-        }
+        Expr::Str(s) => Val::Str(s.to_string()),
+        Expr::Axis(a) => Val::Str(a.to_string()),
+        Expr::R(k) => var("R", &[Val::Num(*k)])?,
+        // One or two indexes (every array the manual defines) are read without a list.
+        Expr::Var(name, idx) => match idx.as_slice() {
+            [] => var(name, &[])?,
+            [i] => var(name, &[eval(i, var)?])?,
+            [i, j] => var(name, &[eval(i, var)?, eval(j, var)?])?,
+            _ => {
+                let idx: Vec<Val> = idx.iter().map(|i| eval(i, var)).collect::<Result<_, _>>()?;
+                var(name, &idx)?
+            }
+        },
         Expr::Neg(a) => Val::Num(-eval(a, var)?.num()?),
         Expr::Bin("<<", a, b) => Val::Str(eval(a, var)?.text() + &eval(b, var)?.text()),
         Expr::Bin(op, a, b) => {
@@ -340,9 +352,9 @@ fn function(name: &str, args: &[Option<Expr>], var: &Reader) -> Result<Val, Eval
             format!("{name}() takes {want} argument(s)"),
         ));
     }
-    let mut v = Vec::with_capacity(2);
-    for a in args.iter().flatten() {
-        v.push(eval(a, var)?.num()?);
+    let mut v = [0.0; 2];
+    for (slot, a) in v.iter_mut().zip(args.iter().flatten()) {
+        *slot = eval(a, var)?.num()?;
     }
     let x = v[0];
     let domain = |ok: bool, r: f64| {

@@ -24,15 +24,11 @@ impl Sinumerik {
     /// The block's frame instruction, if it has one: its axis words are the instruction's
     /// values, and it moves nothing (an own block, §9.2.6).
     pub(super) fn frame_instruction(&mut self, w: &Words) -> Result<bool, ProgramError> {
-        let found: Vec<&String> = w
-            .keys
-            .iter()
-            .filter(|k| FRAMES.contains(&k.as_str()))
-            .collect();
-        let Some(kind) = found.first().map(|k| k.as_str()) else {
+        let mut found = w.keys.iter().copied().filter(|k| FRAMES.contains(k));
+        let Some(kind) = found.next() else {
             return Ok(false);
         };
-        if found.len() > 1 {
+        if found.next().is_some() {
             return Err(self.fault(Fault::SameGroup, "one frame instruction per block"));
         }
         if self.core.comp.is_some() {

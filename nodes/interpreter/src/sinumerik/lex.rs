@@ -4,25 +4,29 @@
 //! digits is an address word (`X20.5`, `G1`, `R10`, `L0128`): names of variables, labels and
 //! programs begin with two letters, so they never look like one.
 
+use std::borrow::Cow;
 use std::fmt;
 
+/// A token borrows its text from the line: lexing a block allocates only the token list (and
+/// a name written in lower case).
 #[derive(Debug, Clone, PartialEq)]
-pub enum Tok {
+pub enum Tok<'s> {
     /// An address letter with digits: the letter, the digits as written (leading zeros are
     /// significant for `L`) and the value, with a fraction when one follows (`X20.5`).
     Word {
         letter: char,
-        digits: String,
+        digits: &'s str,
         value: f64,
     },
-    /// A name: a keyword, a multi-letter address, a variable, a label or a program.
-    Name(String),
+    /// A name in upper case: a keyword, a multi-letter address, a variable, a label or a
+    /// program.
+    Name(Cow<'s, str>),
     Num(f64),
-    Str(String),
+    Str(&'s str),
     Op(&'static str),
 }
 
-impl fmt::Display for Tok {
+impl fmt::Display for Tok<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Tok::Word { letter, digits, .. } => write!(f, "{letter}{digits}"),
@@ -34,74 +38,82 @@ impl fmt::Display for Tok {
     }
 }
 
-const OPS: [&str; 17] = [
-    "==", "<>", "<=", ">=", "<<", "+", "-", "*", "/", "(", ")", "[", "]", ",", "=", "<", ">",
+const OPS: [&str; 19] = [
+    "==", "<>", "<=", ">=", "<<", "+", "-", "*", "/", "(", ")", "[", "]", ",", "=", "<", ">", ":",
+    ".",
 ];
-const OPS_TAIL: [&str; 2] = [":", "."];
 
 /// The line without its comment (`;` outside a string).
 pub fn strip_comment(line: &str) -> &str {
     let mut in_str = false;
-    for (i, c) in line.char_indices() {
+    for (i, c) in line.bytes().enumerate() {
         match c {
-            '"' => in_str = !in_str,
-            ';' if !in_str => return &line[..i],
+            b'"' => in_str = !in_str,
+            b';' if !in_str => return &line[..i],
             _ => {}
         }
     }
     line
 }
 
+/// `name` in upper case, borrowed when it is written so.
+pub fn upper(name: &str) -> Cow<'_, str> {
+    if name.bytes().any(|b| b.is_ascii_lowercase()) {
+        Cow::Owned(name.to_ascii_uppercase())
+    } else {
+        Cow::Borrowed(name)
+    }
+}
+
 /// The tokens of a line (its comment already stripped); an error names the bad character.
-pub fn tokens(line: &str) -> Result<Vec<Tok>, String> {
-    let chars: Vec<char> = line.chars().collect();
-    let mut out = Vec::new();
+/// Everything outside strings is ASCII, so the line is read byte by byte and every token
+/// boundary is a character boundary.
+pub fn tokens(line: &str) -> Result<Vec<Tok<'_>>, String> {
+    let b = line.as_bytes();
+    let mut out = Vec::with_capacity(8);
     let mut i = 0;
-    while i < chars.len() {
-        let c = chars[i];
-        if c == ' ' || c == '\t' || c == '\r' {
+    while i < b.len() {
+        let c = b[i];
+        if c == b' ' || c == b'\t' || c == b'\r' {
             i += 1;
-        } else if c == '"' {
+        } else if c == b'"' {
             let start = i + 1;
-            let end = chars[start..]
+            let end = b[start..]
                 .iter()
-                .position(|&c| c == '"')
+                .position(|&c| c == b'"')
                 .ok_or("a string without its closing \"")?;
-            out.push(Tok::Str(chars[start..start + end].iter().collect()));
+            out.push(Tok::Str(&line[start..start + end]));
             i = start + end + 1;
-        } else if c.is_ascii_digit() || (c == '.' && next_is_digit(&chars, i)) {
-            let (v, next) = number(&chars, i)?;
+        } else if c.is_ascii_digit() || (c == b'.' && next_is_digit(b, i)) {
+            let (v, next) = number(line, i)?;
             out.push(Tok::Num(v));
             i = next;
-        } else if c.is_ascii_alphabetic() && chars.get(i + 1).is_some_and(|d| d.is_ascii_digit()) {
+        } else if c.is_ascii_alphabetic() && next_is_digit(b, i) {
             // An address word: one letter, then its number (`X20.5`, `G1X20`, `L0128`).
             let mut end = i + 1;
-            while end < chars.len() && chars[end].is_ascii_digit() {
+            while end < b.len() && b[end].is_ascii_digit() {
                 end += 1;
             }
-            let (value, next) = number(&chars, i + 1)?;
+            let (value, next) = number(line, i + 1)?;
             out.push(Tok::Word {
-                letter: c.to_ascii_uppercase(),
-                digits: chars[i + 1..end].iter().collect(),
+                letter: char::from(c.to_ascii_uppercase()),
+                digits: &line[i + 1..end],
                 value,
             });
             i = next;
-        } else if c.is_ascii_alphabetic() || c == '_' || c == '$' {
+        } else if c.is_ascii_alphabetic() || c == b'_' || c == b'$' {
             let start = i;
             i += 1;
-            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+            while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
                 i += 1;
             }
-            out.push(Tok::Name(
-                chars[start..i].iter().collect::<String>().to_uppercase(),
-            ));
+            out.push(Tok::Name(upper(&line[start..i])));
         } else {
-            let rest: String = chars[i..chars.len().min(i + 2)].iter().collect();
-            let op = OPS
-                .iter()
-                .chain(OPS_TAIL.iter())
-                .find(|o| rest.starts_with(**o))
-                .ok_or_else(|| format!("character {c:?} is not allowed here"))?;
+            let rest = &b[i..b.len().min(i + 2)];
+            let Some(op) = OPS.iter().find(|o| rest.starts_with(o.as_bytes())) else {
+                let ch = line[i..].chars().next().unwrap_or('?');
+                return Err(format!("character {ch:?} is not allowed here"));
+            };
             out.push(Tok::Op(op));
             i += op.len();
         }
@@ -109,42 +121,42 @@ pub fn tokens(line: &str) -> Result<Vec<Tok>, String> {
     Ok(out)
 }
 
-fn next_is_digit(chars: &[char], i: usize) -> bool {
-    chars.get(i + 1).is_some_and(|c| c.is_ascii_digit())
+fn next_is_digit(b: &[u8], i: usize) -> bool {
+    b.get(i + 1).is_some_and(|c| c.is_ascii_digit())
 }
 
 /// A number from `i`: digits, an optional fraction, an optional `EX` exponent
 /// (`-0.1EX-5`, §9.9.1). Returns the value and where it ends.
-fn number(chars: &[char], mut i: usize) -> Result<(f64, usize), String> {
+fn number(line: &str, mut i: usize) -> Result<(f64, usize), String> {
+    let b = line.as_bytes();
     let start = i;
-    while i < chars.len() && chars[i].is_ascii_digit() {
+    while i < b.len() && b[i].is_ascii_digit() {
         i += 1;
     }
-    if i < chars.len() && chars[i] == '.' {
+    if i < b.len() && b[i] == b'.' {
         i += 1;
-        while i < chars.len() && chars[i].is_ascii_digit() {
+        while i < b.len() && b[i].is_ascii_digit() {
             i += 1;
         }
     }
-    let mantissa: String = chars[start..i].iter().collect();
+    let mantissa = &line[start..i];
     let mut value: f64 = mantissa
         .parse()
         .map_err(|_| format!("number {mantissa:?} is malformed"))?;
-    let ex = chars.len() >= i + 2
-        && chars[i].eq_ignore_ascii_case(&'E')
-        && chars[i + 1].eq_ignore_ascii_case(&'X');
+    let ex = b.len() >= i + 2
+        && b[i].eq_ignore_ascii_case(&b'E')
+        && b[i + 1].eq_ignore_ascii_case(&b'X');
     if ex {
         let mut j = i + 2;
-        let neg = chars.get(j) == Some(&'-');
-        if matches!(chars.get(j), Some('-') | Some('+')) {
+        let neg = b.get(j) == Some(&b'-');
+        if matches!(b.get(j), Some(b'-') | Some(b'+')) {
             j += 1;
         }
         let digits_from = j;
-        while j < chars.len() && chars[j].is_ascii_digit() {
+        while j < b.len() && b[j].is_ascii_digit() {
             j += 1;
         }
-        let digits: String = chars[digits_from..j].iter().collect();
-        let e: i32 = digits
+        let e: i32 = line[digits_from..j]
             .parse()
             .map_err(|_| "EX without its exponent".to_string())?;
         if e > 300 {
@@ -164,10 +176,10 @@ fn number(chars: &[char], mut i: usize) -> Result<(f64, usize), String> {
 mod tests {
     use super::*;
 
-    fn word(letter: char, digits: &str, value: f64) -> Tok {
+    fn word(letter: char, digits: &str, value: f64) -> Tok<'_> {
         Tok::Word {
             letter,
-            digits: digits.into(),
+            digits,
             value,
         }
     }
@@ -181,6 +193,11 @@ mod tests {
         assert_eq!(t[5], Tok::Op("-"));
         assert_eq!(t[6], Tok::Num(12.207));
         assert_eq!(t[14], Tok::Name("MA1".into()));
+        assert!(
+            matches!(&t[3], Tok::Name(Cow::Owned(_))),
+            "written in lower case"
+        );
+        assert!(matches!(&t[14], Tok::Name(Cow::Borrowed(_))));
         assert_eq!(t[15], Tok::Op(":"));
         assert_eq!(t[18], Tok::Num(187_400_000.0));
         assert_eq!(tokens("L0128").unwrap(), [word('L', "0128", 128.0)]);

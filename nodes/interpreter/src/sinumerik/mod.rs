@@ -75,6 +75,8 @@ pub struct Sinumerik {
     pub messages: Vec<(u32, String)>,
     /// A jump the block asked for, done once its other words ran.
     jump: Option<(bool, String)>,
+    /// The lists a block's words are sorted into, kept for the next block.
+    words: exec::Words,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -144,6 +146,7 @@ impl Sinumerik {
             plc: PlcArea::default(),
             messages: Vec::new(),
             jump: None,
+            words: exec::Words::default(),
         };
         front.apply_length();
         front
@@ -271,6 +274,16 @@ impl Sinumerik {
             .iter()
             .map(|e| self.value(e))
             .collect::<Result<_, _>>()?;
+        self.write_at(name, &idx, value)
+    }
+
+    /// `R12=value`: an arithmetic parameter by its number.
+    fn write_param(&mut self, number: f64, value: &Expr) -> Result<(), ProgramError> {
+        self.write_at("R", &[Val::Num(number)], value)
+    }
+
+    /// Writes a variable at evaluated indexes.
+    fn write_at(&mut self, name: &str, idx: &[Val], value: &Expr) -> Result<(), ProgramError> {
         // SET(…) / REP(…): successive elements from the one named (§9.9.2).
         if let Expr::Call(f, args) = value {
             if f == "SET" || f == "REP" {
@@ -281,11 +294,11 @@ impl Sinumerik {
                     })?;
                     vals.push(self.value(a)?);
                 }
-                return self.write_list(name, &idx, &vals, f == "REP");
+                return self.write_list(name, idx, &vals, f == "REP");
             }
         }
         let v = self.value(value)?;
-        self.write_one(name, &idx, v)
+        self.write_one(name, idx, v)
     }
 
     fn write_one(&mut self, name: &str, idx: &[Val], v: Val) -> Result<(), ProgramError> {
@@ -401,12 +414,16 @@ impl Sinumerik {
                     format!("{} cannot name a variable: 2–32 letters, digits or _, the first two letters, and no address or keyword", v.name),
                 ));
             }
-            if self.scopes.last().is_some_and(|s| s.contains_key(&v.name)) {
+            if self
+                .scopes
+                .last()
+                .is_some_and(|s| s.contains_key(v.name.as_ref()))
+            {
                 return Err(self.fault(Fault::Macro, format!("{} is defined twice", v.name)));
             }
-            let var = Var::new(&d.ty, d.len, &v.dims);
+            let var = Var::new(d.ty, d.len, &v.dims);
             if let Some(s) = self.scopes.last_mut() {
-                s.insert(v.name.clone(), var);
+                s.insert(v.name.to_string(), var);
             }
             if let Some(init) = &v.init {
                 self.write(&v.name, &[], init)?;

@@ -126,7 +126,7 @@ impl Sinumerik {
         let here = self.core.work_position();
         let mut end = here.clone();
         let unit = self.unit();
-        for (&i, &(v, mode)) in &w.axes {
+        for (&i, &(v, mode)) in w.axes.iter() {
             let linear = "XYZUVW".contains(self.core.setup.axes[i]);
             let v = if linear { v * unit } else { v };
             let absolute = match mode {
@@ -214,7 +214,7 @@ impl Sinumerik {
         );
         let unit = self.unit();
         let centre_word = |l: Option<char>, start: f64| -> Option<f64> {
-            let (val, mode) = *w.addr.get(&l?.to_string())?;
+            let (val, mode) = *w.addr.get(l?.encode_utf8(&mut [0; 4]) as &str)?;
             Some(if mode == Mode::Abs {
                 val * unit
             } else {
@@ -224,7 +224,7 @@ impl Sinumerik {
         let has_centre = [letters.0, letters.1]
             .iter()
             .flatten()
-            .any(|l| w.addr.contains_key(&l.to_string()));
+            .any(|l| w.addr.contains_key(l.encode_utf8(&mut [0; 4]) as &str));
         let radius = w.get("CR").map(|r| r * unit);
         let angle = w.get("AR");
         let arc_err = |e: ArcError, what: &str| {
@@ -323,12 +323,14 @@ impl Sinumerik {
         let unit = self.unit();
         let coord = |i: usize| -> Result<f64, ProgramError> {
             let l = centre_letter(self.core.setup.axes[i]).map(|c| format!("{c}1"));
-            let (val, mode) = l.and_then(|l| w.addr.get(&l).copied()).ok_or_else(|| {
-                self.fault(
-                    Fault::MissingWord,
-                    "CIP needs the intermediate point I1=/J1=/K1= in the plane",
-                )
-            })?;
+            let (val, mode) = l
+                .and_then(|l| w.addr.get(l.as_str()).copied())
+                .ok_or_else(|| {
+                    self.fault(
+                        Fault::MissingWord,
+                        "CIP needs the intermediate point I1=/J1=/K1= in the plane",
+                    )
+                })?;
             let absolute = match mode {
                 Mode::Abs | Mode::Rotary => true,
                 Mode::Inc => false,
@@ -457,7 +459,7 @@ impl Sinumerik {
         let here = self.core.work_position();
         let mut end = here.clone();
         let unit = self.unit();
-        for (&i, &(v, mode)) in &w.axes {
+        for (&i, &(v, mode)) in w.axes.iter() {
             let absolute = mode != Mode::Inc && (mode != Mode::Modal || self.absolute);
             end[i] = if absolute {
                 v * unit
