@@ -149,3 +149,29 @@ fn every_instruction_not_built_stops_with_12140_and_its_reason() {
         assert!(e.text.contains(reason), "G{g}: {e}");
     }
 }
+
+#[test]
+fn proc_names_the_program_in_its_first_block_only() {
+    let out = ok("; header comment\nPROC RAHMEN\nDEF REAL LEN=4\nG0 X=LEN\nM2\n");
+    assert_eq!(
+        out.iter().filter_map(|c| c.end()).last(),
+        Some(&[4.0, 0.0, 0.0][..])
+    );
+    let (_, e) = run("G0 X1\nPROC RAHMEN\n");
+    let e = e.expect("PROC after a move");
+    assert_eq!((e.number, e.line), (12080, 2), "{e}");
+    let (_, e) = run("PROC RAHMEN(REAL LEN)\n");
+    let e = e.expect("PROC with parameters");
+    assert_eq!((e.number, e.line), (12140, 1), "{e}");
+    let (_, e) = run("PROC\n");
+    assert_eq!(e.map(|e| e.number), Some(12080));
+}
+
+#[test]
+fn h_words_and_machine_data_stop_with_12140() {
+    for text in ["H1=1.987\n", "G0 X1 H5\n", "$MA_FIX_POINT_POS[0]=1\n"] {
+        let (_, e) = run(text);
+        let e = e.unwrap_or_else(|| panic!("{text} ran"));
+        assert_eq!((e.number, e.line), (12140, 1), "{text}: {e}");
+    }
+}

@@ -33,6 +33,9 @@ pub enum Item<'s> {
     Name(Cow<'s, str>),
     /// `NAME(arguments)`: `MSG(…)`, a cycle.
     Call(Cow<'s, str>, Vec<Option<Expr<'s>>>),
+    /// `PROC name`: the program names itself in its first block (`001` §9.11.1); `true`
+    /// when a parameter list follows.
+    Proc(Cow<'s, str>, bool),
     /// `GOTOF label` / `GOTOB label`, under a condition when it came with `IF`.
     Goto {
         condition: Option<Expr<'s>>,
@@ -160,6 +163,17 @@ fn name_item<'s>(p: &mut Parser<'_, 's>, n: Cow<'s, str>) -> Result<Item<'s>, St
                 forward,
                 target,
             });
+        }
+        "PROC" => {
+            let Some(Tok::Name(name)) = p.take() else {
+                return Err("PROC needs the program's name".into());
+            };
+            let params = p.is_op("(");
+            if params {
+                // The list is not read: the executor refuses it; the block ends here.
+                p.at = p.toks.len();
+            }
+            return Ok(Item::Proc(name.clone(), params));
         }
         "GOTOF" | "GOTOB" => {
             p.at -= 1;

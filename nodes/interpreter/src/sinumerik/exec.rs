@@ -113,9 +113,9 @@ const ADDRESSES: [&str; 17] = [
 ];
 
 /// Keywords this front end runs.
-const KEYWORDS: [&str; 19] = [
+const KEYWORDS: [&str; 18] = [
     "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
-    "STOPRE", "RET", "PROC", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
+    "STOPRE", "RET", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
 ];
 
 const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
@@ -133,7 +133,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 20] = [
+pub const NOT_BUILT: [(&str, &str); 33] = [
     (
         "CFC",
         "feed correction on compensated circles is not built: F acts on the cutter centre (CFTCP)",
@@ -169,6 +169,22 @@ pub const NOT_BUILT: [(&str, &str); 20] = [
     ("OFFN", "the contour offset OFFN is not built yet"),
     ("SETPIECE", "tool monitoring is not built"),
     ("RESETMON", "tool monitoring is not built"),
+    ("FP", "G75 fixed point approach is not built yet"),
+    ("TANG", "tangential control is not built"),
+    ("TANGON", "tangential control is not built"),
+    ("TANGOF", "tangential control is not built"),
+    (
+        "ACC",
+        "the acceleration override ACC is not built: the machine's limits hold",
+    ),
+    ("MASLDEF", "master-slave coupling is not built"),
+    ("MASLDEL", "master-slave coupling is not built"),
+    ("MASLON", "master-slave coupling is not built"),
+    ("MASLOF", "master-slave coupling is not built"),
+    ("MASLOFS", "master-slave coupling is not built"),
+    ("PRESETON", "setting actual values (PRESETON) is not built"),
+    ("AXCTSWE", "axis containers are not built"),
+    ("NEWCONF", "machine data are not set from a program here"),
 ];
 
 /// G functions of the manual this controller does not run, each with the reason (the
@@ -202,9 +218,12 @@ pub fn is_address(name: &str) -> bool {
         || NOT_BUILT.iter().any(|(k, _)| *k == name)
         || [
             "DEF", "IF", "GOTOF", "GOTOB", "MSG", "SET", "REP", "AC", "IC", "DC", "ACP", "ACN",
+            "PROC",
         ]
         .contains(&name)
 }
+
+const H_NOT_BUILT: &str = "H functions are not built: the PLC here takes M, S and T";
 
 /// The cycles of chapter 10: issue 24.
 fn is_cycle(name: &str) -> bool {
@@ -229,7 +248,7 @@ impl Sinumerik {
     fn run_words(&mut self, b: &Block, w: &mut Words, text: &Arc<str>) -> Result<(), ProgramError> {
         self.jump = None;
         for item in &b.items {
-            if !matches!(item, Item::Def(_)) {
+            if !matches!(item, Item::Def(_) | Item::Proc(..)) {
                 if let Some(d) = self.may_define.last_mut() {
                     *d = false;
                 }
@@ -311,8 +330,20 @@ impl Sinumerik {
                 }
             }
             Item::Param { number, value } => self.write_param(*number, value)?,
+            Item::Proc(name, params) => self.proc(name, *params)?,
             Item::Assign { name, index, value } => {
                 let axis = self.axis_of(name);
+                if name.starts_with('H') && name[1..].bytes().all(|b| b.is_ascii_digit()) {
+                    return Err(self.fault(Fault::NotSupported, H_NOT_BUILT));
+                }
+                if ["$MA_", "$MN_", "$MC_"].iter().any(|p| name.starts_with(p)) {
+                    return Err(self.fault(
+                        Fault::NotSupported,
+                        format!(
+                            "{name}: machine data are set in the launch config, not from a program"
+                        ),
+                    ));
+                }
                 if index.is_empty()
                     && (axis.is_some()
                         || ADDRESSES.contains(&name.as_ref())
@@ -346,6 +377,24 @@ impl Sinumerik {
                 }
             }
             Item::Call(name, args) => self.call_item(name, args)?,
+        }
+        Ok(())
+    }
+
+    /// `PROC name`: accepted as the program's first block; a parameter list is not built.
+    fn proc(&mut self, name: &str, params: bool) -> Result<(), ProgramError> {
+        if params {
+            return Err(self.fault(
+                Fault::NotSupported,
+                format!("PROC {name}(…): subprograms with parameters are not built yet"),
+            ));
+        }
+        // Nothing but comments (and DEF) before it: the level may still define variables.
+        if !self.may_define.last().copied().unwrap_or(false) {
+            return Err(self.fault(
+                Fault::Macro,
+                format!("PROC {name} must be the first block of its program"),
+            ));
         }
         Ok(())
     }
@@ -494,12 +543,7 @@ impl Sinumerik {
             'N' => {
                 return Err(self.fault(Fault::DataFormat, "the block number N must start the block"))
             }
-            'H' => {
-                return Err(self.fault(
-                    Fault::NotSupported,
-                    "H functions are not built: the PLC here takes M, S and T",
-                ))
-            }
+            'H' => return Err(self.fault(Fault::NotSupported, H_NOT_BUILT)),
             'R' => {
                 return Err(self.fault(
                     Fault::DataFormat,

@@ -245,6 +245,9 @@ impl<'a, 's> Parser<'a, 's> {
         loop {
             if self.is_op(",") || self.is_op(")") {
                 args.push(None);
+            } else if let Some(axis) = self.axis_argument() {
+                self.at += 1;
+                args.push(Some(axis));
             } else {
                 args.push(Some(self.expr()?));
             }
@@ -252,6 +255,19 @@ impl<'a, 's> Parser<'a, 's> {
                 return Ok(args);
             }
             self.expect_op(",")?;
+        }
+    }
+
+    /// An axis or spindle as an argument (`MASLDEF(AUX,S3)`, `PRESETON(Y1,0)`): a word
+    /// alone between `(`, `,` and `)`, other than an R parameter.
+    fn axis_argument(&self) -> Option<Expr<'s>> {
+        match (self.peek(), self.peek_at(1)) {
+            (Some(Tok::Word { letter, digits, .. }), Some(Tok::Op("," | ")")))
+                if *letter != 'R' =>
+            {
+                Some(Expr::Axis(Cow::Owned(format!("{letter}{digits}"))))
+            }
+            _ => None,
         }
     }
 

@@ -1,0 +1,110 @@
+//! What the tests of the 802D manual's example programs share: the fixture's text, the
+//! simulated mill, a run to the end or the first alarm, and comparisons.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+use cnc_interpreter::sinumerik::Sinumerik;
+use cnc_interpreter::{Command, Library, Setup};
+use cnc_interpreter_core::{next_command, ProgramError, ToolOffset};
+
+pub fn dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/fixtures/001")
+}
+
+/// The fixture's text below its header (`; ---- program text as printed below ----`).
+pub fn fixture(number: &str) -> String {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir())
+        .expect("fixtures 001")
+        .filter_map(|e| Some(e.ok()?.path()))
+        .filter(|p| {
+            p.file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with(number))
+        })
+        .collect();
+    paths.sort();
+    let text = std::fs::read_to_string(&paths[0]).expect("fixture text");
+    match text.split_once("; ---- program text as printed below ----\n") {
+        Some((_, body)) => body.to_string(),
+        None => text,
+    }
+}
+
+/// The simulated 802D mill: X Y Z at zero, tool T1 D1 of 10 mm radius and 50 mm length.
+pub fn mill() -> Setup {
+    let mut s = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
+    s.offsets.tools.insert(
+        11,
+        ToolOffset {
+            z: 50.0,
+            radius: 10.0,
+            ..ToolOffset::default()
+        },
+    );
+    s
+}
+
+pub struct Run {
+    pub front: Sinumerik,
+    pub out: Vec<Command>,
+    pub error: Option<ProgramError>,
+}
+
+pub fn run_with(text: &str, setup: Setup, library: Library) -> Run {
+    let mut front = Sinumerik::new(text, setup, library);
+    let mut out = Vec::new();
+    let error = loop {
+        match next_command(&mut front) {
+            Ok(Some(c)) => out.push(c.command),
+            Ok(None) => break None,
+            Err(e) => break Some(e),
+        }
+        assert!(out.len() < 100_000, "runaway program");
+    };
+    Run { front, out, error }
+}
+
+pub fn run(text: &str) -> Run {
+    run_with(text, mill(), Library::new())
+}
+
+impl Run {
+    pub fn ok(self) -> Run {
+        assert!(self.error.is_none(), "{:?}", self.error);
+        self
+    }
+    pub fn alarm(&self) -> (u32, u32) {
+        let e = self.error.as_ref().expect("an alarm");
+        (e.number, e.line)
+    }
+    pub fn moves(&self) -> Vec<&Command> {
+        self.out.iter().filter(|c| c.end().is_some()).collect()
+    }
+    pub fn end(&self) -> Vec<f64> {
+        self.moves()
+            .last()
+            .and_then(|c| c.end())
+            .expect("a move")
+            .to_vec()
+    }
+}
+
+pub fn near(a: &[f64], b: &[f64]) -> bool {
+    within(a, b, 1e-3)
+}
+
+pub fn within(a: &[f64], b: &[f64], tol: f64) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < tol)
+}
+
+pub fn arc(c: &Command) -> (Vec<f64>, Vec<f64>, bool) {
+    match c {
+        Command::Arc {
+            end,
+            center,
+            clockwise,
+            ..
+        } => (end.clone(), center.clone(), *clockwise),
+        other => panic!("not an arc: {other:?}"),
+    }
+}
