@@ -154,7 +154,7 @@ fn every_instruction_not_built_stops_with_12140_and_its_reason() {
 fn proc_names_the_program_in_its_first_block_only() {
     let out = ok("; header comment\nPROC RAHMEN\nDEF REAL LEN=4\nG0 X=LEN\nM2\n");
     assert_eq!(
-        out.iter().filter_map(|c| c.end()).last(),
+        out.iter().filter_map(|c| c.end()).next_back(),
         Some(&[4.0, 0.0, 0.0][..])
     );
     let (_, e) = run("G0 X1\nPROC RAHMEN\n");
