@@ -244,7 +244,8 @@ impl Sinumerik {
         done
     }
 
-    /// The block's items, then its words in the control's order.
+    /// The block's items, then its words in the control's order, then its jump
+    /// (docs/decisions.md D83).
     fn run_words(&mut self, b: &Block, w: &mut Words, text: &Arc<str>) -> Result<(), ProgramError> {
         self.jump = None;
         for item in &b.items {

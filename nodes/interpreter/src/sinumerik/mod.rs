@@ -167,6 +167,11 @@ impl Sinumerik {
         self.scopes.last().and_then(|s| s.get(name))
     }
 
+    /// The PLC data area's byte `k` (`$A_DBB[k]`), as the program has left it.
+    pub fn plc_byte(&self, k: usize) -> Option<u8> {
+        self.plc.bytes.get(k).copied()
+    }
+
     /// The active tool and cutting edge.
     pub fn tool_edge(&self) -> (u32, u32) {
         (self.tool, self.edge)

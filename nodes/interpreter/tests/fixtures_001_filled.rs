@@ -1,0 +1,652 @@
+//! The 802D manual's template fixtures (`../shared/fixtures/001`, issue 23, must-show 1)
+//! with their placeholders filled: every line the manual prints stays as printed, each
+//! placeholder line (`...`, `X... Y...`, a lone `.`) is replaced, in order, by a line the
+//! test gives (the comment says which), and the test asserts what the header's EXPECTED line
+//! states, computed here on its own (angles, offsets, inches). As printed, each stops with
+//! 12080 at its first placeholder (`fixtures_001::every_fixture_without_a_cycle_as_printed`).
+
+#[path = "support/sinumerik.rs"]
+mod support;
+
+use std::collections::BTreeMap;
+
+use cnc_interpreter::{Aux, Command, Library};
+use cnc_interpreter_core::ToolOffset;
+use support::*;
+
+/// A line the manual prints as a placeholder (`...`, `…`, `X... Y...`, a lone `.`).
+fn placeholder(line: &str) -> bool {
+    let code = line.split(';').next().unwrap_or("").trim();
+    code.contains("...") || code.contains('…') || code == "."
+}
+
+/// The fixture with its placeholder lines replaced by `fills`, one each, in order (an
+/// empty fill leaves an empty line, so line numbers stay the manual's).
+fn filled(number: &str, fills: &[&str]) -> String {
+    let text = fixture(number);
+    let holes = text.lines().filter(|l| placeholder(l)).count();
+    assert_eq!(holes, fills.len(), "{number}: {holes} placeholder lines");
+    let mut fills = fills.iter();
+    let mut out = String::new();
+    for line in text.lines() {
+        if placeholder(line) {
+            out.push_str(fills.next().copied().unwrap_or(""));
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn ends(r: &Run) -> Vec<Vec<f64>> {
+    r.moves()
+        .iter()
+        .map(|c| c.end().unwrap_or_default().to_vec())
+        .collect()
+}
+
+fn arcs(r: &Run) -> Vec<(Vec<f64>, Vec<f64>, bool)> {
+    r.out
+        .iter()
+        .filter(|c| matches!(c, Command::Arc { .. }))
+        .map(arc)
+        .collect()
+}
+
+/// The line (1-based) of the fixture text that starts with `block` (`N90`).
+fn line_of(text: &str, block: &str) -> u32 {
+    text.lines()
+        .position(|l| l.trim_start().starts_with(block))
+        .map(|i| i as u32 + 1)
+        .unwrap_or_else(|| panic!("no block {block}"))
+}
+
+/// L10, the manual's contour subprogram of the frame figures: a line and a clockwise arc
+/// from (10, 5) to (20, 15) about (20, 5).
+fn l10() -> Library {
+    let mut lib = Library::new();
+    lib.insert_named(
+        "L10",
+        "L10.SPF",
+        "G1 F200 X10 Y5\nG2 X20 Y15 I10 J0\nG0 X0 Y0\nM17\n",
+    );
+    lib
+}
+
+fn rotate(p: (f64, f64), deg: f64) -> (f64, f64) {
+    let (s, c) = deg.to_radians().sin_cos();
+    (p.0 * c - p.1 * s, p.0 * s + p.1 * c)
+}
+
+#[test]
+fn f001_msg_shows_the_text_until_msg_clears_it() {
+    // N20: a move; N...: nothing.
+    let text = filled("001", &["N20 G0 X10 Y10", ""]);
+    let r = run(&text).ok();
+    assert_eq!(
+        r.front.messages,
+        [
+            (line_of(&text, "N10"), "轮廓粗加工".to_string()),
+            (line_of(&text, "N90"), String::new())
+        ]
+    );
+    assert_eq!(r.front.message(), "");
+    assert_eq!(r.moves().len(), 1);
+}
+
+#[test]
+fn f002_msg_joins_text_and_the_x_position_read_from_aa_iw() {
+    let text = filled("002", &["N20 G0 X10 Y10", ""]);
+    let mut s = mill();
+    s.start = vec![37.5, 0.0, 0.0];
+    let r = run_with(&text, s, Library::new()).ok();
+    assert_eq!(r.front.r(12), 37.5);
+    assert_eq!(r.front.messages[0].1, "X 轴位置37.5检查");
+    assert_eq!(r.front.message(), "");
+}
+
+#[test]
+fn f008_g17_applies_the_tool_length_on_z() {
+    // N10: T1 D1 (the machine changes tools on T); N20: G0 to X10 Y10 Z5.
+    let text = filled("008", &["N10 G17 T1 D1", "N20 G0 X10 Y10 Z5"]);
+    let r = run(&text).ok();
+    // Machine Z = programmed 5 + T1 D1's length 50.
+    assert!(near(&r.end(), &[10.0, 10.0, 55.0]), "{:?}", r.end());
+}
+
+#[test]
+fn f010_g70_reads_inches_until_g71() {
+    // As printed: G1 without F (14800, line 7). With F100 in front and the "..." empty:
+    let text = format!("F100\n{}", filled("010", &[""]));
+    let r = run(&text).ok();
+    let e = ends(&r);
+    assert!(near(&e[0], &[254.0, 0.0, 762.0]), "{e:?}");
+    assert!(near(&e[1], &[1016.0, 0.0, 1270.0]), "{e:?}");
+    assert!(near(&e[2], &[19.0, 0.0, 17.3]), "{e:?}");
+}
+
+#[test]
+fn f011_g112_sets_a_pole_relative_to_the_last_one() {
+    // "...": G0 to the pole; N90/N100's "...": G0, and G1 F200.
+    let text = filled(
+        "011",
+        &[
+            "N30 G0 X17 Y36",
+            "N90 G0 AP=12.5 RP=47.679",
+            "N100 G1 F200 AP=26.3 RP=7.344 Z4",
+        ],
+    );
+    let r = run(&text).ok();
+    let pole1 = (17.0, 36.0);
+    let d = rotate((27.8, 0.0), 45.0);
+    let pole2 = (pole1.0 + d.0, pole1.1 + d.1);
+    let p90 = rotate((47.679, 0.0), 12.5);
+    let p100 = rotate((7.344, 0.0), 26.3);
+    let e = ends(&r);
+    assert!(
+        near(&e[1], &[pole2.0 + p90.0, pole2.1 + p90.1, 0.0]),
+        "{e:?}"
+    );
+    assert!(
+        near(&e[2], &[pole2.0 + p100.0, pole2.1 + p100.1, 4.0]),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn f012_trans_shifts_the_l10_contour_by_x20_y15() {
+    // "...": nothing; after N70 a move to the workpiece zero.
+    let text = format!("{}N80 G0 X0 Y0\n", filled("012", &[""]));
+    let r = run_with(&text, mill(), l10()).ok();
+    let a = arcs(&r);
+    assert_eq!(a.len(), 1);
+    assert!(near(&a[0].0[..2], &[40.0, 30.0]) && near(&a[0].1[..2], &[40.0, 20.0]));
+    assert!(a[0].2, "clockwise as programmed");
+    // N70 TRANS clears the shift: the last G0 X0 Y0 is the workpiece zero.
+    assert!(near(&r.end(), &[0.0, 0.0, 0.0]));
+}
+
+#[test]
+fn f013_trans_then_arot_turns_l10_by_45_degrees_about_the_new_zero() {
+    let text = filled("013", &["N10 G17 G0 X0 Y0", "N80 G0 X0 Y0"]);
+    let r = run_with(&text, mill(), l10()).ok();
+    let a = arcs(&r);
+    assert_eq!(a.len(), 2);
+    assert!(near(&a[0].0[..2], &[40.0, 25.0]));
+    let end = rotate((20.0, 15.0), 45.0);
+    let centre = rotate((20.0, 5.0), 45.0);
+    assert!(near(&a[1].0[..2], &[30.0 + end.0, 26.0 + end.1]), "{a:?}");
+    assert!(near(&a[1].1[..2], &[30.0 + centre.0, 26.0 + centre.1]));
+    assert!(a[1].2, "a rotation keeps the direction");
+}
+
+#[test]
+fn f015_mirror_replaces_amirror_adds_and_each_mirror_reverses_the_arc() {
+    let text = filled("015", &["G0 X0 Y0", "N100 G0 X0 Y0"]);
+    let r = run_with(&text, mill(), l10()).ok();
+    let a = arcs(&r);
+    assert_eq!(a.len(), 4);
+    // Original, mirrored in X, in Y (replacing), in Y and X (added).
+    let expect = [
+        ((20.0, 15.0), (20.0, 5.0), true),
+        ((-20.0, 15.0), (-20.0, 5.0), false),
+        ((20.0, -15.0), (20.0, -5.0), false),
+        ((-20.0, -15.0), (-20.0, -5.0), true),
+    ];
+    for (k, (end, centre, cw)) in expect.iter().enumerate() {
+        assert!(near(&a[k].0[..2], &[end.0, end.1]), "{k}: {a:?}");
+        assert!(near(&a[k].1[..2], &[centre.0, centre.1]), "{k}: {a:?}");
+        assert_eq!(a[k].2, *cw, "{k}");
+    }
+    assert!(near(&r.end(), &[0.0, 0.0, 0.0]));
+}
+
+#[test]
+fn f016_four_workpieces_under_g54_to_g57_then_g500() {
+    let text = filled(
+        "016",
+        &[
+            "N10 G54 G0 X0 Y0",
+            "N30 G55 G0 X0 Y0",
+            "N50 G56 G0 X0 Y0",
+            "N70 G57 G0 X0 Y0",
+            "N90 G500 G0 X0",
+        ],
+    );
+    let mut s = mill();
+    for (i, (x, y)) in [(100.0, 50.0), (200.0, 50.0), (100.0, 150.0), (200.0, 150.0)]
+        .into_iter()
+        .enumerate()
+    {
+        s.offsets
+            .work
+            .insert(i as u8, BTreeMap::from([('X', x), ('Y', y), ('Z', 0.0)]));
+    }
+    let mut lib = Library::new();
+    lib.insert_named("L47", "L47.SPF", "G1 F100 X10 Y10\nG0 X0 Y0\nRET\n");
+    let r = run_with(&text, s, lib).ok();
+    let e = ends(&r);
+    let corners: Vec<&Vec<f64>> = e.iter().filter(|p| p[0] % 100.0 == 10.0).collect();
+    assert_eq!(corners.len(), 4, "{e:?}");
+    for (c, (x, y)) in
+        corners
+            .iter()
+            .zip([(110.0, 60.0), (210.0, 60.0), (110.0, 160.0), (210.0, 160.0)])
+    {
+        assert!(near(&c[..2], &[x, y]), "{e:?}");
+    }
+    // G500: no settable offset; X0 is the machine zero, Y stays where G57 left it.
+    assert!(near(&r.end(), &[0.0, 150.0, 0.0]), "{e:?}");
+}
+
+#[test]
+fn f018_rapid_by_polar_coordinates_about_the_workpiece_zero() {
+    let text = filled("018", &[""]);
+    let r = run(&text).ok();
+    let e = ends(&r);
+    assert!(near(&e[0], &[100.0, 150.0, 65.0]));
+    let p = rotate((16.78, 0.0), 45.0);
+    assert!(near(&e[1], &[p.0, p.1, 65.0]), "{e:?}");
+    assert!(matches!(r.moves()[1], Command::Rapid { .. }));
+}
+
+#[test]
+fn f026_ct_continues_the_line_tangentially() {
+    let text = filled("026", &["N20 CT X40 Y10"]);
+    let r = run(&text).ok();
+    // Tangent +X at (20, 0): the centre lies on X20, equally far from (20, 0) and (40, 10).
+    let a = arcs(&r);
+    assert!(
+        near(&a[0].0[..2], &[40.0, 10.0]) && near(&a[0].1[..2], &[20.0, 25.0]),
+        "{a:?}"
+    );
+    assert!(!a[0].2, "counter-clockwise");
+}
+
+#[test]
+fn f027_helix_with_turn_3_makes_three_turns_and_a_half_to_z33() {
+    let text = filled("027", &["N20 G0 Z0", ""]);
+    let r = run(&text).ok();
+    let a = arcs(&r);
+    assert_eq!(a.len(), 4, "three full turns, then the half: {a:?}");
+    for (end, centre, cw) in &a {
+        assert!(!cw && near(&centre[..2], &[0.0, 25.0]));
+        assert!(f64::hypot(end[0], end[1] - 25.0) - 25.0 < 1e-9);
+    }
+    assert!(near(&a[3].0, &[0.0, 0.0, 33.0]));
+    // Z climbs in proportion to the angle: 3.5 turns to 33, each full turn 33/3.5.
+    assert!(near(&a[0].0, &[0.0, 50.0, 33.0 / 3.5]), "{a:?}");
+}
+
+#[test]
+fn f034_feed_per_minute_then_per_revolution() {
+    let text = filled("034", &["N20 G1 X10"]);
+    let r = run(&text).ok();
+    let feeds: Vec<f64> = r
+        .out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Linear { feed, .. } => Some(*feed),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(feeds, [310.0]);
+    let per_rev = r
+        .out
+        .iter()
+        .position(|c| *c == Command::FeedMode { per_rev: true })
+        .expect("G95");
+    let s200 = r.out.iter().position(|c| *c == Command::Aux(Aux::S(200.0)));
+    assert!(s200.is_some_and(|s| s < per_rev));
+    // F15.5 is now mm/rev: a move after it carries 15.5.
+    let r = run(&format!("{text}G1 X20\n")).ok();
+    assert!(
+        matches!(r.out.iter().rev().find(|c| c.end().is_some()), Some(Command::Linear { feed, .. }) if *feed == 15.5)
+    );
+}
+
+#[test]
+fn f043_dwell_in_seconds_and_in_spindle_revolutions() {
+    let text = filled("043", &["N40 X10"]);
+    let r = run(&text).ok();
+    let dwells: Vec<f64> = r
+        .out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Dwell { seconds } => Some(*seconds),
+            _ => None,
+        })
+        .collect();
+    // 30 revolutions at S300: 0.1 min.
+    assert_eq!(dwells.len(), 2);
+    assert!(
+        (dwells[0] - 2.5).abs() < 1e-9 && (dwells[1] - 6.0).abs() < 1e-9,
+        "{dwells:?}"
+    );
+    // F and S keep their values: N40 moves at F200, the spindle still at 300.
+    assert!(matches!(r.moves().last(), Some(Command::Linear { feed, .. }) if *feed == 200.0));
+}
+
+#[test]
+fn f049_spindle_before_the_move_and_m5_with_the_last_rapid() {
+    let text = filled("049", &["", "N80 S450 G1 X80", ""]);
+    let r = run(&text).ok();
+    let pos = |c: &Command| r.out.iter().position(|x| x == c).expect("emitted");
+    let first_move = r.out.iter().position(|c| c.end().is_some()).unwrap();
+    assert!(pos(&Command::Aux(Aux::S(270.0))) < first_move);
+    assert!(pos(&Command::Aux(Aux::M(3))) < first_move);
+    assert!(pos(&Command::Aux(Aux::S(450.0))) > first_move);
+    // M5 is output with N170's move (before it: M5 does not wait for the spindle).
+    let last_move = r.out.iter().rposition(|c| c.end().is_some()).unwrap();
+    assert_eq!(last_move, pos(&Command::Aux(Aux::M(5))) + 1);
+    assert!(near(&r.end(), &[80.0, 0.0, 180.0]));
+}
+
+#[test]
+fn f055_t_without_m6_changes_the_tool_at_once() {
+    // The first half (without M6): the "..." empty.
+    let text = filled("055", &["", "", ""]);
+    let first: String = text
+        .lines()
+        .take_while(|l| !l.contains("N10 T14"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let r = run(&first).ok();
+    let tools: Vec<&Command> = r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Aux(Aux::T(_))))
+        .collect();
+    assert_eq!(
+        tools,
+        [&Command::Aux(Aux::T(1)), &Command::Aux(Aux::T(588))]
+    );
+    assert_eq!(r.front.tool_edge().0, 588);
+    // With M6 (the machine's setting): T14 goes to the PLC as the preselection, the change
+    // is M6's at N15; before it the old tool stays active.
+    let mut s = mill();
+    s.tool_change_with_m6 = true;
+    let r = run_with("N10 T14\nG0 X1\n", s.clone(), Library::new()).ok();
+    assert_eq!(r.front.tool_edge().0, 0, "preselected only");
+    let r = run_with("N10 T14\nG0 X1\nN15 M6\n", s, Library::new()).ok();
+    let at = |c: Command| r.out.iter().position(|x| *x == c).expect("emitted");
+    let mv = r.out.iter().position(|c| c.end().is_some()).unwrap();
+    assert!(at(Command::Aux(Aux::T(14))) < mv && at(Command::Aux(Aux::M(6))) > mv);
+    assert_eq!(r.front.tool_edge(), (14, 1));
+}
+
+#[test]
+fn f056_d_switches_the_length_of_the_active_tool() {
+    let text = filled("056", &["N11 G0 Z10", "", "N70 G0 Z10 D1"]);
+    let mut s = mill();
+    s.offsets.tools.insert(
+        42,
+        ToolOffset {
+            z: 30.0,
+            ..ToolOffset::default()
+        },
+    );
+    s.offsets.tools.insert(
+        41,
+        ToolOffset {
+            z: 20.0,
+            ..ToolOffset::default()
+        },
+    );
+    let r = run_with(&text, s, Library::new()).ok();
+    let e = ends(&r);
+    // N11 with T1 D1 (50); N70 with T4 D1 (20).
+    assert!(near(&e[0], &[0.0, 0.0, 60.0]), "{e:?}");
+    assert!(near(&e[1], &[0.0, 0.0, 30.0]), "{e:?}");
+}
+
+#[test]
+fn f066_incremental_moves_by_r_values() {
+    let text = filled("066", &[""]);
+    let mut s = mill();
+    for (k, v) in [(1, 10.0), (2, 20.0), (3, 5.0), (4, 2.0), (5, 0.5)] {
+        s.kept.insert(10_000 + k, v);
+    }
+    // The mill has no X/Z lathe plane: X and Z are axes all the same.
+    let r = run_with(&text, s, Library::new()).ok();
+    let e = ends(&r);
+    let z4 = 25.0 + 25.3f64.to_radians().sin() - 0.5;
+    assert!(near(&e[0], &[10.0, 0.0, 20.0]));
+    assert!(near(&e[1], &[10.0, 0.0, 25.0]));
+    assert!(near(&e[2], &[8.0, 0.0, 25.0]));
+    assert!(near(&e[3], &[8.0, 0.0, z4]), "{e:?}");
+}
+
+#[test]
+fn f080_and_f081_a_counter_limit_jumps_to_the_message_and_m0() {
+    for (number, label, msg) in [
+        ("080", "WZZEIT", "刀具作用时间: 达到极限值"),
+        ("081", "SIST", "达到额定工件数"),
+    ] {
+        // As printed the limits are 0: reached at once, the jump skips the placeholder.
+        let text = fixture(number);
+        let r = run(&text).ok();
+        assert_eq!(r.front.message(), msg, "{number}");
+        assert_eq!(
+            r.out
+                .iter()
+                .filter(|c| **c == Command::Aux(Aux::M(0)))
+                .count(),
+            1
+        );
+        // Not reached (R10/R15 = 5): the block after the IF runs and the label is passed.
+        let mut s = mill();
+        s.kept
+            .insert(10_000 + if number == "080" { 10 } else { 15 }, 5.0);
+        let text = filled(number, &["G0 X1 M30"]);
+        let r = run_with(&text, s, Library::new()).ok();
+        assert_eq!(r.front.message(), "", "{number} {label}");
+        assert!(near(&r.end(), &[1.0, 0.0, 0.0]));
+    }
+}
+
+#[test]
+fn f069_plc_data_bytes_written_in_order() {
+    let r = run(&fixture("069")).ok();
+    for k in 1..=4 {
+        assert_eq!(r.front.plc_byte(k), Some(k as u8), "$A_DBB[{k}]");
+    }
+}
+
+#[test]
+fn f057_with_m6_the_new_tool_and_its_edge_take_effect_at_m6() {
+    // "...": nothing; N16/N20: Z10; the last "...": a Z10 move under T4 D3.
+    let text = filled(
+        "057",
+        &["", "N16 G0 Z10", "", "N20 G0 Z10 D2", "", "G0 Z10"],
+    );
+    let mut s = mill();
+    s.tool_change_with_m6 = true;
+    s.offsets.tools.insert(
+        12,
+        ToolOffset {
+            z: 45.0,
+            ..ToolOffset::default()
+        },
+    );
+    s.offsets.tools.insert(
+        43,
+        ToolOffset {
+            z: 20.0,
+            ..ToolOffset::default()
+        },
+    );
+    let r = run_with(&text, s, Library::new()).ok();
+    let e = ends(&r);
+    // N16: T1 D1 (50); N20: T1 D2 (45); after N55 M6: T4 D3 (20).
+    assert!(near(&e[0], &[0.0, 0.0, 60.0]), "{e:?}");
+    assert!(near(&e[1], &[0.0, 0.0, 55.0]), "{e:?}");
+    assert!(near(&e[2], &[0.0, 0.0, 30.0]), "{e:?}");
+    assert_eq!(r.front.tool_edge(), (4, 3));
+}
+
+/// TRC of fixtures 058–060 on one contour: P0 (0, 0), P1 (20, 10) where G42/G41 starts,
+/// the first contour element along +X to (60, 10), then G40 back to P2 (80, 40); cutter
+/// radius 10 (T1 D1).
+#[test]
+fn f058_to_f060_radius_compensation_selected_held_and_cancelled() {
+    // 058: G42 selected on the approach to P1; the first contour element along +X.
+    let text = filled(
+        "058",
+        &[
+            "N10 T1",
+            "N25 G0 X0 Y0",
+            "N30 G1 G42 X20 Y10",
+            "N31 X60 Y10",
+        ],
+    );
+    let mut s = mill();
+    s.offsets.tools.insert(
+        12,
+        ToolOffset {
+            z: 50.0,
+            radius: 10.0,
+            ..ToolOffset::default()
+        },
+    );
+    let r = run_with(&text, s, Library::new()).ok();
+    let e = ends(&r);
+    // Right of a path going +X: the centre 10 below it, at P1 normal to the element.
+    assert!(near(&e[1][..2], &[20.0, 0.0]), "{e:?}");
+    assert!(near(&e[2][..2], &[60.0, 0.0]), "{e:?}");
+    // 059: G41 selected, a Z infeed in between (no contour), then the contour at N22.
+    let text = format!(
+        "T1 D1 F300\nG0 X0 Y0 Z5\n{}G40 G1 X100 Y10\n",
+        filled("059", &["N20 G1 G41 X20 Y10", "N21 Z-5", "N22 X60 Y10"])
+    );
+    let r = run(&text).ok();
+    let e = ends(&r);
+    let z = e
+        .iter()
+        .position(|p| (p[2] - 45.0).abs() < 1e-9)
+        .expect("the infeed to Z-5");
+    // Left of +X: 10 above; the infeed keeps X/Y where the selection ended.
+    assert!(near(&e[z][..2], &[20.0, 20.0]), "{e:?}");
+    assert!(near(&e[z + 1][..2], &[60.0, 20.0]), "{e:?}");
+    // 060: the last contour element ends with the offset normal to it; G40 goes to P2.
+    let text = format!(
+        "T1 D1 F300\nG0 X0 Y0\nG41 G1 X20 Y10\n{}",
+        filled("060", &["X40 Y10", "N100 X60 Y10", "N110 G40 G1 X80 Y40"])
+    );
+    let r = run(&text).ok();
+    let e = ends(&r);
+    let n = e.len();
+    assert!(near(&e[n - 2][..2], &[60.0, 20.0]), "{e:?}");
+    assert!(
+        near(&e[n - 1][..2], &[80.0, 40.0]),
+        "the cutter centre on P2: {e:?}"
+    );
+}
+
+#[test]
+fn f062_m3_before_the_move_and_five_m_functions_in_one_block() {
+    let text = filled("062", &["N10 S500", "N20 G0 X10 M3"]);
+    let r = run(&text).ok();
+    let pos = |c: Command| r.out.iter().position(|x| *x == c).expect("emitted");
+    let mv = r.out.iter().position(|c| c.end().is_some()).unwrap();
+    assert!(pos(Command::Aux(Aux::S(500.0))) < mv && pos(Command::Aux(Aux::M(3))) < mv);
+    let last: Vec<Command> = [78, 67, 10, 12, 37]
+        .map(|m| Command::Aux(Aux::M(m)))
+        .to_vec();
+    let at = pos(Command::Aux(Aux::M(78)));
+    assert_eq!(r.out[at..at + 5], last[..]);
+    // A sixth M in one block: 14750, too many auxiliary functions (at most five, §9.7).
+    let r = run("M78 M67 M10 M12 M37 M8\n");
+    assert_eq!(r.alarm(), (14750, 1));
+}
+
+#[test]
+fn f036_f037_exact_stop_modal_and_per_block_and_continuous_path() {
+    let text = filled(
+        "036",
+        &[
+            "N10 G0 G60 X10",
+            "N20 X20 Y10",
+            "",
+            "N50 G1 G601 X30 F200",
+            "N80 G64 X40",
+            "",
+            "N100 G0 G9 X50",
+            "N111 X60",
+        ],
+    );
+    let r = run(&text).ok();
+    let modes: Vec<bool> = r
+        .out
+        .iter()
+        .filter_map(|c| match c {
+            Command::PathMode { exact_stop } => Some(*exact_stop),
+            _ => None,
+        })
+        .collect();
+    // Power-on G60, N80 G64, N100's G9 for its block only, then G64 again.
+    assert_eq!(modes, [true, false, true, false], "{:?}", r.out);
+    let g9 = r
+        .out
+        .iter()
+        .rposition(|c| *c == Command::PathMode { exact_stop: true })
+        .unwrap();
+    assert!(matches!(&r.out[g9 + 1], Command::Rapid { end } if end[0] == 50.0));
+    // 037: G64 from N10, G60 at N180.
+    let text = filled(
+        "037",
+        &["N10 G64 G1 X10 F300", "N20 Y10", "", "N180 G60 X20"],
+    );
+    let r = run(&text).ok();
+    let modes: Vec<bool> = r
+        .out
+        .iter()
+        .filter_map(|c| match c {
+            Command::PathMode { exact_stop } => Some(*exact_stop),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(modes, [true, false, true]);
+}
+
+#[test]
+fn f071_and_f072_jumps_filled() {
+    // 071: R1=0 does not jump at N10, nor R1>1 at N100; N1000 jumps back to LABEL3 while
+    // R45 == R7+1 (R7=0): once, at R45=1.
+    let text = filled(
+        "071",
+        &[
+            "R7=0 R45=0",
+            "N90 LABEL1: G0 X1",
+            "",
+            "N150 LABEL2: G0 Y1",
+            "",
+            "N800 LABEL3: R45=R45+1 G0 X=IC(1)",
+            "",
+            "",
+        ],
+    );
+    let r = run(&text).ok();
+    // LABEL3's block runs twice.
+    assert_eq!(r.front.r(45), 2.0);
+    assert!(near(&r.end(), &[3.0, 1.0, 0.0]), "{:?}", r.end());
+    // 072 filled: R1=2 takes the second jump of N20, to MA2, after the block's own move to
+    // X5 (D83); X99 is jumped over.
+    let text = format!(
+        "R1=2\n{}",
+        filled(
+            "072",
+            &[
+                "N10 MA1: G0 X1",
+                "",
+                "N20 IF R1==1 GOTOB MA1 IF R1==2 GOTOF MA2 G0 X5",
+                "G0 X99",
+                "N50 MA2: G0 Y7"
+            ]
+        )
+    );
+    let r = run(&text).ok();
+    assert!(near(&r.end(), &[5.0, 7.0, 0.0]), "{:?}", r.end());
+    assert!(ends(&r).iter().all(|p| p[0] != 99.0));
+}
