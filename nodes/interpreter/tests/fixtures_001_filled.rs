@@ -10,7 +10,7 @@ mod support;
 
 use std::collections::BTreeMap;
 
-use cnc_interpreter::{Aux, Command, Library};
+use cnc_interpreter::{Aux, Command, Library, Setup};
 use cnc_interpreter_core::ToolOffset;
 use support::*;
 
@@ -649,4 +649,20 @@ fn f071_and_f072_jumps_filled() {
     let r = run(&text).ok();
     assert!(near(&r.end(), &[5.0, 7.0, 0.0]), "{:?}", r.end());
     assert!(ends(&r).iter().all(|p| p[0] != 99.0));
+}
+
+#[test]
+fn f042_the_fourth_axis_a_moves_with_rapid_with_a_feed_and_alone() {
+    // The simulated mill with the optional 4th axis A (as printed it has none: 12550).
+    let mut s = Setup::new(&['X', 'Y', 'Z', 'A'], &[false; 4], &[0.0; 4]);
+    s.offsets.tools = mill().offsets.tools;
+    let r = run_with(&fixture("042"), s, Library::new()).ok();
+    let m = r.moves();
+    assert!(matches!(m[0], Command::Rapid { end } if near(end, &[10.0, 20.0, 30.0, 45.0])));
+    assert!(
+        matches!(m[1], Command::Linear { end, feed } if near(end, &[12.0, 21.0, 33.0, 60.0]) && *feed == 400.0)
+    );
+    assert!(
+        matches!(m[2], Command::Linear { end, feed } if near(end, &[12.0, 21.0, 33.0, 90.0]) && *feed == 3000.0)
+    );
 }
