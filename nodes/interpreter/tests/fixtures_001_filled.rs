@@ -74,6 +74,21 @@ fn l10() -> Library {
     lib
 }
 
+/// The mill with more cutting edges: offset entry (T×10+D), length, radius.
+fn with_edges(mut s: Setup, edges: &[(u32, f64, f64)]) -> Setup {
+    for &(entry, z, radius) in edges {
+        s.offsets.tools.insert(
+            entry,
+            ToolOffset {
+                z,
+                radius,
+                ..ToolOffset::default()
+            },
+        );
+    }
+    s
+}
+
 fn rotate(p: (f64, f64), deg: f64) -> (f64, f64) {
     let (s, c) = deg.to_radians().sin_cos();
     (p.0 * c - p.1 * s, p.0 * s + p.1 * c)
@@ -379,21 +394,7 @@ fn f055_t_without_m6_changes_the_tool_at_once() {
 #[test]
 fn f056_d_switches_the_length_of_the_active_tool() {
     let text = filled("056", &["N11 G0 Z10", "", "N70 G0 Z10 D1"]);
-    let mut s = mill();
-    s.offsets.tools.insert(
-        42,
-        ToolOffset {
-            z: 30.0,
-            ..ToolOffset::default()
-        },
-    );
-    s.offsets.tools.insert(
-        41,
-        ToolOffset {
-            z: 20.0,
-            ..ToolOffset::default()
-        },
-    );
+    let s = with_edges(mill(), &[(42, 30.0, 0.0), (41, 20.0, 0.0)]);
     let r = run_with(&text, s, Library::new()).ok();
     let e = ends(&r);
     // N11 with T1 D1 (50); N70 with T4 D1 (20).
@@ -461,22 +462,8 @@ fn f057_with_m6_the_new_tool_and_its_edge_take_effect_at_m6() {
         "057",
         &["", "N16 G0 Z10", "", "N20 G0 Z10 D2", "", "G0 Z10"],
     );
-    let mut s = mill();
+    let mut s = with_edges(mill(), &[(12, 45.0, 0.0), (43, 20.0, 0.0)]);
     s.tool_change_with_m6 = true;
-    s.offsets.tools.insert(
-        12,
-        ToolOffset {
-            z: 45.0,
-            ..ToolOffset::default()
-        },
-    );
-    s.offsets.tools.insert(
-        43,
-        ToolOffset {
-            z: 20.0,
-            ..ToolOffset::default()
-        },
-    );
     let r = run_with(&text, s, Library::new()).ok();
     let e = ends(&r);
     // N16: T1 D1 (50); N20: T1 D2 (45); after N55 M6: T4 D3 (20).
@@ -501,15 +488,7 @@ fn f058_to_f060_radius_compensation_selected_held_and_cancelled() {
             "N31 X60 Y10",
         ],
     );
-    let mut s = mill();
-    s.offsets.tools.insert(
-        12,
-        ToolOffset {
-            z: 50.0,
-            radius: 10.0,
-            ..ToolOffset::default()
-        },
-    );
+    let s = with_edges(mill(), &[(12, 50.0, 10.0)]);
     let r = run_with(&text, s, Library::new()).ok();
     let e = ends(&r);
     // Right of a path going +X: the centre 10 below it, at P1 normal to the element.
