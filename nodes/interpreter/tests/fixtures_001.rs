@@ -264,11 +264,12 @@ fn f072_the_first_fulfilled_jump_of_a_block_wins() {
 }
 
 /// The fixtures that call a cycle of chapter 10 (issue 24): 006, 075, 076 and 092–117.
-/// 092–117 stop with 12140 at their first cycle call (103–105 at the MCALL before it),
-/// nothing of that block moving; 006, 075 and 076 are templates that stop earlier, at a
-/// placeholder the manual prints (12080).
+/// The drilling cycles and hole patterns (092–105) run as printed, 103 up to the placeholder
+/// the manual prints in it (`sinumerik_drilling.rs` asserts what each does); the milling
+/// cycles (106–117) stop with 12140 at their first call, nothing of that block moving;
+/// 006, 075 and 076 are templates that stop earlier, at a placeholder (12080).
 #[test]
-fn cycle_fixtures_wait_for_the_cycles_issue() {
+fn cycle_fixtures_drill_and_the_milling_ones_wait() {
     let calls = [
         "CYCLE", "HOLES1", "HOLES2", "LONGHOLE", "SLOT1", "SLOT2", "POCKET3", "POCKET4",
     ];
@@ -294,8 +295,8 @@ fn cycle_fixtures_wait_for_the_cycles_issue() {
         .iter()
         .map(|p| p.file_name().unwrap().to_string_lossy()[..3].to_string())
         .collect();
-    let templates = ["006", "075", "076"];
-    let expected: Vec<String> = templates
+    let templates = ["006", "075", "076", "103"];
+    let expected: Vec<String> = ["006", "075", "076"]
         .iter()
         .map(|n| n.to_string())
         .chain((92..=117).map(|n| format!("{n:03}")))
@@ -303,6 +304,10 @@ fn cycle_fixtures_wait_for_the_cycles_issue() {
     assert_eq!(names, expected);
     for (p, name) in cycles.iter().zip(&names) {
         let r = run(&std::fs::read_to_string(p).unwrap());
+        if name.as_str() >= "092" && name.as_str() <= "105" && name != "103" {
+            assert!(r.error.is_none(), "{}: {:?}", p.display(), r.error);
+            continue;
+        }
         let e = r
             .error
             .as_ref()
@@ -312,11 +317,7 @@ fn cycle_fixtures_wait_for_the_cycles_issue() {
             continue;
         }
         assert_eq!(e.number, 12140, "{}: {e}", p.display());
-        assert!(
-            calls.iter().any(|c| e.text.starts_with(c)) || e.text.starts_with("MCALL"),
-            "{}: {e}",
-            p.display()
-        );
+        assert!(e.text.contains("milling cycles"), "{}: {e}", p.display());
     }
 }
 

@@ -10,6 +10,7 @@ use std::sync::Arc;
 use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, SpindleDir};
 
 use super::block::{Block, Item};
+use super::cycle_call::{is_cycle, CycleCall};
 use super::expr::Expr;
 use super::{find_target, Motion, Sinumerik};
 
@@ -82,6 +83,8 @@ pub struct Words {
     pub keys: Vec<&'static str>,
     /// The program the block calls.
     pub call: Option<String>,
+    /// The cycle the block calls (or makes modal with MCALL).
+    pub cycle: Option<CycleCall>,
 }
 
 impl Words {
@@ -93,6 +96,7 @@ impl Words {
         self.m.clear();
         self.keys.clear();
         self.call = None;
+        self.cycle = None;
     }
 
     pub fn has_g(&self, n: u32) -> bool {
@@ -113,9 +117,9 @@ const ADDRESSES: [&str; 17] = [
 ];
 
 /// Keywords this front end runs.
-const KEYWORDS: [&str; 18] = [
+const KEYWORDS: [&str; 19] = [
     "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
-    "STOPRE", "RET", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
+    "STOPRE", "RET", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM", "MCALL",
 ];
 
 const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
@@ -133,7 +137,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 33] = [
+pub const NOT_BUILT: [(&str, &str); 32] = [
     (
         "CFC",
         "feed correction on compensated circles is not built: F acts on the cutter centre (CFTCP)",
@@ -150,7 +154,6 @@ pub const NOT_BUILT: [(&str, &str); 33] = [
     ("WALIMON", "working area limits G25/G26 are not built yet"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
-    ("MCALL", "modal calls are not built yet"),
     ("EXTCALL", "external programs are not built"),
     ("TRACYL", "the cylinder transformation is not built"),
     ("TRAFOOF", "no transformation is built"),
@@ -225,15 +228,6 @@ pub fn is_address(name: &str) -> bool {
 
 const H_NOT_BUILT: &str = "H functions are not built: the PLC here takes M, S and T";
 
-/// The cycles of chapter 10: issue 24.
-fn is_cycle(name: &str) -> bool {
-    name.starts_with("CYCLE")
-        || [
-            "HOLES1", "HOLES2", "LONGHOLE", "SLOT1", "SLOT2", "POCKET3", "POCKET4",
-        ]
-        .contains(&name)
-}
-
 impl Sinumerik {
     /// Runs one parsed block.
     pub(super) fn run_block(&mut self, b: &Block, text: &Arc<str>) -> Result<(), ProgramError> {
@@ -265,6 +259,7 @@ impl Sinumerik {
         if !nonmodal {
             self.motion_block(w)?;
         }
+        self.cycles(w, nonmodal)?;
         if w.has_g(9) {
             self.core.exact_stop_block(from);
         }
@@ -368,7 +363,9 @@ impl Sinumerik {
                     w.keys.push(k);
                 } else if NOT_BUILT.iter().any(|(k, _)| k == n) {
                     self.not_built(n)?;
-                } else if is_cycle(n) || self.core.library.get_named(n).is_some() {
+                } else if is_cycle(n) {
+                    self.cycle_item(w, n, &[])?;
+                } else if self.core.library.get_named(n).is_some() {
                     self.program_call(w, n)?;
                 } else {
                     return Err(self.fault(
@@ -377,7 +374,7 @@ impl Sinumerik {
                     ));
                 }
             }
-            Item::Call(name, args) => self.call_item(name, args)?,
+            Item::Call(name, args) => self.call_item(w, name, args)?,
         }
         Ok(())
     }
@@ -409,20 +406,33 @@ impl Sinumerik {
     }
 
     fn program_call(&mut self, w: &mut Words, name: &str) -> Result<(), ProgramError> {
-        if is_cycle(name) {
-            return Err(self.fault(
-                Fault::NotSupported,
-                format!("{name}: the cycles of chapter 10 are not built yet"),
-            ));
-        }
-        if w.call.is_some() {
+        if w.call.is_some() || w.cycle.is_some() {
             return Err(self.fault(Fault::Call, "one program call per block"));
         }
         w.call = Some(name.to_string());
         Ok(())
     }
 
-    fn call_item(&mut self, name: &str, args: &[Option<Expr>]) -> Result<(), ProgramError> {
+    /// A cycle call: evaluated now, run after the block's own words.
+    fn cycle_item(
+        &mut self,
+        w: &mut Words,
+        name: &str,
+        args: &[Option<Expr>],
+    ) -> Result<(), ProgramError> {
+        if w.call.is_some() || w.cycle.is_some() {
+            return Err(self.fault(Fault::Call, "one program or cycle call per block"));
+        }
+        w.cycle = Some(self.cycle_call(name, args)?);
+        Ok(())
+    }
+
+    fn call_item(
+        &mut self,
+        w: &mut Words,
+        name: &str,
+        args: &[Option<Expr>],
+    ) -> Result<(), ProgramError> {
         if name == "MSG" {
             let text = match args {
                 [] | [None] => String::new(),
@@ -435,10 +445,7 @@ impl Sinumerik {
             return Ok(());
         }
         if is_cycle(name) {
-            return Err(self.fault(
-                Fault::NotSupported,
-                format!("{name}: the cycles of chapter 10 are not built yet"),
-            ));
+            return self.cycle_item(w, name, args);
         }
         if NOT_BUILT.iter().any(|(k, _)| *k == name) {
             return self.not_built(name);
@@ -568,6 +575,22 @@ impl Sinumerik {
             }
         }
         Ok(())
+    }
+
+    /// The block's cycle: MCALL makes it modal (MCALL alone cancels), a call runs it here;
+    /// without one, a modal cycle runs after a block that moved (§10.1, §10.5).
+    fn cycles(&mut self, w: &mut Words, nonmodal: bool) -> Result<(), ProgramError> {
+        let moved = !nonmodal
+            && (!w.axes.is_empty() || w.addr.contains_key("AP") || w.addr.contains_key("RP"));
+        if w.key("MCALL") {
+            self.set_modal_cycle(w.cycle.take())
+        } else if let Some(c) = w.cycle.take() {
+            self.run_cycle(&c)
+        } else if moved {
+            self.run_modal_cycle()
+        } else {
+            Ok(())
+        }
     }
 
     /// The modal G functions of the block, one per group (§9.1.6).

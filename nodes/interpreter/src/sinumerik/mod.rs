@@ -8,6 +8,8 @@
 
 pub mod alarms;
 pub mod block;
+mod cycle_call;
+mod drilling;
 mod exec;
 pub use exec::{g_group, NOT_BUILT, NOT_BUILT_G};
 pub mod expr;
@@ -77,6 +79,8 @@ pub struct Sinumerik {
     jump: Option<(bool, String)>,
     /// The lists a block's words are sorted into, kept for the next block.
     words: exec::Words,
+    /// The drilling cycle MCALL made modal.
+    modal_cycle: Option<cycle_call::CycleCall>,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -147,6 +151,7 @@ impl Sinumerik {
             messages: Vec::new(),
             jump: None,
             words: exec::Words::default(),
+            modal_cycle: None,
         };
         front.apply_length();
         front

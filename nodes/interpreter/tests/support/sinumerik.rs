@@ -47,21 +47,32 @@ pub fn mill() -> Setup {
 pub struct Run {
     pub front: Sinumerik,
     pub out: Vec<Command>,
+    /// The program line of each command of `out`.
+    pub lines: Vec<u32>,
     pub error: Option<ProgramError>,
 }
 
 pub fn run_with(text: &str, setup: Setup, library: Library) -> Run {
     let mut front = Sinumerik::new(text, setup, library);
     let mut out = Vec::new();
+    let mut lines = Vec::new();
     let error = loop {
         match next_command(&mut front) {
-            Ok(Some(c)) => out.push(c.command),
+            Ok(Some(c)) => {
+                lines.push(c.line);
+                out.push(c.command);
+            }
             Ok(None) => break None,
             Err(e) => break Some(e),
         }
         assert!(out.len() < 100_000, "runaway program");
     };
-    Run { front, out, error }
+    Run {
+        front,
+        out,
+        lines,
+        error,
+    }
 }
 
 pub fn run(text: &str) -> Run {
