@@ -645,3 +645,42 @@ fn f042_the_fourth_axis_a_moves_with_rapid_with_a_feed_and_alone() {
         matches!(m[2], Command::Linear { end, feed } if near(end, &[12.0, 21.0, 33.0, 90.0]) && *feed == 3000.0)
     );
 }
+
+#[test]
+fn f017_walimon_keeps_every_move_inside_the_g25_g26_area() {
+    // Inside the area (the tool tip: T1's 50 mm length is taken off machine Z).
+    let text = filled("017", &["N60 G1 F500 X50 Y50 Z100"]);
+    let r = run(&text).ok();
+    assert!(near(&r.end(), &[50.0, 50.0, 150.0]), "{:?}", r.end());
+    // Leaving it in X: 10730 at that block, none of its moves sent.
+    let text = filled("017", &["N60 G1 F500 X150"]);
+    let r = run(&text);
+    assert_eq!(r.alarm(), (10730, line_of(&text, "N60")));
+    assert!(near(&r.end(), &[90.0, 100.0, 230.0]), "{:?}", r.end());
+    // An arc whose end lies inside but whose bulge crosses Y110: refused too.
+    let text = filled("017", &["N60 G3 F500 X50 Y100 CR=20"]);
+    let r = run(&text);
+    assert_eq!(r.alarm(), (10730, line_of(&text, "N60")));
+    // Below Z30 with the tip (machine Z 79 = tip 29).
+    let r = run(&filled("017", &["N60 G1 F500 Z29"]));
+    assert_eq!(r.alarm().0, 10730);
+    // After WALIMOF the area is no longer watched.
+    let text = format!("{}G0 X200\n", filled("017", &["N60 G1 F500 X50"]));
+    let r = run(&text).ok();
+    assert!(near(&r.end(), &[200.0, 100.0, 230.0]));
+}
+
+#[test]
+fn f050_g25_g26_s_hold_the_spindle_between_12_and_700_rpm() {
+    let text = format!("{}S1000 M3\nS5\nS350\n", fixture("050"));
+    let r = run(&text).ok();
+    let speeds: Vec<f64> = r
+        .out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Aux(Aux::S(s)) => Some(*s),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(speeds, [700.0, 12.0, 350.0]);
+}

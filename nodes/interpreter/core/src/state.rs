@@ -315,6 +315,12 @@ impl Core {
         self.push(Command::Aux(a));
     }
 
+    /// The commands queued from index `from` on (what a block produced, when `from` is
+    /// [`Core::queued`] before it).
+    pub fn queued_since(&self, from: usize) -> impl Iterator<Item = &Command> {
+        self.pending.iter().skip(from).map(|c| &c.command)
+    }
+
     /// How many commands are queued: a front end compares it before and after a block to
     /// know what the block produced.
     pub fn queued(&self) -> usize {

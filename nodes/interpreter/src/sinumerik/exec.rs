@@ -117,9 +117,10 @@ const ADDRESSES: [&str; 17] = [
 ];
 
 /// Keywords this front end runs.
-const KEYWORDS: [&str; 19] = [
+const KEYWORDS: [&str; 20] = [
     "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
     "STOPRE", "RET", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM", "MCALL",
+    "WALIMON",
 ];
 
 const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
@@ -137,7 +138,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 32] = [
+pub const NOT_BUILT: [(&str, &str); 31] = [
     (
         "CFC",
         "feed correction on compensated circles is not built: F acts on the cutter centre (CFTCP)",
@@ -151,7 +152,6 @@ pub const NOT_BUILT: [(&str, &str); 32] = [
         "feedforward is the drives' setting, not switched by the program",
     ),
     ("COMPCAD", "the compressor is not built"),
-    ("WALIMON", "working area limits G25/G26 are not built yet"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
     ("EXTCALL", "external programs are not built"),
@@ -192,15 +192,13 @@ pub const NOT_BUILT: [(&str, &str); 32] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 19] = [
+pub const NOT_BUILT_G: [(u32, &str); 17] = [
     (33, "G33 thread cutting is not built yet for the mill"),
     (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
     (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
     (63, "G63 tapping with a compensating chuck is not built yet"),
     (74, "G74 reference point approach from the program is not built yet"),
     (75, "G75 fixed point approach is not built yet"),
-    (25, "G25/G26 working area and spindle limits are not built yet"),
-    (26, "G25/G26 working area and spindle limits are not built yet"),
     (147, "smooth approach and retraction (WAB) is not built"),
     (148, "smooth approach and retraction (WAB) is not built"),
     (247, "smooth approach and retraction (WAB) is not built"),
@@ -251,6 +249,7 @@ impl Sinumerik {
             self.item(item, w)?;
         }
         let from = self.core.queued();
+        let start = self.core.pos.clone();
         self.modal(w)?;
         self.feed_and_speed(w)?;
         self.tool_words(w)?;
@@ -260,6 +259,7 @@ impl Sinumerik {
             self.motion_block(w)?;
         }
         self.cycles(w, nonmodal)?;
+        self.check_work_area(from, &start)?;
         if w.has_g(9) {
             self.core.exact_stop_block(from);
         }
@@ -649,6 +649,8 @@ impl Sinumerik {
             match *k {
                 "CIP" => self.motion = Motion::Cip,
                 "CT" => self.motion = Motion::Ct,
+                "WALIMON" => self.limits.monitored = true,
+                "WALIMOF" => self.limits.monitored = false,
                 _ => {}
             }
         }
@@ -664,11 +666,13 @@ impl Sinumerik {
             }
             self.core.feed = if self.inch_feed { f * 25.4 } else { f };
         }
-        if let Some(s) = w.get("S").filter(|_| !dwell) {
+        // Under G25/G26, S is a limit (limits.rs), not the speed.
+        let limit = w.has_g(25) || w.has_g(26);
+        if let Some(s) = w.get("S").filter(|_| !dwell && !limit) {
             if !(0.0..=99_999.999).contains(&s) {
                 return Err(self.fault(Fault::OutOfRange, "S is 0…99999.999 rpm"));
             }
-            self.core.set_rpm(s);
+            self.core.set_rpm(self.limited_rpm(s));
         }
         Ok(())
     }

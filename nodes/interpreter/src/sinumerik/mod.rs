@@ -15,6 +15,7 @@ pub use exec::{g_group, NOT_BUILT, NOT_BUILT_G};
 pub mod expr;
 mod frames;
 pub mod lex;
+mod limits;
 mod motion;
 mod tool;
 pub mod vars;
@@ -81,6 +82,8 @@ pub struct Sinumerik {
     words: exec::Words,
     /// The drilling cycle MCALL made modal.
     modal_cycle: Option<cycle_call::CycleCall>,
+    /// G25/G26 working area and spindle limits, WALIMON.
+    limits: limits::Limits,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -152,6 +155,7 @@ impl Sinumerik {
             jump: None,
             words: exec::Words::default(),
             modal_cycle: None,
+            limits: limits::Limits::default(),
         };
         front.apply_length();
         front

@@ -46,6 +46,9 @@ impl Sinumerik {
         if w.has_g(4) {
             return self.dwell(w).map(|()| true);
         }
+        if self.limits_block(w)? {
+            return Ok(true);
+        }
         if self.frame_instruction(w)? {
             return Ok(true);
         }
