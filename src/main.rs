@@ -162,8 +162,8 @@ struct ProgramArgs {
     /// (sim_lathe, sim_mill, sim_mill_802d); default: the built-in sim_lathe.
     #[arg(long, visible_alias = "launch")]
     config: Option<PathBuf>,
-    /// The program's dialect; default: the config's.
-    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(cnc_runtime::config::DIALECTS))]
+    /// The program's dialect; default: the config's (`sinumerik` is `sinumerik-802d`).
+    #[arg(long, value_parser = dialect_names())]
     dialect: Option<String>,
     /// Folder of subprograms (O number on the first line or file name O1234.nc);
     /// default: the program's folder.
@@ -173,6 +173,18 @@ struct ProgramArgs {
     /// `machine.tool_table`: H<n> is the length, D<n> the radius of entry n.
     #[arg(long)]
     tools: Option<PathBuf>,
+}
+
+/// The dialects `--dialect` takes, with `sinumerik` for the 802D.
+fn dialect_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(cnc_runtime::config::DIALECTS.map(|d| {
+        let v = clap::builder::PossibleValue::new(d);
+        if d == "sinumerik-802d" {
+            v.alias("sinumerik")
+        } else {
+            v
+        }
+    }))
 }
 
 /// A program ready to interpret: the launch config, its text, the dialect (the command

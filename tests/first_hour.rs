@@ -140,13 +140,24 @@ fn help_and_dialect_choices_name_every_dialect_of_the_interpreter() {
         assert!(help.contains(d), "{d} missing from check --help:\n{help}");
     }
     let demo = format!("{REPO}/examples/lathe/demo_shaft.nc");
-    let out = user.run(&["check", "--dialect", "sinumerik", &demo]);
+    let out = user.run(&["check", "--dialect", "heidenhain", &demo]);
     assert!(!out.status.success());
     assert!(
-        text(&out).contains("possible values: huaxing-lathe, gtc2e-lathe, iso-lathe, fanuc-mill"),
+        text(&out).contains(
+            "possible values: huaxing-lathe, gtc2e-lathe, iso-lathe, fanuc-mill, sinumerik-802d"
+        ),
         "{}",
         text(&out)
     );
+    // `sinumerik` names the 802D: the lathe program is read in its dialect, whose syntax
+    // alarm 12080 refuses the FANUC-style comment in its first line.
+    let out = user.run(&["check", "--dialect", "sinumerik", &demo]);
+    assert!(
+        text(&out).contains("alarm 12080 at line 1"),
+        "{}",
+        text(&out)
+    );
+    assert!(!text(&out).contains("invalid value"), "{}", text(&out));
 }
 
 #[test]
