@@ -684,3 +684,125 @@ fn f050_g25_g26_s_hold_the_spindle_between_12_and_700_rpm() {
         .collect();
     assert_eq!(speeds, [700.0, 12.0, 350.0]);
 }
+
+/// The moves' ends and kinds after `skip` moves, as (end X/Y, centre X/Y if an arc, ccw, feed).
+type Piece = ((f64, f64), Option<(f64, f64)>, bool, f64);
+
+fn pieces(r: &Run) -> Vec<Piece> {
+    r.moves()
+        .iter()
+        .map(|c| match c {
+            Command::Linear { end, feed } => ((end[0], end[1]), None, false, *feed),
+            Command::Arc {
+                end,
+                center,
+                clockwise,
+                feed,
+                ..
+            } => (
+                (end[0], end[1]),
+                Some((center[0], center[1])),
+                !clockwise,
+                *feed,
+            ),
+            Command::Rapid { end } => ((end[0], end[1]), None, false, 0.0),
+            _ => unreachable!(),
+        })
+        .collect()
+}
+
+fn dist(a: (f64, f64), b: (f64, f64)) -> f64 {
+    (a.0 - b.0).hypot(a.1 - b.1)
+}
+
+#[test]
+fn f052_chamfers_by_length_and_by_legs_with_their_feed() {
+    let text = filled(
+        "052",
+        &[
+            "N5 G17 G94 F300 G1 X0 Y0",
+            "N10 G1 X40 CHF=5",
+            "N20 X40 Y40",
+            "",
+            "N100 G1 X0 CHR=7",
+            "N110 X0 Y0",
+            "",
+            "N200 G1 FRC=200 X40 CHR=4",
+            "N210 X40 Y-40",
+        ],
+    );
+    let r = run(&text).ok();
+    let p = pieces(&r);
+    let ends: Vec<(f64, f64)> = p.iter().map(|q| q.0).collect();
+    // CHF=5 at a right angle: legs of 5/√2; the chamfer itself 5 long.
+    let leg = 5.0 / 2f64.sqrt();
+    let k = ends
+        .iter()
+        .position(|e| dist(*e, (40.0 - leg, 0.0)) < 1e-6)
+        .expect("cut back");
+    assert!(dist(ends[k + 1], (40.0, leg)) < 1e-6);
+    assert!((dist(ends[k], ends[k + 1]) - 5.0).abs() < 1e-6);
+    // CHR=7: legs of 7 at (0, 40).
+    let k = ends
+        .iter()
+        .position(|e| dist(*e, (7.0, 40.0)) < 1e-6)
+        .expect("CHR=7");
+    assert!(dist(ends[k + 1], (0.0, 33.0)) < 1e-6);
+    // CHR=4 at F200 (FRC), the lines at F300.
+    let k = ends
+        .iter()
+        .position(|e| dist(*e, (36.0, 0.0)) < 1e-6)
+        .expect("CHR=4");
+    assert!(dist(ends[k + 1], (40.0, -4.0)) < 1e-6);
+    assert_eq!((p[k].3, p[k + 1].3, p[k + 2].3), (300.0, 200.0, 300.0));
+    assert!(near(&r.end(), &[40.0, -40.0, 0.0]));
+}
+
+#[test]
+fn f053_roundings_single_and_modal_between_lines_and_arcs() {
+    let text = filled(
+        "053",
+        &[
+            "N5 G17 G94 F300 G1 X0 Y0",
+            "N10 G1 X40 RND=8",
+            "N20 X40 Y40",
+            "",
+            "N50 G1 X60 FRCM= 200 RNDM=7.3",
+            "N60 G3 X80 Y60 I20 J0",
+            "N70 G1 X80 Y80 RNDM=0",
+            "N80 X100 Y80",
+        ],
+    );
+    let r = run(&text).ok();
+    let p = pieces(&r);
+    let fillets: Vec<&Piece> = p
+        .iter()
+        .enumerate()
+        .filter(|(i, q)| {
+            q.1.is_some() && *i > 0 && {
+                let c = q.1.unwrap();
+                let start = p[i - 1].0;
+                (dist(start, c) - dist(q.0, c)).abs() < 1e-6 && dist(q.0, c) < 10.0
+            }
+        })
+        .map(|(_, q)| q)
+        .collect();
+    assert_eq!(fillets.len(), 3, "{p:?}");
+    // RND=8 at (40, 0), +X into +Y: centre (32, 8), counter-clockwise, at F300.
+    assert!(dist(fillets[0].1.unwrap(), (32.0, 8.0)) < 1e-6 && fillets[0].2);
+    assert_eq!(fillets[0].3, 300.0);
+    // RNDM 7.3 at FRCM 200 where N50 (+X) meets the arc about (80, 40) going down at
+    // (60, 40): a right turn; the centre 7.3 below the line and 20 + 7.3 from the arc's.
+    let c = fillets[1].1.unwrap();
+    assert!((c.1 - 32.7).abs() < 1e-6, "{c:?}");
+    assert!((dist(c, (80.0, 40.0)) - 27.3).abs() < 1e-6, "{c:?}");
+    assert!(!fillets[1].2 && fillets[1].3 == 200.0);
+    // And where the arc leaves (80, 60) going −X into N70's +Y: a right turn again, the
+    // centre 7.3 right of the line (X 87.3) and 27.3 from the arc's centre.
+    let c = fillets[2].1.unwrap();
+    assert!((c.0 - 87.3).abs() < 1e-6, "{c:?}");
+    assert!((dist(c, (80.0, 40.0)) - 27.3).abs() < 1e-6, "{c:?}");
+    // RNDM=0 in N70: the corner at its end stays sharp.
+    assert!(p.iter().any(|q| dist(q.0, (80.0, 80.0)) < 1e-9));
+    assert!(near(&r.end(), &[100.0, 80.0, 0.0]));
+}

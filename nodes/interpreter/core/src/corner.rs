@@ -3,19 +3,24 @@
 //! elements, or rounded by an arc of radius D tangent to both lines.
 //!
 //! The line is held back until the next move shows the corner, like an element under radius
-//! compensation; commands queued after it wait for it.
+//! compensation; commands queued after it wait for it. A front end whose corners join arcs
+//! too holds any element with [`Core::hold_corner_element`]; its corner is `fillet.rs`'s.
 
 use crate::emit::MoveKind;
 use crate::error::{Fault, ProgramError};
-use crate::geometry::Pt;
+use crate::fillet::{self, Shape};
+use crate::geometry::{Elem, Pt};
 use crate::show;
 use crate::state::Core;
 
 /// What the corner gets.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Chamfer {
+    /// A chamfer whose ends lie this far from the corner.
     Line(f64),
     Round(f64),
+    /// A chamfer this long (measured along the chamfer, not its legs).
+    Length(f64),
 }
 
 /// A G01 whose end is a chamfered or rounded corner, waiting for the next move.
@@ -27,6 +32,13 @@ pub struct Corner {
     pub feed: f64,
     pub line: u32,
     pub chamfer: Chamfer,
+    /// The held element: a line at `feed`, or an arc.
+    pub kind: MoveKind,
+    /// The corner element's own feed, else the element's.
+    pub corner_feed: Option<f64>,
+    /// Arcs may take part on either side (`fillet.rs`); else only a line is held and only a
+    /// chamfer meets an arc after it.
+    pub general: bool,
 }
 
 fn unit(z: f64, r: f64) -> Option<(f64, f64)> {
@@ -58,8 +70,59 @@ impl Core {
             feed,
             line: self.line,
             chamfer,
+            kind: MoveKind::Feed(feed),
+            corner_feed: None,
+            general: false,
         });
         // The program goes on from the corner: incremental words of the next block start there.
+        self.pos = self.to_machine(&end);
+        Ok(())
+    }
+
+    /// A line or an arc (`kind`) to `end` with a chamfer or rounding at its end, whichever
+    /// element follows: held until the next move.
+    pub fn hold_corner_element(
+        &mut self,
+        end: Vec<f64>,
+        kind: MoveKind,
+        chamfer: Chamfer,
+        corner_feed: Option<f64>,
+    ) -> Result<(), ProgramError> {
+        let feed = match kind {
+            MoveKind::Feed(f) | MoveKind::Arc { feed: f, .. } => f,
+            _ => {
+                return Err(self.fault(
+                    Fault::NotSupported,
+                    "a chamfer or rounding ends a line or an arc, not a rapid or a thread",
+                ))
+            }
+        };
+        if self.comp.is_some() {
+            return Err(self.fault(
+                Fault::NotSupported,
+                format!(
+                    "chamfer/rounding while {} is active is not built yet",
+                    self.rules.comp.name
+                ),
+            ));
+        }
+        self.resolve_corner(Some((&end, kind)))?;
+        let start = self.work_position();
+        self.check_feed(feed)?;
+        if let Some(f) = corner_feed {
+            self.check_feed(f)?;
+        }
+        self.hold_at = Some(self.pending.len());
+        self.corner = Some(Corner {
+            start,
+            end: end.clone(),
+            feed,
+            line: self.line,
+            chamfer,
+            kind,
+            corner_feed,
+            general: true,
+        });
         self.pos = self.to_machine(&end);
         Ok(())
     }
@@ -85,6 +148,9 @@ impl Core {
         corner: &Corner,
         next: Option<(&[f64], MoveKind)>,
     ) -> Result<(), ProgramError> {
+        if corner.general {
+            return self.general_corner(corner, next);
+        }
         let feed = MoveKind::Feed(corner.feed);
         let a = self.plane_point(&corner.start)?;
         let p = self.plane_point(&corner.end)?;
@@ -111,7 +177,7 @@ impl Core {
                 }
                 let len2 = p.dist(b);
                 let (d, round) = match chamfer {
-                    Chamfer::Line(l) => (l, None),
+                    Chamfer::Line(l) | Chamfer::Length(l) => (l, None),
                     Chamfer::Round(r) => {
                         // Tangent length of a radius-r arc in the corner.
                         let turn = cross.atan2(dot).abs();
@@ -150,7 +216,7 @@ impl Core {
                     }
                 }
             }
-            (Chamfer::Line(l), MoveKind::Arc { center, ccw, .. }) => {
+            (Chamfer::Line(l) | Chamfer::Length(l), MoveKind::Arc { center, ccw, .. }) => {
                 // The chamfer ends on the arc, l from the corner, in the arc's direction.
                 let rho = center.dist(p);
                 // The arc's own sweep from the corner to its end, in its direction.
@@ -185,6 +251,74 @@ impl Core {
                 Fault::NotSupported,
                 "corner rounding D between a line and an arc: the manual leaves it \"to be extended\"",
             )),
+        }
+    }
+
+    /// The corner of `fillet.rs` between the held element and the next move: lines and arcs
+    /// in the plane; a rapid, a thread or a move across the plane after it leaves the
+    /// element as it is.
+    fn general_corner(
+        &mut self,
+        corner: &Corner,
+        next: Option<(&[f64], MoveKind)>,
+    ) -> Result<(), ProgramError> {
+        let plain = |me: &mut Self| me.after_corner(&corner.end, corner.kind);
+        let a = self.plane_point(&corner.start)?;
+        let p = self.plane_point(&corner.end)?;
+        let element = |a: Pt, b: Pt, kind: MoveKind| match kind {
+            MoveKind::Feed(_) if a.dist(b) > 1e-9 => Some(Elem::Line { a, b }),
+            MoveKind::Arc { center, ccw, .. } => Some(Elem::Arc {
+                a,
+                b,
+                c: center,
+                ccw,
+            }),
+            _ => None,
+        };
+        let (Some(first), Some((next_end, next_kind))) = (element(a, p, corner.kind), next) else {
+            return plain(self);
+        };
+        let b = self.plane_point(next_end)?;
+        let Some(second) = element(p, b, next_kind) else {
+            return plain(self);
+        };
+        let (h, v) = self.plane_axes()?;
+        let across = |x: &[f64], y: &[f64]| {
+            (0..x.len()).any(|i| i != h && i != v && (x[i] - y[i]).abs() > 1e-9)
+        };
+        if across(&corner.start, &corner.end) || across(&corner.end, next_end) {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "a chamfer or rounding between moves that leave the plane is not built",
+            ));
+        }
+        let shape = match corner.chamfer {
+            Chamfer::Line(d) => Shape::Legs(d),
+            Chamfer::Length(l) => Shape::Length(l),
+            Chamfer::Round(r) => Shape::Round(r),
+        };
+        let cut = match fillet::corner(first, second, shape) {
+            Ok(Some(cut)) => cut,
+            Ok(None) => return plain(self),
+            Err(why) => return Err(self.fault(Fault::ChamferTooShort, why)),
+        };
+        let base = corner.end.clone();
+        if cut.first.start().dist(cut.first.end()) > 1e-9 {
+            self.after_corner(&self.with_point(&base, cut.first.end()), corner.kind)?;
+        }
+        let feed = corner.corner_feed.unwrap_or(corner.feed);
+        match cut.corner {
+            Elem::Line { b, .. } => {
+                self.after_corner(&self.with_point(&base, b), MoveKind::Feed(feed))
+            }
+            Elem::Arc { b, c, ccw, .. } => self.after_corner(
+                &self.with_point(&base, b),
+                MoveKind::Arc {
+                    center: c,
+                    ccw,
+                    feed,
+                },
+            ),
         }
     }
 }

@@ -23,6 +23,7 @@ pub mod cycles;
 pub mod driver;
 pub mod emit;
 pub mod error;
+pub mod fillet;
 pub mod flow;
 pub mod geometry;
 pub mod rough;

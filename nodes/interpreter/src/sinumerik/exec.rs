@@ -257,6 +257,8 @@ impl Sinumerik {
         let nonmodal = self.non_modal(w)?;
         if !nonmodal {
             self.motion_block(w)?;
+            // A corner no element took (G53) does not carry over.
+            self.corner = None;
         }
         self.cycles(w, nonmodal)?;
         self.check_work_area(from, &start)?;

@@ -8,6 +8,7 @@
 
 pub mod alarms;
 pub mod block;
+mod contour;
 mod cycle_call;
 mod drilling;
 mod exec;
@@ -84,6 +85,11 @@ pub struct Sinumerik {
     modal_cycle: Option<cycle_call::CycleCall>,
     /// G25/G26 working area and spindle limits, WALIMON.
     limits: limits::Limits,
+    /// RNDM: the rounding of every corner (None: off); FRCM: the corners' feed.
+    rndm: Option<f64>,
+    frcm: Option<f64>,
+    /// The corner the block's move ends with (CHF/CHR/RND/RNDM), taken by its last element.
+    corner: contour::BlockCorner,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -156,6 +162,9 @@ impl Sinumerik {
             words: exec::Words::default(),
             modal_cycle: None,
             limits: limits::Limits::default(),
+            rndm: None,
+            frcm: None,
+            corner: None,
         };
         front.apply_length();
         front

@@ -35,11 +35,13 @@ impl Sinumerik {
     /// The non-modal instructions that take the block's words for themselves: dwell,
     /// frames, pole; `true` when the block moves nothing else.
     pub(super) fn non_modal(&mut self, w: &Words) -> Result<bool, ProgramError> {
-        for k in ["CHF", "CHR", "RND", "RNDM", "FRC", "FRCM", "ANG", "SF"] {
+        for k in ["ANG", "SF"] {
             if w.addr.contains_key(k) {
                 return Err(self.fault(
                     Fault::NotSupported,
-                    format!("{k}= is not built yet (contour elements, chamfers and roundings)"),
+                    format!(
+                        "{k}= is not built yet (contour definitions by angle, thread start angle)"
+                    ),
                 ));
             }
         }
@@ -120,6 +122,7 @@ impl Sinumerik {
         let polar = w.addr.contains_key("AP") || w.addr.contains_key("RP");
         let moves =
             !w.axes.is_empty() || polar || arc_words.iter().any(|k| w.addr.contains_key(*k));
+        self.corner = self.block_corner(w, moves)?;
         if !moves {
             return Ok(());
         }
@@ -163,7 +166,7 @@ impl Sinumerik {
                 } else {
                     MoveKind::Feed(feed)
                 };
-                self.core.emit(&end, kind)?;
+                self.emit_element(&end, kind)?;
                 if a.dist(b) > 1e-9 {
                     let l = a.dist(b);
                     self.tangent = Some(Pt::new((b.z - a.z) / l, (b.r - a.r) / l));
@@ -420,7 +423,7 @@ impl Sinumerik {
                 },
             )?;
         }
-        self.core.emit(
+        self.emit_element(
             end,
             MoveKind::Arc {
                 center: c,
