@@ -806,3 +806,38 @@ fn f053_roundings_single_and_modal_between_lines_and_arcs() {
     assert!(p.iter().any(|q| dist(q.0, (80.0, 80.0)) < 1e-9));
     assert!(near(&r.end(), &[100.0, 80.0, 0.0]));
 }
+
+#[test]
+fn roundings_and_chamfers_under_radius_compensation_are_offset_like_the_contour() {
+    // A 40 mm square traversed counter-clockwise, cut outside (G42) by T1 D1 (radius 10),
+    // three corners rounded R5 and one chamfered: the cutter centre runs 10 mm outside, the
+    // roundings on arcs of R15 about the contour's rounding centres.
+    let text = "G17 G90 T1 D1 F300\nG0 X-20 Y-20 Z5\nG1 Z-5\nG42 G1 X0 Y0\n\
+        X40 RND=5\nY40 RND=5\nX0 CHR=5\nY0\nG40 G1 X-20 Y-20\nM30\n";
+    let r = run(text).ok();
+    let p = pieces(&r);
+    let arcs: Vec<((f64, f64), bool)> = p.iter().filter_map(|q| q.1.map(|c| (c, q.2))).collect();
+    for centre in [(35.0, 5.0), (35.0, 35.0)] {
+        let k = arcs
+            .iter()
+            .position(|a| dist(a.0, centre) < 1e-6)
+            .unwrap_or_else(|| panic!("an arc about {centre:?}: {p:?}"));
+        assert!(arcs[k].1, "counter-clockwise");
+        let end = p.iter().find(|q| q.1 == Some(arcs[k].0)).unwrap().0;
+        assert!((dist(end, centre) - 15.0).abs() < 1e-6, "R15: {end:?}");
+    }
+    // The chamfer (5, 40)–(0, 35) offset 10 mm outward along its normal (−1, 1)/√2.
+    let s = 10.0 / 2f64.sqrt();
+    let ends: Vec<(f64, f64)> = p.iter().map(|q| q.0).collect();
+    assert!(
+        ends.iter().any(|e| dist(*e, (0.0 - s, 35.0 + s)) < 1e-6),
+        "{ends:?}"
+    );
+    // The straight sides 10 mm out: X50 on the right, Y50 on top, X−10 on the left.
+    assert!(ends
+        .iter()
+        .any(|e| (e.0 - 50.0).abs() < 1e-6 && (e.1 - 35.0).abs() < 1e-6));
+    assert!(ends
+        .iter()
+        .any(|e| (e.0 + 10.0).abs() < 1e-6 && e.1.abs() < 1e-6));
+}

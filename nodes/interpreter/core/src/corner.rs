@@ -97,22 +97,15 @@ impl Core {
                 ))
             }
         };
-        if self.comp.is_some() {
-            return Err(self.fault(
-                Fault::NotSupported,
-                format!(
-                    "chamfer/rounding while {} is active is not built yet",
-                    self.rules.comp.name
-                ),
-            ));
-        }
         self.resolve_corner(Some((&end, kind)))?;
         let start = self.work_position();
         self.check_feed(feed)?;
         if let Some(f) = corner_feed {
             self.check_feed(f)?;
         }
-        self.hold_at = Some(self.pending.len());
+        // Under radius compensation its hold point (before anything queued after the element
+        // it holds) stays: the corner's element will go through compensation to that point.
+        self.hold_at = Some(self.hold_at.unwrap_or(self.pending.len()));
         self.corner = Some(Corner {
             start,
             end: end.clone(),
@@ -136,11 +129,16 @@ impl Core {
             return Ok(());
         };
         // The line and the chamfer go where the line was in program order, on its line.
-        self.queue_held(|me| {
+        let (result, end) = self.queue_held(|me| {
             me.line = corner.line;
+            // The held element starts where it started (the program has gone on to its end):
+            // the stages after this one take their start from the position.
+            me.pos = me.to_machine(&corner.start);
             me.corner_moves(&corner, next)
-        })
-        .0
+        });
+        // Compensation holding its last element again: its hold point follows what was queued.
+        self.hold_at = self.comp.as_ref().filter(|c| c.holding()).map(|_| end);
+        result
     }
 
     fn corner_moves(
