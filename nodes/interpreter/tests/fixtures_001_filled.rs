@@ -841,3 +841,23 @@ fn roundings_and_chamfers_under_radius_compensation_are_offset_like_the_contour(
         .iter()
         .any(|e| (e.0 + 10.0).abs() < 1e-6 && e.1.abs() < 1e-6));
 }
+
+#[test]
+fn an_m_function_between_rounded_compensated_blocks_keeps_its_place() {
+    let text = "G17 G90 T1 D1 F300\nG0 X-20 Y-20 Z5\nG1 Z-5\nG42 G1 X0 Y0\n\
+        X40 RND=5\nY40 RND=5\nM8\nX0 RND=5\nY0\nG40 G1 X-20 Y-20\nM30\n";
+    let r = run(text).ok();
+    let m8 = r
+        .out
+        .iter()
+        .position(|c| *c == Command::Aux(Aux::M(8)))
+        .unwrap();
+    let moves_of = |line: u32| -> Vec<usize> {
+        (0..r.out.len())
+            .filter(|&i| r.lines[i] == line && r.out[i].end().is_some())
+            .collect()
+    };
+    // Y40's moves and its rounding (line 6) before M8 (line 7); X0's (line 8) after.
+    assert!(moves_of(6).iter().all(|&i| i < m8) && !moves_of(6).is_empty());
+    assert!(moves_of(8).iter().all(|&i| i > m8) && !moves_of(8).is_empty());
+}

@@ -485,3 +485,30 @@ fn modal_information_names_the_codes_in_force() {
     // G42 G44, G01, G83 G99, G18 G91, G56 G61.
     assert_eq!(got, [4244.0, 1.0, 8399.0, 1891.0, 5661.0]);
 }
+
+/// Under cutter compensation a block's moves wait for the next block (to know the corner);
+/// M and S functions of the blocks in between still come out in program order: after the
+/// moves of the block before them, before those of the block after.
+#[test]
+fn m_and_s_between_compensated_blocks_keep_their_place() {
+    let text = "O1\nG17 G90 G0 X-20. Y-20. Z5. S1000 M3\nG1 Z-5. F300\nG41 D1 G1 X0 Y0\n\
+        Y40.\nX40.\nM8\nY0\nS800 X0\nG40 G1 X-20. Y-20.\nM30\n";
+    let out = run(text).unwrap();
+    let at = |pred: &dyn Fn(&Canon) -> bool| out.iter().position(pred).unwrap();
+    let m8 = at(&|c| c.command == cnc_interpreter::Command::Aux(cnc_interpreter::Aux::M(8)));
+    let s800 = at(&|c| c.command == cnc_interpreter::Command::Aux(cnc_interpreter::Aux::S(800.0)));
+    let last_of = |line: u32| {
+        out.iter()
+            .rposition(|c| c.line == line && c.command.end().is_some())
+            .unwrap()
+    };
+    let first_of = |line: u32| {
+        out.iter()
+            .position(|c| c.line == line && c.command.end().is_some())
+            .unwrap()
+    };
+    // M8 (line 7) after X40's moves (line 6), before Y0's (line 8).
+    assert!(last_of(6) < m8 && m8 < first_of(8), "{out:?}");
+    // S800 in the X0 block (line 9) before its move, after Y0's.
+    assert!(last_of(8) < s800 && s800 < first_of(9), "{out:?}");
+}

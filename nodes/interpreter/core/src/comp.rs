@@ -543,6 +543,15 @@ impl RadiusComp {
         }
     }
 
+    /// The source line of the element waiting for the next one.
+    pub fn held_line(&self) -> Option<u32> {
+        match (&self.startup, &self.held) {
+            (Some(s), _) => Some(s.4),
+            (None, Some(h)) => Some(h.line),
+            (None, None) => None,
+        }
+    }
+
     /// True while an element waits for the next one.
     pub fn holding(&self) -> bool {
         self.held.is_some() || self.startup.is_some()

@@ -63,7 +63,7 @@ impl Core {
         self.resolve_corner(Some((&end, MoveKind::Feed(feed))))?;
         let start = self.work_position();
         self.check_feed(feed)?;
-        self.hold_at = Some(self.pending.len());
+        self.corner_slot = Some(self.pending.len());
         self.corner = Some(Corner {
             start,
             end: end.clone(),
@@ -103,9 +103,7 @@ impl Core {
         if let Some(f) = corner_feed {
             self.check_feed(f)?;
         }
-        // Under radius compensation its hold point (before anything queued after the element
-        // it holds) stays: the corner's element will go through compensation to that point.
-        self.hold_at = Some(self.hold_at.unwrap_or(self.pending.len()));
+        self.corner_slot = Some(self.pending.len());
         self.corner = Some(Corner {
             start,
             end: end.clone(),
@@ -128,16 +126,25 @@ impl Core {
         let Some(corner) = self.corner.take() else {
             return Ok(());
         };
-        // The line and the chamfer go where the line was in program order, on its line.
-        let (result, end) = self.queue_held(|me| {
+        // The line and the chamfer go where the line was in program order (the corner's
+        // slot), on its line; under compensation, which places them there itself.
+        let release = |me: &mut Self| {
             me.line = corner.line;
             // The held element starts where it started (the program has gone on to its end):
             // the stages after this one take their start from the position.
             me.pos = me.to_machine(&corner.start);
             me.corner_moves(&corner, next)
-        });
-        // Compensation holding its last element again: its hold point follows what was queued.
-        self.hold_at = self.comp.as_ref().filter(|c| c.holding()).map(|_| end);
+        };
+        let result = if self.comp.is_some() {
+            let saved = self.line;
+            let r = release(self);
+            self.line = saved;
+            r
+        } else {
+            let at = self.corner_slot.unwrap_or(self.pending.len());
+            self.insert_queued(at, release).0
+        };
+        self.corner_slot = None;
         result
     }
 

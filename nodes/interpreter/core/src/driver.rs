@@ -23,9 +23,12 @@ pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>
         if let Some(e) = &core.error {
             return Err(e.clone());
         }
-        if core.hold_at != Some(0) {
+        if core.gate() != Some(0) {
             if let Some(c) = core.pending.pop_front() {
-                if let Some(h) = core.hold_at.as_mut() {
+                for h in [core.hold_at.as_mut(), core.corner_slot.as_mut()]
+                    .into_iter()
+                    .flatten()
+                {
                     *h -= 1;
                 }
                 core.silent_blocks = 0;

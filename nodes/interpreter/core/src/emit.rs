@@ -11,9 +11,11 @@
 //! 3. [`Core::machine`]: the range check, the feed check, the spindle speed under constant
 //!    surface speed, the transform chain, and the command in the queue.
 //!
-//! While a stage holds an element back, the queue has a hold point (`hold_at`): commands
-//! queued after it (a block's M codes, say) wait behind it, and the element's moves, once
-//! released, go in at the hold point, so commands leave in program order.
+//! While a stage holds an element back, the queue has a hold point: commands queued after it
+//! (a block's M codes, say) wait behind it, and the element's moves, once released, go in at
+//! the hold point, so commands leave in program order. Each stage has its own: the corner's
+//! slot (`corner_slot`) and compensation's (`hold_at`), which is the earlier of the two
+//! since compensation holds an older element; nothing leaves the queue past the earlier.
 
 use crate::canon::{Canon, Command};
 use crate::comp::{self, CompError, RadiusComp};
@@ -287,6 +289,7 @@ impl Core {
             }
         };
         let line = self.line;
+        let held_line = self.comp.as_ref().and_then(|c| c.held_line());
         // No move in the plane; an arc never is one: ending where it starts it is a full
         // circle (with a normal move, a helix).
         let still =
@@ -313,19 +316,29 @@ impl Core {
             };
             pushed.map_err(|e| self.comp_fault(e))?
         };
-        self.emit_outs(outs, end)
+        self.emit_outs(outs, end, held_line)
     }
 
-    /// Runs `f`, which queues the moves of an element that was held back (compensation,
-    /// chamfer), and moves what it queued to where the element was in program order: before
-    /// the commands of later blocks queued meanwhile. Returns `f`'s result and the index just
-    /// after the moved commands. The source line is restored afterwards.
-    pub(crate) fn queue_held(
+    /// Where nothing may leave the queue yet: the earlier hold point.
+    pub(crate) fn gate(&self) -> Option<usize> {
+        match (self.hold_at, self.corner_slot) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// Runs `f`, which queues the moves of an element that was held back, and moves what it
+    /// queued to index `at`, where the element was in program order: before the commands of
+    /// later blocks queued meanwhile. A hold point at or behind `at` moves on with them.
+    /// Returns `f`'s result and the index just after the moved commands. The source line is
+    /// restored afterwards.
+    pub(crate) fn insert_queued(
         &mut self,
+        at: usize,
         f: impl FnOnce(&mut Self) -> Result<(), ProgramError>,
     ) -> (Result<(), ProgramError>, usize) {
         let before = self.pending.len();
-        let at = self.hold_at.take().unwrap_or(before).min(before);
+        let at = at.min(before);
         let saved_line = self.line;
         let result = f(self);
         self.line = saved_line;
@@ -334,40 +347,76 @@ impl Core {
         for (k, c) in moved.into_iter().enumerate() {
             self.pending.insert(at + k, c);
         }
+        for h in [self.hold_at.as_mut(), self.corner_slot.as_mut()]
+            .into_iter()
+            .flatten()
+        {
+            if *h >= at {
+                *h += n;
+            }
+        }
         (result, at + n)
     }
 
-    /// Queues compensated moves where they belong in program order (before anything queued
-    /// after the element compensation held back), then puts the program's position back on
-    /// the programmed end point: incremental words and the next element start there.
+    /// Queues compensated moves where they belong in program order, then puts the program's
+    /// position back on the programmed end point: incremental words and the next element
+    /// start there. The moves of the element compensation held (`held_line`, and the moves
+    /// along the normal after it) go in at its hold point, before the commands queued after
+    /// it; those of the element just given (this line) where it belongs: the held corner's
+    /// slot, or the end of the queue. Compensation then holds the new element there.
     pub(crate) fn emit_outs(
         &mut self,
-        outs: Vec<comp::Out>,
+        mut outs: Vec<comp::Out>,
         programmed_end: &[f64],
+        held_line: Option<u32>,
     ) -> Result<(), ProgramError> {
-        let (result, held_end) = self.queue_held(|me| {
-            for o in outs {
-                me.line = o.line;
-                let base = me.work_position();
-                let mut end = me.with_point(&base, o.path.end());
-                if let Some(i) = me.plane_normal() {
-                    end[i] = o.depth;
-                }
-                let kind = match (o.path, o.kind) {
-                    (Elem::Arc { c, ccw, .. }, comp::Kind::Feed(feed)) => MoveKind::Arc {
-                        center: c,
-                        ccw,
-                        feed,
-                    },
-                    (_, comp::Kind::Feed(f)) => MoveKind::Feed(f),
-                    (_, comp::Kind::Rapid) => MoveKind::Rapid,
-                };
-                me.machine(&end, kind)?;
-            }
-            Ok(())
-        });
-        self.hold_at = self.comp.as_ref().filter(|c| c.holding()).map(|_| held_end);
+        let hold = self.hold_at.take();
+        let line = self.line;
+        // Without an older element held (or one of this very line) all go in together.
+        let newer = if held_line.is_some_and(|h| h != line) {
+            outs.iter().rev().take_while(|o| o.line == line).count()
+        } else {
+            0
+        };
+        let new = outs.split_off(outs.len() - newer);
+        let slot = |me: &Self| me.corner_slot.unwrap_or(me.pending.len());
+        let at = hold.unwrap_or_else(|| slot(self));
+        let (result, old_end) = self.insert_queued(at, |me| me.queue_outs(outs));
+        let held_end = if held_line.is_some_and(|h| h != line) {
+            let at = slot(self);
+            let (r, end) = self.insert_queued(at, |me| me.queue_outs(new));
+            result.and(r).map(|()| end)
+        } else {
+            result.map(|()| old_end)
+        };
+        self.hold_at = match held_end {
+            Ok(end) => self.comp.as_ref().filter(|c| c.holding()).map(|_| end),
+            Err(_) => None,
+        };
         self.pos = self.to_machine(programmed_end);
-        result
+        held_end.map(|_| ())
+    }
+
+    /// The compensated moves as commands, each on its source line.
+    fn queue_outs(&mut self, outs: Vec<comp::Out>) -> Result<(), ProgramError> {
+        for o in outs {
+            self.line = o.line;
+            let base = self.work_position();
+            let mut end = self.with_point(&base, o.path.end());
+            if let Some(i) = self.plane_normal() {
+                end[i] = o.depth;
+            }
+            let kind = match (o.path, o.kind) {
+                (Elem::Arc { c, ccw, .. }, comp::Kind::Feed(feed)) => MoveKind::Arc {
+                    center: c,
+                    ccw,
+                    feed,
+                },
+                (_, comp::Kind::Feed(f)) => MoveKind::Feed(f),
+                (_, comp::Kind::Rapid) => MoveKind::Rapid,
+            };
+            self.machine(&end, kind)?;
+        }
+        Ok(())
     }
 }

@@ -143,11 +143,13 @@ impl Core {
         let _ = self.resolve_corner(None);
         // Program end cancels compensation: the held element ends at its offset end.
         if let Some(mut comp) = self.comp.take() {
+            let held = comp.held_line();
             let outs = comp.flush();
             let here = self.work_position();
-            let _ = self.emit_outs(outs, &here);
+            let _ = self.emit_outs(outs, &here, held);
         }
         self.hold_at = None;
+        self.corner_slot = None;
         self.push(Command::ProgramEnd);
         self.done = true;
     }

@@ -118,9 +118,12 @@ pub struct Core {
     pub comp_cancel: bool,
     pub corner: Option<Corner>,
     pub chip_break: Option<ChipBreak>,
-    /// While a filter holds an element back, commands from this index of `pending` on wait
-    /// for it (they come after it in the program).
+    /// While compensation holds an element back, commands from this index of `pending` on
+    /// wait for it (they come after it in the program).
     pub(crate) hold_at: Option<usize>,
+    /// While a chamfered or rounded corner's element is held, the index of `pending` where its
+    /// moves belong (commands from it on came after it in the program).
+    pub(crate) corner_slot: Option<usize>,
     /// Common variables by number.
     pub common: HashMap<i64, f64>,
     // The stream.
@@ -166,6 +169,7 @@ impl Core {
             corner: None,
             chip_break: None,
             hold_at: None,
+            corner_slot: None,
             common,
             pending: VecDeque::new(),
             line: 0,
