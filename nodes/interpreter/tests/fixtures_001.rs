@@ -265,8 +265,9 @@ fn f072_the_first_fulfilled_jump_of_a_block_wins() {
 
 /// The fixtures that call a cycle of chapter 10 (issue 24): 006, 075, 076 and 092–117.
 /// The drilling cycles and hole patterns (092–105) run as printed, 103 up to the placeholder
-/// the manual prints in it (`sinumerik_drilling.rs` asserts what each does); the milling
-/// cycles (106–117) stop with 12140 at their first call, nothing of that block moving;
+/// the manual prints in it (`sinumerik_drilling.rs` asserts what each does); CYCLE90 (116,
+/// 117) mills its thread (`sinumerik_milling.rs`); the other milling cycles (106–115) stop
+/// with 12140 at their first call, nothing of that block moving;
 /// 006, 075 and 076 are templates that stop earlier, at a placeholder (12080).
 #[test]
 fn cycle_fixtures_drill_and_the_milling_ones_wait() {
@@ -304,8 +305,14 @@ fn cycle_fixtures_drill_and_the_milling_ones_wait() {
     assert_eq!(names, expected);
     for (p, name) in cycles.iter().zip(&names) {
         let r = run(&std::fs::read_to_string(p).unwrap());
-        if name.as_str() >= "092" && name.as_str() <= "105" && name != "103" {
+        let runs = name.as_str() >= "092" && name.as_str() <= "105" && name != "103";
+        if runs || name == "116" {
             assert!(r.error.is_none(), "{}: {:?}", p.display(), r.error);
+            continue;
+        }
+        if name == "117" {
+            // It passes DP, which it never defines (`sinumerik_milling.rs`).
+            assert_eq!(r.error.as_ref().map(|e| e.number), Some(12550));
             continue;
         }
         let e = r

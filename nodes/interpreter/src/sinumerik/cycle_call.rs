@@ -10,10 +10,12 @@ use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleD
 
 use super::drilling::{self, CycleAlarm, DeepHole, Levels, Step};
 use super::expr::Expr;
+use super::thread_mill::{thread_milling, Move, Thread, P3};
 use super::Sinumerik;
+use cnc_interpreter_core::geometry::Pt;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 12] = [
+const CYCLES: [(&str, &[&str]); 13] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -50,14 +52,21 @@ const CYCLES: [(&str, &[&str]); 12] = [
         &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB", "SDIR"],
     ),
     ("CYCLE89", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
+    (
+        "CYCLE90",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "DPR", "DIATH", "KDIAM", "PIT", "FFR", "CDIR", "TYPTH",
+            "CPA", "CPO",
+        ],
+    ),
     ("HOLES1", &["SPCA", "SPCO", "STA1", "FDIS", "DBH", "NUM"]),
     ("HOLES2", &["CPA", "CPO", "RAD", "STA1", "INDA", "NUM"]),
 ];
 
 /// Parameters that are lengths (converted under G70/G700).
-const LENGTHS: [&str; 17] = [
+const LENGTHS: [&str; 21] = [
     "RTP", "RFP", "SDIS", "DP", "DPR", "FDEP", "FDPR", "DAM", "PIT", "RPA", "RPO", "RPAP", "SPCA",
-    "SPCO", "FDIS", "DBH", "RAD",
+    "SPCO", "FDIS", "DBH", "RAD", "DIATH", "KDIAM", "CPA", "CPO",
 ];
 
 /// The names of every cycle of chapter 10 (the milling ones are not built yet).
@@ -86,7 +95,7 @@ impl CycleCall {
         self.get(p).unwrap_or(default)
     }
     fn is_drilling(&self) -> bool {
-        !self.name.starts_with("HOLES")
+        !self.name.starts_with("HOLES") && self.name != "CYCLE90"
     }
 }
 
@@ -146,6 +155,9 @@ impl Sinumerik {
     pub(super) fn run_cycle(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
         if pattern(c.name) {
             return self.run_pattern(c);
+        }
+        if c.name == "CYCLE90" {
+            return self.mill_thread(c);
         }
         self.drill_hole(c)
     }
@@ -359,6 +371,74 @@ impl Sinumerik {
                 self.core.emit(&end, MoveKind::Rapid)
             }
         }
+    }
+
+    /// CYCLE90: the thread milled about CPA/CPO with the active cutting edge's radius.
+    fn mill_thread(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
+        let (rtp, rfp) = (c.or("RTP", 0.0), c.or("RFP", 0.0));
+        let bottom = match (c.get("DPR").filter(|d| *d != 0.0), c.get("DP")) {
+            (Some(r), _) => rfp - (rtp - rfp).signum() * r.abs(),
+            (None, Some(dp)) => dp,
+            (None, None) => rfp,
+        };
+        let external = match c.or("TYPTH", 0.0).round() as i64 {
+            0 => false,
+            1 => true,
+            _ => {
+                return Err(self.cycle_alarm(
+                    CycleAlarm {
+                        number: 61002,
+                        text: "TYPTH is 0 (internal) or 1 (external)".into(),
+                    },
+                    c.name,
+                ))
+            }
+        };
+        let t = Thread {
+            rtp,
+            rfp,
+            sdis: c.or("SDIS", 0.0),
+            bottom,
+            diath: c.or("DIATH", 0.0),
+            kdiam: c.or("KDIAM", 0.0),
+            pit: c.or("PIT", 0.0),
+            ffr: c.or("FFR", 0.0),
+            // CDIR 2 is G2; anything else G3, as the manual's message says.
+            ccw: c.or("CDIR", 3.0).round() != 2.0,
+            external,
+            centre: (c.or("CPA", 0.0), c.or("CPO", 0.0)),
+        };
+        let radius = self.offset_entry().map_or(0.0, |e| e.radius);
+        let moves = thread_milling(t, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
+        let (h, v) = self.core.plane_axes()?;
+        let d = self.drill_axis()?;
+        for m in moves {
+            let point = |me: &Self, p: P3| {
+                let mut end = me.core.work_position();
+                end[h] = p.0;
+                end[v] = p.1;
+                end[d] = p.2;
+                end
+            };
+            match m {
+                Move::Rapid(p) => self.core.emit(&point(self, p), MoveKind::Rapid)?,
+                Move::Line(p, f) => self.core.emit(&point(self, p), MoveKind::Feed(f))?,
+                Move::Arc {
+                    end,
+                    centre,
+                    ccw,
+                    feed,
+                } => self.core.emit(
+                    &point(self, end),
+                    MoveKind::Arc {
+                        center: Pt::new(centre.0, centre.1),
+                        ccw,
+                        feed,
+                    },
+                )?,
+            }
+        }
+        Ok(())
     }
 
     /// HOLES1/HOLES2: each position at rapid in the plane, the modal cycle there.

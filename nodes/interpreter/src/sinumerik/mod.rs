@@ -18,6 +18,7 @@ mod frames;
 pub mod lex;
 mod limits;
 mod motion;
+mod thread_mill;
 mod tool;
 pub mod vars;
 

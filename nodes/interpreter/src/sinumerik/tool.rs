@@ -78,7 +78,7 @@ impl Sinumerik {
     }
 
     /// The active edge's entry on the offset page.
-    fn offset_entry(&self) -> Option<cnc_interpreter_core::ToolOffset> {
+    pub(super) fn offset_entry(&self) -> Option<cnc_interpreter_core::ToolOffset> {
         (self.tool > 0 && self.edge > 0)
             .then(|| self.core.setup.offsets.tool(self.tool * 10 + self.edge))
     }
