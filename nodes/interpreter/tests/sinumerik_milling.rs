@@ -68,7 +68,7 @@ fn helix(r: &Run, centre: (f64, f64)) -> Helix {
                 let re = (end[0] - centre.0).hypot(end[1] - centre.1);
                 assert!((rs - re).abs() < 1e-6, "the helix keeps its radius");
                 assert!(radius.is_none_or(|x: f64| (x - re).abs() < 1e-6));
-                assert!(ccw.is_none_or(|x| x == !clockwise), "one direction");
+                assert!(ccw.is_none_or(|x| x != *clockwise), "one direction");
                 radius = Some(re);
                 ccw = Some(!clockwise);
                 span = (
