@@ -193,3 +193,272 @@ fn thread_milling_alarms() {
     ));
     assert_eq!(r.alarm(), (61002, 4));
 }
+
+/// The stock the cutter sweeps: a height map over a grid, starting flat at `top`; the cutter
+/// a flat-ended cylinder of its radius. Following the stream, every move is sampled at most
+/// 0.1 mm apart; what it removes lowers the map. It knows nothing of the cycle.
+struct Stock {
+    origin: (f64, f64),
+    step: f64,
+    n: usize,
+    h: Vec<f64>,
+    top: f64,
+    radius: f64,
+    /// Rapid moves that removed material.
+    rapid_cuts: usize,
+    /// Farthest a cut reached from `centre` (sample distance + cutter radius).
+    reach: f64,
+    centre: (f64, f64),
+    /// Levels of moves that cut at a constant level.
+    levels: Vec<f64>,
+}
+
+impl Stock {
+    fn new(centre: (f64, f64), half: f64, top: f64, radius: f64) -> Stock {
+        let step = 0.5;
+        let n = (2.0 * half / step) as usize + 1;
+        Stock {
+            origin: (centre.0 - half, centre.1 - half),
+            step,
+            n,
+            h: vec![top; n * n],
+            top,
+            radius,
+            rapid_cuts: 0,
+            reach: 0.0,
+            centre,
+            levels: Vec::new(),
+        }
+    }
+
+    fn at(&self, i: usize, j: usize) -> (f64, f64) {
+        (
+            self.origin.0 + i as f64 * self.step,
+            self.origin.1 + j as f64 * self.step,
+        )
+    }
+
+    /// The cutter's end at `p`: true when it removed material.
+    fn stamp(&mut self, p: (f64, f64, f64)) -> bool {
+        if p.2 >= self.top - 1e-9 {
+            return false;
+        }
+        self.reach = self
+            .reach
+            .max((p.0 - self.centre.0).hypot(p.1 - self.centre.1) + self.radius);
+        let k = (self.radius / self.step).ceil() as i64 + 1;
+        let ci = ((p.0 - self.origin.0) / self.step).round() as i64;
+        let cj = ((p.1 - self.origin.1) / self.step).round() as i64;
+        let mut removed = false;
+        for i in (ci - k).max(0)..=(ci + k).min(self.n as i64 - 1) {
+            for j in (cj - k).max(0)..=(cj + k).min(self.n as i64 - 1) {
+                let q = self.at(i as usize, j as usize);
+                if (q.0 - p.0).hypot(q.1 - p.1) <= self.radius {
+                    let cell = &mut self.h[i as usize * self.n + j as usize];
+                    if p.2 < *cell - 1e-6 {
+                        *cell = p.2;
+                        removed = true;
+                    }
+                }
+            }
+        }
+        removed
+    }
+
+    fn follow(&mut self, out: &[Command], start: [f64; 3]) {
+        let mut here = start;
+        for c in out {
+            let Some(e) = c.end() else { continue };
+            let end = [e[0], e[1], e[2]];
+            let samples: Vec<(f64, f64, f64)> = match c {
+                Command::Arc {
+                    center, clockwise, ..
+                } => {
+                    let (cx, cy) = (center[0], center[1]);
+                    let r = (here[0] - cx).hypot(here[1] - cy);
+                    let a0 = (here[1] - cy).atan2(here[0] - cx);
+                    let a1 = (end[1] - cy).atan2(end[0] - cx);
+                    let mut sweep = if *clockwise { a0 - a1 } else { a1 - a0 };
+                    sweep = sweep.rem_euclid(TAU);
+                    if sweep < 1e-9 {
+                        sweep = TAU;
+                    }
+                    let n = ((r * sweep) / 0.1).ceil().max(1.0) as usize;
+                    let s = if *clockwise { -1.0 } else { 1.0 };
+                    (0..=n)
+                        .map(|k| {
+                            let t = k as f64 / n as f64;
+                            let a = a0 + s * sweep * t;
+                            (
+                                cx + r * a.cos(),
+                                cy + r * a.sin(),
+                                here[2] + (end[2] - here[2]) * t,
+                            )
+                        })
+                        .collect()
+                }
+                _ => {
+                    let l = (end[0] - here[0])
+                        .hypot(end[1] - here[1])
+                        .hypot(end[2] - here[2]);
+                    let n = (l / 0.1).ceil().max(1.0) as usize;
+                    (0..=n)
+                        .map(|k| {
+                            let t = k as f64 / n as f64;
+                            (
+                                here[0] + (end[0] - here[0]) * t,
+                                here[1] + (end[1] - here[1]) * t,
+                                here[2] + (end[2] - here[2]) * t,
+                            )
+                        })
+                        .collect()
+                }
+            };
+            let rapid = matches!(c, Command::Rapid { .. });
+            let mut removed = false;
+            for s in samples {
+                removed |= self.stamp(s);
+            }
+            if rapid && removed {
+                self.rapid_cuts += 1;
+            }
+            if !rapid && removed && (end[2] - here[2]).abs() < 1e-9 {
+                self.levels.push(end[2]);
+            }
+            here = end;
+        }
+    }
+
+    /// Lowest and highest floor of the cells within `r` of the centre, and the lowest cell.
+    fn floor_within(&self, r: f64) -> (f64, f64, f64) {
+        let (mut lo, mut hi, mut min) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY);
+        for i in 0..self.n {
+            for j in 0..self.n {
+                let q = self.at(i, j);
+                let z = self.h[i * self.n + j];
+                min = min.min(z);
+                if (q.0 - self.centre.0).hypot(q.1 - self.centre.1) <= r {
+                    lo = lo.min(z);
+                    hi = hi.max(z);
+                }
+            }
+        }
+        (lo, hi, min)
+    }
+}
+
+fn assert_within(a: f64, b: f64, what: &str) {
+    assert!((a - b).abs() <= 0.01, "{what}: {a} vs {b}");
+}
+
+#[test]
+fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
+    // POCKET4(3, 0, 0, -20, 25, 50, 60, 6, 0, 0, 200, 100, 1, 21, 0, 0, 0, 2, 3): R25 at
+    // X50 Y60 to Z−20, MID 6, no allowances, conventional milling under M3 (G2), helical
+    // insertion R2 at 3 mm a turn, with a 20 mm cutter (T1 D1) of length 0.
+    let r = go(&fixture("115")).ok();
+    let mut stock = Stock::new((50.0, 60.0), 40.0, 0.0, 10.0);
+    stock.follow(&r.out, [50.0, 50.0, 0.0]);
+    assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
+    assert_within(stock.reach, 25.0, "the wall");
+    let (lo, hi, min) = stock.floor_within(25.0 - 0.5);
+    assert_within(lo, -20.0, "floor");
+    assert_within(hi, -20.0, "floor everywhere inside");
+    assert_within(min, -20.0, "nothing deeper");
+    // Cutting levels at most MID apart from RFP down.
+    let mut levels = stock.levels.clone();
+    levels.sort_by(|a, b| b.total_cmp(a));
+    levels.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    let mut last = 0.0;
+    for l in &levels {
+        assert!(
+            last - l <= 6.0 + 1e-9,
+            "infeed {} > MID: {levels:?}",
+            last - l
+        );
+        last = *l;
+    }
+    // Conventional under M3: clockwise rings.
+    assert!(r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Arc { .. }))
+        .all(|c| matches!(
+            c,
+            Command::Arc {
+                clockwise: true,
+                ..
+            }
+        )));
+    assert!(near(&r.end(), &[50.0, 60.0, 3.0]));
+}
+
+#[test]
+fn pocket4_roughing_leaves_the_allowances_and_finishing_takes_them() {
+    let head = "G17 G90 T1 D1 S800 M3\nG0 X0 Y0 Z10\n";
+    // R30 to Z−12 from RFP 0, MID 5, FAL 1, FALD 0.5, climb (G3 under M3), vertical insertion.
+    let rough = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 11, 12)\n";
+    let finish = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 12, 12)\n";
+    let r = go(&format!("{head}{rough}")).ok();
+    let mut stock = Stock::new((0.0, 0.0), 45.0, 0.0, 10.0);
+    stock.follow(&r.out, [0.0, 0.0, 10.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 29.0, "the wall, 1 mm inside");
+    let (lo, hi, min) = stock.floor_within(29.0 - 0.5);
+    assert_within(lo, -11.5, "the floor, 0.5 mm above DP");
+    assert_within(hi, -11.5, "everywhere");
+    assert_within(min, -11.5, "nothing deeper");
+    assert!(r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Arc { .. }))
+        .all(|c| matches!(
+            c,
+            Command::Arc {
+                clockwise: false,
+                ..
+            }
+        )));
+    // Finishing after it: the wall and the floor on size, no rapid into what is left.
+    let r = go(&format!("{head}{rough}{finish}")).ok();
+    let mut stock = Stock::new((0.0, 0.0), 45.0, 0.0, 10.0);
+    stock.follow(&r.out, [0.0, 0.0, 10.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 30.0, "the wall");
+    let (lo, hi, min) = stock.floor_within(30.0 - 0.5);
+    assert_within(lo, -12.0, "the floor");
+    assert_within(hi, -12.0, "everywhere");
+    assert_within(min, -12.0, "nothing deeper");
+}
+
+#[test]
+fn pocket4_alarms() {
+    let head = "G17 G90 S800 M3\nG0 X0 Y0 Z10\n";
+    let call = |vari: &str, prad: &str| {
+        format!("POCKET4(10, 0, 1, -12, {prad}, 0, 0, 5, 0, 0, 300, 100, 0, {vari}, 0)\n")
+    };
+    // No cutting edge: 61000.
+    assert_eq!(
+        go(&format!("{head}{}", call("11", "30"))).alarm(),
+        (61000, 3)
+    );
+    let head = format!("{head}T1 D1\n");
+    // The cutter (R10) does not fit R9: 61105; VARI 13: 61002; CDIR 7: 61109.
+    assert_eq!(
+        go(&format!("{head}{}", call("11", "9"))).alarm(),
+        (61105, 4)
+    );
+    assert_eq!(
+        go(&format!("{head}{}", call("13", "30"))).alarm(),
+        (61002, 4)
+    );
+    let r = go(&format!(
+        "{head}POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 0, 0, 300, 100, 7, 11, 0)\n"
+    ));
+    assert_eq!(r.alarm(), (61109, 4));
+    // A helix wider than the pocket allows: 61108.
+    let r = go(&format!(
+        "{head}POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 0, 0, 300, 100, 0, 21, 0, , , 25, 2)\n"
+    ));
+    assert_eq!(r.alarm(), (61108, 4));
+}

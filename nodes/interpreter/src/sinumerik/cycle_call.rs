@@ -10,12 +10,12 @@ use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleD
 
 use super::drilling::{self, CycleAlarm, DeepHole, Levels, Step};
 use super::expr::Expr;
-use super::thread_mill::{thread_milling, Move, Thread, P3};
+use super::pocket::{circular_pocket, CirclePocket, Insertion};
+use super::thread_mill::{thread_milling, Thread};
 use super::Sinumerik;
-use cnc_interpreter_core::geometry::Pt;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 13] = [
+const CYCLES: [(&str, &[&str]); 14] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -59,14 +59,22 @@ const CYCLES: [(&str, &[&str]); 13] = [
             "CPA", "CPO",
         ],
     ),
+    (
+        "POCKET4",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "PRAD", "PA", "PO", "MID", "FAL", "FALD", "FFP1", "FFD",
+            "CDIR", "VARI", "MIDA", "AP1", "AD", "RAD1", "DP1",
+        ],
+    ),
     ("HOLES1", &["SPCA", "SPCO", "STA1", "FDIS", "DBH", "NUM"]),
     ("HOLES2", &["CPA", "CPO", "RAD", "STA1", "INDA", "NUM"]),
 ];
 
 /// Parameters that are lengths (converted under G70/G700).
-const LENGTHS: [&str; 21] = [
+const LENGTHS: [&str; 32] = [
     "RTP", "RFP", "SDIS", "DP", "DPR", "FDEP", "FDPR", "DAM", "PIT", "RPA", "RPO", "RPAP", "SPCA",
-    "SPCO", "FDIS", "DBH", "RAD", "DIATH", "KDIAM", "CPA", "CPO",
+    "SPCO", "FDIS", "DBH", "RAD", "DIATH", "KDIAM", "CPA", "CPO", "PRAD", "PA", "PO", "MID", "FAL",
+    "FALD", "MIDA", "AP1", "AD", "RAD1", "DP1",
 ];
 
 /// The names of every cycle of chapter 10 (the milling ones are not built yet).
@@ -95,7 +103,7 @@ impl CycleCall {
         self.get(p).unwrap_or(default)
     }
     fn is_drilling(&self) -> bool {
-        !self.name.starts_with("HOLES") && self.name != "CYCLE90"
+        self.name.starts_with("CYCLE8")
     }
 }
 
@@ -156,8 +164,10 @@ impl Sinumerik {
         if pattern(c.name) {
             return self.run_pattern(c);
         }
-        if c.name == "CYCLE90" {
-            return self.mill_thread(c);
+        match c.name {
+            "CYCLE90" => return self.mill_thread(c),
+            "POCKET4" => return self.circular_pocket(c),
+            _ => {}
         }
         self.drill_hole(c)
     }
@@ -410,35 +420,71 @@ impl Sinumerik {
         };
         let radius = self.offset_entry().map_or(0.0, |e| e.radius);
         let moves = thread_milling(t, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
-        let (h, v) = self.core.plane_axes()?;
-        let d = self.drill_axis()?;
-        for m in moves {
-            let point = |me: &Self, p: P3| {
-                let mut end = me.core.work_position();
-                end[h] = p.0;
-                end[v] = p.1;
-                end[d] = p.2;
-                end
-            };
-            match m {
-                Move::Rapid(p) => self.core.emit(&point(self, p), MoveKind::Rapid)?,
-                Move::Line(p, f) => self.core.emit(&point(self, p), MoveKind::Feed(f))?,
-                Move::Arc {
-                    end,
-                    centre,
-                    ccw,
-                    feed,
-                } => self.core.emit(
-                    &point(self, end),
-                    MoveKind::Arc {
-                        center: Pt::new(centre.0, centre.1),
-                        ccw,
-                        feed,
-                    },
-                )?,
+        self.run_path(moves)
+    }
+
+    /// POCKET4: the circular pocket with the active cutting edge.
+    fn circular_pocket(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
+        let wrong = |number: u32, text: &str| CycleAlarm {
+            number,
+            text: text.into(),
+        };
+        let vari = c.or("VARI", 0.0).round() as i64;
+        let roughing = match vari % 10 {
+            1 => true,
+            2 => false,
+            _ => {
+                return Err(
+                    self.cycle_alarm(wrong(61002, "VARI: units 1 roughing, 2 finishing"), c.name)
+                )
             }
-        }
-        Ok(())
+        };
+        let insertion = match vari / 10 {
+            0 | 1 => Insertion::Vertical,
+            2 => Insertion::Helix {
+                radius: c.or("RAD1", 0.0),
+                per_turn: c.or("DP1", 0.0),
+            },
+            _ => {
+                return Err(self.cycle_alarm(
+                    wrong(61002, "VARI: tens 0/1 vertical, 2 helical insertion"),
+                    c.name,
+                ))
+            }
+        };
+        let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
+            (2, _) => false,
+            (3, _) => true,
+            // Climb milling inside a pocket runs against the cutter's turning: M3 G3, M4 G2.
+            (0, SpindleDir::Ccw) | (1, SpindleDir::Cw | SpindleDir::Stopped) => false,
+            (0, _) | (1, SpindleDir::Ccw) => true,
+            _ => {
+                return Err(self.cycle_alarm(
+                    wrong(61109, "CDIR is 0 climb, 1 conventional, 2 G2 or 3 G3"),
+                    c.name,
+                ))
+            }
+        };
+        let p = CirclePocket {
+            rtp: c.or("RTP", 0.0),
+            rfp: c.or("RFP", 0.0),
+            sdis: c.or("SDIS", 0.0),
+            dp: c.or("DP", 0.0),
+            prad: c.or("PRAD", 0.0),
+            centre: (c.or("PA", 0.0), c.or("PO", 0.0)),
+            mid: c.or("MID", 0.0).abs(),
+            fal: c.or("FAL", 0.0).abs(),
+            fald: c.or("FALD", 0.0).abs(),
+            ffp1: c.or("FFP1", 0.0),
+            ffd: c.or("FFD", 0.0),
+            ccw,
+            roughing,
+            insertion,
+            mida: c.or("MIDA", 0.0).abs(),
+        };
+        let radius = self.offset_entry().map(|e| e.radius);
+        let moves = circular_pocket(p, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
+        self.run_path(moves)
     }
 
     /// HOLES1/HOLES2: each position at rapid in the plane, the modal cycle there.

@@ -9,6 +9,7 @@
 pub mod alarms;
 pub mod block;
 mod contour;
+mod cutter_path;
 mod cycle_call;
 mod drilling;
 mod exec;
@@ -18,6 +19,7 @@ mod frames;
 pub mod lex;
 mod limits;
 mod motion;
+mod pocket;
 mod thread_mill;
 mod tool;
 pub mod vars;

@@ -5,24 +5,8 @@
 
 use std::f64::consts::TAU;
 
+use super::cutter_path::Move;
 use super::drilling::CycleAlarm;
-
-/// A point: 1st and 2nd plane axis, infeed axis.
-pub type P3 = (f64, f64, f64);
-
-/// One move of the cutter's centre.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Move {
-    Rapid(P3),
-    Line(P3, f64),
-    /// An arc (a helix when the infeed axis moves) about a centre in the plane.
-    Arc {
-        end: P3,
-        centre: (f64, f64),
-        ccw: bool,
-        feed: f64,
-    },
-}
 
 /// CYCLE90's parameters, lengths in mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
