@@ -206,15 +206,23 @@ struct Stock {
     radius: f64,
     /// Rapid moves that removed material.
     rapid_cuts: usize,
-    /// Farthest a cut reached from `centre` (sample distance + cutter radius).
+    /// The wall to check against: the signed distance of a point from it (outside positive).
+    wall: Box<dyn Fn((f64, f64)) -> f64>,
+    /// How far beyond the wall a cut reached (the largest signed distance of a cutting
+    /// position plus the cutter's radius): 0 when the cut touches the wall and stops there.
     reach: f64,
-    centre: (f64, f64),
     /// Levels of moves that cut at a constant level.
     levels: Vec<f64>,
 }
 
 impl Stock {
-    fn new(centre: (f64, f64), half: f64, top: f64, radius: f64) -> Stock {
+    fn new(
+        centre: (f64, f64),
+        half: f64,
+        top: f64,
+        radius: f64,
+        wall: impl Fn((f64, f64)) -> f64 + 'static,
+    ) -> Stock {
         let step = 0.5;
         let n = (2.0 * half / step) as usize + 1;
         Stock {
@@ -225,8 +233,8 @@ impl Stock {
             top,
             radius,
             rapid_cuts: 0,
-            reach: 0.0,
-            centre,
+            wall: Box::new(wall),
+            reach: f64::NEG_INFINITY,
             levels: Vec::new(),
         }
     }
@@ -243,9 +251,7 @@ impl Stock {
         if p.2 >= self.top - 1e-9 {
             return false;
         }
-        self.reach = self
-            .reach
-            .max((p.0 - self.centre.0).hypot(p.1 - self.centre.1) + self.radius);
+        self.reach = self.reach.max((self.wall)((p.0, p.1)) + self.radius);
         let k = (self.radius / self.step).ceil() as i64 + 1;
         let ci = ((p.0 - self.origin.0) / self.step).round() as i64;
         let cj = ((p.1 - self.origin.1) / self.step).round() as i64;
@@ -329,21 +335,38 @@ impl Stock {
         }
     }
 
-    /// Lowest and highest floor of the cells within `r` of the centre, and the lowest cell.
-    fn floor_within(&self, r: f64) -> (f64, f64, f64) {
+    /// Lowest and highest floor of the cells `inset` inside the wall, and the lowest cell.
+    fn floor_within(&self, inset: f64) -> (f64, f64, f64) {
         let (mut lo, mut hi, mut min) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY);
         for i in 0..self.n {
             for j in 0..self.n {
                 let q = self.at(i, j);
                 let z = self.h[i * self.n + j];
                 min = min.min(z);
-                if (q.0 - self.centre.0).hypot(q.1 - self.centre.1) <= r {
+                if (self.wall)(q) <= -inset {
                     lo = lo.min(z);
                     hi = hi.max(z);
                 }
             }
         }
         (lo, hi, min)
+    }
+}
+
+/// The signed distance from a circle's wall.
+fn circle(c: (f64, f64), r: f64) -> impl Fn((f64, f64)) -> f64 {
+    move |p| (p.0 - c.0).hypot(p.1 - c.1) - r
+}
+
+/// The signed distance from the wall of a rectangle about `c`, `a` × `b` from its centre,
+/// corners rounded by `r`, its long side at `deg` to the 1st axis.
+fn rounded_rect(c: (f64, f64), a: f64, b: f64, r: f64, deg: f64) -> impl Fn((f64, f64)) -> f64 {
+    let (s, co) = deg.to_radians().sin_cos();
+    move |p| {
+        let (dx, dy) = (p.0 - c.0, p.1 - c.1);
+        let (x, y) = (dx * co + dy * s, -dx * s + dy * co);
+        let (qx, qy) = (x.abs() - (a - r), y.abs() - (b - r));
+        qx.max(0.0).hypot(qy.max(0.0)) + qx.max(qy).min(0.0) - r
     }
 }
 
@@ -357,11 +380,11 @@ fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
     // X50 Y60 to Z−20, MID 6, no allowances, conventional milling under M3 (G2), helical
     // insertion R2 at 3 mm a turn, with a 20 mm cutter (T1 D1) of length 0.
     let r = go(&fixture("115")).ok();
-    let mut stock = Stock::new((50.0, 60.0), 40.0, 0.0, 10.0);
+    let mut stock = Stock::new((50.0, 60.0), 40.0, 0.0, 10.0, circle((50.0, 60.0), 25.0));
     stock.follow(&r.out, [50.0, 50.0, 0.0]);
     assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
-    assert_within(stock.reach, 25.0, "the wall");
-    let (lo, hi, min) = stock.floor_within(25.0 - 0.5);
+    assert_within(stock.reach, 0.0, "the wall R25");
+    let (lo, hi, min) = stock.floor_within(0.5);
     assert_within(lo, -20.0, "floor");
     assert_within(hi, -20.0, "floor everywhere inside");
     assert_within(min, -20.0, "nothing deeper");
@@ -400,11 +423,11 @@ fn pocket4_roughing_leaves_the_allowances_and_finishing_takes_them() {
     let rough = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 11, 12)\n";
     let finish = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 12, 12)\n";
     let r = go(&format!("{head}{rough}")).ok();
-    let mut stock = Stock::new((0.0, 0.0), 45.0, 0.0, 10.0);
+    let mut stock = Stock::new((0.0, 0.0), 45.0, 0.0, 10.0, circle((0.0, 0.0), 29.0));
     stock.follow(&r.out, [0.0, 0.0, 10.0]);
     assert_eq!(stock.rapid_cuts, 0);
-    assert_within(stock.reach, 29.0, "the wall, 1 mm inside");
-    let (lo, hi, min) = stock.floor_within(29.0 - 0.5);
+    assert_within(stock.reach, 0.0, "the wall, 1 mm inside R30");
+    let (lo, hi, min) = stock.floor_within(0.5);
     assert_within(lo, -11.5, "the floor, 0.5 mm above DP");
     assert_within(hi, -11.5, "everywhere");
     assert_within(min, -11.5, "nothing deeper");
@@ -421,11 +444,11 @@ fn pocket4_roughing_leaves_the_allowances_and_finishing_takes_them() {
         )));
     // Finishing after it: the wall and the floor on size, no rapid into what is left.
     let r = go(&format!("{head}{rough}{finish}")).ok();
-    let mut stock = Stock::new((0.0, 0.0), 45.0, 0.0, 10.0);
+    let mut stock = Stock::new((0.0, 0.0), 45.0, 0.0, 10.0, circle((0.0, 0.0), 30.0));
     stock.follow(&r.out, [0.0, 0.0, 10.0]);
     assert_eq!(stock.rapid_cuts, 0);
-    assert_within(stock.reach, 30.0, "the wall");
-    let (lo, hi, min) = stock.floor_within(30.0 - 0.5);
+    assert_within(stock.reach, 0.0, "the wall R30");
+    let (lo, hi, min) = stock.floor_within(0.5);
     assert_within(lo, -12.0, "the floor");
     assert_within(hi, -12.0, "everywhere");
     assert_within(min, -12.0, "nothing deeper");
@@ -461,4 +484,92 @@ fn pocket4_alarms() {
         "{head}POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 0, 0, 300, 100, 0, 21, 0, , , 25, 2)\n"
     ));
     assert_eq!(r.alarm(), (61108, 4));
+}
+
+/// The mill with T1 D1 a 10 mm cutter of length 0.
+fn cutter5() -> cnc_interpreter::Setup {
+    let mut s = mill();
+    s.offsets.tools.insert(
+        11,
+        cnc_interpreter_core::ToolOffset {
+            radius: 5.0,
+            ..Default::default()
+        },
+    );
+    s
+}
+
+#[test]
+fn f114_pocket3_roughing_leaves_the_allowances_on_a_60_by_40_pocket() {
+    // POCKET3(5, 0, 0.5, −17.5, 60, 40, 8, 60, 40, 0, 4, 0.75, 0.2, 1000, 750, 0, 11, 5):
+    // 60 × 40 about X60 Y40, corners R8, to Z−17.5; MID 4, FAL 0.75, FALD 0.2, climb under
+    // M4 (G2), vertical insertion at F750, MIDA 5; a 10 mm cutter.
+    let r = run_with(&fixture("114"), cutter5(), Library::new()).ok();
+    let wall = rounded_rect((60.0, 40.0), 29.25, 19.25, 7.25, 0.0);
+    let mut stock = Stock::new((60.0, 40.0), 40.0, 0.0, 5.0, wall);
+    stock.follow(&r.out, [60.0, 40.0, 5.0]);
+    assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
+    assert_within(stock.reach, 0.0, "the wall 0.75 inside");
+    let (lo, hi, min) = stock.floor_within(0.5);
+    assert_within(lo, -17.3, "the floor 0.2 above DP");
+    assert_within(hi, -17.3, "everywhere");
+    assert_within(min, -17.3, "nothing deeper");
+    let mut levels = stock.levels.clone();
+    levels.sort_by(|a, b| b.total_cmp(a));
+    levels.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    let mut last = 0.0;
+    for l in &levels {
+        assert!(last - l <= 4.0 + 1e-9, "infeed {} > MID", last - l);
+        last = *l;
+    }
+    assert!(r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Arc { .. }))
+        .all(|c| matches!(
+            c,
+            Command::Arc {
+                clockwise: true,
+                ..
+            }
+        )));
+}
+
+#[test]
+fn pocket3_turned_helical_then_finished_on_size() {
+    // 50 × 30 about X10 Y−5 turned 30°, corners R6, to Z−8 from RFP 0; helical insertion.
+    let head = "G17 G90 T1 D1 S800 M3\nG0 X10 Y-5 Z10\n";
+    let call = |vari: u32| {
+        format!("POCKET3(10, 0, 1, -8, 50, 30, 6, 10, -5, 30, 3, 0.5, 0.3, 400, 150, 3, {vari}, 6, , , , 3, 1.5)\n")
+    };
+    let r = run_with(&format!("{head}{}", call(21)), cutter5(), Library::new()).ok();
+    let mut stock = Stock::new(
+        (10.0, -5.0),
+        35.0,
+        0.0,
+        5.0,
+        rounded_rect((10.0, -5.0), 24.5, 14.5, 5.5, 30.0),
+    );
+    stock.follow(&r.out, [10.0, -5.0, 10.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 0.0, "roughed wall");
+    let (lo, hi, _) = stock.floor_within(0.5);
+    assert_within(lo, -7.7, "roughed floor");
+    assert_within(hi, -7.7, "everywhere");
+    let text = format!("{head}{}{}", call(21), call(22));
+    let r = run_with(&text, cutter5(), Library::new()).ok();
+    let mut stock = Stock::new(
+        (10.0, -5.0),
+        35.0,
+        0.0,
+        5.0,
+        rounded_rect((10.0, -5.0), 25.0, 15.0, 6.0, 30.0),
+    );
+    stock.follow(&r.out, [10.0, -5.0, 10.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 0.0, "finished wall");
+    let (lo, hi, min) = stock.floor_within(0.5);
+    assert_within(lo, -8.0, "finished floor");
+    assert_within(hi, -8.0, "everywhere");
+    assert_within(min, -8.0, "nothing deeper");
 }

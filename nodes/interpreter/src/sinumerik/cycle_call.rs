@@ -11,11 +11,12 @@ use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleD
 use super::drilling::{self, CycleAlarm, DeepHole, Levels, Step};
 use super::expr::Expr;
 use super::pocket::{circular_pocket, CirclePocket, Insertion};
+use super::rect_pocket::{rectangular_pocket, RectPocket};
 use super::thread_mill::{thread_milling, Thread};
 use super::Sinumerik;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 14] = [
+const CYCLES: [(&str, &[&str]); 15] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -60,6 +61,13 @@ const CYCLES: [(&str, &[&str]); 14] = [
         ],
     ),
     (
+        "POCKET3",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "LENG", "WID", "CRAD", "PA", "PO", "STA", "MID", "FAL",
+            "FALD", "FFP1", "FFD", "CDIR", "VARI", "MIDA", "AP1", "AP2", "AD", "RAD1", "DP1",
+        ],
+    ),
+    (
         "POCKET4",
         &[
             "RTP", "RFP", "SDIS", "DP", "PRAD", "PA", "PO", "MID", "FAL", "FALD", "FFP1", "FFD",
@@ -71,10 +79,10 @@ const CYCLES: [(&str, &[&str]); 14] = [
 ];
 
 /// Parameters that are lengths (converted under G70/G700).
-const LENGTHS: [&str; 32] = [
+const LENGTHS: [&str; 36] = [
     "RTP", "RFP", "SDIS", "DP", "DPR", "FDEP", "FDPR", "DAM", "PIT", "RPA", "RPO", "RPAP", "SPCA",
     "SPCO", "FDIS", "DBH", "RAD", "DIATH", "KDIAM", "CPA", "CPO", "PRAD", "PA", "PO", "MID", "FAL",
-    "FALD", "MIDA", "AP1", "AD", "RAD1", "DP1",
+    "FALD", "MIDA", "AP1", "AD", "RAD1", "DP1", "LENG", "WID", "CRAD", "AP2",
 ];
 
 /// The names of every cycle of chapter 10 (the milling ones are not built yet).
@@ -166,6 +174,7 @@ impl Sinumerik {
         }
         match c.name {
             "CYCLE90" => return self.mill_thread(c),
+            "POCKET3" => return self.rectangular_pocket(c),
             "POCKET4" => return self.circular_pocket(c),
             _ => {}
         }
@@ -423,21 +432,22 @@ impl Sinumerik {
         self.run_path(moves)
     }
 
-    /// POCKET4: the circular pocket with the active cutting edge.
-    fn circular_pocket(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
-        let wrong = |number: u32, text: &str| CycleAlarm {
-            number,
-            text: text.into(),
+    /// POCKET3/POCKET4's VARI and CDIR: roughing or finishing, the insertion, G3 or G2.
+    fn pocket_modes(&self, c: &CycleCall) -> Result<(bool, Insertion, bool), ProgramError> {
+        let wrong = |number: u32, text: &str| {
+            self.cycle_alarm(
+                CycleAlarm {
+                    number,
+                    text: text.into(),
+                },
+                c.name,
+            )
         };
         let vari = c.or("VARI", 0.0).round() as i64;
         let roughing = match vari % 10 {
             1 => true,
             2 => false,
-            _ => {
-                return Err(
-                    self.cycle_alarm(wrong(61002, "VARI: units 1 roughing, 2 finishing"), c.name)
-                )
-            }
+            _ => return Err(wrong(61002, "VARI: units 1 roughing, 2 finishing")),
         };
         let insertion = match vari / 10 {
             0 | 1 => Insertion::Vertical,
@@ -445,12 +455,13 @@ impl Sinumerik {
                 radius: c.or("RAD1", 0.0),
                 per_turn: c.or("DP1", 0.0),
             },
-            _ => {
-                return Err(self.cycle_alarm(
-                    wrong(61002, "VARI: tens 0/1 vertical, 2 helical insertion"),
-                    c.name,
+            3 if c.name == "POCKET3" => {
+                return Err(wrong(
+                    12140,
+                    "VARI tens 3, reciprocating insertion, is not built yet",
                 ))
             }
+            _ => return Err(wrong(61002, "VARI: tens 0/1 vertical, 2 helical insertion")),
         };
         let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
             (2, _) => false,
@@ -459,12 +470,46 @@ impl Sinumerik {
             (0, SpindleDir::Ccw) | (1, SpindleDir::Cw | SpindleDir::Stopped) => false,
             (0, _) | (1, SpindleDir::Ccw) => true,
             _ => {
-                return Err(self.cycle_alarm(
-                    wrong(61109, "CDIR is 0 climb, 1 conventional, 2 G2 or 3 G3"),
-                    c.name,
+                return Err(wrong(
+                    61109,
+                    "CDIR is 0 climb, 1 conventional, 2 G2 or 3 G3",
                 ))
             }
         };
+        Ok((roughing, insertion, ccw))
+    }
+
+    /// POCKET3: the rectangular pocket with the active cutting edge.
+    fn rectangular_pocket(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
+        let (roughing, insertion, ccw) = self.pocket_modes(c)?;
+        let p = RectPocket {
+            rtp: c.or("RTP", 0.0),
+            rfp: c.or("RFP", 0.0),
+            sdis: c.or("SDIS", 0.0),
+            dp: c.or("DP", 0.0),
+            leng: c.or("LENG", 0.0),
+            wid: c.or("WID", 0.0),
+            crad: c.or("CRAD", 0.0).abs(),
+            centre: (c.or("PA", 0.0), c.or("PO", 0.0)),
+            sta: c.or("STA", 0.0),
+            mid: c.or("MID", 0.0).abs(),
+            fal: c.or("FAL", 0.0).abs(),
+            fald: c.or("FALD", 0.0).abs(),
+            ffp1: c.or("FFP1", 0.0),
+            ffd: c.or("FFD", 0.0),
+            ccw,
+            roughing,
+            insertion,
+            mida: c.or("MIDA", 0.0).abs(),
+        };
+        let radius = self.offset_entry().map(|e| e.radius);
+        let moves = rectangular_pocket(p, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
+        self.run_path(moves)
+    }
+
+    /// POCKET4: the circular pocket with the active cutting edge.
+    fn circular_pocket(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
+        let (roughing, insertion, ccw) = self.pocket_modes(c)?;
         let p = CirclePocket {
             rtp: c.or("RTP", 0.0),
             rfp: c.or("RFP", 0.0),

@@ -20,6 +20,7 @@ pub mod lex;
 mod limits;
 mod motion;
 mod pocket;
+mod rect_pocket;
 mod thread_mill;
 mod tool;
 pub mod vars;

@@ -1,0 +1,255 @@
+//! POCKET3, the rectangular pocket (`001` §10.6.9; inventory §4.5), as a pure function, the
+//! way `pocket.rs` makes POCKET4: level by level within MID, entered at the centre straight
+//! down or on a helix, then cleared from a slot along the long axis outwards by rounded
+//! rectangles at most MIDA apart; finishing takes the wall once per level (entered and left on
+//! quarter circles) and the floor. Decision D87.
+
+use super::cutter_path::{Move, P3};
+use super::drilling::CycleAlarm;
+use super::pocket::{levels, Insertion};
+
+/// POCKET3's parameters, lengths in mm, the direction already resolved from CDIR.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RectPocket {
+    pub rtp: f64,
+    pub rfp: f64,
+    pub sdis: f64,
+    pub dp: f64,
+    pub leng: f64,
+    pub wid: f64,
+    pub crad: f64,
+    pub centre: (f64, f64),
+    /// The long axis's angle to the 1st plane axis, degrees.
+    pub sta: f64,
+    pub mid: f64,
+    pub fal: f64,
+    pub fald: f64,
+    pub ffp1: f64,
+    pub ffd: f64,
+    pub ccw: bool,
+    pub roughing: bool,
+    pub insertion: Insertion,
+    pub mida: f64,
+}
+
+fn alarm(number: u32, text: &str) -> CycleAlarm {
+    CycleAlarm {
+        number,
+        text: text.into(),
+    }
+}
+
+/// The pocket's own frame: points about its centre, its long side along x.
+struct Frame {
+    centre: (f64, f64),
+    cos: f64,
+    sin: f64,
+}
+
+impl Frame {
+    fn put(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        (
+            self.centre.0 + x * self.cos - y * self.sin,
+            self.centre.1 + x * self.sin + y * self.cos,
+        )
+    }
+    fn line(&self, p: (f64, f64), z: f64, feed: f64) -> Move {
+        let q = self.put(p);
+        Move::Line((q.0, q.1, z), feed)
+    }
+    fn arc(&self, end: (f64, f64), centre: (f64, f64), z: f64, ccw: bool, feed: f64) -> Move {
+        let (e, c) = (self.put(end), self.put(centre));
+        Move::Arc {
+            end: (e.0, e.1, z),
+            centre: c,
+            ccw,
+            feed,
+        }
+    }
+    fn point(&self, p: (f64, f64), z: f64) -> P3 {
+        let q = self.put(p);
+        (q.0, q.1, z)
+    }
+}
+
+/// A point the path goes to, and the centre of the corner arc that ends there (a side ends
+/// with none).
+type Corner = ((f64, f64), Option<(f64, f64)>);
+
+/// One turn round the rounded rectangle of half sizes `a` × `b` and corner radius `r`, from
+/// the middle of its +x side and back there.
+fn round_rect(f: &Frame, a: f64, b: f64, r: f64, z: f64, ccw: bool, feed: f64) -> Vec<Move> {
+    let r = r.min(a).min(b).max(0.0);
+    let (ia, ib) = (a - r, b - r);
+    // Counter-clockwise: the sides and the corner arcs in turn.
+    let mut pts: Vec<Corner> = vec![
+        ((a, ib), None),
+        ((ia, b), Some((ia, ib))),
+        ((-ia, b), None),
+        ((-a, ib), Some((-ia, ib))),
+        ((-a, -ib), None),
+        ((-ia, -b), Some((-ia, -ib))),
+        ((ia, -b), None),
+        ((a, -ib), Some((ia, -ib))),
+        ((a, 0.0), None),
+    ];
+    if !ccw {
+        // The same points the other way round: each arc keeps its centre, ending where the
+        // side before it began.
+        let mut back = Vec::new();
+        let n = pts.len();
+        for k in (0..n - 1).rev() {
+            back.push((pts[k].0, pts[k + 1].1));
+        }
+        back.push(((a, 0.0), None));
+        pts = back;
+    }
+    let mut m = Vec::new();
+    for (end, centre) in pts {
+        match centre {
+            Some(c) if r > 1e-9 => m.push(f.arc(end, c, z, ccw, feed)),
+            Some(_) => {}
+            None => m.push(f.line(end, z, feed)),
+        }
+    }
+    m
+}
+
+/// The cutter centre's moves for POCKET3 with a cutter of `tool_radius` (`None`: no cutting
+/// edge active).
+pub fn rectangular_pocket(
+    p: RectPocket,
+    tool_radius: Option<f64>,
+) -> Result<Vec<Move>, CycleAlarm> {
+    let wr = tool_radius.ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
+    if wr <= 0.0 {
+        return Err(alarm(61117, "active tool radius ≤ 0"));
+    }
+    let down = (p.dp - p.rfp).signum();
+    if p.dp == p.rfp || (p.rtp - p.rfp) * down >= 0.0 {
+        return Err(alarm(
+            61101,
+            "reference plane defined incorrectly: RTP before RFP, DP beyond it",
+        ));
+    }
+    let (la, lb) = (p.leng.abs() / 2.0, p.wid.abs() / 2.0);
+    if wr >= la.min(lb) - p.fal {
+        return Err(alarm(61105, "cutter radius too large for the pocket"));
+    }
+    if p.crad > la.min(lb) {
+        return Err(alarm(61113, "corner radius CRAD too large"));
+    }
+    let mida = if p.mida > 0.0 { p.mida } else { 1.6 * wr };
+    if mida > 2.0 * wr {
+        return Err(alarm(61111, "infeed width MIDA > tool diameter"));
+    }
+    if p.mid > 0.0 && p.fald > p.mid {
+        return Err(alarm(61110, "base allowance FALD > depth infeed MID"));
+    }
+    if p.ffp1 <= 0.0 || p.ffd <= 0.0 {
+        return Err(alarm(
+            61003,
+            "no feed programmed in the cycle: FFP1 and FFD",
+        ));
+    }
+    // Along the long side.
+    let (long, short, sta) = if la >= lb {
+        (la, lb, p.sta)
+    } else {
+        (lb, la, p.sta + 90.0)
+    };
+    let (sin, cos) = sta.to_radians().sin_cos();
+    let f = Frame {
+        centre: p.centre,
+        cos,
+        sin,
+    };
+    let (cx, cy) = p.centre;
+    let safety = p.rfp - down * p.sdis.abs();
+    let floor = p.dp - down * p.fald.abs();
+    let mut m = vec![Move::Rapid((cx, cy, p.rtp)), Move::Rapid((cx, cy, safety))];
+    // Clearing out to the centre path of half sizes a × b, corner radius r.
+    let clear = |m: &mut Vec<Move>, a: f64, b: f64, r: f64, z: f64| {
+        let n = (b / mida - 1e-9).ceil().max(1.0) as usize;
+        // The slot along the long axis, then rectangles out to the wall's path.
+        if a - b > 1e-9 {
+            m.push(f.line((-(a - b), 0.0), z, p.ffp1));
+            m.push(f.line((a - b, 0.0), z, p.ffp1));
+        }
+        for k in 1..=n {
+            let d = b * (1.0 - k as f64 / n as f64);
+            m.push(f.line((a - d, 0.0), z, p.ffp1));
+            m.extend(round_rect(&f, a - d, b - d, r - d, z, p.ccw, p.ffp1));
+        }
+        m.push(f.line((0.0, 0.0), z, p.ffp1));
+    };
+    if p.roughing {
+        let (a, b) = (long - p.fal - wr, short - p.fal - wr);
+        let r = (p.crad - p.fal - wr).max(0.0);
+        if let Insertion::Helix { radius, per_turn } = p.insertion {
+            if radius <= 0.0 || per_turn <= 0.0 || radius > b {
+                return Err(alarm(61108, "illegal values for RAD1 and DP1"));
+            }
+        }
+        let mut z = safety;
+        for level in levels(p.rfp, floor, p.mid) {
+            match p.insertion {
+                Insertion::Vertical => m.push(Move::Line((cx, cy, level), p.ffd)),
+                Insertion::Helix { radius, per_turn } => {
+                    // Started on the positive long axis (§10.6.9).
+                    let start = f.put((radius, 0.0));
+                    m.push(Move::Line((start.0, start.1, z), p.ffp1));
+                    let turns = ((level - z).abs() / per_turn - 1e-9).ceil().max(1.0) as usize;
+                    for k in 1..=turns {
+                        let at = z + (level - z) * k as f64 / turns as f64;
+                        m.push(Move::Arc {
+                            end: (start.0, start.1, at),
+                            centre: (cx, cy),
+                            ccw: p.ccw,
+                            feed: p.ffd,
+                        });
+                    }
+                    m.push(Move::Arc {
+                        end: (start.0, start.1, level),
+                        centre: (cx, cy),
+                        ccw: p.ccw,
+                        feed: p.ffd,
+                    });
+                    m.push(Move::Line((cx, cy, level), p.ffp1));
+                }
+            }
+            clear(&mut m, a, b, r, level);
+            z = level;
+        }
+    } else {
+        let (a, b) = (long - wr, short - wr);
+        let r = (p.crad - wr).max(0.0);
+        if p.fal > 0.0 {
+            let ra = p.fal.max(2.0).min(b / 2.0);
+            let turn = if p.ccw { 1.0 } else { -1.0 };
+            let roughed = (long - p.fal - wr, short - p.fal - wr);
+            for level in levels(p.rfp, floor, p.mid) {
+                let entry = (a - ra, -turn * ra);
+                m.push(Move::Rapid((cx, cy, level)));
+                // The entry point was cleared by roughing when it lies inside its path.
+                let inside = entry.0 <= roughed.0 && entry.1.abs() <= roughed.1;
+                if inside {
+                    m.push(Move::Rapid(f.point(entry, level)));
+                } else {
+                    m.push(f.line(entry, level, p.ffp1));
+                }
+                m.push(f.arc((a, 0.0), (a - ra, 0.0), level, p.ccw, p.ffp1));
+                m.extend(round_rect(&f, a, b, r, level, p.ccw, p.ffp1));
+                m.push(f.arc((a - ra, turn * ra), (a - ra, 0.0), level, p.ccw, p.ffp1));
+                m.push(Move::Line((cx, cy, level), p.ffp1));
+            }
+        }
+        if p.fald > 0.0 {
+            m.push(Move::Rapid((cx, cy, floor - down * p.sdis.abs())));
+            m.push(Move::Line((cx, cy, p.dp), p.ffd));
+            clear(&mut m, a, b, r, p.dp);
+        }
+    }
+    m.push(Move::Rapid((cx, cy, p.rtp)));
+    Ok(m)
+}
