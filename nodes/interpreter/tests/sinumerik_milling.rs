@@ -377,7 +377,7 @@ fn assert_within(a: f64, b: f64, what: &str) {
 #[test]
 fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
     // POCKET4(3, 0, 0, -20, 25, 50, 60, 6, 0, 0, 200, 100, 1, 21, 0, 0, 0, 2, 3): R25 at
-    // X50 Y60 to Z−20, MID 6, no allowances, conventional milling under M3 (G2), helical
+    // X50 Y60 to Z−20, MID 6, no allowances, conventional milling under M3 (against it: G3), helical
     // insertion R2 at 3 mm a turn, with a 20 mm cutter (T1 D1) of length 0.
     let r = go(&fixture("115")).ok();
     let mut stock = Stock::new((50.0, 60.0), 40.0, 0.0, 10.0, circle((50.0, 60.0), 25.0));
@@ -401,7 +401,7 @@ fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
         );
         last = *l;
     }
-    // Conventional under M3: clockwise rings.
+    // Conventional under M3: against the spindle, counter-clockwise rings.
     assert!(r
         .out
         .iter()
@@ -409,7 +409,7 @@ fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
         .all(|c| matches!(
             c,
             Command::Arc {
-                clockwise: true,
+                clockwise: false,
                 ..
             }
         )));
@@ -419,7 +419,7 @@ fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
 #[test]
 fn pocket4_roughing_leaves_the_allowances_and_finishing_takes_them() {
     let head = "G17 G90 T1 D1 S800 M3\nG0 X0 Y0 Z10\n";
-    // R30 to Z−12 from RFP 0, MID 5, FAL 1, FALD 0.5, climb (G3 under M3), vertical insertion.
+    // R30 to Z−12 from RFP 0, MID 5, FAL 1, FALD 0.5, climb (with the spindle: G2 under M3).
     let rough = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 11, 12)\n";
     let finish = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 12, 12)\n";
     let r = go(&format!("{head}{rough}")).ok();
@@ -438,7 +438,7 @@ fn pocket4_roughing_leaves_the_allowances_and_finishing_takes_them() {
         .all(|c| matches!(
             c,
             Command::Arc {
-                clockwise: false,
+                clockwise: true,
                 ..
             }
         )));
@@ -503,7 +503,7 @@ fn cutter5() -> cnc_interpreter::Setup {
 fn f114_pocket3_roughing_leaves_the_allowances_on_a_60_by_40_pocket() {
     // POCKET3(5, 0, 0.5, −17.5, 60, 40, 8, 60, 40, 0, 4, 0.75, 0.2, 1000, 750, 0, 11, 5):
     // 60 × 40 about X60 Y40, corners R8, to Z−17.5; MID 4, FAL 0.75, FALD 0.2, climb under
-    // M4 (G2), vertical insertion at F750, MIDA 5; a 10 mm cutter.
+    // M4 (with the spindle: G3), vertical insertion at F750, MIDA 5; a 10 mm cutter.
     let r = run_with(&fixture("114"), cutter5(), Library::new()).ok();
     let wall = rounded_rect((60.0, 40.0), 29.25, 19.25, 7.25, 0.0);
     let mut stock = Stock::new((60.0, 40.0), 40.0, 0.0, 5.0, wall);
@@ -529,7 +529,7 @@ fn f114_pocket3_roughing_leaves_the_allowances_on_a_60_by_40_pocket() {
         .all(|c| matches!(
             c,
             Command::Arc {
-                clockwise: true,
+                clockwise: false,
                 ..
             }
         )));

@@ -466,9 +466,10 @@ impl Sinumerik {
         let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
             (2, _) => false,
             (3, _) => true,
-            // Climb milling inside a pocket runs against the cutter's turning: M3 G3, M4 G2.
-            (0, SpindleDir::Ccw) | (1, SpindleDir::Cw | SpindleDir::Stopped) => false,
-            (0, _) | (1, SpindleDir::Ccw) => true,
+            // Climb milling inside a pocket goes the way the spindle turns (§10.6.9): M3 G2,
+            // M4 G3; conventional the other way.
+            (0, SpindleDir::Cw | SpindleDir::Stopped) | (1, SpindleDir::Ccw) => false,
+            (0, SpindleDir::Ccw) | (1, _) => true,
             _ => {
                 return Err(wrong(
                     61109,
