@@ -573,3 +573,121 @@ fn pocket3_turned_helical_then_finished_on_size() {
     assert_within(hi, -8.0, "everywhere");
     assert_within(min, -8.0, "nothing deeper");
 }
+
+impl Stock {
+    /// Lowest and highest level of the cells where `pred` holds.
+    fn floor_where(&self, pred: impl Fn((f64, f64)) -> bool) -> (f64, f64) {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for i in 0..self.n {
+            for j in 0..self.n {
+                let q = self.at(i, j);
+                if pred(q) {
+                    let z = self.h[i * self.n + j];
+                    lo = lo.min(z);
+                    hi = hi.max(z);
+                }
+            }
+        }
+        (lo, hi)
+    }
+}
+
+fn with_edge(entry: u32, radius: f64) -> cnc_interpreter::Setup {
+    let mut s = mill();
+    s.offsets.tools.insert(
+        entry,
+        cnc_interpreter_core::ToolOffset {
+            radius,
+            ..Default::default()
+        },
+    );
+    s
+}
+
+#[test]
+fn f109_cycle76_clears_the_blank_round_a_turned_spigot() {
+    // CYCLE76(10, 0, 2, −17.5, , 60, 40, 15, 80, 60, 10, 11, , , 900, 800, 0, 1, 80, 50):
+    // 60 × 40, corners R15, about X80 Y60 turned 10°, to Z−17.5 in levels within 11, from a
+    // blank 80 × 50, climb under M3 (G3); T20 D1 a 12 mm cutter.
+    let r = run_with(&fixture("109"), with_edge(201, 6.0), Library::new()).ok();
+    let spigot = rounded_rect((80.0, 60.0), 30.0, 20.0, 15.0, 10.0);
+    let blank = rounded_rect((80.0, 60.0), 40.0, 25.0, 0.0, 10.0);
+    // The cutter may go anywhere outside the spigot: the "wall" is the spigot, inside out.
+    let mut stock = Stock::new((80.0, 60.0), 60.0, 0.0, 6.0, move |p| -spigot(p));
+    stock.follow(&r.out, [100.0, 100.0, 0.0]);
+    assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
+    assert_within(stock.reach, 0.0, "the spigot's wall");
+    let spigot = rounded_rect((80.0, 60.0), 30.0, 20.0, 15.0, 10.0);
+    let (lo, hi) = stock.floor_where(|q| spigot(q) >= 0.5 && blank(q) <= 0.0);
+    assert_within(lo, -17.5, "the blank cleared to the floor");
+    assert_within(hi, -17.5, "everywhere round the spigot");
+    let (lo, _) = stock.floor_where(|q| spigot(q) <= -0.01);
+    assert!(lo >= 0.0 - 1e-9, "nothing cut inside the spigot");
+    assert!(r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Arc { center, .. } if (center[0] - 80.0).abs() < 40.0))
+        .any(|c| matches!(
+            c,
+            Command::Arc {
+                clockwise: false,
+                ..
+            }
+        )));
+}
+
+#[test]
+fn f110_cycle77_roughs_with_an_allowance_then_finishes_to_50() {
+    // T1 D1 roughs Ø50 at X60 Y70 from a Ø55 blank to Z−20 leaving 0.5; T2 D1 finishes.
+    let mut s = with_edge(11, 8.0);
+    s.offsets.tools.insert(
+        21,
+        cnc_interpreter_core::ToolOffset {
+            radius: 5.0,
+            ..Default::default()
+        },
+    );
+    let text = fixture("110");
+    let rough: String = text.lines().take(3).map(|l| format!("{l}\n")).collect();
+    let r = run_with(&rough, s.clone(), Library::new()).ok();
+    let mut stock = Stock::new((60.0, 70.0), 45.0, 0.0, 8.0, circle((60.0, 70.0), -1.0));
+    stock.wall = Box::new(|p| 25.5 - (p.0 - 60.0).hypot(p.1 - 70.0));
+    stock.follow(&r.out, [0.0, 0.0, 10.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 0.0, "the wall 0.5 outside Ø50");
+    let ring = |q: (f64, f64)| {
+        let d = (q.0 - 60.0).hypot(q.1 - 70.0);
+        (26.0..=27.5).contains(&d)
+    };
+    let (lo, hi) = stock.floor_where(ring);
+    assert_within(lo, -20.0, "floor");
+    assert_within(hi, -20.0, "floor all round");
+    // Conventional under M3 round a spigot: G2.
+    assert!(r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Arc { center, .. } if (center[0] - 60.0).abs() < 1e-9 && (center[1] - 70.0).abs() < 1e-9))
+        .all(|c| matches!(c, Command::Arc { clockwise: true, .. })));
+    let r = run_with(&text, s, Library::new()).ok();
+    let mut stock = Stock::new((60.0, 70.0), 45.0, 0.0, 8.0, circle((60.0, 70.0), -1.0));
+    stock.wall = Box::new(|p| 25.0 - (p.0 - 60.0).hypot(p.1 - 70.0));
+    // Both cutters: the stock follows the first with R8, then the second with R5.
+    let split = r.lines.iter().position(|l| *l >= 4).unwrap();
+    stock.follow(&r.out[..split], [0.0, 0.0, 10.0]);
+    stock.radius = 5.0;
+    let here = r.out[..split]
+        .iter()
+        .rev()
+        .find_map(|c| c.end())
+        .unwrap()
+        .to_vec();
+    stock.follow(&r.out[split..], [here[0], here[1], here[2]]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 0.0, "the wall at Ø50");
+    let (lo, hi) = stock.floor_where(|q| {
+        let d = (q.0 - 60.0).hypot(q.1 - 70.0);
+        (25.5..=27.5).contains(&d)
+    });
+    assert_within(lo, -20.0, "floor");
+    assert_within(hi, -20.0, "floor all round");
+}

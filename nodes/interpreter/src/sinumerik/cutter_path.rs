@@ -63,3 +63,83 @@ impl Sinumerik {
         Ok(())
     }
 }
+
+/// A cycle's own frame: points about its centre, turned so its long side runs along x.
+pub struct Frame {
+    pub centre: (f64, f64),
+    pub cos: f64,
+    pub sin: f64,
+}
+
+impl Frame {
+    pub fn put(&self, (x, y): (f64, f64)) -> (f64, f64) {
+        (
+            self.centre.0 + x * self.cos - y * self.sin,
+            self.centre.1 + x * self.sin + y * self.cos,
+        )
+    }
+    pub fn line(&self, p: (f64, f64), z: f64, feed: f64) -> Move {
+        let q = self.put(p);
+        Move::Line((q.0, q.1, z), feed)
+    }
+    pub fn arc(&self, end: (f64, f64), centre: (f64, f64), z: f64, ccw: bool, feed: f64) -> Move {
+        let (e, c) = (self.put(end), self.put(centre));
+        Move::Arc {
+            end: (e.0, e.1, z),
+            centre: c,
+            ccw,
+            feed,
+        }
+    }
+    pub fn point(&self, p: (f64, f64), z: f64) -> P3 {
+        let q = self.put(p);
+        (q.0, q.1, z)
+    }
+}
+
+/// A point the path goes to, and the centre of the corner arc that ends there (a side ends
+/// with none).
+pub type Corner = ((f64, f64), Option<(f64, f64)>);
+
+/// One turn round the rounded rectangle of half sizes `a` × `b` and corner radius `r`, from
+/// the middle of its +x side and back there.
+pub fn round_rect(f: &Frame, a: f64, b: f64, r: f64, z: f64, ccw: bool, feed: f64) -> Vec<Move> {
+    let r = r.min(a).min(b).max(0.0);
+    let (ia, ib) = (a - r, b - r);
+    // Counter-clockwise: the sides and the corner arcs in turn.
+    let mut pts: Vec<Corner> = vec![
+        ((a, ib), None),
+        ((ia, b), Some((ia, ib))),
+        ((-ia, b), None),
+        ((-a, ib), Some((-ia, ib))),
+        ((-a, -ib), None),
+        ((-ia, -b), Some((-ia, -ib))),
+        ((ia, -b), None),
+        ((a, -ib), Some((ia, -ib))),
+        ((a, 0.0), None),
+    ];
+    if !ccw {
+        // The same points the other way round: each arc keeps its centre, ending where the
+        // side before it began.
+        let mut back = Vec::new();
+        let n = pts.len();
+        for k in (0..n - 1).rev() {
+            back.push((pts[k].0, pts[k + 1].1));
+        }
+        back.push(((a, 0.0), None));
+        pts = back;
+    }
+    let mut m = Vec::new();
+    let mut here = (a, 0.0);
+    for (end, centre) in pts {
+        match centre {
+            Some(c) if r > 1e-9 => m.push(f.arc(end, c, z, ccw, feed)),
+            Some(_) => continue,
+            // A side of no length (a circle: the corners meet) is no move.
+            None if (end.0 - here.0).hypot(end.1 - here.1) < 1e-9 => continue,
+            None => m.push(f.line(end, z, feed)),
+        }
+        here = end;
+    }
+    m
+}

@@ -10,13 +10,10 @@ use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleD
 
 use super::drilling::{self, CycleAlarm, DeepHole, Levels, Step};
 use super::expr::Expr;
-use super::pocket::{circular_pocket, CirclePocket, Insertion};
-use super::rect_pocket::{rectangular_pocket, RectPocket};
-use super::thread_mill::{thread_milling, Thread};
 use super::Sinumerik;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 15] = [
+const CYCLES: [(&str, &[&str]); 17] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -58,6 +55,20 @@ const CYCLES: [(&str, &[&str]); 15] = [
         &[
             "RTP", "RFP", "SDIS", "DP", "DPR", "DIATH", "KDIAM", "PIT", "FFR", "CDIR", "TYPTH",
             "CPA", "CPO",
+        ],
+    ),
+    (
+        "CYCLE76",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "DPR", "LENG", "WID", "CRAD", "PA", "PO", "STA", "MID",
+            "FAL", "FALD", "FFP1", "FFD", "CDIR", "VARI", "AP1", "AP2",
+        ],
+    ),
+    (
+        "CYCLE77",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "DPR", "PRAD", "PA", "PO", "MID", "FAL", "FALD", "FFP1",
+            "FFD", "CDIR", "VARI", "AP1",
         ],
     ),
     (
@@ -103,11 +114,11 @@ pub struct CycleCall {
 }
 
 impl CycleCall {
-    fn get(&self, p: &str) -> Option<f64> {
+    pub(super) fn get(&self, p: &str) -> Option<f64> {
         let i = self.params.iter().position(|n| *n == p)?;
         self.values.get(i).copied().flatten()
     }
-    fn or(&self, p: &str, default: f64) -> f64 {
+    pub(super) fn or(&self, p: &str, default: f64) -> f64 {
         self.get(p).unwrap_or(default)
     }
     fn is_drilling(&self) -> bool {
@@ -121,7 +132,7 @@ fn pattern(name: &str) -> bool {
 }
 
 impl Sinumerik {
-    fn cycle_alarm(&self, a: CycleAlarm, name: &str) -> ProgramError {
+    pub(super) fn cycle_alarm(&self, a: CycleAlarm, name: &str) -> ProgramError {
         let mut e = self.fault(Fault::NotSupported, format!("{name}: {}", a.text));
         e.number = a.number;
         e
@@ -175,6 +186,7 @@ impl Sinumerik {
         match c.name {
             "CYCLE90" => return self.mill_thread(c),
             "POCKET3" => return self.rectangular_pocket(c),
+            "CYCLE76" | "CYCLE77" => return self.spigot(c),
             "POCKET4" => return self.circular_pocket(c),
             _ => {}
         }
@@ -390,147 +402,6 @@ impl Sinumerik {
                 self.core.emit(&end, MoveKind::Rapid)
             }
         }
-    }
-
-    /// CYCLE90: the thread milled about CPA/CPO with the active cutting edge's radius.
-    fn mill_thread(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
-        let (rtp, rfp) = (c.or("RTP", 0.0), c.or("RFP", 0.0));
-        let bottom = match (c.get("DPR").filter(|d| *d != 0.0), c.get("DP")) {
-            (Some(r), _) => rfp - (rtp - rfp).signum() * r.abs(),
-            (None, Some(dp)) => dp,
-            (None, None) => rfp,
-        };
-        let external = match c.or("TYPTH", 0.0).round() as i64 {
-            0 => false,
-            1 => true,
-            _ => {
-                return Err(self.cycle_alarm(
-                    CycleAlarm {
-                        number: 61002,
-                        text: "TYPTH is 0 (internal) or 1 (external)".into(),
-                    },
-                    c.name,
-                ))
-            }
-        };
-        let t = Thread {
-            rtp,
-            rfp,
-            sdis: c.or("SDIS", 0.0),
-            bottom,
-            diath: c.or("DIATH", 0.0),
-            kdiam: c.or("KDIAM", 0.0),
-            pit: c.or("PIT", 0.0),
-            ffr: c.or("FFR", 0.0),
-            // CDIR 2 is G2; anything else G3, as the manual's message says.
-            ccw: c.or("CDIR", 3.0).round() != 2.0,
-            external,
-            centre: (c.or("CPA", 0.0), c.or("CPO", 0.0)),
-        };
-        let radius = self.offset_entry().map_or(0.0, |e| e.radius);
-        let moves = thread_milling(t, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
-        self.run_path(moves)
-    }
-
-    /// POCKET3/POCKET4's VARI and CDIR: roughing or finishing, the insertion, G3 or G2.
-    fn pocket_modes(&self, c: &CycleCall) -> Result<(bool, Insertion, bool), ProgramError> {
-        let wrong = |number: u32, text: &str| {
-            self.cycle_alarm(
-                CycleAlarm {
-                    number,
-                    text: text.into(),
-                },
-                c.name,
-            )
-        };
-        let vari = c.or("VARI", 0.0).round() as i64;
-        let roughing = match vari % 10 {
-            1 => true,
-            2 => false,
-            _ => return Err(wrong(61002, "VARI: units 1 roughing, 2 finishing")),
-        };
-        let insertion = match vari / 10 {
-            0 | 1 => Insertion::Vertical,
-            2 => Insertion::Helix {
-                radius: c.or("RAD1", 0.0),
-                per_turn: c.or("DP1", 0.0),
-            },
-            3 if c.name == "POCKET3" => {
-                return Err(wrong(
-                    12140,
-                    "VARI tens 3, reciprocating insertion, is not built yet",
-                ))
-            }
-            _ => return Err(wrong(61002, "VARI: tens 0/1 vertical, 2 helical insertion")),
-        };
-        let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
-            (2, _) => false,
-            (3, _) => true,
-            // Climb milling inside a pocket goes the way the spindle turns (§10.6.9): M3 G2,
-            // M4 G3; conventional the other way.
-            (0, SpindleDir::Cw | SpindleDir::Stopped) | (1, SpindleDir::Ccw) => false,
-            (0, SpindleDir::Ccw) | (1, _) => true,
-            _ => {
-                return Err(wrong(
-                    61109,
-                    "CDIR is 0 climb, 1 conventional, 2 G2 or 3 G3",
-                ))
-            }
-        };
-        Ok((roughing, insertion, ccw))
-    }
-
-    /// POCKET3: the rectangular pocket with the active cutting edge.
-    fn rectangular_pocket(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
-        let (roughing, insertion, ccw) = self.pocket_modes(c)?;
-        let p = RectPocket {
-            rtp: c.or("RTP", 0.0),
-            rfp: c.or("RFP", 0.0),
-            sdis: c.or("SDIS", 0.0),
-            dp: c.or("DP", 0.0),
-            leng: c.or("LENG", 0.0),
-            wid: c.or("WID", 0.0),
-            crad: c.or("CRAD", 0.0).abs(),
-            centre: (c.or("PA", 0.0), c.or("PO", 0.0)),
-            sta: c.or("STA", 0.0),
-            mid: c.or("MID", 0.0).abs(),
-            fal: c.or("FAL", 0.0).abs(),
-            fald: c.or("FALD", 0.0).abs(),
-            ffp1: c.or("FFP1", 0.0),
-            ffd: c.or("FFD", 0.0),
-            ccw,
-            roughing,
-            insertion,
-            mida: c.or("MIDA", 0.0).abs(),
-        };
-        let radius = self.offset_entry().map(|e| e.radius);
-        let moves = rectangular_pocket(p, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
-        self.run_path(moves)
-    }
-
-    /// POCKET4: the circular pocket with the active cutting edge.
-    fn circular_pocket(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
-        let (roughing, insertion, ccw) = self.pocket_modes(c)?;
-        let p = CirclePocket {
-            rtp: c.or("RTP", 0.0),
-            rfp: c.or("RFP", 0.0),
-            sdis: c.or("SDIS", 0.0),
-            dp: c.or("DP", 0.0),
-            prad: c.or("PRAD", 0.0),
-            centre: (c.or("PA", 0.0), c.or("PO", 0.0)),
-            mid: c.or("MID", 0.0).abs(),
-            fal: c.or("FAL", 0.0).abs(),
-            fald: c.or("FALD", 0.0).abs(),
-            ffp1: c.or("FFP1", 0.0),
-            ffd: c.or("FFD", 0.0),
-            ccw,
-            roughing,
-            insertion,
-            mida: c.or("MIDA", 0.0).abs(),
-        };
-        let radius = self.offset_entry().map(|e| e.radius);
-        let moves = circular_pocket(p, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
-        self.run_path(moves)
     }
 
     /// HOLES1/HOLES2: each position at rapid in the plane, the modal cycle there.

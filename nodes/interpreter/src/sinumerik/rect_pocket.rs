@@ -4,7 +4,7 @@
 //! rectangles at most MIDA apart; finishing takes the wall once per level (entered and left on
 //! quarter circles) and the floor. Decision D87.
 
-use super::cutter_path::{Move, P3};
+use super::cutter_path::{round_rect, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::{levels, Insertion};
 
@@ -37,82 +37,6 @@ fn alarm(number: u32, text: &str) -> CycleAlarm {
         number,
         text: text.into(),
     }
-}
-
-/// The pocket's own frame: points about its centre, its long side along x.
-struct Frame {
-    centre: (f64, f64),
-    cos: f64,
-    sin: f64,
-}
-
-impl Frame {
-    fn put(&self, (x, y): (f64, f64)) -> (f64, f64) {
-        (
-            self.centre.0 + x * self.cos - y * self.sin,
-            self.centre.1 + x * self.sin + y * self.cos,
-        )
-    }
-    fn line(&self, p: (f64, f64), z: f64, feed: f64) -> Move {
-        let q = self.put(p);
-        Move::Line((q.0, q.1, z), feed)
-    }
-    fn arc(&self, end: (f64, f64), centre: (f64, f64), z: f64, ccw: bool, feed: f64) -> Move {
-        let (e, c) = (self.put(end), self.put(centre));
-        Move::Arc {
-            end: (e.0, e.1, z),
-            centre: c,
-            ccw,
-            feed,
-        }
-    }
-    fn point(&self, p: (f64, f64), z: f64) -> P3 {
-        let q = self.put(p);
-        (q.0, q.1, z)
-    }
-}
-
-/// A point the path goes to, and the centre of the corner arc that ends there (a side ends
-/// with none).
-type Corner = ((f64, f64), Option<(f64, f64)>);
-
-/// One turn round the rounded rectangle of half sizes `a` × `b` and corner radius `r`, from
-/// the middle of its +x side and back there.
-fn round_rect(f: &Frame, a: f64, b: f64, r: f64, z: f64, ccw: bool, feed: f64) -> Vec<Move> {
-    let r = r.min(a).min(b).max(0.0);
-    let (ia, ib) = (a - r, b - r);
-    // Counter-clockwise: the sides and the corner arcs in turn.
-    let mut pts: Vec<Corner> = vec![
-        ((a, ib), None),
-        ((ia, b), Some((ia, ib))),
-        ((-ia, b), None),
-        ((-a, ib), Some((-ia, ib))),
-        ((-a, -ib), None),
-        ((-ia, -b), Some((-ia, -ib))),
-        ((ia, -b), None),
-        ((a, -ib), Some((ia, -ib))),
-        ((a, 0.0), None),
-    ];
-    if !ccw {
-        // The same points the other way round: each arc keeps its centre, ending where the
-        // side before it began.
-        let mut back = Vec::new();
-        let n = pts.len();
-        for k in (0..n - 1).rev() {
-            back.push((pts[k].0, pts[k + 1].1));
-        }
-        back.push(((a, 0.0), None));
-        pts = back;
-    }
-    let mut m = Vec::new();
-    for (end, centre) in pts {
-        match centre {
-            Some(c) if r > 1e-9 => m.push(f.arc(end, c, z, ccw, feed)),
-            Some(_) => {}
-            None => m.push(f.line(end, z, feed)),
-        }
-    }
-    m
 }
 
 /// The cutter centre's moves for POCKET3 with a cutter of `tool_radius` (`None`: no cutting
