@@ -307,8 +307,14 @@ fn cycle_fixtures_drill_and_the_milling_ones_wait() {
     for (p, name) in cycles.iter().zip(&names) {
         let r = run(&std::fs::read_to_string(p).unwrap());
         let runs = name.as_str() >= "092" && name.as_str() <= "105" && name != "103";
-        if runs || ["109", "110", "114", "115", "116"].contains(&name.as_str()) {
+        if runs || ["114", "115", "116"].contains(&name.as_str()) {
             assert!(r.error.is_none(), "{}: {:?}", p.display(), r.error);
+            continue;
+        }
+        if name == "109" || name == "110" {
+            // T20 and T2 have no cutting edge on this test's machine (`sinumerik_milling.rs`
+            // runs them with one): no tool compensation, 61009.
+            assert_eq!(r.error.as_ref().map(|e| e.number), Some(61009), "{name}");
             continue;
         }
         if name == "117" {
