@@ -691,3 +691,94 @@ fn f110_cycle77_roughs_with_an_allowance_then_finishes_to_50() {
     assert_within(lo, -20.0, "floor");
     assert_within(hi, -20.0, "floor all round");
 }
+
+impl Stock {
+    /// Only where `region` holds is there material; elsewhere air.
+    fn only(mut self, region: impl Fn((f64, f64)) -> bool) -> Stock {
+        for i in 0..self.n {
+            for j in 0..self.n {
+                if !region(self.at(i, j)) {
+                    self.h[i * self.n + j] = f64::NEG_INFINITY;
+                }
+            }
+        }
+        self
+    }
+}
+
+#[test]
+fn f106_cycle71_faces_a_turned_rectangle_in_two_levels() {
+    // CYCLE71(10, 0, 2, −11, 100, 100, 60, 40, 10, 6, 10, 5, 0, 4000, 31, 2): the face from
+    // the corner X100 Y100, 60 × 40 turned 10°, to Z−11 within MID 6, passes along the 1st
+    // axis back and forth at most MIDA 10 apart, overrun 2; T2 D2 a 20 mm cutter.
+    let r = run_with(&fixture("106"), with_edge(22, 10.0), Library::new()).ok();
+    // The rectangle's centre in its frame is (30, 20) from the corner.
+    let (s, c) = 10f64.to_radians().sin_cos();
+    let centre = (100.0 + 30.0 * c - 20.0 * s, 100.0 + 30.0 * s + 20.0 * c);
+    let face = rounded_rect(centre, 30.0, 20.0, 0.0, 10.0);
+    let inside = move |q: (f64, f64)| face(q) <= 0.0;
+    let mut stock = Stock::new(centre, 70.0, 0.0, 10.0, |_| -1.0).only(inside);
+    stock.follow(&r.out, [0.0, 0.0, 20.0]);
+    assert_eq!(stock.rapid_cuts, 0, "down and across only outside the face");
+    let face = rounded_rect(centre, 30.0, 20.0, 0.0, 10.0);
+    let (lo, hi) = stock.floor_where(|q| face(q) <= 0.0);
+    assert_within(lo, -11.0, "the face at Z−11");
+    assert_within(hi, -11.0, "everywhere");
+    let mut levels = stock.levels.clone();
+    levels.sort_by(|a, b| b.total_cmp(a));
+    levels.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    assert_eq!(levels.len(), 2, "{levels:?}");
+    assert_within(levels[0], -5.5, "half way");
+    assert!(
+        near(&r.end(), &[0.0, 0.0, 10.0]),
+        "N40 G0 X0 Y0 (Z stays at RTP): {:?}",
+        r.end()
+    );
+}
+
+#[test]
+fn cycle71_finishing_one_way_and_its_alarms() {
+    // Roughing leaving FALD 0.4, then finishing along the 2nd axis one way.
+    let head = "G17 G90 T1 D1 S2000 M3\nG0 X-50 Y-50 Z20\n";
+    let rough = "CYCLE71(20, 5, 2, -3, 0, 0, 80, -50, 0, 4, 12, 3, 0.4, 3000, 11, 3)\n";
+    let finish = "CYCLE71(20, 5, 2, -3, 0, 0, 80, -50, 0, 4, 12, 3, 0.4, 3000, 22, 3)\n";
+    let s = with_edge(11, 8.0);
+    let r = run_with(&format!("{head}{rough}"), s.clone(), Library::new()).ok();
+    let face = rounded_rect((40.0, -25.0), 40.0, 25.0, 0.0, 0.0);
+    let mut stock =
+        Stock::new((40.0, -25.0), 70.0, 5.0, 8.0, |_| -1.0).only(move |q| face(q) <= 0.0);
+    stock.follow(&r.out, [-50.0, -50.0, 20.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    let face = rounded_rect((40.0, -25.0), 40.0, 25.0, 0.0, 0.0);
+    let (lo, hi) = stock.floor_where(|q| face(q) <= 0.0);
+    assert_within(lo, -2.6, "roughed, FALD left");
+    assert_within(hi, -2.6, "everywhere");
+    let r = run_with(&format!("{head}{rough}{finish}"), s.clone(), Library::new()).ok();
+    let face = rounded_rect((40.0, -25.0), 40.0, 25.0, 0.0, 0.0);
+    let mut stock =
+        Stock::new((40.0, -25.0), 70.0, 5.0, 8.0, |_| -1.0).only(move |q| face(q) <= 0.0);
+    stock.follow(&r.out, [-50.0, -50.0, 20.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    let face = rounded_rect((40.0, -25.0), 40.0, 25.0, 0.0, 0.0);
+    let (lo, hi) = stock.floor_where(|q| face(q) <= 0.0);
+    assert_within(lo, -3.0, "finished");
+    assert_within(hi, -3.0, "everywhere");
+    // VARI 15: 61002; MIDA wider than the cutter: 61111; a face of no width: 61118.
+    for (call, alarm) in [
+        (
+            "CYCLE71(20, 5, 2, -3, 0, 0, 80, -50, 0, 4, 12, 3, 0.4, 3000, 15, 3)",
+            61002,
+        ),
+        (
+            "CYCLE71(20, 5, 2, -3, 0, 0, 80, -50, 0, 4, 20, 3, 0.4, 3000, 11, 3)",
+            61111,
+        ),
+        (
+            "CYCLE71(20, 5, 2, -3, 0, 0, 80, 0, 0, 4, 12, 3, 0.4, 3000, 11, 3)",
+            61118,
+        ),
+    ] {
+        let r = run_with(&format!("{head}{call}\n"), s.clone(), Library::new());
+        assert_eq!(r.alarm(), (alarm, 3), "{call}");
+    }
+}

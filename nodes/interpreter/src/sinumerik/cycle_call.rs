@@ -13,7 +13,7 @@ use super::expr::Expr;
 use super::Sinumerik;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 17] = [
+const CYCLES: [(&str, &[&str]); 18] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -58,6 +58,13 @@ const CYCLES: [(&str, &[&str]); 17] = [
         ],
     ),
     (
+        "CYCLE71",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "PA", "PO", "LENG", "WID", "STA", "MID", "MIDA", "FDP",
+            "FALD", "FFP1", "VARI", "FDP1",
+        ],
+    ),
+    (
         "CYCLE76",
         &[
             "RTP", "RFP", "SDIS", "DP", "DPR", "LENG", "WID", "CRAD", "PA", "PO", "STA", "MID",
@@ -90,10 +97,10 @@ const CYCLES: [(&str, &[&str]); 17] = [
 ];
 
 /// Parameters that are lengths (converted under G70/G700).
-const LENGTHS: [&str; 36] = [
+const LENGTHS: [&str; 38] = [
     "RTP", "RFP", "SDIS", "DP", "DPR", "FDEP", "FDPR", "DAM", "PIT", "RPA", "RPO", "RPAP", "SPCA",
     "SPCO", "FDIS", "DBH", "RAD", "DIATH", "KDIAM", "CPA", "CPO", "PRAD", "PA", "PO", "MID", "FAL",
-    "FALD", "MIDA", "AP1", "AD", "RAD1", "DP1", "LENG", "WID", "CRAD", "AP2",
+    "FALD", "MIDA", "AP1", "AD", "RAD1", "DP1", "LENG", "WID", "CRAD", "AP2", "FDP", "FDP1",
 ];
 
 /// The names of every cycle of chapter 10 (the milling ones are not built yet).
@@ -187,6 +194,7 @@ impl Sinumerik {
             "CYCLE90" => return self.mill_thread(c),
             "POCKET3" => return self.rectangular_pocket(c),
             "CYCLE76" | "CYCLE77" => return self.spigot(c),
+            "CYCLE71" => return self.face(c),
             "POCKET4" => return self.circular_pocket(c),
             _ => {}
         }

@@ -8,6 +8,7 @@ use cnc_interpreter_core::{ProgramError, SpindleDir};
 
 use super::cycle_call::CycleCall;
 use super::drilling::CycleAlarm;
+use super::face::{face_milling, Face};
 use super::pocket::{circular_pocket, CirclePocket, Insertion};
 use super::rect_pocket::{rectangular_pocket, RectPocket};
 use super::spigot::{spigot, Spigot};
@@ -15,6 +16,30 @@ use super::thread_mill::{thread_milling, Thread};
 use super::Sinumerik;
 
 impl Sinumerik {
+    /// CYCLE71: face milling with the active cutting edge.
+    pub(super) fn face(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
+        let p = Face {
+            rtp: c.or("RTP", 0.0),
+            rfp: c.or("RFP", 0.0),
+            sdis: c.or("SDIS", 0.0),
+            dp: c.or("DP", 0.0),
+            corner: (c.or("PA", 0.0), c.or("PO", 0.0)),
+            leng: c.or("LENG", 0.0),
+            wid: c.or("WID", 0.0),
+            sta: c.or("STA", 0.0),
+            mid: c.or("MID", 0.0).abs(),
+            mida: c.or("MIDA", 0.0).abs(),
+            fdp: c.or("FDP", 0.0),
+            fald: c.or("FALD", 0.0).abs(),
+            ffp1: c.or("FFP1", 0.0),
+            vari: c.or("VARI", 0.0).round() as i64,
+            fdp1: c.or("FDP1", 0.0),
+        };
+        let radius = self.offset_entry().map(|e| e.radius);
+        let moves = face_milling(p, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
+        self.run_path(moves)
+    }
+
     /// CYCLE90: the thread milled about CPA/CPO with the active cutting edge's radius.
     pub(super) fn mill_thread(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
         let (rtp, rfp) = (c.or("RTP", 0.0), c.or("RFP", 0.0));

@@ -13,6 +13,7 @@ mod cutter_path;
 mod cycle_call;
 mod drilling;
 mod exec;
+mod face;
 pub use exec::{g_group, NOT_BUILT, NOT_BUILT_G};
 pub mod expr;
 mod frames;
