@@ -266,9 +266,10 @@ fn f072_the_first_fulfilled_jump_of_a_block_wins() {
 /// The fixtures that call a cycle of chapter 10 (issue 24): 006, 075, 076 and 092–117.
 /// The drilling cycles and hole patterns (092–105) run as printed, 103 up to the placeholder
 /// the manual prints in it (`sinumerik_drilling.rs` asserts what each does); CYCLE71 (106),
-/// CYCLE76 (109), CYCLE77 (110), POCKET3 (114), POCKET4 (115) and CYCLE90 (116, 117) mill
-/// (`sinumerik_milling.rs`); the other milling cycles (107, 108, 111–113) stop with 12140 at
-/// their first call, nothing of that block moving;
+/// CYCLE76 (109), CYCLE77 (110), LONGHOLE (111), SLOT1 (112), POCKET3 (114), POCKET4 (115)
+/// and CYCLE90 (116, 117) mill (`sinumerik_milling.rs`; here some meet the alarm of a tool
+/// this machine lacks); CYCLE72 (107, 108) and SLOT2 (113) stop with 12140 at their first
+/// call, nothing of that block moving;
 /// 006, 075 and 076 are templates that stop earlier, at a placeholder (12080).
 #[test]
 fn cycle_fixtures_drill_and_the_milling_ones_wait() {
@@ -317,9 +318,14 @@ fn cycle_fixtures_drill_and_the_milling_ones_wait() {
             assert_eq!(r.error.as_ref().map(|e| e.number), Some(61009), "{name}");
             continue;
         }
-        if name == "106" {
-            // T2 D2 has no cutting edge here either: no tool offset, 61000.
+        if name == "106" || name == "111" {
+            // T2 D2 and T10 D9 have no cutting edge here either: no tool offset, 61000.
             assert_eq!(r.error.as_ref().map(|e| e.number), Some(61000), "{name}");
+            continue;
+        }
+        if name == "112" {
+            // This machine's T1 D1 (20 mm) is wider than the 15 mm slot: 61105.
+            assert_eq!(r.error.as_ref().map(|e| e.number), Some(61105), "{name}");
             continue;
         }
         if name == "117" {

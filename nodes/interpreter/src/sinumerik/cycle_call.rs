@@ -13,7 +13,7 @@ use super::expr::Expr;
 use super::Sinumerik;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 18] = [
+const CYCLES: [(&str, &[&str]); 20] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -58,6 +58,20 @@ const CYCLES: [(&str, &[&str]); 18] = [
         ],
     ),
     (
+        "LONGHOLE",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "DPR", "NUM", "LENG", "CPA", "CPO", "RAD", "STA1", "INDA",
+            "FFD", "FFP1", "MID",
+        ],
+    ),
+    (
+        "SLOT1",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "DPR", "NUM", "LENG", "WID", "CPA", "CPO", "RAD", "STA1",
+            "INDA", "FFD", "FFP1", "MID", "CDIR", "FAL", "VARI", "MIDF", "FFP2", "SSF",
+        ],
+    ),
+    (
         "CYCLE71",
         &[
             "RTP", "RFP", "SDIS", "DP", "PA", "PO", "LENG", "WID", "STA", "MID", "MIDA", "FDP",
@@ -97,13 +111,14 @@ const CYCLES: [(&str, &[&str]); 18] = [
 ];
 
 /// Parameters that are lengths (converted under G70/G700).
-const LENGTHS: [&str; 38] = [
+const LENGTHS: [&str; 39] = [
     "RTP", "RFP", "SDIS", "DP", "DPR", "FDEP", "FDPR", "DAM", "PIT", "RPA", "RPO", "RPAP", "SPCA",
     "SPCO", "FDIS", "DBH", "RAD", "DIATH", "KDIAM", "CPA", "CPO", "PRAD", "PA", "PO", "MID", "FAL",
     "FALD", "MIDA", "AP1", "AD", "RAD1", "DP1", "LENG", "WID", "CRAD", "AP2", "FDP", "FDP1",
+    "MIDF",
 ];
 
-/// The names of every cycle of chapter 10 (the milling ones are not built yet).
+/// The names of every cycle of chapter 10.
 pub fn is_cycle(name: &str) -> bool {
     name.starts_with("CYCLE")
         || [
@@ -195,6 +210,7 @@ impl Sinumerik {
             "POCKET3" => return self.rectangular_pocket(c),
             "CYCLE76" | "CYCLE77" => return self.spigot(c),
             "CYCLE71" => return self.face(c),
+            "LONGHOLE" | "SLOT1" => return self.slots(c),
             "POCKET4" => return self.circular_pocket(c),
             _ => {}
         }

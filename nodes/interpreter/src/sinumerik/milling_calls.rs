@@ -11,11 +11,66 @@ use super::drilling::CycleAlarm;
 use super::face::{face_milling, Face};
 use super::pocket::{circular_pocket, CirclePocket, Insertion};
 use super::rect_pocket::{rectangular_pocket, RectPocket};
+use super::slots::{long_holes, slots, Pattern, Slot};
 use super::spigot::{spigot, Spigot};
 use super::thread_mill::{thread_milling, Thread};
 use super::Sinumerik;
 
 impl Sinumerik {
+    /// LONGHOLE and SLOT1: holes or slots on a circle with the active cutting edge; SLOT1
+    /// finishes at SSF when it is given.
+    pub(super) fn slots(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
+        let (rtp, rfp) = (c.or("RTP", 0.0), c.or("RFP", 0.0));
+        let dp = match c.get("DPR").filter(|d| *d != 0.0) {
+            Some(r) => rfp - (rtp - rfp).signum() * r.abs(),
+            None => c.or("DP", rfp),
+        };
+        let p = Pattern {
+            rtp,
+            rfp,
+            sdis: c.or("SDIS", 0.0),
+            dp,
+            num: c.or("NUM", 0.0).round().clamp(0.0, 9_999.0) as usize,
+            leng: c.or("LENG", 0.0).abs(),
+            centre: (c.or("CPA", 0.0), c.or("CPO", 0.0)),
+            rad: c.or("RAD", 0.0),
+            sta1: c.or("STA1", 0.0),
+            inda: c.or("INDA", 0.0),
+            ffd: c.or("FFD", 0.0),
+            ffp1: c.or("FFP1", 0.0),
+            mid: c.or("MID", 0.0).abs(),
+        };
+        let radius = self.offset_entry().map(|e| e.radius);
+        if c.name == "LONGHOLE" {
+            let (h, v) = self.core.plane_axes()?;
+            let here = self.core.work_position();
+            let moves = long_holes(p, radius, (here[h], here[v]))
+                .map_err(|a| self.cycle_alarm(a, c.name))?;
+            return self.run_path(moves);
+        }
+        let s = Slot {
+            wid: c.or("WID", 0.0).abs(),
+            // CDIR 2 is G2; anything else G3, as the manual's message says.
+            ccw: c.or("CDIR", 3.0).round() != 2.0,
+            fal: c.or("FAL", 0.0),
+            vari: c.or("VARI", 0.0).round() as i64,
+            midf: c.or("MIDF", 0.0).abs(),
+            ffp2: c.or("FFP2", 0.0),
+        };
+        let (rough, finish) = slots(p, s, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
+        self.run_path(rough)?;
+        let before = self.core.rpm;
+        let ssf = c.get("SSF").filter(|s| *s > 0.0 && !finish.is_empty());
+        if let Some(s) = ssf {
+            self.core.set_rpm(s);
+        }
+        self.run_path(finish)?;
+        if ssf.is_some() {
+            self.core.set_rpm(before);
+        }
+        Ok(())
+    }
+
     /// CYCLE71: face milling with the active cutting edge.
     pub(super) fn face(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
         let p = Face {

@@ -23,6 +23,7 @@ mod milling_calls;
 mod motion;
 mod pocket;
 mod rect_pocket;
+mod slots;
 mod spigot;
 mod thread_mill;
 mod tool;

@@ -1,0 +1,255 @@
+//! LONGHOLE and SLOT1, elongated holes and slots on a circle (`001` §10.6.6–§10.6.7;
+//! inventory §4.5), as pure functions. Each hole or slot lies with its long axis radial, its
+//! middle on the circle of radius RAD about CPA/CPO, at STA1 + k·INDA (INDA 0: spread over
+//! the full circle); LENG is its whole length. A long hole is as wide as the cutter and is
+//! milled back and forth, the cutter plunging at alternate ends; a slot is a stadium, roughed
+//! along its middle and then round it out to the allowance, and finished round its wall.
+//! Decision D90.
+
+use super::cutter_path::{round_rect, Frame, Move};
+use super::drilling::CycleAlarm;
+use super::pocket::levels;
+
+/// Where the holes or slots lie, their size and depth; lengths in mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pattern {
+    pub rtp: f64,
+    pub rfp: f64,
+    pub sdis: f64,
+    pub dp: f64,
+    pub num: usize,
+    pub leng: f64,
+    pub centre: (f64, f64),
+    pub rad: f64,
+    pub sta1: f64,
+    pub inda: f64,
+    pub ffd: f64,
+    pub ffp1: f64,
+    pub mid: f64,
+}
+
+/// SLOT1's own parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slot {
+    pub wid: f64,
+    pub ccw: bool,
+    pub fal: f64,
+    /// 0 roughing and finishing, 1 roughing, 2 finishing.
+    pub vari: i64,
+    /// Finishing infeed (0: the whole depth at once) and feed.
+    pub midf: f64,
+    pub ffp2: f64,
+}
+
+fn alarm(number: u32, text: &str) -> CycleAlarm {
+    CycleAlarm {
+        number,
+        text: text.into(),
+    }
+}
+
+impl Pattern {
+    fn check(&self) -> Result<f64, CycleAlarm> {
+        if self.num == 0 {
+            return Err(alarm(61103, "number of holes is zero"));
+        }
+        if self.ffd <= 0.0 || self.ffp1 <= 0.0 {
+            return Err(alarm(
+                61003,
+                "no feed programmed in the cycle: FFD and FFP1",
+            ));
+        }
+        let down = (self.dp - self.rfp).signum();
+        if self.dp == self.rfp || (self.rtp - self.rfp) * down >= 0.0 {
+            return Err(alarm(
+                61101,
+                "reference plane defined incorrectly: RTP before RFP, DP beyond it",
+            ));
+        }
+        Ok(down)
+    }
+
+    /// The frame of hole `k`: its middle at the origin, its long axis along x.
+    fn frame(&self, k: usize) -> Frame {
+        let inda = if self.inda == 0.0 {
+            360.0 / self.num as f64
+        } else {
+            self.inda
+        };
+        let a = (self.sta1 + inda * k as f64).to_radians();
+        Frame {
+            centre: (
+                self.centre.0 + self.rad * a.cos(),
+                self.centre.1 + self.rad * a.sin(),
+            ),
+            cos: a.cos(),
+            sin: a.sin(),
+        }
+    }
+
+    /// 61104 when two of the holes, `half` their length less `width`/2 either side of their
+    /// middle along the radius, come closer than `width`.
+    fn apart(&self, half: f64, width: f64) -> Result<(), CycleAlarm> {
+        let seg = |k: usize| {
+            let f = self.frame(k);
+            (f.put((-half, 0.0)), f.put((half, 0.0)))
+        };
+        for i in 0..self.num {
+            for j in i + 1..self.num {
+                if segment_distance(seg(i), seg(j)) < width - 1e-9 {
+                    return Err(alarm(
+                        61104,
+                        "contour violation of slots/elongated holes: they overlap",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+type Pt2 = (f64, f64);
+
+fn point_segment(p: Pt2, (a, b): (Pt2, Pt2)) -> f64 {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((p.0 - a.0) * dx + (p.1 - a.1) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p.0 - a.0 - t * dx).hypot(p.1 - a.1 - t * dy)
+}
+
+fn segment_distance(s: (Pt2, Pt2), t: (Pt2, Pt2)) -> f64 {
+    let cross = |o: Pt2, a: Pt2, b: Pt2| (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0);
+    let d1 = cross(t.0, t.1, s.0);
+    let d2 = cross(t.0, t.1, s.1);
+    let d3 = cross(s.0, s.1, t.0);
+    let d4 = cross(s.0, s.1, t.1);
+    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+        return 0.0;
+    }
+    point_segment(s.0, t)
+        .min(point_segment(s.1, t))
+        .min(point_segment(t.0, s))
+        .min(point_segment(t.1, s))
+}
+
+/// LONGHOLE: each hole from its end nearer to the tool, plunging at FFD at alternate ends
+/// and milling to the other at FFP1, level by level within MID, out at rapid to RTP.
+pub fn long_holes(
+    p: Pattern,
+    tool_radius: Option<f64>,
+    from: Pt2,
+) -> Result<Vec<Move>, CycleAlarm> {
+    let wr = tool_radius
+        .filter(|r| *r > 0.0)
+        .ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
+    let down = p.check()?;
+    if p.leng < 2.0 * wr {
+        return Err(alarm(
+            61105,
+            "the hole is shorter than the cutter's diameter",
+        ));
+    }
+    let half = p.leng / 2.0 - wr;
+    p.apart(half, 2.0 * wr)?;
+    let safety = p.rfp - down * p.sdis.abs();
+    let mut m = Vec::new();
+    let mut here = from;
+    for k in 0..p.num {
+        let f = p.frame(k);
+        let ends = [f.put((-half, 0.0)), f.put((half, 0.0))];
+        let near = |q: Pt2| (q.0 - here.0).hypot(q.1 - here.1);
+        let mut at = usize::from(near(ends[1]) < near(ends[0]));
+        m.push(Move::Rapid((ends[at].0, ends[at].1, p.rtp)));
+        m.push(Move::Rapid((ends[at].0, ends[at].1, safety)));
+        for level in levels(p.rfp, p.dp, p.mid) {
+            m.push(Move::Line((ends[at].0, ends[at].1, level), p.ffd));
+            at = 1 - at;
+            m.push(Move::Line((ends[at].0, ends[at].1, level), p.ffp1));
+        }
+        m.push(Move::Rapid((ends[at].0, ends[at].1, p.rtp)));
+        here = ends[at];
+    }
+    Ok(m)
+}
+
+/// SLOT1: roughing and finishing as two move lists (finishing may turn at its own speed).
+pub fn slots(
+    p: Pattern,
+    s: Slot,
+    tool_radius: Option<f64>,
+) -> Result<(Vec<Move>, Vec<Move>), CycleAlarm> {
+    let wr = tool_radius
+        .filter(|r| *r > 0.0)
+        .ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
+    let down = p.check()?;
+    if !(0..=2).contains(&s.vari) {
+        return Err(alarm(
+            61002,
+            "VARI is 0 complete, 1 roughing or 2 finishing",
+        ));
+    }
+    let (a, b) = (p.leng / 2.0, s.wid / 2.0);
+    if 2.0 * wr >= s.wid || a < b {
+        return Err(alarm(
+            61105,
+            "cutter radius too large: its diameter must be below the width WID",
+        ));
+    }
+    // The allowance shrinks when the cutter leaves no room for it (§10.6.7).
+    let fal = s.fal.abs().min(b - wr - 1e-3).max(0.0);
+    p.apart(a - b, s.wid)?;
+    let safety = p.rfp - down * p.sdis.abs();
+    let step = 1.6 * wr;
+    let (mut rough, mut finish) = (Vec::new(), Vec::new());
+    for k in 0..p.num {
+        let f = p.frame(k);
+        let mid_end = |sign: f64| f.put((sign * (a - b), 0.0));
+        if s.vari != 2 {
+            let m = &mut rough;
+            let start = mid_end(-1.0);
+            m.push(Move::Rapid((start.0, start.1, p.rtp)));
+            m.push(Move::Rapid((start.0, start.1, safety)));
+            // Loops from the middle line out to the allowance, at most 80 % of the
+            // cutter's diameter apart.
+            let last = fal + wr;
+            let n = ((b - last) / step - 1e-9).ceil().max(1.0) as usize;
+            let mut end = -1.0;
+            for level in levels(p.rfp, p.dp, p.mid) {
+                let q = mid_end(end);
+                m.push(Move::Line((q.0, q.1, level), p.ffd));
+                end = -end;
+                let q = mid_end(end);
+                m.push(Move::Line((q.0, q.1, level), p.ffp1));
+                for i in 1..=n {
+                    let o = b - (b - last) * i as f64 / n as f64;
+                    m.push(f.line((a - o, 0.0), level, p.ffp1));
+                    m.extend(round_rect(&f, a - o, b - o, b - o, level, s.ccw, p.ffp1));
+                }
+                let q = mid_end(1.0);
+                m.push(Move::Line((q.0, q.1, level), p.ffp1));
+                end = 1.0;
+            }
+            let q = mid_end(1.0);
+            m.push(Move::Rapid((q.0, q.1, p.rtp)));
+        }
+        if s.vari != 1 {
+            let m = &mut finish;
+            let feed = if s.ffp2 > 0.0 { s.ffp2 } else { p.ffp1 };
+            let q = mid_end(1.0);
+            m.push(Move::Rapid((q.0, q.1, p.rtp)));
+            m.push(Move::Rapid((q.0, q.1, safety)));
+            for level in levels(p.rfp, p.dp, s.midf) {
+                m.push(Move::Line((q.0, q.1, level), p.ffd));
+                m.push(f.line((a - wr, 0.0), level, feed));
+                m.extend(round_rect(&f, a - wr, b - wr, b - wr, level, s.ccw, feed));
+                m.push(Move::Line((q.0, q.1, level), feed));
+            }
+            m.push(Move::Rapid((q.0, q.1, p.rtp)));
+        }
+    }
+    Ok((rough, finish))
+}
