@@ -530,7 +530,7 @@ fn cycle_alarms_as_the_manual_lists_them() {
         (61106, 3)
     );
     // A milling cycle: not built yet, with the reason.
-    let r = run(&format!("{head}SLOT1(110, 100, 2, 35, , 4, 30, 10, 50, 50, 20, 0, 90, 100, 200, 5, 2, 0.5, 0, 2, 150, 500)\n"));
+    let r = run(&format!("{head}SLOT2(110, 100, 2, 35, , 3, 70, 15, 60, 60, 42, , 120, 100, 300, 6, 2, 0.5, 0, , 0, )\n"));
     assert_eq!(r.alarm(), (12140, 2));
     assert!(r.error.unwrap().text.contains("milling cycles"));
 }
