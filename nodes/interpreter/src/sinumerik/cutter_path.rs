@@ -5,7 +5,37 @@
 use cnc_interpreter_core::geometry::Pt;
 use cnc_interpreter_core::{MoveKind, ProgramError};
 
+use super::drilling::CycleAlarm;
 use super::Sinumerik;
+
+/// Most moves one cycle call makes: a call whose parameters would make more (a MID of a
+/// micrometre on a deep pocket) is refused with 12140 before anything moves.
+pub const MAX_MOVES: usize = 200_000;
+
+fn too_many() -> CycleAlarm {
+    CycleAlarm {
+        number: 12140,
+        text: format!("the call would make more than {MAX_MOVES} moves: its steps are too fine for this controller"),
+    }
+}
+
+/// `x` rounded up to a whole number of steps (at least `least`), refused beyond what one
+/// cycle may make.
+pub fn steps(x: f64, least: usize) -> Result<usize, CycleAlarm> {
+    let n = (x - 1e-9).ceil();
+    if !n.is_finite() || n > MAX_MOVES as f64 {
+        return Err(too_many());
+    }
+    Ok((n.max(0.0) as usize).max(least))
+}
+
+/// Refuses a path grown beyond [`MAX_MOVES`].
+pub fn within_budget(m: &[Move]) -> Result<(), CycleAlarm> {
+    if m.len() > MAX_MOVES {
+        return Err(too_many());
+    }
+    Ok(())
+}
 
 /// A point: 1st and 2nd plane axis, infeed axis.
 pub type P3 = (f64, f64, f64);

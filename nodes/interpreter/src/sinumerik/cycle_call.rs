@@ -8,6 +8,7 @@
 
 use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleDir};
 
+use super::cutter_path::MAX_MOVES;
 use super::drilling::{self, CycleAlarm, DeepHole, Levels, Step};
 use super::expr::Expr;
 use super::Sinumerik;
@@ -239,6 +240,20 @@ impl Sinumerik {
         }
     }
 
+    /// 12140 when a call would make more than [`MAX_MOVES`] moves.
+    fn within_budget(&self, moves: usize, name: &str) -> Result<(), ProgramError> {
+        if moves > MAX_MOVES {
+            return Err(self.cycle_alarm(
+                CycleAlarm {
+                    number: 12140,
+                    text: format!("the call would make more than {MAX_MOVES} moves"),
+                },
+                name,
+            ));
+        }
+        Ok(())
+    }
+
     /// The drilling axis: the plane's normal.
     fn drill_axis(&self) -> Result<usize, ProgramError> {
         self.core.plane_normal().ok_or_else(|| {
@@ -254,6 +269,7 @@ impl Sinumerik {
         let name = c.name;
         let d = self.drill_axis()?;
         let steps = self.drill_steps(c).map_err(|a| self.cycle_alarm(a, name))?;
+        self.within_budget(steps.len(), name)?;
         let hole = self.core.work_position();
         for s in steps {
             self.do_step(d, &hole, s)?;
@@ -446,6 +462,11 @@ impl Sinumerik {
             e.number = 62100;
             return Err(e);
         };
+        let per_hole = self
+            .drill_steps(&modal)
+            .map_err(|a| self.cycle_alarm(a, modal.name))?
+            .len();
+        self.within_budget(per_hole.saturating_mul(points.len()), c.name)?;
         let (h, v) = self.core.plane_axes()?;
         let here = self.core.work_position();
         // The row starts at the end nearer to where the tool is (§10.5.2).

@@ -4,7 +4,7 @@
 //! forth, each pass at most MIDA from the last, the cutter running out past the edges and
 //! coming down outside the face. No radius compensation. Decision D89.
 
-use super::cutter_path::{Frame, Move};
+use super::cutter_path::{steps, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::levels;
 
@@ -92,7 +92,7 @@ pub fn face_milling(p: Face, tool_radius: Option<f64>) -> Result<Vec<Move>, Cycl
     // centre FDP1 − its radius past the far edge.
     let first = w0 + mida - wr;
     let last = (w1 + p.fdp1 - wr).max(first);
-    let n = ((last - first) / mida - 1e-9).ceil().max(0.0) as usize;
+    let n = steps((last - first) / mida, 0)?;
     let passes: Vec<f64> = (0..=n)
         .map(|k| {
             if n == 0 {
@@ -108,7 +108,7 @@ pub fn face_milling(p: Face, tool_radius: Option<f64>) -> Result<Vec<Move>, Cycl
     let planes = if finishing {
         vec![p.dp]
     } else {
-        levels(p.rfp, floor, p.mid)
+        levels(p.rfp, floor, p.mid)?
     };
     let put = |u: f64, w: f64, z: f64| {
         let q = f.put(frame(u, w));
@@ -149,6 +149,7 @@ pub fn face_milling(p: Face, tool_radius: Option<f64>) -> Result<Vec<Move>, Cycl
         }
         let here = m_point(&m);
         m.push(Move::Rapid((here.0, here.1, lift)));
+        within_budget(&m)?;
     }
     let here = m_point(&m);
     m.push(Move::Rapid((here.0, here.1, p.rtp)));

@@ -4,7 +4,7 @@
 //! or on a helix, then widening in rings at most MIDA apart; finishing takes the wall in one
 //! turn per level, entered and left on quarter circles, then the floor. Decision D87.
 
-use super::cutter_path::{Move, P3};
+use super::cutter_path::{steps, within_budget, Move, P3};
 use super::drilling::CycleAlarm;
 
 /// How roughing enters each level.
@@ -48,16 +48,12 @@ fn alarm(number: u32, text: &str) -> CycleAlarm {
 
 /// The levels from `top` to `bottom`, at most `mid` apart and evenly spread (the fewest);
 /// `mid` 0: one.
-pub fn levels(top: f64, bottom: f64, mid: f64) -> Vec<f64> {
+pub fn levels(top: f64, bottom: f64, mid: f64) -> Result<Vec<f64>, CycleAlarm> {
     let depth = (bottom - top).abs();
-    let n = if mid > 0.0 {
-        (depth / mid - 1e-9).ceil().max(1.0) as usize
-    } else {
-        1
-    };
-    (1..=n)
+    let n = if mid > 0.0 { steps(depth / mid, 1)? } else { 1 };
+    Ok((1..=n)
         .map(|k| top + (bottom - top) * k as f64 / n as f64)
-        .collect()
+        .collect())
 }
 
 /// The cutter centre's moves for POCKET4 with a cutter of `tool_radius` (`None`: no cutting
@@ -104,12 +100,13 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
         });
     };
     // Rings out to `outer` (the centre's radius), at most `mida` apart.
-    let rings = |m: &mut Vec<Move>, outer: f64, z: f64| {
-        let n = (outer / mida - 1e-9).ceil().max(1.0) as usize;
+    let rings = |m: &mut Vec<Move>, outer: f64, z: f64| -> Result<(), CycleAlarm> {
+        let n = steps(outer / mida, 1)?;
         for k in 1..=n {
             ring(m, outer * k as f64 / n as f64, z, p.ffp1);
         }
         m.push(Move::Line((cx, cy, z), p.ffp1));
+        within_budget(m)
     };
     if p.roughing {
         let outer = p.prad - p.fal - wr;
@@ -119,12 +116,12 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
             }
         }
         let mut z = safety;
-        for level in levels(p.rfp, floor, p.mid) {
+        for level in levels(p.rfp, floor, p.mid)? {
             match p.insertion {
                 Insertion::Vertical => m.push(Move::Line((cx, cy, level), p.ffd)),
                 Insertion::Helix { radius, per_turn } => {
                     m.push(Move::Line((cx + radius, cy, z), p.ffp1));
-                    let turns = ((level - z).abs() / per_turn - 1e-9).ceil().max(1.0) as usize;
+                    let turns = steps((level - z).abs() / per_turn, 1)?;
                     for k in 1..=turns {
                         let at = z + (level - z) * k as f64 / turns as f64;
                         m.push(Move::Arc {
@@ -139,7 +136,7 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
                     m.push(Move::Line((cx, cy, level), p.ffp1));
                 }
             }
-            rings(&mut m, outer, level);
+            rings(&mut m, outer, level)?;
             z = level;
         }
     } else {
@@ -150,7 +147,7 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
             let turn = if p.ccw { 1.0 } else { -1.0 };
             let inside = wall - ra;
             let clear = |pt: (f64, f64)| (pt.0 - cx).hypot(pt.1 - cy) <= wall - p.fal;
-            for level in levels(p.rfp, floor, p.mid) {
+            for level in levels(p.rfp, floor, p.mid)? {
                 let a: P3 = (cx + inside, cy - turn * ra, level);
                 m.push(Move::Rapid((cx, cy, level)));
                 if clear((a.0, a.1)) {
@@ -182,7 +179,7 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
         if p.fald > 0.0 {
             m.push(Move::Rapid((cx, cy, floor - down * p.sdis.abs())));
             m.push(Move::Line((cx, cy, p.dp), p.ffd));
-            rings(&mut m, wall, p.dp);
+            rings(&mut m, wall, p.dp)?;
         }
     }
     m.push(Move::Rapid((cx, cy, p.rtp)));
@@ -195,8 +192,12 @@ mod tests {
 
     #[test]
     fn levels_are_even_and_at_most_mid_apart() {
-        assert_eq!(levels(0.0, -20.0, 6.0), [-5.0, -10.0, -15.0, -20.0]);
-        assert_eq!(levels(0.0, -20.0, 0.0), [-20.0]);
-        assert_eq!(levels(0.0, -12.0, 4.0), [-4.0, -8.0, -12.0]);
+        assert_eq!(
+            levels(0.0, -20.0, 6.0).unwrap(),
+            [-5.0, -10.0, -15.0, -20.0]
+        );
+        assert_eq!(levels(0.0, -20.0, 0.0).unwrap(), [-20.0]);
+        assert_eq!(levels(0.0, -12.0, 4.0).unwrap(), [-4.0, -8.0, -12.0]);
+        assert_eq!(levels(0.0, -1000.0, 1e-6).unwrap_err().number, 12140);
     }
 }

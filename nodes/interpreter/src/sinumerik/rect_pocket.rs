@@ -4,7 +4,7 @@
 //! rectangles at most MIDA apart; finishing takes the wall once per level (entered and left on
 //! quarter circles) and the floor. Decision D87.
 
-use super::cutter_path::{round_rect, Frame, Move};
+use super::cutter_path::{round_rect, steps, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::{levels, Insertion};
 
@@ -93,8 +93,8 @@ pub fn rectangular_pocket(
     let floor = p.dp - down * p.fald.abs();
     let mut m = vec![Move::Rapid((cx, cy, p.rtp)), Move::Rapid((cx, cy, safety))];
     // Clearing out to the centre path of half sizes a × b, corner radius r.
-    let clear = |m: &mut Vec<Move>, a: f64, b: f64, r: f64, z: f64| {
-        let n = (b / mida - 1e-9).ceil().max(1.0) as usize;
+    let clear = |m: &mut Vec<Move>, a: f64, b: f64, r: f64, z: f64| -> Result<(), CycleAlarm> {
+        let n = steps(b / mida, 1)?;
         // The slot along the long axis, then rectangles out to the wall's path.
         if a - b > 1e-9 {
             m.push(f.line((-(a - b), 0.0), z, p.ffp1));
@@ -106,6 +106,7 @@ pub fn rectangular_pocket(
             m.extend(round_rect(&f, a - d, b - d, r - d, z, p.ccw, p.ffp1));
         }
         m.push(f.line((0.0, 0.0), z, p.ffp1));
+        within_budget(m)
     };
     if p.roughing {
         let (a, b) = (long - p.fal - wr, short - p.fal - wr);
@@ -116,14 +117,14 @@ pub fn rectangular_pocket(
             }
         }
         let mut z = safety;
-        for level in levels(p.rfp, floor, p.mid) {
+        for level in levels(p.rfp, floor, p.mid)? {
             match p.insertion {
                 Insertion::Vertical => m.push(Move::Line((cx, cy, level), p.ffd)),
                 Insertion::Helix { radius, per_turn } => {
                     // Started on the positive long axis (§10.6.9).
                     let start = f.put((radius, 0.0));
                     m.push(Move::Line((start.0, start.1, z), p.ffp1));
-                    let turns = ((level - z).abs() / per_turn - 1e-9).ceil().max(1.0) as usize;
+                    let turns = steps((level - z).abs() / per_turn, 1)?;
                     for k in 1..=turns {
                         let at = z + (level - z) * k as f64 / turns as f64;
                         m.push(Move::Arc {
@@ -142,7 +143,7 @@ pub fn rectangular_pocket(
                     m.push(Move::Line((cx, cy, level), p.ffp1));
                 }
             }
-            clear(&mut m, a, b, r, level);
+            clear(&mut m, a, b, r, level)?;
             z = level;
         }
     } else {
@@ -152,7 +153,7 @@ pub fn rectangular_pocket(
             let ra = p.fal.max(2.0).min(b / 2.0);
             let turn = if p.ccw { 1.0 } else { -1.0 };
             let roughed = (long - p.fal - wr, short - p.fal - wr);
-            for level in levels(p.rfp, floor, p.mid) {
+            for level in levels(p.rfp, floor, p.mid)? {
                 let entry = (a - ra, -turn * ra);
                 m.push(Move::Rapid((cx, cy, level)));
                 // The entry point was cleared by roughing when it lies inside its path.
@@ -171,7 +172,7 @@ pub fn rectangular_pocket(
         if p.fald > 0.0 {
             m.push(Move::Rapid((cx, cy, floor - down * p.sdis.abs())));
             m.push(Move::Line((cx, cy, p.dp), p.ffd));
-            clear(&mut m, a, b, r, p.dp);
+            clear(&mut m, a, b, r, p.dp)?;
         }
     }
     m.push(Move::Rapid((cx, cy, p.rtp)));

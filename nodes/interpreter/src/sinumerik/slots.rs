@@ -6,7 +6,7 @@
 //! along its middle and then round it out to the allowance, and finished round its wall.
 //! Decision D90.
 
-use super::cutter_path::{round_rect, Frame, Move};
+use super::cutter_path::{round_rect, steps, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::levels;
 
@@ -165,13 +165,14 @@ pub fn long_holes(
         let mut at = usize::from(near(ends[1]) < near(ends[0]));
         m.push(Move::Rapid((ends[at].0, ends[at].1, p.rtp)));
         m.push(Move::Rapid((ends[at].0, ends[at].1, safety)));
-        for level in levels(p.rfp, p.dp, p.mid) {
+        for level in levels(p.rfp, p.dp, p.mid)? {
             m.push(Move::Line((ends[at].0, ends[at].1, level), p.ffd));
             at = 1 - at;
             m.push(Move::Line((ends[at].0, ends[at].1, level), p.ffp1));
         }
         m.push(Move::Rapid((ends[at].0, ends[at].1, p.rtp)));
         here = ends[at];
+        within_budget(&m)?;
     }
     Ok(m)
 }
@@ -216,9 +217,9 @@ pub fn slots(
             // Loops from the middle line out to the allowance, at most 80 % of the
             // cutter's diameter apart.
             let last = fal + wr;
-            let n = ((b - last) / step - 1e-9).ceil().max(1.0) as usize;
+            let n = steps((b - last) / step, 1)?;
             let mut end = -1.0;
-            for level in levels(p.rfp, p.dp, p.mid) {
+            for level in levels(p.rfp, p.dp, p.mid)? {
                 let q = mid_end(end);
                 m.push(Move::Line((q.0, q.1, level), p.ffd));
                 end = -end;
@@ -232,6 +233,7 @@ pub fn slots(
                 let q = mid_end(1.0);
                 m.push(Move::Line((q.0, q.1, level), p.ffp1));
                 end = 1.0;
+                within_budget(m)?;
             }
             let q = mid_end(1.0);
             m.push(Move::Rapid((q.0, q.1, p.rtp)));
@@ -242,11 +244,12 @@ pub fn slots(
             let q = mid_end(1.0);
             m.push(Move::Rapid((q.0, q.1, p.rtp)));
             m.push(Move::Rapid((q.0, q.1, safety)));
-            for level in levels(p.rfp, p.dp, s.midf) {
+            for level in levels(p.rfp, p.dp, s.midf)? {
                 m.push(Move::Line((q.0, q.1, level), p.ffd));
                 m.push(f.line((a - wr, 0.0), level, feed));
                 m.extend(round_rect(&f, a - wr, b - wr, b - wr, level, s.ccw, feed));
                 m.push(Move::Line((q.0, q.1, level), feed));
+                within_budget(m)?;
             }
             m.push(Move::Rapid((q.0, q.1, p.rtp)));
         }

@@ -4,7 +4,7 @@
 //! on a semicircle, goes round the spigot from the blank's edge inwards (one turn when no
 //! blank is given, as the manual's cycle does), leaves on a semicircle. Decision D88.
 
-use super::cutter_path::{round_rect, Frame, Move};
+use super::cutter_path::{round_rect, steps, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::levels;
 
@@ -76,12 +76,12 @@ pub fn spigot(p: Spigot, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAla
     // Offsets of the cutter's centre from the spigot's wall, outermost first: out to where
     // the cutter's edge reaches the blank's farthest corner, at most 80 % of its diameter
     // apart, in to `last`.
-    let offsets = |last: f64| -> Vec<f64> {
+    let offsets = |last: f64| -> Result<Vec<f64>, CycleAlarm> {
         let far = p.blank.map_or(last, |(bx, by)| {
             (outside((bx, by), (a, b), r) - wr + 1e-3).max(last)
         });
-        let n = ((far - last) / step - 1e-9).ceil().max(0.0) as usize;
-        (0..=n)
+        let n = steps((far - last) / step, 0)?;
+        Ok((0..=n)
             .map(|k| {
                 if n == 0 {
                     last
@@ -89,52 +89,54 @@ pub fn spigot(p: Spigot, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAla
                     far - (far - last) * k as f64 / n as f64
                 }
             })
-            .collect()
+            .collect())
     };
     let safety = p.rfp - down * p.sdis.abs();
     let ra = wr;
-    let turn_round = |m: &mut Vec<Move>, offs: &[f64], z: f64, feed_in: f64| {
-        let o0 = offs[0];
-        let start = (a + o0 + 2.0 * ra, 0.0);
-        m.push(f.line(start, z, feed_in));
-        // In on a semicircle against the milling direction, tangent to the first turn.
-        m.push(f.arc((a + o0, 0.0), (a + o0 + ra, 0.0), z, !p.ccw, p.ffp1));
-        for (k, o) in offs.iter().enumerate() {
-            if k > 0 {
-                m.push(f.line((a + o, 0.0), z, p.ffp1));
+    let turn_round =
+        |m: &mut Vec<Move>, offs: &[f64], z: f64, feed_in: f64| -> Result<(), CycleAlarm> {
+            let o0 = offs[0];
+            let start = (a + o0 + 2.0 * ra, 0.0);
+            m.push(f.line(start, z, feed_in));
+            // In on a semicircle against the milling direction, tangent to the first turn.
+            m.push(f.arc((a + o0, 0.0), (a + o0 + ra, 0.0), z, !p.ccw, p.ffp1));
+            for (k, o) in offs.iter().enumerate() {
+                if k > 0 {
+                    m.push(f.line((a + o, 0.0), z, p.ffp1));
+                }
+                m.extend(round_rect(&f, a + o, b + o, r + o, z, p.ccw, p.ffp1));
             }
-            m.extend(round_rect(&f, a + o, b + o, r + o, z, p.ccw, p.ffp1));
-        }
-        if offs.len() > 1 {
-            m.push(f.line((a + o0, 0.0), z, p.ffp1));
-        }
-        m.push(f.arc(start, (a + o0 + ra, 0.0), z, !p.ccw, p.ffp1));
-    };
-    let start = f.put((a + offsets(p.fal + wr)[0] + 2.0 * ra, 0.0));
+            if offs.len() > 1 {
+                m.push(f.line((a + o0, 0.0), z, p.ffp1));
+            }
+            m.push(f.arc(start, (a + o0 + ra, 0.0), z, !p.ccw, p.ffp1));
+            within_budget(m)
+        };
+    let start = f.put((a + offsets(p.fal + wr)?[0] + 2.0 * ra, 0.0));
     let mut m = vec![
         Move::Rapid((start.0, start.1, p.rtp)),
         Move::Rapid((start.0, start.1, safety)),
     ];
     if p.roughing {
-        let offs = offsets(p.fal + wr);
+        let offs = offsets(p.fal + wr)?;
         let floor = p.dp - down * p.fald.abs();
-        for level in levels(p.rfp, floor, p.mid) {
-            turn_round(&mut m, &offs, level, p.ffd);
+        for level in levels(p.rfp, floor, p.mid)? {
+            turn_round(&mut m, &offs, level, p.ffd)?;
         }
     } else {
         // Finishing takes the spigot to size (§10.6.4: the allowances 0): one turn at each
         // level down to DP, then the floor at DP out to the blank.
         let first = f.put((a + wr + 2.0 * ra, 0.0));
         m.push(Move::Rapid((first.0, first.1, safety)));
-        for level in levels(p.rfp, p.dp, p.mid) {
-            turn_round(&mut m, &[wr], level, p.ffd);
+        for level in levels(p.rfp, p.dp, p.mid)? {
+            turn_round(&mut m, &[wr], level, p.ffd)?;
         }
-        let offs = offsets(wr);
+        let offs = offsets(wr)?;
         if offs.len() > 1 {
             m.push(Move::Rapid((first.0, first.1, safety)));
             let s = f.put((a + offs[0] + 2.0 * ra, 0.0));
             m.push(Move::Rapid((s.0, s.1, safety)));
-            turn_round(&mut m, &offs, p.dp, p.ffd);
+            turn_round(&mut m, &offs, p.dp, p.ffd)?;
         }
     }
     let end = m.last().map_or(start, |x| match x {

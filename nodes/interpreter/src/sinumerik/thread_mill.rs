@@ -5,7 +5,7 @@
 
 use std::f64::consts::TAU;
 
-use super::cutter_path::Move;
+use super::cutter_path::{steps, Move};
 use super::drilling::CycleAlarm;
 
 /// CYCLE90's parameters, lengths in mm.
@@ -115,6 +115,8 @@ pub fn thread_milling(t: Thread, tool_radius: f64) -> Result<Vec<Move>, CycleAla
         });
     }
     // The helix: whole turns, then the rest.
+    // Whole turns (the helix's last part follows); refused when there would be too many.
+    steps(sweep / TAU, 0)?;
     let turns = (sweep / TAU).floor() as usize;
     let dz = (z1 - z0) / sweep * TAU;
     for k in 1..=turns {
