@@ -175,3 +175,26 @@ fn h_words_and_machine_data_stop_with_12140() {
         assert_eq!((e.number, e.line), (12140, 1), "{text}: {e}");
     }
 }
+
+#[test]
+fn g74_takes_the_axes_named_to_their_reference_points_at_rapid() {
+    let mut s = mill();
+    s.reference = vec![-10.0, 20.0, 150.0];
+    let text = "G0 X5 Y6 Z7\nTRANS X100\nN10 G74 X1=0 Z1=0\nG0 X1\n";
+    let mut front = Sinumerik::new(text, s, Library::new());
+    let mut out = Vec::new();
+    while let Some(c) = next_command(&mut front).unwrap() {
+        out.push(c.command);
+    }
+    let ends: Vec<&[f64]> = out.iter().filter_map(|c| c.end()).collect();
+    // Machine X and Z at their reference points, Y where it was, whatever the frame.
+    assert_eq!(ends[1], [-10.0, 6.0, 150.0]);
+    assert!(matches!(
+        out.iter().filter(|c| c.end().is_some()).nth(1),
+        Some(Command::Rapid { .. })
+    ));
+    // Programming goes on in the frame: X1 is machine X101.
+    assert_eq!(ends[2], [101.0, 6.0, 150.0]);
+    let (_, e) = run("G74\n");
+    assert_eq!(e.map(|e| e.number), Some(12080));
+}

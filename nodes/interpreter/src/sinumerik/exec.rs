@@ -192,12 +192,11 @@ pub const NOT_BUILT: [(&str, &str); 31] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 17] = [
+pub const NOT_BUILT_G: [(u32, &str); 16] = [
     (33, "G33 thread cutting is not built yet for the mill"),
     (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
     (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
     (63, "G63 tapping with a compensating chuck is not built yet"),
-    (74, "G74 reference point approach from the program is not built yet"),
     (75, "G75 fixed point approach is not built yet"),
     (147, "smooth approach and retraction (WAB) is not built"),
     (148, "smooth approach and retraction (WAB) is not built"),

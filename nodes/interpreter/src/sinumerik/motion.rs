@@ -51,6 +51,9 @@ impl Sinumerik {
         if self.limits_block(w)? {
             return Ok(true);
         }
+        if w.has_g(74) {
+            return self.reference_approach(w).map(|()| true);
+        }
         if self.frame_instruction(w)? {
             return Ok(true);
         }
@@ -59,6 +62,31 @@ impl Sinumerik {
             return Ok(true);
         }
         Ok(false)
+    }
+
+    /// G74 (§9.3.23): each axis named (`X1=0`; the value is not used) to its reference
+    /// point at rapid, in machine coordinates; an own block, not under radius compensation.
+    fn reference_approach(&mut self, w: &Words) -> Result<(), ProgramError> {
+        if self.core.comp.is_some() {
+            return Err(self.fault(
+                Fault::CompInCycle,
+                "G74 while radius compensation is active: G40 first",
+            ));
+        }
+        if w.axes.is_empty() {
+            return Err(self.fault(Fault::MissingWord, "G74 names the axes: X1=0 Y1=0 Z1=0"));
+        }
+        let mut target = self.core.pos.clone();
+        for (&i, _) in w.axes.iter() {
+            if let Some(r) = self.core.setup.reference.get(i) {
+                target[i] = *r;
+            }
+        }
+        self.core.push(Command::Rapid {
+            end: target.clone(),
+        });
+        self.core.pos = target;
+        Ok(())
     }
 
     /// G4 F seconds or S spindle revolutions (§9.3.22); F and S stay as they were.
