@@ -861,3 +861,70 @@ fn an_m_function_between_rounded_compensated_blocks_keeps_its_place() {
     assert!(moves_of(6).iter().all(|&i| i < m8) && !moves_of(6).is_empty());
     assert!(moves_of(8).iter().all(|&i| i > m8) && !moves_of(8).is_empty());
 }
+
+/// Where the line from `p` at `a1` degrees meets the line through `q` at `a2` degrees,
+/// worked out by Cramer's rule.
+fn crossing(p: (f64, f64), a1: f64, q: (f64, f64), a2: f64) -> (f64, f64) {
+    let (d1, d2) = (
+        (a1.to_radians().cos(), a1.to_radians().sin()),
+        (a2.to_radians().cos(), a2.to_radians().sin()),
+    );
+    // p + t·d1 = q + u·d2
+    let det = d1.0 * (-d2.1) - d1.1 * (-d2.0);
+    let (rx, ry) = (q.0 - p.0, q.1 - p.1);
+    let t = (rx * (-d2.1) - ry * (-d2.0)) / det;
+    (p.0 + t * d1.0, p.1 + t * d1.1)
+}
+
+/// Distance from `c` to the line through `p` at `a` degrees.
+fn to_line(c: (f64, f64), p: (f64, f64), a: f64) -> f64 {
+    let (s, co) = a.to_radians().sin_cos();
+    ((c.0 - p.0) * s - (c.1 - p.1) * co).abs()
+}
+
+#[test]
+fn f054_contour_definitions_with_ang() {
+    // As printed the angles are placeholders (its first alarm: N10 without a feed). Filled:
+    // Fig. 9-41 a and b, one coordinate and the angle.
+    let r = run("F100\nN10 G1 X10 Y10\nN20 X40 ANG=30\n").ok();
+    assert!(near(
+        &r.end(),
+        &[40.0, 10.0 + 30.0 * 30f64.to_radians().tan(), 0.0]
+    ));
+    let r = run("F100\nN10 G1 X10 Y10\nN20 Y40 ANG=60\n").ok();
+    assert!(near(
+        &r.end(),
+        &[10.0 + 30.0 / 60f64.to_radians().tan(), 40.0, 0.0]
+    ));
+    // Fig. 9-42: the end of N20 unknown, found where its line meets N30's.
+    let r = run("F100\nN10 G1 X10 Y10\nN20 ANG=30\nN30 X60 Y20 ANG=-45\n").ok();
+    let c = crossing((10.0, 10.0), 30.0, (60.0, 20.0), -45.0);
+    let ends: Vec<(f64, f64)> = pieces(&r).iter().map(|q| q.0).collect();
+    assert_eq!(ends.len(), 3, "{ends:?}");
+    assert!(
+        dist(ends[1], c) < 1e-9 && dist(ends[2], (60.0, 20.0)) < 1e-9,
+        "{ends:?}"
+    );
+    // With a rounding at that corner, and a second rounding at N30's end.
+    let r = run("F100\nN10 G1 X10 Y10\nN20 ANG=30 RND=4\nN30 X60 Y20 ANG=-45 RND=3\nN40 X80 Y60\n")
+        .ok();
+    let p = pieces(&r);
+    let arcs: Vec<&Piece> = p.iter().filter(|q| q.1.is_some()).collect();
+    assert_eq!(arcs.len(), 2, "{p:?}");
+    let c1 = arcs[0].1.unwrap();
+    assert!((to_line(c1, (10.0, 10.0), 30.0) - 4.0).abs() < 1e-9);
+    assert!((to_line(c1, (60.0, 20.0), -45.0) - 4.0).abs() < 1e-9);
+    let c2 = arcs[1].1.unwrap();
+    assert!((to_line(c2, (60.0, 20.0), -45.0) - 3.0).abs() < 1e-9);
+    let a3 = (60.0f64 - 20.0).atan2(80.0 - 60.0).to_degrees();
+    assert!((to_line(c2, (80.0, 60.0), a3) - 3.0).abs() < 1e-9);
+    // A chamfer instead: its legs 2 mm either side of the crossing.
+    let r = run("F100\nN10 G1 X10 Y10\nN20 ANG=30 CHR=2\nN30 X60 Y20 ANG=-45\n").ok();
+    let ends: Vec<(f64, f64)> = pieces(&r).iter().map(|q| q.0).collect();
+    assert!((dist(ends[1], c) - 2.0).abs() < 1e-9 && (dist(ends[2], c) - 2.0).abs() < 1e-9);
+    // Refused: both coordinates and an angle with no waiting line; parallel lines; an arc
+    // after a waiting line.
+    assert_eq!(run("F100\nG1 X10 Y10 ANG=30\n").alarm(), (12080, 2));
+    assert_eq!(run("F100\nG1 ANG=30\nX50 Y50 ANG=30\n").alarm().0, 14040);
+    assert_eq!(run("F100\nG1 ANG=30\nG2 X50 Y50 CR=40\n").alarm().0, 12080);
+}

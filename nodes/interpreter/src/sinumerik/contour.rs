@@ -92,3 +92,98 @@ impl Sinumerik {
         }
     }
 }
+
+/// An ANG block with no end point (`ANG=α1`): its line waits for the next block, whose end
+/// point and angle close it (§9.5.2).
+#[derive(Debug, Clone)]
+pub struct AngPending {
+    angle: f64,
+    kind: MoveKind,
+    corner: BlockCorner,
+}
+
+/// What an ANG word makes of the block's line.
+pub enum AngStep {
+    /// No ANG: the end point as programmed.
+    Plain,
+    /// The line waits for the next block.
+    Wait,
+    /// The waiting line ends at this point first (work coordinates), then this block's.
+    Via(Vec<f64>),
+}
+
+impl Sinumerik {
+    /// ANG= (§9.5.2): with one coordinate of the plane, the other from the angle to the
+    /// abscissa (counter-clockwise); with none, the line waits; with both, after a waiting
+    /// line, the two lines' intersection is the corner between them.
+    pub(super) fn ang_end(
+        &mut self,
+        w: &Words,
+        here: &[f64],
+        end: &mut [f64],
+        kind: MoveKind,
+    ) -> Result<AngStep, ProgramError> {
+        let Some(angle) = w.get("ANG") else {
+            if self.ang.is_some() {
+                return Err(self.fault(
+                    Fault::MissingWord,
+                    "ANG: the block after ANG=… alone needs the end point and its own ANG",
+                ));
+            }
+            return Ok(AngStep::Plain);
+        };
+        let (h, v) = self.core.plane_axes()?;
+        let given = (w.axes.contains_key(&h), w.axes.contains_key(&v));
+        let (s, c) = angle.to_radians().sin_cos();
+        match (given, self.ang.take()) {
+            ((false, false), None) => {
+                self.ang = Some(AngPending {
+                    angle,
+                    kind,
+                    corner: self.corner.take(),
+                });
+                Ok(AngStep::Wait)
+            }
+            ((true, true), Some(first)) => {
+                // The first line from here at its angle, the second through the end point at
+                // this one: where they cross.
+                let (s1, c1) = first.angle.to_radians().sin_cos();
+                let det = c1 * s - s1 * c;
+                if det.abs() < 1e-9 {
+                    return Err(self.fault(
+                        Fault::ArcEnd,
+                        "ANG: the two lines are parallel and do not meet",
+                    ));
+                }
+                let (dx, dy) = (end[h] - here[h], end[v] - here[v]);
+                let t = (dx * s - dy * c) / det;
+                let mut corner = here.to_vec();
+                corner[h] = here[h] + t * c1;
+                corner[v] = here[v] + t * s1;
+                let mine = self.corner.take();
+                self.corner = first.corner;
+                self.emit_element(&corner, first.kind)?;
+                self.corner = mine;
+                Ok(AngStep::Via(corner))
+            }
+            ((true, false), None) if c.abs() > 1e-9 => {
+                end[v] = here[v] + (end[h] - here[h]) * s / c;
+                Ok(AngStep::Plain)
+            }
+            ((false, true), None) if s.abs() > 1e-9 => {
+                end[h] = here[h] + (end[v] - here[v]) * c / s;
+                Ok(AngStep::Plain)
+            }
+            (_, pending) => {
+                self.ang = pending;
+                Err(self.fault(
+                    Fault::DataFormat,
+                    format!(
+                        "ANG={}: one coordinate of the plane with the angle, none (the line waits) or both after a waiting ANG line",
+                        cnc_interpreter_core::show(angle)
+                    ),
+                ))
+            }
+        }
+    }
+}

@@ -98,6 +98,8 @@ pub struct Sinumerik {
     frcm: Option<f64>,
     /// The corner the block's move ends with (CHF/CHR/RND/RNDM), taken by its last element.
     corner: contour::BlockCorner,
+    /// A line given only its angle (`ANG=α`), waiting for the block that closes it.
+    ang: Option<contour::AngPending>,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -173,6 +175,7 @@ impl Sinumerik {
             rndm: None,
             frcm: None,
             corner: None,
+            ang: None,
         };
         front.apply_length();
         front

@@ -12,6 +12,7 @@ use cnc_interpreter_core::geometry::{
 };
 use cnc_interpreter_core::{Command, Fault, MoveKind, ProgramError, NO_WORK_OFFSET};
 
+use super::contour::AngStep;
 use super::exec::{Mode, Words};
 use super::{Motion, Sinumerik};
 
@@ -35,15 +36,11 @@ impl Sinumerik {
     /// The non-modal instructions that take the block's words for themselves: dwell,
     /// frames, pole; `true` when the block moves nothing else.
     pub(super) fn non_modal(&mut self, w: &Words) -> Result<bool, ProgramError> {
-        for k in ["ANG", "SF"] {
-            if w.addr.contains_key(k) {
-                return Err(self.fault(
-                    Fault::NotSupported,
-                    format!(
-                        "{k}= is not built yet (contour definitions by angle, thread start angle)"
-                    ),
-                ));
-            }
+        if w.addr.contains_key("SF") {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "SF= (the thread's start angle) is not built yet: G33 is not built",
+            ));
         }
         if w.has_g(4) {
             return self.dwell(w).map(|()| true);
@@ -148,8 +145,10 @@ impl Sinumerik {
     pub(super) fn motion_block(&mut self, w: &Words) -> Result<(), ProgramError> {
         let arc_words = ["I", "J", "K", "CR", "AR", "I1", "J1", "K1", "TURN"];
         let polar = w.addr.contains_key("AP") || w.addr.contains_key("RP");
-        let moves =
-            !w.axes.is_empty() || polar || arc_words.iter().any(|k| w.addr.contains_key(*k));
+        let moves = !w.axes.is_empty()
+            || polar
+            || w.addr.contains_key("ANG")
+            || arc_words.iter().any(|k| w.addr.contains_key(*k));
         self.corner = self.block_corner(w, moves)?;
         if !moves {
             return Ok(());
@@ -194,6 +193,12 @@ impl Sinumerik {
                 } else {
                     MoveKind::Feed(feed)
                 };
+                let a = match self.ang_end(w, &here, &mut end, kind)? {
+                    AngStep::Wait => return Ok(()),
+                    AngStep::Via(corner) => self.core.plane_point(&corner)?,
+                    AngStep::Plain => a,
+                };
+                let b = self.core.plane_point(&end)?;
                 self.emit_element(&end, kind)?;
                 if a.dist(b) > 1e-9 {
                     let l = a.dist(b);
@@ -201,6 +206,12 @@ impl Sinumerik {
                 }
             }
             _ => {
+                if w.addr.contains_key("ANG") || self.ang.is_some() {
+                    return Err(self.fault(
+                        Fault::IllegalWord,
+                        "ANG defines straight lines (G0/G1), not circles",
+                    ));
+                }
                 let (c, ccw, end) = if circle {
                     self.circle(w, a, end, polar)?
                 } else if self.motion == Motion::Cip {
