@@ -3,18 +3,23 @@
 //! (`../shared/fixtures/001/061`, as printed, header comments and all) and a subprogram it
 //! calls by name, starts it through the ROS 2 services, and reads the machine's topics: the
 //! program completes without alarm, the part is counted at its M2 (D82), and the axes stand
-//! where the manual's program ends. Run by `scripts/test.sh` inside a network namespace.
+//! where the manual's program ends. Issue 24, must-show 4: a job of the 802D's cycles (a
+//! bore with an oriented stop, a bore with M5 and M0, a circular pocket) runs through the
+//! PLC; at CYCLE87's M0 the machine holds at the bore's bottom with the spindle stopped, and a
+//! cycle start from the supervisor runs it to its end. Run by `scripts/test.sh` inside a
+//! network namespace.
 
 use std::time::Duration;
 
 use cnc::cell::Cell;
 use cnc::client::CellClient;
-use cnc_msgs::msg::MachineState;
+use cnc_msgs::msg::{MachineState, SpindleState};
 use ros2_client::ServiceMapping;
 
 mod common;
 
 const DOMAIN: u16 = 88;
+const CYCLES_DOMAIN: u16 = 89;
 
 fn fixture_061() -> String {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
@@ -101,6 +106,83 @@ fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() 
             (at(0) - 5.0).abs() < 0.001
                 && (at(1) - 60.0).abs() < 0.001
                 && (at(2) - (50.0 + length)).abs() < 0.001
+        })
+    });
+    assert!(ok, "final position {:?}", client.axes);
+    let (_, errors) = cell.stop();
+    assert!(errors.is_empty(), "{errors:?}");
+}
+
+#[test]
+fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start() {
+    let cfg = common::machine("sim_mill_802d", CYCLES_DOMAIN);
+    let length = cfg.machine.tools.get(&11).expect("T1 D1").z;
+    let cell = Cell::start(&cfg).expect("the cell starts");
+    let mut client = CellClient::new(
+        &cfg.network,
+        "mill2",
+        "test_supervisor",
+        ServiceMapping::Enhanced,
+    )
+    .expect("supervisor node");
+    client.wait_ready(Duration::from_secs(30)).expect("ready");
+    let job = "N10 G17 G90 G500 T1 D1 S1000 M3 F300\n\
+               N20 G0 X50 Y50 Z60\n\
+               N30 CYCLE86(10, 0, 2, -6, , 0.5, 3, -1, -1, 1, 45)\n\
+               N40 G0 X100 Y50\n\
+               N50 CYCLE87(10, 0, 2, -6, , 3)\n\
+               N60 POCKET4(10, 0, 1, -4, 14, 150, 50, 2, 0, 0, 600, 200, 0, 11, 0)\n\
+               N70 G0 X0 Y0 Z100\n\
+               N80 M2\n";
+    assert!(client.load_program("CYCLES.MPF", job).unwrap().accepted);
+    let r = client.start_program("CYCLES.MPF").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    // CYCLE87: M5 and M0 at the bore's bottom, X100 Y50 Z−6 (+ T1 D1's length).
+    let (ok, seen) = client.wait_until(Duration::from_secs(120), |c| {
+        c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::FEED_HOLD)
+            && c.axes.as_ref().is_some_and(|a| {
+                (a.axes[0].actual_position - 100.0).abs() < 0.001
+                    && (a.axes[2].actual_position - (-6.0 + length)).abs() < 0.001
+            })
+    });
+    let names: Vec<&str> = seen.iter().map(|s| s.execution_name.as_str()).collect();
+    assert!(
+        ok,
+        "no hold at the bottom; states {names:?}, alarms {:?}",
+        client.alarms
+    );
+    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
+        c.spindle.as_ref().is_some_and(|s| {
+            s.direction == SpindleState::DIRECTION_STOP && s.actual_rpm.abs() < 1.0
+        })
+    });
+    assert!(ok, "the spindle stands at the M0: {:?}", client.spindle);
+    // Cycle start goes on: out of the bore, the pocket, the end.
+    let r = client.start_program("").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let (ok, seen) = client.wait_until(Duration::from_secs(180), |c| {
+        c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+            && c.part_count.as_ref().is_some_and(|p| p.count == 1)
+    });
+    let names: Vec<&str> = seen.iter().map(|s| s.execution_name.as_str()).collect();
+    assert!(
+        ok,
+        "did not complete; states {names:?}, alarms {:?}",
+        client.alarms
+    );
+    assert!(
+        client.alarms.as_ref().is_some_and(|a| a.alarms.is_empty()),
+        "alarms {:?}",
+        client.alarms
+    );
+    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
+        c.axes.as_ref().is_some_and(|a| {
+            let at = |i: usize| a.axes[i].actual_position;
+            at(0).abs() < 0.001 && at(1).abs() < 0.001 && (at(2) - (100.0 + length)).abs() < 0.001
         })
     });
     assert!(ok, "final position {:?}", client.axes);
