@@ -894,3 +894,66 @@ fn f112_slot1_roughs_and_finishes_four_slots() {
     let r = run_with(&fixture("112"), with_edge(11, 7.5), Library::new());
     assert_eq!(r.alarm().0, 61105);
 }
+
+/// The signed distance from the walls of slots bent along the circle `rad` about `c`, each
+/// from `a` over `len` degrees, `half` either side of its middle arc.
+fn arc_slots_wall(
+    c: (f64, f64),
+    rad: f64,
+    starts: Vec<f64>,
+    len: f64,
+    half: f64,
+) -> impl Fn((f64, f64)) -> f64 {
+    move |p| {
+        let (dx, dy) = (p.0 - c.0, p.1 - c.1);
+        let r = dx.hypot(dy);
+        let phi = dy.atan2(dx).to_degrees();
+        starts
+            .iter()
+            .map(|a| {
+                let along = (phi - a).rem_euclid(360.0);
+                if along <= len {
+                    (r - rad).abs() - half
+                } else {
+                    let end = |ang: f64| {
+                        let (s, co) = ang.to_radians().sin_cos();
+                        (p.0 - c.0 - rad * co).hypot(p.1 - c.1 - rad * s)
+                    };
+                    end(*a).min(end(a + len)) - half
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+#[test]
+fn f113_slot2_mills_three_slots_along_the_circle() {
+    // SLOT2(2, 0, 2, −23, , 3, 70, 15, 60, 60, 42, , 120, 100, 300, 6, 2, 0.5, 0, , 0, ):
+    // three slots 15 wide over 70° of the circle R42 about X60 Y60, from 0° every 120°, to
+    // Z−23 within MID 6, G2, FAL 0.5, roughed and finished; a 10 mm cutter.
+    let r = run_with(&fixture("113"), cutter5(), Library::new()).ok();
+    let wall = arc_slots_wall((60.0, 60.0), 42.0, vec![0.0, 120.0, 240.0], 70.0, 7.5);
+    let mut stock = Stock::new((60.0, 60.0), 55.0, 0.0, 5.0, wall);
+    stock.follow(&r.out, [60.0, 60.0, 5.0]);
+    assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
+    assert_within(stock.reach, 0.0, "the slots' walls");
+    let (lo, hi, min) = stock.floor_within(0.01);
+    assert_within(lo, -23.0, "floor");
+    assert_within(hi, -23.0, "every slot to the floor");
+    assert_within(min, -23.0, "nothing deeper");
+    // Roughing alone stops 0.5 inside.
+    let rough = fixture("113").replace(", 0.5, 0, , 0, )", ", 0.5, 1, , 0, )");
+    let r = run_with(&rough, cutter5(), Library::new()).ok();
+    let wall = arc_slots_wall((60.0, 60.0), 42.0, vec![0.0, 120.0, 240.0], 70.0, 7.0);
+    let mut stock = Stock::new((60.0, 60.0), 55.0, 0.0, 5.0, wall);
+    stock.follow(&r.out, [60.0, 60.0, 5.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 0.0, "0.5 inside the walls");
+    // Slots that would overlap (over 120° each, 120° apart): 61104.
+    let r = run_with(
+        &fixture("113").replace(", 3, 70, 15,", ", 3, 115, 15,"),
+        cutter5(),
+        Library::new(),
+    );
+    assert_eq!(r.alarm().0, 61104);
+}

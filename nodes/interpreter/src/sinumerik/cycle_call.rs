@@ -14,7 +14,7 @@ use super::expr::Expr;
 use super::Sinumerik;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 20] = [
+const CYCLES: [(&str, &[&str]); 21] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -69,6 +69,13 @@ const CYCLES: [(&str, &[&str]); 20] = [
         "SLOT1",
         &[
             "RTP", "RFP", "SDIS", "DP", "DPR", "NUM", "LENG", "WID", "CPA", "CPO", "RAD", "STA1",
+            "INDA", "FFD", "FFP1", "MID", "CDIR", "FAL", "VARI", "MIDF", "FFP2", "SSF",
+        ],
+    ),
+    (
+        "SLOT2",
+        &[
+            "RTP", "RFP", "SDIS", "DP", "DPR", "NUM", "AFSL", "WID", "CPA", "CPO", "RAD", "STA1",
             "INDA", "FFD", "FFP1", "MID", "CDIR", "FAL", "VARI", "MIDF", "FFP2", "SSF",
         ],
     ),
@@ -211,7 +218,7 @@ impl Sinumerik {
             "POCKET3" => return self.rectangular_pocket(c),
             "CYCLE76" | "CYCLE77" => return self.spigot(c),
             "CYCLE71" => return self.face(c),
-            "LONGHOLE" | "SLOT1" => return self.slots(c),
+            "LONGHOLE" | "SLOT1" | "SLOT2" => return self.slots(c),
             "POCKET4" => return self.circular_pocket(c),
             _ => {}
         }

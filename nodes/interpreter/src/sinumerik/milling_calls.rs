@@ -11,14 +11,14 @@ use super::drilling::CycleAlarm;
 use super::face::{face_milling, Face};
 use super::pocket::{circular_pocket, CirclePocket, Insertion};
 use super::rect_pocket::{rectangular_pocket, RectPocket};
-use super::slots::{long_holes, slots, Pattern, Slot};
+use super::slots::{arc_slots, long_holes, slots, ArcSlot, Pattern, Slot};
 use super::spigot::{spigot, Spigot};
 use super::thread_mill::{thread_milling, Thread};
 use super::Sinumerik;
 
 impl Sinumerik {
-    /// LONGHOLE and SLOT1: holes or slots on a circle with the active cutting edge; SLOT1
-    /// finishes at SSF when it is given.
+    /// LONGHOLE, SLOT1 and SLOT2: holes or slots on a circle with the active cutting edge;
+    /// the slots finish at SSF when it is given.
     pub(super) fn slots(&mut self, c: &CycleCall) -> Result<(), ProgramError> {
         let (rtp, rfp) = (c.or("RTP", 0.0), c.or("RFP", 0.0));
         let dp = match c.get("DPR").filter(|d| *d != 0.0) {
@@ -57,7 +57,16 @@ impl Sinumerik {
             midf: c.or("MIDF", 0.0).abs(),
             ffp2: c.or("FFP2", 0.0),
         };
-        let (rough, finish) = slots(p, s, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
+        let made = if c.name == "SLOT2" {
+            let arc = ArcSlot {
+                afsl: c.or("AFSL", 0.0),
+                slot: s,
+            };
+            arc_slots(p, arc, radius)
+        } else {
+            slots(p, s, radius)
+        };
+        let (rough, finish) = made.map_err(|a| self.cycle_alarm(a, c.name))?;
         self.run_path(rough)?;
         let before = self.core.rpm;
         let ssf = c.get("SSF").filter(|s| *s > 0.0 && !finish.is_empty());

@@ -256,3 +256,185 @@ pub fn slots(
     }
     Ok((rough, finish))
 }
+
+/// SLOT2's own parameters: the slot's angular length and width, as SLOT1's otherwise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcSlot {
+    /// Angular length, degrees (the middle line's, end centre to end centre).
+    pub afsl: f64,
+    pub slot: Slot,
+}
+
+/// A slot bent along the circle: the loop at `d` either side of its middle arc, starting
+/// where its far end (`b`, degrees) meets the outer arc; around the slot counter-clockwise
+/// when `ccw`, every end a half circle.
+fn arc_loop(
+    c: (f64, f64),
+    rad: f64,
+    (a, b): (f64, f64),
+    d: f64,
+    z: f64,
+    ccw: bool,
+    feed: f64,
+) -> Vec<Move> {
+    let at = |ang: f64, r: f64| {
+        let (s, co) = ang.to_radians().sin_cos();
+        (c.0 + r * co, c.1 + r * s, z)
+    };
+    let end = |ang: f64| {
+        let q = at(ang, rad);
+        (q.0, q.1)
+    };
+    let arc = |to: (f64, f64, f64), centre: (f64, f64), ccw: bool| Move::Arc {
+        end: to,
+        centre,
+        ccw,
+        feed,
+    };
+    if ccw {
+        vec![
+            arc(at(b, rad - d), end(b), true),
+            arc(at(a, rad - d), c, false),
+            arc(at(a, rad + d), end(a), true),
+            arc(at(b, rad + d), c, true),
+        ]
+    } else {
+        vec![
+            arc(at(a, rad + d), c, false),
+            arc(at(a, rad - d), end(a), false),
+            arc(at(b, rad - d), c, true),
+            arc(at(b, rad + d), end(b), false),
+        ]
+    }
+}
+
+/// SLOT2: slots along the circle (§10.6.8), each from STA1 + k·INDA over AFSL degrees;
+/// roughing along the middle arc and round bent slots out to FAL, finishing round the wall.
+pub fn arc_slots(
+    p: Pattern,
+    s: ArcSlot,
+    tool_radius: Option<f64>,
+) -> Result<(Vec<Move>, Vec<Move>), CycleAlarm> {
+    let wr = tool_radius
+        .filter(|r| *r > 0.0)
+        .ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
+    let down = p.check()?;
+    let slot = s.slot;
+    if !(0..=2).contains(&slot.vari) {
+        return Err(alarm(
+            61002,
+            "VARI is 0 complete, 1 roughing or 2 finishing",
+        ));
+    }
+    let half = slot.wid / 2.0;
+    if 2.0 * wr >= slot.wid {
+        return Err(alarm(
+            61105,
+            "cutter radius too large: its diameter must be below the width WID",
+        ));
+    }
+    let afsl = s.afsl.abs();
+    let inda = if p.inda == 0.0 {
+        360.0 / p.num as f64
+    } else {
+        p.inda
+    };
+    // The slots' middle arcs apart by their width, and off the centre.
+    if p.rad <= half || afsl <= 0.0 {
+        return Err(alarm(
+            61104,
+            "contour violation: the slot reaches the circle's centre or has no length",
+        ));
+    }
+    let spans: Vec<(f64, f64)> = (0..p.num)
+        .map(|k| {
+            let a = p.sta1 + inda * k as f64;
+            (a, a + afsl)
+        })
+        .collect();
+    for i in 0..p.num {
+        for j in i + 1..p.num {
+            let gap = arc_gap(spans[i], spans[j]);
+            if 2.0 * p.rad * (gap.to_radians().min(std::f64::consts::PI) / 2.0).sin()
+                < slot.wid - 1e-9
+            {
+                return Err(alarm(61104, "contour violation of slots: they overlap"));
+            }
+        }
+    }
+    let fal = slot.fal.abs().min(half - wr - 1e-3).max(0.0);
+    let safety = p.rfp - down * p.sdis.abs();
+    let step = 1.6 * wr;
+    let c = p.centre;
+    let at = |ang: f64, r: f64, z: f64| {
+        let (s, co) = ang.to_radians().sin_cos();
+        (c.0 + r * co, c.1 + r * s, z)
+    };
+    let (mut rough, mut finish) = (Vec::new(), Vec::new());
+    for &(a, b) in &spans {
+        if slot.vari != 2 {
+            let m = &mut rough;
+            let last = half - fal - wr;
+            let n = steps(last / step, 1)?;
+            let start = at(a, p.rad, p.rtp);
+            m.push(Move::Rapid(start));
+            m.push(Move::Rapid((start.0, start.1, safety)));
+            for level in levels(p.rfp, p.dp, p.mid)? {
+                m.push(Move::Line(at(a, p.rad, level), p.ffd));
+                m.push(Move::Arc {
+                    end: at(b, p.rad, level),
+                    centre: c,
+                    ccw: true,
+                    feed: p.ffp1,
+                });
+                for i in 1..=n {
+                    let d = last * i as f64 / n as f64;
+                    m.push(Move::Line(at(b, p.rad + d, level), p.ffp1));
+                    m.extend(arc_loop(c, p.rad, (a, b), d, level, slot.ccw, p.ffp1));
+                }
+                m.push(Move::Line(at(b, p.rad, level), p.ffp1));
+                m.push(Move::Arc {
+                    end: at(a, p.rad, level),
+                    centre: c,
+                    ccw: false,
+                    feed: p.ffp1,
+                });
+                within_budget(m)?;
+            }
+            m.push(Move::Rapid(at(a, p.rad, p.rtp)));
+        }
+        if slot.vari != 1 {
+            let m = &mut finish;
+            let feed = if slot.ffp2 > 0.0 { slot.ffp2 } else { p.ffp1 };
+            let top = at(b, p.rad, p.rtp);
+            m.push(Move::Rapid(top));
+            m.push(Move::Rapid((top.0, top.1, safety)));
+            for level in levels(p.rfp, p.dp, slot.midf)? {
+                m.push(Move::Line(at(b, p.rad, level), p.ffd));
+                m.push(Move::Line(at(b, p.rad + half - wr, level), feed));
+                m.extend(arc_loop(c, p.rad, (a, b), half - wr, level, slot.ccw, feed));
+                m.push(Move::Line(at(b, p.rad, level), feed));
+                within_budget(m)?;
+            }
+            m.push(Move::Rapid(top));
+        }
+    }
+    Ok((rough, finish))
+}
+
+/// The smallest angle between two spans of degrees (0 when they overlap).
+fn arc_gap(x: (f64, f64), y: (f64, f64)) -> f64 {
+    let norm = |a: f64| a.rem_euclid(360.0);
+    let inside = |a: f64, (s, e): (f64, f64)| norm(a - s) <= e - s + 1e-9;
+    if inside(x.0, y) || inside(x.1, y) || inside(y.0, x) || inside(y.1, x) {
+        return 0.0;
+    }
+    let d = |a: f64, b: f64| {
+        let t = norm(a - b);
+        t.min(360.0 - t)
+    };
+    d(x.0, y.1)
+        .min(d(x.1, y.0))
+        .min(d(x.0, y.0))
+        .min(d(x.1, y.1))
+}
