@@ -530,7 +530,9 @@ fn cycle_alarms_as_the_manual_lists_them() {
         (61106, 3)
     );
     // A milling cycle: not built yet, with the reason.
-    let r = run(&format!("{head}SLOT2(110, 100, 2, 35, , 3, 70, 15, 60, 60, 42, , 120, 100, 300, 6, 2, 0.5, 0, , 0, )\n"));
+    let r = run(&format!(
+        "{head}CYCLE72(\"KONTUR\", 10, 0, 2, -5, 2, 0.5, 0.2, 300, 100, 11, 41, 2, 5, 300, 2, 5)\n"
+    ));
     assert_eq!(r.alarm(), (12140, 2));
     assert!(r.error.unwrap().text.contains("milling cycles"));
 }

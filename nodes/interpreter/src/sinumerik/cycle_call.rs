@@ -175,9 +175,15 @@ impl Sinumerik {
         args: &[Option<Expr>],
     ) -> Result<CycleCall, ProgramError> {
         let Some(&(name, params)) = CYCLES.iter().find(|(n, _)| *n == name) else {
+            if name == "CYCLE72" {
+                return Err(self.fault(
+                    Fault::NotSupported,
+                    "CYCLE72: contour milling, of the milling cycles of chapter 10 the one not built yet",
+                ));
+            }
             return Err(self.fault(
-                Fault::NotSupported,
-                format!("{name}: the milling cycles of chapter 10 are not built yet"),
+                Fault::NoSuchAddress,
+                format!("{name}(…) is no cycle of chapter 10"),
             ));
         };
         if args.len() > params.len() {
