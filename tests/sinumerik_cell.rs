@@ -35,26 +35,31 @@ fn fixture_061() -> String {
     std::fs::read_to_string(path).expect("fixture text")
 }
 
-#[test]
-fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() {
-    // No kept memory: the PLC comes up as at its first power-up, with the builder's keep
-    // relays (K1.1, D82).
-    let cfg = common::machine("sim_mill_802d", DOMAIN);
-    // T1 D1 as the launch config sets it: the test's expectations follow from it.
-    let edge = cfg
+/// The 802D mill on `domain` (no kept memory: the PLC comes up as at its first power-up,
+/// with the builder's keep relays, K1.1, D82), a supervisor node, and T1 D1's length as the
+/// launch config sets it: the tests' expectations follow from it.
+fn start(domain: u16) -> (Cell, CellClient, f64) {
+    let cfg = common::machine("sim_mill_802d", domain);
+    let length = cfg
         .machine
         .tools
         .get(&11)
-        .expect("T1 D1 in sim_mill_802d.yaml");
-    let length = edge.z;
+        .expect("T1 D1 in sim_mill_802d.yaml")
+        .z;
     let cell = Cell::start(&cfg).expect("the cell starts");
-    let mut client = CellClient::new(
+    let client = CellClient::new(
         &cfg.network,
         "mill2",
         "test_supervisor",
         ServiceMapping::Enhanced,
     )
     .expect("supervisor node");
+    (cell, client, length)
+}
+
+#[test]
+fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() {
+    let (cell, mut client, length) = start(DOMAIN);
     let (ok, _) = client.wait_until(Duration::from_secs(30), |c| {
         c.part_count.is_some() && c.state.is_some() && c.axes.is_some()
     });
@@ -115,16 +120,7 @@ fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() 
 
 #[test]
 fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start() {
-    let cfg = common::machine("sim_mill_802d", CYCLES_DOMAIN);
-    let length = cfg.machine.tools.get(&11).expect("T1 D1").z;
-    let cell = Cell::start(&cfg).expect("the cell starts");
-    let mut client = CellClient::new(
-        &cfg.network,
-        "mill2",
-        "test_supervisor",
-        ServiceMapping::Enhanced,
-    )
-    .expect("supervisor node");
+    let (cell, mut client, length) = start(CYCLES_DOMAIN);
     client.wait_ready(Duration::from_secs(30)).expect("ready");
     let job = "N10 G17 G90 G500 T1 D1 S1000 M3 F300\n\
                N20 G0 X50 Y50 Z60\n\

@@ -29,6 +29,49 @@ pub fn steps(x: f64, least: usize) -> Result<usize, CycleAlarm> {
     Ok((n.max(0.0) as usize).max(least))
 }
 
+/// The active cutting edge's radius: none is 61000, one not above 0 61117.
+pub fn cutter(tool_radius: Option<f64>) -> Result<f64, CycleAlarm> {
+    let wr = tool_radius.ok_or_else(|| CycleAlarm::new(61000, "no tool offset active (D)"))?;
+    if wr <= 0.0 {
+        return Err(CycleAlarm::new(61117, "active tool radius ≤ 0"));
+    }
+    Ok(wr)
+}
+
+/// Which way the infeed goes from RFP to DP (−1 or +1); DP on RFP, or RTP not before RFP,
+/// is 61101.
+pub fn infeed(rtp: f64, rfp: f64, dp: f64) -> Result<f64, CycleAlarm> {
+    let down = (dp - rfp).signum();
+    if dp == rfp || (rtp - rfp) * down >= 0.0 {
+        return Err(CycleAlarm::new(
+            61101,
+            "reference plane defined incorrectly: RTP before RFP, DP beyond it",
+        ));
+    }
+    Ok(down)
+}
+
+/// MIDA, the widest step in the plane: 0 is 80 % of the cutter's diameter; wider than the
+/// cutter 61111.
+pub fn width_step(mida: f64, wr: f64) -> Result<f64, CycleAlarm> {
+    let mida = if mida > 0.0 { mida } else { 1.6 * wr };
+    if mida > 2.0 * wr {
+        return Err(CycleAlarm::new(61111, "infeed width MIDA > tool diameter"));
+    }
+    Ok(mida)
+}
+
+/// Feeds of a cycle, each above 0, else 61003.
+pub fn feeds(feeds: &[f64], names: &str) -> Result<(), CycleAlarm> {
+    if feeds.iter().any(|f| *f <= 0.0) {
+        return Err(CycleAlarm::new(
+            61003,
+            format!("no feed programmed in the cycle: {names}"),
+        ));
+    }
+    Ok(())
+}
+
 /// Refuses a path grown beyond [`MAX_MOVES`].
 pub fn within_budget(m: &[Move]) -> Result<(), CycleAlarm> {
     if m.len() > MAX_MOVES {

@@ -30,11 +30,17 @@ pub struct CycleAlarm {
     pub text: String,
 }
 
-fn alarm(number: u32, text: impl Into<String>) -> CycleAlarm {
-    CycleAlarm {
-        number,
-        text: text.into(),
+impl CycleAlarm {
+    pub fn new(number: u32, text: impl Into<String>) -> CycleAlarm {
+        CycleAlarm {
+            number,
+            text: text.into(),
+        }
     }
+}
+
+fn alarm(number: u32, text: impl Into<String>) -> CycleAlarm {
+    CycleAlarm::new(number, text)
 }
 
 /// The hole's levels from RTP, RFP, SDIS, DP and DPR (§10.4.3).

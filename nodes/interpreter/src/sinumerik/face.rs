@@ -4,7 +4,7 @@
 //! forth, each pass at most MIDA from the last, the cutter running out past the edges and
 //! coming down outside the face. No radius compensation. Decision D89.
 
-use super::cutter_path::{steps, within_budget, Frame, Move};
+use super::cutter_path::{cutter, feeds, infeed, steps, width_step, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::levels;
 
@@ -32,19 +32,13 @@ pub struct Face {
 }
 
 fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm {
-        number,
-        text: text.into(),
-    }
+    CycleAlarm::new(number, text)
 }
 
 /// The cutter centre's moves for CYCLE71 with a cutter of `tool_radius` (`None`: no cutting
 /// edge active).
 pub fn face_milling(p: Face, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAlarm> {
-    let wr = tool_radius.ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
-    if wr <= 0.0 {
-        return Err(alarm(61117, "active tool radius ≤ 0"));
-    }
+    let wr = cutter(tool_radius)?;
     let (units, tens) = (p.vari % 10, p.vari / 10);
     if !(1..=2).contains(&units) || !(1..=4).contains(&tens) {
         return Err(alarm(
@@ -55,20 +49,9 @@ pub fn face_milling(p: Face, tool_radius: Option<f64>) -> Result<Vec<Move>, Cycl
     if p.leng == 0.0 || p.wid == 0.0 {
         return Err(alarm(61118, "length or width = 0"));
     }
-    let mida = if p.mida > 0.0 { p.mida } else { 1.6 * wr };
-    if mida > 2.0 * wr {
-        return Err(alarm(61111, "infeed width MIDA > tool diameter"));
-    }
-    if p.ffp1 <= 0.0 {
-        return Err(alarm(61003, "no feed programmed in the cycle: FFP1"));
-    }
-    let down = (p.dp - p.rfp).signum();
-    if p.dp == p.rfp || (p.rtp - p.rfp) * down >= 0.0 {
-        return Err(alarm(
-            61101,
-            "reference plane defined incorrectly: RTP before RFP, DP beyond it",
-        ));
-    }
+    let mida = width_step(p.mida, wr)?;
+    feeds(&[p.ffp1], "FFP1")?;
+    let down = infeed(p.rtp, p.rfp, p.dp)?;
     let (sin, cos) = p.sta.to_radians().sin_cos();
     let f = Frame {
         centre: p.corner,

@@ -4,7 +4,7 @@
 //! or on a helix, then widening in rings at most MIDA apart; finishing takes the wall in one
 //! turn per level, entered and left on quarter circles, then the floor. Decision D87.
 
-use super::cutter_path::{steps, within_budget, Move, P3};
+use super::cutter_path::{cutter, feeds, infeed, steps, width_step, within_budget, Move, P3};
 use super::drilling::CycleAlarm;
 
 /// How roughing enters each level.
@@ -40,10 +40,7 @@ pub struct CirclePocket {
 }
 
 fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm {
-        number,
-        text: text.into(),
-    }
+    CycleAlarm::new(number, text)
 }
 
 /// The levels from `top` to `bottom`, at most `mid` apart and evenly spread (the fewest);
@@ -59,33 +56,16 @@ pub fn levels(top: f64, bottom: f64, mid: f64) -> Result<Vec<f64>, CycleAlarm> {
 /// The cutter centre's moves for POCKET4 with a cutter of `tool_radius` (`None`: no cutting
 /// edge active).
 pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAlarm> {
-    let wr = tool_radius.ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
-    if wr <= 0.0 {
-        return Err(alarm(61117, "active tool radius ≤ 0"));
-    }
-    let down = (p.dp - p.rfp).signum();
-    if p.dp == p.rfp || (p.rtp - p.rfp) * down >= 0.0 {
-        return Err(alarm(
-            61101,
-            "reference plane defined incorrectly: RTP before RFP, DP beyond it",
-        ));
-    }
+    let wr = cutter(tool_radius)?;
+    let down = infeed(p.rtp, p.rfp, p.dp)?;
     if p.prad - p.fal <= wr {
         return Err(alarm(61105, "cutter radius too large for the pocket"));
     }
-    let mida = if p.mida > 0.0 { p.mida } else { 1.6 * wr };
-    if mida > 2.0 * wr {
-        return Err(alarm(61111, "infeed width MIDA > tool diameter"));
-    }
+    let mida = width_step(p.mida, wr)?;
     if p.mid > 0.0 && p.fald > p.mid {
         return Err(alarm(61110, "base allowance FALD > depth infeed MID"));
     }
-    if p.ffp1 <= 0.0 || p.ffd <= 0.0 {
-        return Err(alarm(
-            61003,
-            "no feed programmed in the cycle: FFP1 and FFD",
-        ));
-    }
+    feeds(&[p.ffp1, p.ffd], "FFP1 and FFD")?;
     let (cx, cy) = p.centre;
     let safety = p.rfp - down * p.sdis.abs();
     let floor = p.dp - down * p.fald.abs();

@@ -4,7 +4,9 @@
 //! rectangles at most MIDA apart; finishing takes the wall once per level (entered and left on
 //! quarter circles) and the floor. Decision D87.
 
-use super::cutter_path::{round_rect, steps, within_budget, Frame, Move};
+use super::cutter_path::{
+    cutter, feeds, infeed, round_rect, steps, width_step, within_budget, Frame, Move,
+};
 use super::drilling::CycleAlarm;
 use super::pocket::{levels, Insertion};
 
@@ -33,10 +35,7 @@ pub struct RectPocket {
 }
 
 fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm {
-        number,
-        text: text.into(),
-    }
+    CycleAlarm::new(number, text)
 }
 
 /// The cutter centre's moves for POCKET3 with a cutter of `tool_radius` (`None`: no cutting
@@ -45,17 +44,8 @@ pub fn rectangular_pocket(
     p: RectPocket,
     tool_radius: Option<f64>,
 ) -> Result<Vec<Move>, CycleAlarm> {
-    let wr = tool_radius.ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
-    if wr <= 0.0 {
-        return Err(alarm(61117, "active tool radius ≤ 0"));
-    }
-    let down = (p.dp - p.rfp).signum();
-    if p.dp == p.rfp || (p.rtp - p.rfp) * down >= 0.0 {
-        return Err(alarm(
-            61101,
-            "reference plane defined incorrectly: RTP before RFP, DP beyond it",
-        ));
-    }
+    let wr = cutter(tool_radius)?;
+    let down = infeed(p.rtp, p.rfp, p.dp)?;
     let (la, lb) = (p.leng.abs() / 2.0, p.wid.abs() / 2.0);
     if wr >= la.min(lb) - p.fal {
         return Err(alarm(61105, "cutter radius too large for the pocket"));
@@ -63,19 +53,11 @@ pub fn rectangular_pocket(
     if p.crad > la.min(lb) {
         return Err(alarm(61113, "corner radius CRAD too large"));
     }
-    let mida = if p.mida > 0.0 { p.mida } else { 1.6 * wr };
-    if mida > 2.0 * wr {
-        return Err(alarm(61111, "infeed width MIDA > tool diameter"));
-    }
+    let mida = width_step(p.mida, wr)?;
     if p.mid > 0.0 && p.fald > p.mid {
         return Err(alarm(61110, "base allowance FALD > depth infeed MID"));
     }
-    if p.ffp1 <= 0.0 || p.ffd <= 0.0 {
-        return Err(alarm(
-            61003,
-            "no feed programmed in the cycle: FFP1 and FFD",
-        ));
-    }
+    feeds(&[p.ffp1, p.ffd], "FFP1 and FFD")?;
     // Along the long side.
     let (long, short, sta) = if la >= lb {
         (la, lb, p.sta)

@@ -6,7 +6,7 @@
 //! along its middle and then round it out to the allowance, and finished round its wall.
 //! Decision D90.
 
-use super::cutter_path::{round_rect, steps, within_budget, Frame, Move};
+use super::cutter_path::{feeds, infeed, round_rect, steps, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::levels;
 
@@ -42,10 +42,7 @@ pub struct Slot {
 }
 
 fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm {
-        number,
-        text: text.into(),
-    }
+    CycleAlarm::new(number, text)
 }
 
 impl Pattern {
@@ -53,20 +50,8 @@ impl Pattern {
         if self.num == 0 {
             return Err(alarm(61103, "number of holes is zero"));
         }
-        if self.ffd <= 0.0 || self.ffp1 <= 0.0 {
-            return Err(alarm(
-                61003,
-                "no feed programmed in the cycle: FFD and FFP1",
-            ));
-        }
-        let down = (self.dp - self.rfp).signum();
-        if self.dp == self.rfp || (self.rtp - self.rfp) * down >= 0.0 {
-            return Err(alarm(
-                61101,
-                "reference plane defined incorrectly: RTP before RFP, DP beyond it",
-            ));
-        }
-        Ok(down)
+        feeds(&[self.ffd, self.ffp1], "FFD and FFP1")?;
+        infeed(self.rtp, self.rfp, self.dp)
     }
 
     /// The frame of hole `k`: its middle at the origin, its long axis along x.

@@ -4,7 +4,7 @@
 //! on a semicircle, goes round the spigot from the blank's edge inwards (one turn when no
 //! blank is given, as the manual's cycle does), leaves on a semicircle. Decision D88.
 
-use super::cutter_path::{round_rect, steps, within_budget, Frame, Move};
+use super::cutter_path::{feeds, infeed, round_rect, steps, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::levels;
 
@@ -33,10 +33,7 @@ pub struct Spigot {
 }
 
 fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm {
-        number,
-        text: text.into(),
-    }
+    CycleAlarm::new(number, text)
 }
 
 /// How far a point of the spigot's frame lies outside its rounded rectangle.
@@ -51,19 +48,8 @@ pub fn spigot(p: Spigot, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAla
     let wr = tool_radius
         .filter(|r| *r > 0.0)
         .ok_or_else(|| alarm(61009, "no tool compensation active (T and D)"))?;
-    let down = (p.dp - p.rfp).signum();
-    if p.dp == p.rfp || (p.rtp - p.rfp) * down >= 0.0 {
-        return Err(alarm(
-            61101,
-            "reference plane defined incorrectly: RTP before RFP, DP beyond it",
-        ));
-    }
-    if p.ffp1 <= 0.0 || p.ffd <= 0.0 {
-        return Err(alarm(
-            61003,
-            "no feed programmed in the cycle: FFP1 and FFD",
-        ));
-    }
+    let down = infeed(p.rtp, p.rfp, p.dp)?;
+    feeds(&[p.ffp1, p.ffd], "FFP1 and FFD")?;
     let (a, b) = p.half;
     let r = p.crad.min(a).min(b).max(0.0);
     let (sin, cos) = p.sta.to_radians().sin_cos();

@@ -27,10 +27,7 @@ pub struct Thread {
 }
 
 fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm {
-        number,
-        text: text.into(),
-    }
+    CycleAlarm::new(number, text)
 }
 
 /// The cutter's path: to the start at RTP, down, a tangential approach arc, the helix (PIT
