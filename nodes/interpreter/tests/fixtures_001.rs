@@ -265,14 +265,12 @@ fn f072_the_first_fulfilled_jump_of_a_block_wins() {
 
 /// The fixtures that call a cycle of chapter 10 (issue 24): 006, 075, 076 and 092–117.
 /// The drilling cycles and hole patterns (092–105) run as printed, 103 up to the placeholder
-/// the manual prints in it (`sinumerik_drilling.rs` asserts what each does); CYCLE71 (106),
-/// CYCLE76 (109), CYCLE77 (110), LONGHOLE (111), SLOT1 (112), SLOT2 (113), POCKET3 (114),
-/// POCKET4 (115) and CYCLE90 (116, 117) mill (`sinumerik_milling.rs`; here some meet the
-/// alarm of a tool this machine lacks); CYCLE72 (107, 108) stops with 12140 at its first
-/// call, nothing of that block moving;
+/// the manual prints in it (`sinumerik_drilling.rs` asserts what each does); the milling
+/// cycles of 106–117 mill (`sinumerik_milling.rs`; here some meet the alarm of a tool this
+/// machine lacks, or of a program it does not hold);
 /// 006, 075 and 076 are templates that stop earlier, at a placeholder (12080).
 #[test]
-fn cycle_fixtures_drill_and_the_milling_ones_wait() {
+fn cycle_fixtures_as_printed() {
     let calls = [
         "CYCLE", "HOLES1", "HOLES2", "LONGHOLE", "SLOT1", "SLOT2", "POCKET3", "POCKET4",
     ];
@@ -308,7 +306,7 @@ fn cycle_fixtures_drill_and_the_milling_ones_wait() {
     for (p, name) in cycles.iter().zip(&names) {
         let r = run(&std::fs::read_to_string(p).unwrap());
         let runs = name.as_str() >= "092" && name.as_str() <= "105" && name != "103";
-        if runs || ["114", "115", "116"].contains(&name.as_str()) {
+        if runs || ["108", "114", "115", "116"].contains(&name.as_str()) {
             assert!(r.error.is_none(), "{}: {:?}", p.display(), r.error);
             continue;
         }
@@ -330,6 +328,12 @@ fn cycle_fixtures_drill_and_the_milling_ones_wait() {
             assert_eq!(r.error.as_ref().map(|e| e.number), Some(61105), "{name}");
             continue;
         }
+        if name == "107" {
+            // Its contour subprogram follows in the same listing, not in program memory:
+            // run as one text it does not exist (`sinumerik_milling.rs` stores it).
+            assert_eq!(r.error.as_ref().map(|e| e.number), Some(14011), "{name}");
+            continue;
+        }
         if name == "117" {
             // It passes DP, which it never defines (`sinumerik_milling.rs`).
             assert_eq!(r.error.as_ref().map(|e| e.number), Some(12550));
@@ -343,8 +347,7 @@ fn cycle_fixtures_drill_and_the_milling_ones_wait() {
             assert_eq!(e.number, 12080, "{}: {e}", p.display());
             continue;
         }
-        assert_eq!(e.number, 12140, "{}: {e}", p.display());
-        assert!(e.text.contains("milling cycles"), "{}: {e}", p.display());
+        panic!("{}: not expected: {e}", p.display());
     }
 }
 

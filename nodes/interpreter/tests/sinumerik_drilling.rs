@@ -529,12 +529,14 @@ fn cycle_alarms_as_the_manual_lists_them() {
         )),
         (61106, 3)
     );
-    // A milling cycle: not built yet, with the reason.
+    // A cycle the manual does not have: no such name.
+    let r = run(&format!("{head}CYCLE99(10, 0, 2, -5)\n"));
+    assert_eq!(r.alarm(), (12550, 2));
+    // CYCLE72 with a contour program that is not there: 14011.
     let r = run(&format!(
-        "{head}CYCLE72(\"KONTUR\", 10, 0, 2, -5, 2, 0.5, 0.2, 300, 100, 11, 41, 2, 5, 300, 2, 5)\n"
+        "{head}T1 D1\nCYCLE72(\"KONTUR\", 10, 0, 2, -5, 2, 0.5, 0.2, 300, 100, 11, 41, 2, 5, 300, 2, 5)\n"
     ));
-    assert_eq!(r.alarm(), (12140, 2));
-    assert!(r.error.unwrap().text.contains("milling cycles"));
+    assert_eq!(r.alarm(), (14011, 3));
 }
 
 #[test]

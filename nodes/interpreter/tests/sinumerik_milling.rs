@@ -957,3 +957,83 @@ fn f113_slot2_mills_three_slots_along_the_circle() {
     );
     assert_eq!(r.alarm().0, 61104);
 }
+
+/// The contour of fixtures 107 and 108, worked out here: X150 Y160 → X230 with a 10 mm
+/// chamfer → Y80 with a 10 mm chamfer → X125 → Y135 → clockwise R25 about X150 Y135 back to
+/// X150 Y160; its corners, the arc every degree (0.001 mm from the true arc).
+fn contour_107() -> Vec<(f64, f64)> {
+    let leg = 10.0 / 2f64.sqrt();
+    let mut pts = vec![
+        (150.0, 160.0),
+        (230.0 - leg, 160.0),
+        (230.0, 160.0 - leg),
+        (230.0, 80.0 + leg),
+        (230.0 - leg, 80.0),
+        (125.0, 80.0),
+    ];
+    // From (125, 135) round by the top to (150, 160), clockwise about (150, 135).
+    pts.extend((0..90).map(|k| {
+        let a = (180.0 - k as f64).to_radians();
+        (150.0 + 25.0 * a.cos(), 135.0 + 25.0 * a.sin())
+    }));
+    pts
+}
+
+fn point_segment(p: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let t = (((p.0 - a.0) * dx + (p.1 - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+    dist(p, (a.0 + t * dx, a.1 + t * dy))
+}
+
+/// Signed distance from a closed polygon (positive outside).
+fn outside_of(poly: Vec<(f64, f64)>) -> impl Fn((f64, f64)) -> f64 {
+    move |p| {
+        let mut d = f64::INFINITY;
+        let mut inside = false;
+        for i in 0..poly.len() {
+            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+            d = d.min(point_segment(p, a, b));
+            if (a.1 > p.1) != (b.1 > p.1) && p.0 < a.0 + (p.1 - a.1) * (b.0 - a.0) / (b.1 - a.1) {
+                inside = !inside;
+            }
+        }
+        if inside {
+            -d
+        } else {
+            d
+        }
+    }
+}
+
+#[test]
+fn f107_f108_cycle72_mills_round_the_contour_from_a_subprogram_or_labels() {
+    // CYCLE72(…, 250, 200, 3, 175, 10, 1, 1.5, 800, 400, VARI, 41, 2, 20, 1000, 2, 20): the
+    // contour from outside (G41 on a clockwise contour), quarter circles R20 in and out,
+    // roughing to Z175 + 1.5 within 10 mm, 1 mm left in the plane; T3 D1 a 14 mm cutter.
+    let text = fixture("107");
+    let (main, sub) = text.split_once("%_N_EX72CONTOUR_SPF").unwrap();
+    let sub = sub.split_once('\n').unwrap().1;
+    let mut lib = Library::new();
+    lib.insert_named("EX72CONTOUR", "EX72CONTOUR.SPF", sub);
+    for (program, library) in [(main.to_string(), lib), (fixture("108"), Library::new())] {
+        let r = run_with(&program, with_edge(31, 7.0), library).ok();
+        let out = outside_of(contour_107());
+        let mut stock = Stock::new((180.0, 120.0), 90.0, 200.0, 7.0, move |p| 1.0 - out(p));
+        stock.follow(&r.out, [100.0, 200.0, 250.0]);
+        assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
+        assert_within(stock.reach, 0.0, "the contour 1 mm out");
+        let out = outside_of(contour_107());
+        let (lo, hi) = stock.floor_where(|q| (1.01..=8.0).contains(&out(q)));
+        assert_within(lo, 176.5, "down to Z175 + 1.5");
+        assert_within(hi, 176.5, "all round");
+        let mut levels = stock.levels.clone();
+        levels.sort_by(|a, b| b.total_cmp(a));
+        levels.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+        assert_eq!(levels.len(), 3, "{levels:?}");
+        assert!(near(&r.end(), &[100.0, 200.0, 250.0]), "{:?}", r.end());
+    }
+}
+
+fn dist(a: (f64, f64), b: (f64, f64)) -> f64 {
+    (a.0 - b.0).hypot(a.1 - b.1)
+}

@@ -14,7 +14,7 @@ use super::expr::Expr;
 use super::Sinumerik;
 
 /// The cycles built, each with its parameters in the manual's order.
-const CYCLES: [(&str, &[&str]); 21] = [
+const CYCLES: [(&str, &[&str]); 22] = [
     ("CYCLE81", &["RTP", "RFP", "SDIS", "DP", "DPR"]),
     ("CYCLE82", &["RTP", "RFP", "SDIS", "DP", "DPR", "DTB"]),
     (
@@ -80,6 +80,13 @@ const CYCLES: [(&str, &[&str]); 21] = [
         ],
     ),
     (
+        "CYCLE72",
+        &[
+            "KNAME", "RTP", "RFP", "SDIS", "DP", "MID", "FAL", "FALD", "FFP1", "FFD", "VARI", "RL",
+            "AS1", "LP1", "FF3", "AS2", "LP2",
+        ],
+    ),
+    (
         "CYCLE71",
         &[
             "RTP", "RFP", "SDIS", "DP", "PA", "PO", "LENG", "WID", "STA", "MID", "MIDA", "FDP",
@@ -141,6 +148,8 @@ pub struct CycleCall {
     pub name: &'static str,
     params: &'static [&'static str],
     values: Vec<Option<f64>>,
+    /// A text parameter (CYCLE72's KNAME).
+    pub text: Option<String>,
 }
 
 impl CycleCall {
@@ -175,12 +184,6 @@ impl Sinumerik {
         args: &[Option<Expr>],
     ) -> Result<CycleCall, ProgramError> {
         let Some(&(name, params)) = CYCLES.iter().find(|(n, _)| *n == name) else {
-            if name == "CYCLE72" {
-                return Err(self.fault(
-                    Fault::NotSupported,
-                    "CYCLE72: contour milling, of the milling cycles of chapter 10 the one not built yet",
-                ));
-            }
             return Err(self.fault(
                 Fault::NoSuchAddress,
                 format!("{name}(…) is no cycle of chapter 10"),
@@ -200,7 +203,17 @@ impl Sinumerik {
         }
         let unit = if self.inch { 25.4 } else { 1.0 };
         let mut values = Vec::with_capacity(args.len());
+        let mut text = None;
         for (a, p) in args.iter().zip(params) {
+            if *p == "KNAME" {
+                // The contour's name or label section, a string.
+                text = match a {
+                    Some(e) => Some(self.value(e)?.text()),
+                    None => None,
+                };
+                values.push(None);
+                continue;
+            }
             let v = match a {
                 Some(e) => Some(self.number(e)?),
                 None => None,
@@ -211,6 +224,7 @@ impl Sinumerik {
             name,
             params,
             values,
+            text,
         })
     }
 
@@ -225,6 +239,10 @@ impl Sinumerik {
             "CYCLE76" | "CYCLE77" => return self.spigot(c),
             "CYCLE71" => return self.face(c),
             "LONGHOLE" | "SLOT1" | "SLOT2" => return self.slots(c),
+            "CYCLE72" => {
+                let kname = c.text.clone().unwrap_or_default();
+                return self.contour_milling(c, &kname);
+            }
             "POCKET4" => return self.circular_pocket(c),
             _ => {}
         }

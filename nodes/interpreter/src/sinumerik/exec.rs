@@ -228,6 +228,13 @@ const H_NOT_BUILT: &str = "H functions are not built: the PLC here takes M, S an
 impl Sinumerik {
     /// Runs one parsed block.
     pub(super) fn run_block(&mut self, b: &Block, text: &Arc<str>) -> Result<(), ProgramError> {
+        if !self
+            .program_text
+            .as_ref()
+            .is_some_and(|t| Arc::ptr_eq(t, text))
+        {
+            self.program_text = Some(text.clone());
+        }
         let mut w = std::mem::take(&mut self.words);
         w.clear();
         let done = self.run_words(b, &mut w, text);

@@ -9,6 +9,7 @@
 pub mod alarms;
 pub mod block;
 mod contour;
+mod contour_cycle;
 mod cutter_path;
 mod cycle_call;
 mod drilling;
@@ -100,6 +101,8 @@ pub struct Sinumerik {
     corner: contour::BlockCorner,
     /// A line given only its angle (`ANG=α`), waiting for the block that closes it.
     ang: Option<contour::AngPending>,
+    /// The text of the program whose block runs (CYCLE72 finds label sections in it).
+    program_text: Option<Arc<str>>,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -176,6 +179,7 @@ impl Sinumerik {
             frcm: None,
             corner: None,
             ang: None,
+            program_text: None,
         };
         front.apply_length();
         front
