@@ -586,3 +586,27 @@ fn cycles_keep_the_frame_and_the_tool_length() {
         &[Rapid(61.0), Feed(50.0, 100.0), Dwell(0.5), Rapid(70.0)],
     );
 }
+
+#[test]
+fn f076_mcall_cycle82_with_holes1_drills_a_row() {
+    // As printed its parameters are placeholders (12080 at N10). Filled: CYCLE82 from RFP 100
+    // to Z50 with a 1 s dwell at four holes 20 apart from X10 along X.
+    assert_eq!(run(&fixture("076")).alarm().0, 12080);
+    let text = "G17 G90 F120 S500 M3\nG0 X0 Y0 Z110\n\
+        N10 MCALL CYCLE82(110, 100, 2, 50, , 1)\nN20 HOLES1(0, 0, 0, 10, 20, 4)\nN30 MCALL\nG0 X0\n";
+    let r = run(text).ok();
+    let hs = holes(&r, &[4], XYZ);
+    same_set(
+        &hs.iter().map(|h| h.at).collect::<Vec<_>>(),
+        &row(0.0, 0.0, 0.0, 10.0, 20.0, 4),
+    );
+    use Ev::*;
+    for h in &hs {
+        assert_levels(
+            &h.events,
+            &[Rapid(102.0), Feed(50.0, 120.0), Dwell(1.0), Rapid(110.0)],
+        );
+    }
+    // After MCALL alone the last move drills nothing.
+    assert!(matches!(r.moves().last(), Some(Command::Rapid { end }) if end[0] == 0.0));
+}
