@@ -610,3 +610,37 @@ fn f076_mcall_cycle82_with_holes1_drills_a_row() {
     // After MCALL alone the last move drills nothing.
     assert!(matches!(r.moves().last(), Some(Command::Rapid { end }) if end[0] == 0.0));
 }
+
+#[test]
+fn cycle840_sdr0_reverses_the_spindle_turning_and_cycle83_takes_fdpr() {
+    use Ev::*;
+    // SDR 0: the spindle turning M3 goes out M4; SDAC 5 stops it after.
+    let text = "G17 G90 F100 S400 M3\nG0 X10 Y10 Z20\nCYCLE840(20, 10, 1, 0, , 0, 0, 5, 1)\n";
+    let r = run(text).ok();
+    let hs = holes(&r, &[3], XYZ);
+    assert_levels(
+        &hs[0].events,
+        &[
+            Rapid(11.0),
+            Feed(0.0, 100.0),
+            M(4),
+            Feed(11.0, 100.0),
+            Rapid(20.0),
+            M(5),
+        ],
+    );
+    // CYCLE83 with the first depth relative (FDPR 4 from RFP 10: Z6), DAM 0: the next infeed
+    // 4 again; the 6 left are more than one infeed and no more than two: 3 and 3 (D84).
+    // Chip breaking: back 1 mm after each.
+    let text =
+        "G17 G90 F100 S400 M3\nG0 X10 Y10 Z20\nCYCLE83(20, 10, 1, 0, , , 4, 0, 0, 0, 1, 0)\n";
+    let r = run(text).ok();
+    let hs = holes(&r, &[3], XYZ);
+    let feeds: Vec<f64> = hs[0]
+        .feeds()
+        .iter()
+        .filter(|(_, f)| *f == 100.0)
+        .map(|(l, _)| *l)
+        .collect();
+    assert_eq!(feeds, [6.0, 7.0, 3.0, 4.0, 0.0], "{feeds:?}");
+}

@@ -716,3 +716,103 @@ fn f107_f108_cycle72_mills_round_the_contour_from_a_subprogram_or_labels() {
         assert!(near(&r.end(), &[100.0, 200.0, 250.0]), "{:?}", r.end());
     }
 }
+
+#[test]
+fn variants_slot1_finishing_alone_cycle71_along_the_2nd_axis_cycle72_finishing_and_g40() {
+    // SLOT1 roughed (VARI 1), then finished by a call of its own (VARI 2): the walls on size.
+    let rough = fixture("112").replace(", 0.5, 0, , 0, )", ", 0.5, 1, , 0, )");
+    let finish = fixture("112")
+        .replace(", 0.5, 0, , 0, )", ", 0.5, 2, , 0, )")
+        .replace("N40 M02", "");
+    let text = format!(
+        "{}{}",
+        rough.replace("N40 M02", ""),
+        finish
+            .lines()
+            .skip(2)
+            .map(|l| format!("{l}\n"))
+            .collect::<String>()
+    );
+    let r = run_with(&text, cutter5(), Library::new()).ok();
+    let wall = slots_wall(
+        (40.0, 45.0),
+        20.0,
+        vec![45.0, 135.0, 225.0, 315.0],
+        15.0,
+        7.5,
+    );
+    let mut stock = Stock::new((40.0, 45.0), 45.0, 0.0, 5.0, wall);
+    stock.follow(&r.out, [20.0, 50.0, 5.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 0.0, "finished walls");
+    let (lo, hi, _) = stock.floor_within(0.01);
+    assert_within(lo, -23.0, "floor");
+    assert_within(hi, -23.0, "floor");
+    // CYCLE71 roughing along the 2nd axis one way (21) and back and forth (41).
+    for vari in [21, 41] {
+        let text = format!(
+            "G17 G90 T1 D1 S2000 M3\nG0 X-50 Y-50 Z20\nCYCLE71(20, 5, 2, -3, 0, 0, 60, 40, 0, 4, 12, 3, 0, 3000, {vari}, 3)\n"
+        );
+        let r = run_with(&text, with_edge(11, 8.0), Library::new()).ok();
+        let face = rounded_rect((30.0, 20.0), 30.0, 20.0, 0.0, 0.0);
+        let mut stock =
+            Stock::new((30.0, 20.0), 60.0, 5.0, 8.0, |_| -1.0).only(move |q| face(q) <= 0.0);
+        stock.follow(&r.out, [-50.0, -50.0, 20.0]);
+        assert_eq!(stock.rapid_cuts, 0, "VARI {vari}");
+        let face = rounded_rect((30.0, 20.0), 30.0, 20.0, 0.0, 0.0);
+        let (lo, hi) = stock.floor_where(|q| face(q) <= 0.0);
+        assert_within(lo, -3.0, "faced");
+        assert_within(hi, -3.0, "everywhere");
+        stock.assert_infeeds_within(5.0, 4.0);
+    }
+    // CYCLE72 roughed (VARI 111) then finished (VARI 212: retract by SDIS between levels),
+    // the contour of 108 on size all round at Z175.
+    let text = fixture("108");
+    let finish = text.replace(
+        ", 11, 41, 2, 20, 1000, 2, 20)",
+        ", 212, 41, 2, 20, 1000, 2, 20)",
+    );
+    let both = text.replace(
+        "N50 X100 Y200",
+        &finish
+            .lines()
+            .find(|l| l.contains("CYCLE72"))
+            .unwrap()
+            .replace("N40", "N45"),
+    );
+    let r = run_with(&both, with_edge(31, 7.0), Library::new()).ok();
+    let out = outside_of(contour_107());
+    let mut stock = Stock::new((180.0, 120.0), 90.0, 200.0, 7.0, move |p| -out(p));
+    stock.follow(&r.out, [100.0, 200.0, 250.0]);
+    assert_eq!(stock.rapid_cuts, 0);
+    assert_within(stock.reach, 0.0, "the contour on size");
+    let out = outside_of(contour_107());
+    let (lo, hi) = stock.floor_where(|q| (0.01..=7.0).contains(&out(q)));
+    assert_within(lo, 175.0, "finished down to DP");
+    assert_within(hi, 175.0, "all round");
+    // RL 40: the centre on the contour, straight approach only; a quarter circle is 61115.
+    let g40 = text.replace(
+        ", 11, 41, 2, 20, 1000, 2, 20)",
+        ", 11, 40, 1, 20, 1000, 1, 20)",
+    );
+    let r = run_with(&g40, with_edge(31, 7.0), Library::new()).ok();
+    let ends: Vec<(f64, f64)> = r
+        .moves()
+        .iter()
+        .filter_map(|c| c.end().map(|e| (e[0], e[1])))
+        .collect();
+    for corner in contour_107().iter().take(6) {
+        assert!(
+            ends.iter().any(|e| dist(*e, *corner) < 1e-6),
+            "the cutter's centre at {corner:?}"
+        );
+    }
+    let bad = text.replace(
+        ", 11, 41, 2, 20, 1000, 2, 20)",
+        ", 11, 40, 2, 20, 1000, 2, 20)",
+    );
+    assert_eq!(
+        run_with(&bad, with_edge(31, 7.0), Library::new()).alarm().0,
+        61115
+    );
+}
