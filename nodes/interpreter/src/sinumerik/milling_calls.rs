@@ -139,7 +139,7 @@ impl Sinumerik {
             external,
             centre: (c.or("CPA", 0.0), c.or("CPO", 0.0)),
         };
-        let radius = self.offset_entry().map_or(0.0, |e| e.radius);
+        let radius = self.offset_entry().map(|e| e.radius);
         let moves = thread_milling(t, radius).map_err(|a| self.cycle_alarm(a, c.name))?;
         self.run_path(moves)
     }

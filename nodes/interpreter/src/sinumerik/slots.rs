@@ -6,7 +6,7 @@
 //! along its middle and then round it out to the allowance, and finished round its wall.
 //! Decision D90.
 
-use super::cutter_path::{feeds, infeed, round_rect, steps, within_budget, Frame, Move};
+use super::cutter_path::{cutter, feeds, infeed, round_rect, steps, within_budget, Frame, Move};
 use super::drilling::CycleAlarm;
 use super::pocket::levels;
 
@@ -43,6 +43,18 @@ pub struct Slot {
 
 fn alarm(number: u32, text: &str) -> CycleAlarm {
     CycleAlarm::new(number, text)
+}
+
+/// VARI of SLOT1 and SLOT2: 0 complete, 1 roughing, 2 finishing; anything else is 61002.
+fn machining_kind(vari: i64) -> Result<(), CycleAlarm> {
+    if (0..=2).contains(&vari) {
+        Ok(())
+    } else {
+        Err(alarm(
+            61002,
+            "VARI is 0 complete, 1 roughing or 2 finishing",
+        ))
+    }
 }
 
 impl Pattern {
@@ -128,9 +140,7 @@ pub fn long_holes(
     tool_radius: Option<f64>,
     from: Pt2,
 ) -> Result<Vec<Move>, CycleAlarm> {
-    let wr = tool_radius
-        .filter(|r| *r > 0.0)
-        .ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
+    let wr = cutter(tool_radius)?;
     let down = p.check()?;
     if p.leng < 2.0 * wr {
         return Err(alarm(
@@ -168,16 +178,9 @@ pub fn slots(
     s: Slot,
     tool_radius: Option<f64>,
 ) -> Result<(Vec<Move>, Vec<Move>), CycleAlarm> {
-    let wr = tool_radius
-        .filter(|r| *r > 0.0)
-        .ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
+    let wr = cutter(tool_radius)?;
     let down = p.check()?;
-    if !(0..=2).contains(&s.vari) {
-        return Err(alarm(
-            61002,
-            "VARI is 0 complete, 1 roughing or 2 finishing",
-        ));
-    }
+    machining_kind(s.vari)?;
     let (a, b) = (p.leng / 2.0, s.wid / 2.0);
     if 2.0 * wr >= s.wid || a < b {
         return Err(alarm(
@@ -300,17 +303,10 @@ pub fn arc_slots(
     s: ArcSlot,
     tool_radius: Option<f64>,
 ) -> Result<(Vec<Move>, Vec<Move>), CycleAlarm> {
-    let wr = tool_radius
-        .filter(|r| *r > 0.0)
-        .ok_or_else(|| alarm(61000, "no tool offset active (D)"))?;
+    let wr = cutter(tool_radius)?;
     let down = p.check()?;
     let slot = s.slot;
-    if !(0..=2).contains(&slot.vari) {
-        return Err(alarm(
-            61002,
-            "VARI is 0 complete, 1 roughing or 2 finishing",
-        ));
-    }
+    machining_kind(slot.vari)?;
     let half = slot.wid / 2.0;
     if 2.0 * wr >= slot.wid {
         return Err(alarm(

@@ -5,7 +5,7 @@
 
 use std::f64::consts::TAU;
 
-use super::cutter_path::{steps, Move};
+use super::cutter_path::{cutter, steps, Move};
 use super::drilling::CycleAlarm;
 
 /// CYCLE90's parameters, lengths in mm.
@@ -34,13 +34,8 @@ fn alarm(number: u32, text: &str) -> CycleAlarm {
 /// per turn, half a pitch beyond each end of the thread), a tangential retraction arc, out to
 /// RTP. Internal threads are entered from the hole's centre on a semicircle in the milling
 /// direction; external ones from outside on a quarter circle against it (§10.6.11).
-pub fn thread_milling(t: Thread, tool_radius: f64) -> Result<Vec<Move>, CycleAlarm> {
-    if tool_radius <= 0.0 {
-        return Err(alarm(
-            61000,
-            "no tool offset active: the cutter needs its radius (D)",
-        ));
-    }
+pub fn thread_milling(t: Thread, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAlarm> {
+    let tool_radius = cutter(tool_radius)?;
     if !(0.001..=2000.0).contains(&t.pit) {
         return Err(alarm(61001, "thread pitch wrong: PIT is 0.001…2000 mm"));
     }
@@ -182,7 +177,7 @@ mod tests {
 
     #[test]
     fn an_internal_thread_turns_once_per_pitch_from_half_a_pitch_above() {
-        let m = thread_milling(internal(), 5.0).unwrap();
+        let m = thread_milling(internal(), Some(5.0)).unwrap();
         // 40 mm and a pitch beyond: 21 turns of the 25 mm path.
         let helix: Vec<&Move> = m
             .iter()
@@ -198,12 +193,19 @@ mod tests {
 
     #[test]
     fn refusals() {
-        assert_eq!(thread_milling(internal(), 0.0).unwrap_err().number, 61000);
-        assert_eq!(thread_milling(internal(), 25.0).unwrap_err().number, 61105);
+        assert_eq!(thread_milling(internal(), None).unwrap_err().number, 61000);
+        assert_eq!(
+            thread_milling(internal(), Some(0.0)).unwrap_err().number,
+            61117
+        );
+        assert_eq!(
+            thread_milling(internal(), Some(25.0)).unwrap_err().number,
+            61105
+        );
         let bad = Thread {
             pit: 0.0,
             ..internal()
         };
-        assert_eq!(thread_milling(bad, 5.0).unwrap_err().number, 61001);
+        assert_eq!(thread_milling(bad, Some(5.0)).unwrap_err().number, 61001);
     }
 }
