@@ -57,6 +57,35 @@ fn start(domain: u16) -> (Cell, CellClient, f64) {
     (cell, client, length)
 }
 
+/// Waits until the program has completed and its part is counted, without an alarm, and the
+/// axes stand at `end` (machine coordinates); returns the execution states seen on the way.
+fn completes_at(client: &mut CellClient, within: Duration, end: [f64; 3]) -> Vec<String> {
+    let (ok, seen) = client.wait_until(within, |c| {
+        c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+            && c.part_count.as_ref().is_some_and(|p| p.count == 1)
+    });
+    let names: Vec<String> = seen.iter().map(|s| s.execution_name.clone()).collect();
+    assert!(
+        ok,
+        "did not complete and count; states {names:?}, alarms {:?}",
+        client.alarms
+    );
+    assert!(
+        client.alarms.as_ref().is_some_and(|a| a.alarms.is_empty()),
+        "alarms {:?}",
+        client.alarms
+    );
+    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
+        c.axes
+            .as_ref()
+            .is_some_and(|a| (0..3).all(|i| (a.axes[i].actual_position - end[i]).abs() < 0.001))
+    });
+    assert!(ok, "final position {:?}, not {end:?}", client.axes);
+    names
+}
+
 #[test]
 fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() {
     let (cell, mut client, length) = start(DOMAIN);
@@ -86,34 +115,13 @@ fn the_manuals_compensated_contour_runs_in_the_cell_and_counts_its_part_at_m2() 
     assert!(client.load_program("JOB.MPF", main).unwrap().accepted);
     let r = client.start_program("JOB.MPF").unwrap();
     assert!(r.accepted, "{}", r.message);
-    let (ok, seen) = client.wait_until(Duration::from_secs(120), |c| {
-        c.state
-            .as_ref()
-            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
-            && c.part_count.as_ref().is_some_and(|p| p.count == 1)
-    });
-    let names: Vec<&str> = seen.iter().map(|s| s.execution_name.as_str()).collect();
-    assert!(
-        ok,
-        "did not complete and count; states {names:?}, alarms {:?}",
-        client.alarms
-    );
-    assert!(names.contains(&"ACTIVE"), "{names:?}");
-    assert!(
-        client.alarms.as_ref().is_some_and(|a| a.alarms.is_empty()),
-        "alarms {:?}",
-        client.alarms
-    );
     // The manual's end: X5 Y60 Z50 with T1 D1's length along Z (G17), machine coordinates.
-    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
-        c.axes.as_ref().is_some_and(|a| {
-            let at = |i: usize| a.axes[i].actual_position;
-            (at(0) - 5.0).abs() < 0.001
-                && (at(1) - 60.0).abs() < 0.001
-                && (at(2) - (50.0 + length)).abs() < 0.001
-        })
-    });
-    assert!(ok, "final position {:?}", client.axes);
+    let names = completes_at(
+        &mut client,
+        Duration::from_secs(120),
+        [5.0, 60.0, 50.0 + length],
+    );
+    assert!(names.iter().any(|n| n == "ACTIVE"), "{names:?}");
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
 }
@@ -158,30 +166,11 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
     // Cycle start goes on: out of the bore, the pocket, the end.
     let r = client.start_program("").unwrap();
     assert!(r.accepted, "{}", r.message);
-    let (ok, seen) = client.wait_until(Duration::from_secs(180), |c| {
-        c.state
-            .as_ref()
-            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
-            && c.part_count.as_ref().is_some_and(|p| p.count == 1)
-    });
-    let names: Vec<&str> = seen.iter().map(|s| s.execution_name.as_str()).collect();
-    assert!(
-        ok,
-        "did not complete; states {names:?}, alarms {:?}",
-        client.alarms
+    completes_at(
+        &mut client,
+        Duration::from_secs(180),
+        [0.0, 0.0, 100.0 + length],
     );
-    assert!(
-        client.alarms.as_ref().is_some_and(|a| a.alarms.is_empty()),
-        "alarms {:?}",
-        client.alarms
-    );
-    let (ok, _) = client.wait_until(Duration::from_secs(10), |c| {
-        c.axes.as_ref().is_some_and(|a| {
-            let at = |i: usize| a.axes[i].actual_position;
-            at(0).abs() < 0.001 && at(1).abs() < 0.001 && (at(2) - (100.0 + length)).abs() < 0.001
-        })
-    });
-    assert!(ok, "final position {:?}", client.axes);
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
 }
