@@ -31,23 +31,19 @@ pub struct Face {
     pub fdp1: f64,
 }
 
-fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm::new(number, text)
-}
-
 /// The cutter centre's moves for CYCLE71 with a cutter of `tool_radius` (`None`: no cutting
 /// edge active).
 pub fn face_milling(p: Face, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAlarm> {
     let wr = cutter(tool_radius)?;
     let (units, tens) = (p.vari % 10, p.vari / 10);
     if !(1..=2).contains(&units) || !(1..=4).contains(&tens) {
-        return Err(alarm(
+        return Err(CycleAlarm::new(
             61002,
             "VARI: units 1 roughing or 2 finishing, tens 1–4 the direction",
         ));
     }
     if p.leng == 0.0 || p.wid == 0.0 {
-        return Err(alarm(61118, "length or width = 0"));
+        return Err(CycleAlarm::new(61118, "length or width = 0"));
     }
     let mida = width_step(p.mida, wr)?;
     feeds(&[p.ffp1], "FFP1")?;

@@ -39,10 +39,6 @@ pub struct CirclePocket {
     pub mida: f64,
 }
 
-fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm::new(number, text)
-}
-
 /// The levels from `top` to `bottom`, at most `mid` apart and evenly spread (the fewest);
 /// `mid` 0: one.
 pub fn levels(top: f64, bottom: f64, mid: f64) -> Result<Vec<f64>, CycleAlarm> {
@@ -59,11 +55,17 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
     let wr = cutter(tool_radius)?;
     let down = infeed(p.rtp, p.rfp, p.dp)?;
     if p.prad - p.fal <= wr {
-        return Err(alarm(61105, "cutter radius too large for the pocket"));
+        return Err(CycleAlarm::new(
+            61105,
+            "cutter radius too large for the pocket",
+        ));
     }
     let mida = width_step(p.mida, wr)?;
     if p.mid > 0.0 && p.fald > p.mid {
-        return Err(alarm(61110, "base allowance FALD > depth infeed MID"));
+        return Err(CycleAlarm::new(
+            61110,
+            "base allowance FALD > depth infeed MID",
+        ));
     }
     feeds(&[p.ffp1, p.ffd], "FFP1 and FFD")?;
     let (cx, cy) = p.centre;
@@ -92,7 +94,7 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
         let outer = p.prad - p.fal - wr;
         if let Insertion::Helix { radius, per_turn } = p.insertion {
             if radius <= 0.0 || per_turn <= 0.0 || radius > outer {
-                return Err(alarm(61108, "illegal values for RAD1 and DP1"));
+                return Err(CycleAlarm::new(61108, "illegal values for RAD1 and DP1"));
             }
         }
         let mut z = safety;

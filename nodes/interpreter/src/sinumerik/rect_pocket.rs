@@ -34,10 +34,6 @@ pub struct RectPocket {
     pub mida: f64,
 }
 
-fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm::new(number, text)
-}
-
 /// The cutter centre's moves for POCKET3 with a cutter of `tool_radius` (`None`: no cutting
 /// edge active).
 pub fn rectangular_pocket(
@@ -48,14 +44,20 @@ pub fn rectangular_pocket(
     let down = infeed(p.rtp, p.rfp, p.dp)?;
     let (la, lb) = (p.leng.abs() / 2.0, p.wid.abs() / 2.0);
     if wr >= la.min(lb) - p.fal {
-        return Err(alarm(61105, "cutter radius too large for the pocket"));
+        return Err(CycleAlarm::new(
+            61105,
+            "cutter radius too large for the pocket",
+        ));
     }
     if p.crad > la.min(lb) {
-        return Err(alarm(61113, "corner radius CRAD too large"));
+        return Err(CycleAlarm::new(61113, "corner radius CRAD too large"));
     }
     let mida = width_step(p.mida, wr)?;
     if p.mid > 0.0 && p.fald > p.mid {
-        return Err(alarm(61110, "base allowance FALD > depth infeed MID"));
+        return Err(CycleAlarm::new(
+            61110,
+            "base allowance FALD > depth infeed MID",
+        ));
     }
     feeds(&[p.ffp1, p.ffd], "FFP1 and FFD")?;
     // Along the long side.
@@ -95,7 +97,7 @@ pub fn rectangular_pocket(
         let r = (p.crad - p.fal - wr).max(0.0);
         if let Insertion::Helix { radius, per_turn } = p.insertion {
             if radius <= 0.0 || per_turn <= 0.0 || radius > b {
-                return Err(alarm(61108, "illegal values for RAD1 and DP1"));
+                return Err(CycleAlarm::new(61108, "illegal values for RAD1 and DP1"));
             }
         }
         let mut z = safety;

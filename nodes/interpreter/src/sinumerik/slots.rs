@@ -41,16 +41,12 @@ pub struct Slot {
     pub ffp2: f64,
 }
 
-fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm::new(number, text)
-}
-
 /// VARI of SLOT1 and SLOT2: 0 complete, 1 roughing, 2 finishing; anything else is 61002.
 fn machining_kind(vari: i64) -> Result<(), CycleAlarm> {
     if (0..=2).contains(&vari) {
         Ok(())
     } else {
-        Err(alarm(
+        Err(CycleAlarm::new(
             61002,
             "VARI is 0 complete, 1 roughing or 2 finishing",
         ))
@@ -60,7 +56,7 @@ fn machining_kind(vari: i64) -> Result<(), CycleAlarm> {
 impl Pattern {
     fn check(&self) -> Result<f64, CycleAlarm> {
         if self.num == 0 {
-            return Err(alarm(61103, "number of holes is zero"));
+            return Err(CycleAlarm::new(61103, "number of holes is zero"));
         }
         feeds(&[self.ffd, self.ffp1], "FFD and FFP1")?;
         infeed(self.rtp, self.rfp, self.dp)
@@ -94,7 +90,7 @@ impl Pattern {
         for i in 0..self.num {
             for j in i + 1..self.num {
                 if segment_distance(seg(i), seg(j)) < width - 1e-9 {
-                    return Err(alarm(
+                    return Err(CycleAlarm::new(
                         61104,
                         "contour violation of slots/elongated holes: they overlap",
                     ));
@@ -143,7 +139,7 @@ pub fn long_holes(
     let wr = cutter(tool_radius)?;
     let down = p.check()?;
     if p.leng < 2.0 * wr {
-        return Err(alarm(
+        return Err(CycleAlarm::new(
             61105,
             "the hole is shorter than the cutter's diameter",
         ));
@@ -183,7 +179,7 @@ pub fn slots(
     machining_kind(s.vari)?;
     let (a, b) = (p.leng / 2.0, s.wid / 2.0);
     if 2.0 * wr >= s.wid || a < b {
-        return Err(alarm(
+        return Err(CycleAlarm::new(
             61105,
             "cutter radius too large: its diameter must be below the width WID",
         ));
@@ -309,7 +305,7 @@ pub fn arc_slots(
     machining_kind(slot.vari)?;
     let half = slot.wid / 2.0;
     if 2.0 * wr >= slot.wid {
-        return Err(alarm(
+        return Err(CycleAlarm::new(
             61105,
             "cutter radius too large: its diameter must be below the width WID",
         ));
@@ -322,7 +318,7 @@ pub fn arc_slots(
     };
     // The slots' middle arcs apart by their width, and off the centre.
     if p.rad <= half || afsl <= 0.0 {
-        return Err(alarm(
+        return Err(CycleAlarm::new(
             61104,
             "contour violation: the slot reaches the circle's centre or has no length",
         ));
@@ -339,7 +335,10 @@ pub fn arc_slots(
             if 2.0 * p.rad * (gap.to_radians().min(std::f64::consts::PI) / 2.0).sin()
                 < slot.wid - 1e-9
             {
-                return Err(alarm(61104, "contour violation of slots: they overlap"));
+                return Err(CycleAlarm::new(
+                    61104,
+                    "contour violation of slots: they overlap",
+                ));
             }
         }
     }

@@ -32,10 +32,6 @@ pub struct Spigot {
     pub blank: Option<(f64, f64)>,
 }
 
-fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm::new(number, text)
-}
-
 /// How far a point of the spigot's frame lies outside its rounded rectangle.
 fn outside(p: (f64, f64), half: (f64, f64), r: f64) -> f64 {
     let (qx, qy) = (p.0.abs() - (half.0 - r), p.1.abs() - (half.1 - r));
@@ -47,7 +43,7 @@ fn outside(p: (f64, f64), half: (f64, f64), r: f64) -> f64 {
 pub fn spigot(p: Spigot, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAlarm> {
     let wr = tool_radius
         .filter(|r| *r > 0.0)
-        .ok_or_else(|| alarm(61009, "no tool compensation active (T and D)"))?;
+        .ok_or_else(|| CycleAlarm::new(61009, "no tool compensation active (T and D)"))?;
     let down = infeed(p.rtp, p.rfp, p.dp)?;
     feeds(&[p.ffp1, p.ffd], "FFP1 and FFD")?;
     let (a, b) = p.half;

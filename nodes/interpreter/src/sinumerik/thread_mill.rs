@@ -26,10 +26,6 @@ pub struct Thread {
     pub centre: (f64, f64),
 }
 
-fn alarm(number: u32, text: &str) -> CycleAlarm {
-    CycleAlarm::new(number, text)
-}
-
 /// The cutter's path: to the start at RTP, down, a tangential approach arc, the helix (PIT
 /// per turn, half a pitch beyond each end of the thread), a tangential retraction arc, out to
 /// RTP. Internal threads are entered from the hole's centre on a semicircle in the milling
@@ -37,16 +33,22 @@ fn alarm(number: u32, text: &str) -> CycleAlarm {
 pub fn thread_milling(t: Thread, tool_radius: Option<f64>) -> Result<Vec<Move>, CycleAlarm> {
     let tool_radius = cutter(tool_radius)?;
     if !(0.001..=2000.0).contains(&t.pit) {
-        return Err(alarm(61001, "thread pitch wrong: PIT is 0.001…2000 mm"));
+        return Err(CycleAlarm::new(
+            61001,
+            "thread pitch wrong: PIT is 0.001…2000 mm",
+        ));
     }
     if t.ffr <= 0.0 {
-        return Err(alarm(61003, "no feed programmed in the cycle: FFR"));
+        return Err(CycleAlarm::new(
+            61003,
+            "no feed programmed in the cycle: FFR",
+        ));
     }
     let r = if t.external {
         t.diath / 2.0 + tool_radius
     } else {
         if tool_radius >= t.kdiam / 2.0 || t.diath <= t.kdiam {
-            return Err(alarm(
+            return Err(CycleAlarm::new(
                 61105,
                 "cutter radius too large for the core diameter KDIAM, or DIATH not above KDIAM",
             ));
@@ -54,7 +56,7 @@ pub fn thread_milling(t: Thread, tool_radius: Option<f64>) -> Result<Vec<Move>, 
         t.diath / 2.0 - tool_radius
     };
     if t.rfp == t.bottom {
-        return Err(alarm(
+        return Err(CycleAlarm::new(
             61101,
             "reference plane defined incorrectly: no thread length",
         ));
