@@ -118,6 +118,12 @@ fn check_and_simulate_work_from_any_folder() {
     );
     assert!(text(&out).contains("ARC"), "{}", text(&out));
 
+    // The built-in 802D mill, by name, simulates the manual's compensated contour as printed.
+    let contour = format!("{REPO}/../shared/fixtures/001/061_trc_complete_example.mpf");
+    let out = user.run(&["simulate", "--config", "sim_mill_802d", &contour]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("cycle time: "), "{}", text(&out));
+
     // A config that is neither a file nor a built-in machine is named, with the choices.
     let out = user.run(&["check", "--config", "sim_lathe.yaml", &demo]);
     assert!(!out.status.success());
