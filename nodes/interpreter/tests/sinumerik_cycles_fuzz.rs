@@ -3,14 +3,12 @@
 //! zero, huge or out of range, and one too many now and then; drilling cycles also called
 //! modally and under HOLES1/HOLES2. Each program sets the machine's travel as the working area
 //! (G25/G26, WALIMON), so no move outside it is ever sent. Every call must end, or stop with a
-//! numbered alarm on its line: no panic, no hang (a command limit, and a time bound per call),
-//! nothing outside the travel. `SINUMERIK_CYCLE_FUZZ_SEED` and `SINUMERIK_CYCLE_FUZZ_CALLS`
-//! widen the search by hand.
+//! numbered alarm on its line: no panic, no endless output (a command limit; a cycle's own
+//! moves are bounded by its budget, 12140), nothing outside the travel.
+//! `SINUMERIK_CYCLE_FUZZ_SEED` and `SINUMERIK_CYCLE_FUZZ_CALLS` widen the search by hand.
 
 #[path = "support/mutate.rs"]
 mod mutate;
-
-use std::time::{Duration, Instant};
 
 use cnc_interpreter::sinumerik::Sinumerik;
 use cnc_interpreter::{Library, Setup};
@@ -125,7 +123,6 @@ fn random_cycle_calls_end_or_stop_with_a_numbered_alarm_inside_the_travel() {
     let mut by_number = std::collections::BTreeMap::new();
     for _ in 0..calls {
         let text = format!("{head}{}\nM30\n", call(&mut rng));
-        let started = Instant::now();
         let result = std::panic::catch_unwind(|| {
             let mut lib = Library::new();
             lib.insert_named(
@@ -156,11 +153,6 @@ fn random_cycle_calls_end_or_stop_with_a_numbered_alarm_inside_the_travel() {
             panic!("panic on\n{text}");
         };
         assert!(!cut, "more than {LIMIT} commands from one call:\n{text}");
-        assert!(
-            started.elapsed() < Duration::from_secs(60),
-            "a call took {:?}:\n{text}",
-            started.elapsed()
-        );
         for m in &moves {
             for (i, (lo, hi)) in TRAVEL.iter().enumerate() {
                 assert!(
