@@ -301,15 +301,7 @@ fn pocket4_alarms() {
 
 /// The mill with T1 D1 a 10 mm cutter of length 0.
 fn cutter5() -> cnc_interpreter::Setup {
-    let mut s = mill();
-    s.offsets.tools.insert(
-        11,
-        cnc_interpreter_core::ToolOffset {
-            radius: 5.0,
-            ..Default::default()
-        },
-    );
-    s
+    with_edge(11, 5.0)
 }
 
 #[test]
@@ -378,18 +370,6 @@ fn pocket3_turned_helical_then_finished_on_size() {
     assert_within(lo, -8.0, "finished floor");
     assert_within(hi, -8.0, "everywhere");
     assert_within(min, -8.0, "nothing deeper");
-}
-
-fn with_edge(entry: u32, radius: f64) -> cnc_interpreter::Setup {
-    let mut s = mill();
-    s.offsets.tools.insert(
-        entry,
-        cnc_interpreter_core::ToolOffset {
-            radius,
-            ..Default::default()
-        },
-    );
-    s
 }
 
 #[test]

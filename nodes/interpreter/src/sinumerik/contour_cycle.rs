@@ -5,7 +5,9 @@
 //! start, the core's radius compensation (G41/G42 by RL, the radius plus FAL when roughing)
 //! takes it on a perpendicular line onto the approach (a tangential line, quarter or half
 //! circle of LP1), along the contour, off on the departure (AS2/LP2) and back off
-//! perpendicularly; then it retracts as VARI's hundreds say. Decision D92.
+//! perpendicularly; then it retracts as VARI's hundreds say. A spatial approach or
+//! departure (AS1/AS2 tens 1) takes the last SDIS of the infeed, or the first of the
+//! retraction, along the approach or departure path itself. Decision D92.
 
 use std::sync::Arc;
 
@@ -191,12 +193,6 @@ impl Sinumerik {
         let as2 = c.get("AS2").map_or(as1, |v| v.round() as i64);
         let (lp1, lp2) = (c.or("LP1", 0.0), c.get("LP2").unwrap_or(c.or("LP1", 0.0)));
         for a in [as1, as2] {
-            if a / 10 == 1 {
-                return Err(alarm(
-                    self,
-                    wrong(12140, "a spatial approach (AS tens 1) is not built yet"),
-                ));
-            }
             if !(1..=3).contains(&(a % 10)) || a / 10 > 1 || (side.is_none() && a % 10 != 1) {
                 return Err(alarm(
                     self,
@@ -207,6 +203,7 @@ impl Sinumerik {
                 ));
             }
         }
+        let (spatial_in, spatial_out) = (as1 / 10 == 1, as2 / 10 == 1);
         if lp1 <= 0.0 || lp2 <= 0.0 {
             return Err(alarm(self, wrong(61116, "approach/retract path = 0")));
         }
@@ -340,35 +337,53 @@ impl Sinumerik {
             if (self.core.work_position()[d] - safety) * down < 0.0 {
                 go(self, at(self, a, safety), MoveKind::Rapid)?;
             }
-            go(self, at(self, a, level), MoveKind::Feed(ffd))?;
+            // A spatial approach (AS1 tens 1) comes down its last SDIS along the approach,
+            // a line or a helix, at FFD; a spatial departure rises SDIS along its path at FF3.
+            let approach_top = if spatial_in {
+                level - down * sdis
+            } else {
+                level
+            };
+            let departure_top = if spatial_out {
+                level - down * sdis
+            } else {
+                level
+            };
+            go(self, at(self, a, approach_top), MoveKind::Feed(ffd))?;
             if let Some(sd) = side {
                 self.core
                     .start_comp(sd, radius, 0, Startup::ToNextElement)?;
-                self.core.emit(&at(self, s, level), MoveKind::Feed(ffp1))?;
+                self.core
+                    .emit(&at(self, s, approach_top), MoveKind::Feed(ffp1))?;
             }
-            let path = std::iter::once(approach)
-                .chain(pieces.iter().copied())
-                .chain(std::iter::once(departure));
-            for piece in path {
+            let path = std::iter::once((approach, level, if spatial_in { ffd } else { ffp1 }))
+                .chain(pieces.iter().map(|p| (*p, level, ffp1)))
+                .chain(std::iter::once((
+                    departure,
+                    departure_top,
+                    if spatial_out { ff3 } else { ffp1 },
+                )));
+            for (piece, z, feed) in path {
                 let kind = match piece {
-                    Piece::Line(_) => MoveKind::Feed(ffp1),
+                    Piece::Line(_) => MoveKind::Feed(feed),
                     Piece::Arc { c, ccw, .. } => MoveKind::Arc {
                         center: c,
                         ccw,
-                        feed: ffp1,
+                        feed,
                     },
                 };
-                self.core.emit(&at(self, piece.end(), level), kind)?;
+                self.core.emit(&at(self, piece.end(), z), kind)?;
             }
             if side.is_some() {
                 self.core.comp_cancel = true;
-                self.core.emit(&at(self, b, level), MoveKind::Feed(ffp1))?;
+                self.core
+                    .emit(&at(self, b, departure_top), MoveKind::Feed(ffp1))?;
             }
             let lift = match hundreds {
                 0 => rtp,
                 1 => safety,
                 2 => level - down * sdis,
-                _ => level,
+                _ => departure_top,
             };
             go(self, at(self, b, lift), between(tens))?;
         }

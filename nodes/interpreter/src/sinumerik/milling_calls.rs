@@ -167,12 +167,9 @@ impl Sinumerik {
                 radius: c.or("RAD1", 0.0),
                 per_turn: c.or("DP1", 0.0),
             },
-            3 if c.name == "POCKET3" => {
-                return Err(wrong(
-                    12140,
-                    "VARI tens 3, reciprocating insertion, is not built yet",
-                ))
-            }
+            3 if c.name == "POCKET3" => Insertion::Reciprocating {
+                angle: c.or("RAD1", 0.0),
+            },
             _ => return Err(wrong(61002, "VARI: tens 0/1 vertical, 2 helical insertion")),
         };
         let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {

@@ -14,6 +14,9 @@ pub enum Insertion {
     Vertical,
     /// On a helix of radius `radius` (the centre's path), `per_turn` deeper each turn.
     Helix { radius: f64, per_turn: f64 },
+    /// POCKET3 only: back and forth along the long axis, sloping down at most `angle`
+    /// degrees to the level, then once more along it on the level (§10.6.9).
+    Reciprocating { angle: f64 },
 }
 
 /// POCKET4's parameters, lengths in mm, the direction already resolved from CDIR.
@@ -100,7 +103,10 @@ pub fn circular_pocket(p: CirclePocket, tool_radius: Option<f64>) -> Result<Vec<
         let mut z = safety;
         for level in levels(p.rfp, floor, p.mid)? {
             match p.insertion {
-                Insertion::Vertical => m.push(Move::Line((cx, cy, level), p.ffd)),
+                // POCKET4 has no reciprocating insertion: its call refuses tens 3.
+                Insertion::Vertical | Insertion::Reciprocating { .. } => {
+                    m.push(Move::Line((cx, cy, level), p.ffd))
+                }
                 Insertion::Helix { radius, per_turn } => {
                     m.push(Move::Line((cx + radius, cy, z), p.ffp1));
                     let turns = steps((level - z).abs() / per_turn, 1)?;

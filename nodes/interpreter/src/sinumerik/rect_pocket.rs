@@ -95,10 +95,19 @@ pub fn rectangular_pocket(
     if p.roughing {
         let (a, b) = (long - p.fal - wr, short - p.fal - wr);
         let r = (p.crad - p.fal - wr).max(0.0);
-        if let Insertion::Helix { radius, per_turn } = p.insertion {
-            if radius <= 0.0 || per_turn <= 0.0 || radius > b {
+        match p.insertion {
+            Insertion::Helix { radius, per_turn }
+                if radius <= 0.0 || per_turn <= 0.0 || radius > b =>
+            {
                 return Err(CycleAlarm::new(61108, "illegal values for RAD1 and DP1"));
             }
+            Insertion::Reciprocating { angle } if !(angle > 0.0 && angle <= 90.0) => {
+                return Err(CycleAlarm::new(
+                    61108,
+                    "RAD1, the insertion angle, must be over 0° and at most 90°",
+                ));
+            }
+            _ => {}
         }
         let mut z = safety;
         for level in levels(p.rfp, floor, p.mid)? {
@@ -125,6 +134,9 @@ pub fn rectangular_pocket(
                         feed: p.ffd,
                     });
                     m.push(Move::Line((cx, cy, level), p.ffp1));
+                }
+                Insertion::Reciprocating { angle } => {
+                    reciprocate(&mut m, &f, &p, angle, a, (z, level))?;
                 }
             }
             clear(&mut m, a, b, r, level)?;
@@ -161,4 +173,34 @@ pub fn rectangular_pocket(
     }
     m.push(Move::Rapid((cx, cy, p.rtp)));
     Ok(m)
+}
+
+/// Reciprocating insertion (VARI tens 3): from the centre at `z` out to one end of the long
+/// axis, `reach` from the centre, then end to end, each pass sloping down evenly and no
+/// steeper than `angle`, until `level`; one pass more on the level takes the slope away,
+/// and the cutter comes back to the centre. The pass length is the long axis's whole
+/// cleared length, which makes the fewest passes (D87).
+fn reciprocate(
+    m: &mut Vec<Move>,
+    f: &Frame,
+    p: &RectPocket,
+    angle: f64,
+    reach: f64,
+    (z, level): (f64, f64),
+) -> Result<(), CycleAlarm> {
+    let (ffd, ffp1) = (p.ffd, p.ffp1);
+    let depth = (level - z).abs();
+    // Angle 90°: straight down, tan is huge and one pass does.
+    let run = depth / angle.to_radians().tan().max(1e-12);
+    let passes = steps(run / (2.0 * reach), 1)?;
+    let mut end = -reach;
+    m.push(f.line((end, 0.0), z, ffp1));
+    for k in 1..=passes {
+        end = -end;
+        let at = z + (level - z) * k as f64 / passes as f64;
+        m.push(f.line((end, 0.0), at, ffd));
+    }
+    m.push(f.line((-end, 0.0), level, ffd));
+    m.push(f.line((0.0, 0.0), level, ffp1));
+    within_budget(m)
 }

@@ -44,6 +44,20 @@ pub fn mill() -> Setup {
     s
 }
 
+/// The mill with one cutting edge (`entry` T·10+D) of `radius` and length 0: machine Z is
+/// the cutter's tip.
+pub fn with_edge(entry: u32, radius: f64) -> Setup {
+    let mut s = mill();
+    s.offsets.tools.insert(
+        entry,
+        ToolOffset {
+            radius,
+            ..ToolOffset::default()
+        },
+    );
+    s
+}
+
 pub struct Run {
     pub front: Sinumerik,
     pub out: Vec<Command>,
