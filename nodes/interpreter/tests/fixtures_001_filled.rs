@@ -14,31 +14,6 @@ use cnc_interpreter::{Aux, Command, Library, Setup};
 use cnc_interpreter_core::ToolOffset;
 use support::*;
 
-/// A line the manual prints as a placeholder (`...`, `…`, `X... Y...`, a lone `.`).
-fn placeholder(line: &str) -> bool {
-    let code = line.split(';').next().unwrap_or("").trim();
-    code.contains("...") || code.contains('…') || code == "."
-}
-
-/// The fixture with its placeholder lines replaced by `fills`, one each, in order (an
-/// empty fill leaves an empty line, so line numbers stay the manual's).
-fn filled(number: &str, fills: &[&str]) -> String {
-    let text = fixture(number);
-    let holes = text.lines().filter(|l| placeholder(l)).count();
-    assert_eq!(holes, fills.len(), "{number}: {holes} placeholder lines");
-    let mut fills = fills.iter();
-    let mut out = String::new();
-    for line in text.lines() {
-        if placeholder(line) {
-            out.push_str(fills.next().copied().unwrap_or(""));
-        } else {
-            out.push_str(line);
-        }
-        out.push('\n');
-    }
-    out
-}
-
 fn ends(r: &Run) -> Vec<Vec<f64>> {
     r.moves()
         .iter()
@@ -52,14 +27,6 @@ fn arcs(r: &Run) -> Vec<(Vec<f64>, Vec<f64>, bool)> {
         .filter(|c| matches!(c, Command::Arc { .. }))
         .map(arc)
         .collect()
-}
-
-/// The line (1-based) of the fixture text that starts with `block` (`N90`).
-fn line_of(text: &str, block: &str) -> u32 {
-    text.lines()
-        .position(|l| l.trim_start().starts_with(block))
-        .map(|i| i as u32 + 1)
-        .unwrap_or_else(|| panic!("no block {block}"))
 }
 
 /// L10, the manual's contour subprogram of the frame figures: a line and a clockwise arc

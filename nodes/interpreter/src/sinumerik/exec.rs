@@ -192,11 +192,9 @@ pub const NOT_BUILT: [(&str, &str); 31] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 16] = [
-    (33, "G33 thread cutting is not built yet for the mill"),
+pub const NOT_BUILT_G: [(u32, &str); 13] = [
     (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
     (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
-    (63, "G63 tapping with a compensating chuck is not built yet"),
     (75, "G75 fixed point approach is not built yet"),
     (147, "smooth approach and retraction (WAB) is not built"),
     (148, "smooth approach and retraction (WAB) is not built"),
@@ -205,7 +203,6 @@ pub const NOT_BUILT_G: [(u32, &str); 16] = [
     (347, "smooth approach and retraction (WAB) is not built"),
     (348, "smooth approach and retraction (WAB) is not built"),
     (291, "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill"),
-    (153, "G153 (suppressing the basic frame too) is not built: there is no basic frame"),
     (451, "G451 (intersection at outer corners) is not built: G450 transition circles"),
     (62, "corner deceleration G62/G621 is not built"),
     (621, "corner deceleration G62/G621 is not built"),
@@ -625,6 +622,7 @@ impl Sinumerik {
                 1 => self.motion = Motion::Line,
                 2 => self.motion = Motion::Cw,
                 3 => self.motion = Motion::Ccw,
+                33 => self.motion = Motion::Thread,
                 17..=19 => self.set_plane(g as u8)?,
                 90 => self.absolute = true,
                 91 => self.absolute = false,

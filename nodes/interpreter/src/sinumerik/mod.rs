@@ -52,6 +52,8 @@ pub enum Motion {
     Cip,
     /// CT: a circle tangent to the path before it.
     Ct,
+    /// G33: a thread locked to the spindle.
+    Thread,
 }
 
 /// The 802D front end: the core plus the control's own modal state.
@@ -103,6 +105,8 @@ pub struct Sinumerik {
     ang: Option<contour::AngPending>,
     /// The text of the program whose block runs (CYCLE72 finds label sections in it).
     program_text: Option<Arc<str>>,
+    /// SF=: the thread's start angle after the spindle's index pulse, degrees (modal).
+    thread_angle: f64,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -180,6 +184,7 @@ impl Sinumerik {
             corner: None,
             ang: None,
             program_text: None,
+            thread_angle: 0.0,
         };
         front.apply_length();
         front

@@ -36,11 +36,11 @@ impl Sinumerik {
     /// The non-modal instructions that take the block's words for themselves: dwell,
     /// frames, pole; `true` when the block moves nothing else.
     pub(super) fn non_modal(&mut self, w: &Words) -> Result<bool, ProgramError> {
-        if w.addr.contains_key("SF") {
-            return Err(self.fault(
-                Fault::NotSupported,
-                "SF= (the thread's start angle) is not built yet: G33 is not built",
-            ));
+        if let Some(sf) = w.get("SF") {
+            if !(0.0..360.0).contains(&sf) {
+                return Err(self.fault(Fault::OutOfRange, "SF= is 0…359.999 degrees"));
+            }
+            self.thread_angle = sf;
         }
         if w.has_g(4) {
             return self.dwell(w).map(|()| true);
@@ -153,7 +153,7 @@ impl Sinumerik {
         if !moves {
             return Ok(());
         }
-        if w.has_g(53) {
+        if w.has_g(53) || w.has_g(153) {
             return self.machine_coordinates(w);
         }
         let here = self.core.work_position();
@@ -177,6 +177,9 @@ impl Sinumerik {
             self.core.set_plane_point(&mut end, p);
         }
         self.start_compensation()?;
+        if self.motion == Motion::Thread || w.has_g(63) {
+            return self.thread_move(w, &here, &end);
+        }
         let a = self.core.plane_point(&here)?;
         let b = self.core.plane_point(&end)?;
         let feed = self.core.feed;
@@ -223,6 +226,74 @@ impl Sinumerik {
             }
         }
         Ok(())
+    }
+
+    /// G33 (§9.3.7): a straight thread locked to the spindle, its lead the I, J or K word
+    /// of its longest axis (mm per revolution; inches under G70/G700), starting SF= degrees
+    /// after the index pulse. G63 (§9.3.8, non-modal): tapping with a compensating chuck,
+    /// where F must equal S × pitch and the overrides are out: the move is locked to the
+    /// spindle at F/S per revolution (F under G95), which keeps both promises (D93).
+    fn thread_move(&mut self, w: &Words, here: &[f64], end: &[f64]) -> Result<(), ProgramError> {
+        let what = if w.has_g(63) { "G63" } else { "G33" };
+        for k in ["CR", "AR", "I1", "J1", "K1", "TURN", "AP", "RP", "ANG"] {
+            if w.addr.contains_key(k) {
+                return Err(self.fault(
+                    Fault::IllegalWord,
+                    format!("{k} does not belong to {what}: a straight move"),
+                ));
+            }
+        }
+        if self.corner.is_some() || self.ang.is_some() {
+            return Err(self.fault(
+                Fault::IllegalWord,
+                format!("{what} takes no chamfer, rounding or ANG"),
+            ));
+        }
+        let travel = |i: usize| (end[i] - here[i]).abs();
+        let long = (0..end.len())
+            .max_by(|&i, &j| travel(i).total_cmp(&travel(j)))
+            .filter(|&i| travel(i) > 1e-9)
+            .ok_or_else(|| self.fault(Fault::MissingWord, format!("{what} needs an end point")))?;
+        let leads: Vec<&str> = ["I", "J", "K"]
+            .into_iter()
+            .filter(|k| w.addr.contains_key(*k))
+            .collect();
+        let lead = if w.has_g(63) {
+            if let Some(k) = leads.first() {
+                return Err(self.fault(
+                    Fault::IllegalWord,
+                    format!("{k}: G63 takes its pitch from F and S"),
+                ));
+            }
+            if self.core.feed_per_rev {
+                self.core.feed
+            } else if self.core.rpm > 0.0 {
+                self.core.feed / self.core.rpm
+            } else {
+                return Err(self.fault(Fault::FeedRange, "G63 needs S: the pitch is F/S"));
+            }
+        } else {
+            let letter = centre_letter(self.core.setup.axes[long])
+                .ok_or_else(|| self.fault(Fault::AxisAddress, "G33 threads along X, Y or Z"))?;
+            let word = letter.to_string();
+            match w.get(&word) {
+                Some(k) => k * self.unit(),
+                None => {
+                    return Err(self.fault(
+                        Fault::MissingWord,
+                        format!(
+                            "G33 needs the lead of its longest axis {} as {word}",
+                            self.core.setup.axes[long]
+                        ),
+                    ))
+                }
+            }
+        };
+        let kind = MoveKind::Thread {
+            lead,
+            angle: self.thread_angle,
+        };
+        self.core.emit(end, kind)
     }
 
     /// AP/RP of the block, or the last ones; IC makes them incremental.
@@ -481,7 +552,8 @@ impl Sinumerik {
     }
 
     /// G53: this block's positions are machine positions (settable and programmable offsets
-    /// off; the tool length stays), §9.2.10.
+    /// off; the tool length stays), §9.2.10. G153 suppresses the basic frame as well; this
+    /// controller has no basic frame, so G153 is G53 (D93).
     fn machine_coordinates(&mut self, w: &Words) -> Result<(), ProgramError> {
         if self.core.comp.is_some() {
             return Err(self.fault(

@@ -58,6 +58,39 @@ pub fn with_edge(entry: u32, radius: f64) -> Setup {
     s
 }
 
+/// A line the manual prints as a placeholder (`...`, `…`, `X... Y...`, a lone `.`).
+pub fn placeholder(line: &str) -> bool {
+    let code = line.split(';').next().unwrap_or("").trim();
+    code.contains("...") || code.contains('…') || code == "."
+}
+
+/// The fixture with its placeholder lines replaced by `fills`, one each, in order (an
+/// empty fill leaves an empty line, so line numbers stay the manual's).
+pub fn filled(number: &str, fills: &[&str]) -> String {
+    let text = fixture(number);
+    let holes = text.lines().filter(|l| placeholder(l)).count();
+    assert_eq!(holes, fills.len(), "{number}: {holes} placeholder lines");
+    let mut fills = fills.iter();
+    let mut out = String::new();
+    for line in text.lines() {
+        if placeholder(line) {
+            out.push_str(fills.next().copied().unwrap_or(""));
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The line (1-based) of the fixture text that starts with `block` (`N90`).
+pub fn line_of(text: &str, block: &str) -> u32 {
+    text.lines()
+        .position(|l| l.trim_start().starts_with(block))
+        .map(|i| i as u32 + 1)
+        .unwrap_or_else(|| panic!("no block {block}"))
+}
+
 pub struct Run {
     pub front: Sinumerik,
     pub out: Vec<Command>,
