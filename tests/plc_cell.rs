@@ -744,3 +744,88 @@ fn in_the_handwheel_trial_run_the_program_moves_as_fast_as_the_wheel_turns() {
     assert!(r.run_until(10.0, |r| r.program_done()), "{:?}", r.events);
     assert!((z(&r) - 40.0).abs() < 1e-9);
 }
+
+/// The 802D mill (`sim_mill_802d`): the standard ladder with K1.2 runs its drum magazine of
+/// 24 pockets. T12 preselects (the drum turns the short way to pocket 12 and locks before the
+/// T is acknowledged), M6 stops and orients the spindle and puts tool 12 into it (the NC's
+/// current tool G68), M19 orients a running spindle; T30, beyond the magazine, is A3.2.
+/// Decision D94.
+#[test]
+fn the_mill_magazine_preselects_with_t_changes_with_m6_and_m19_orients() {
+    // The launch config changes tools with T at once; with M6 here (the builder's K1.3 and
+    // the interpreter's machine data).
+    let mut cfg = config("sim_mill_802d");
+    assert!(!cfg.machine.tool_change_with_m6);
+    cfg.machine.tool_change_with_m6 = true;
+    cfg.plc.keep_relays.push("K1.3".into());
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let program = "T12\nS1000 M3\nG0 X10 Y10 Z50\nM6\nD1\nS800 M3\nG0 X20\nM19\nG0 X30\nM30\n";
+    let mut r = Rig::on(cfg.clone(), program, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    assert_eq!(r.turret_station(), Some(1));
+    let mut pockets = vec![1u8];
+    let (mut t_fin, mut m6_fin, mut m19_fin) = (None, None, None);
+    let ok = r.run_until(60.0, |r| {
+        if let Some(s) = r.turret_station() {
+            if pockets.last() != Some(&s) {
+                pockets.push(s);
+            }
+        }
+        let fin = r.gi.get(g::FIN);
+        let m = r.nc().read_i32(f::M_CODE);
+        let seen = (
+            r.sim.devices.turret_station(),
+            r.xi.get(x::TURRET_LOCKED),
+            r.fb.spindle_rpm,
+            r.fb.spindle_angle_deg,
+            r.gi.bytes[g::NTOL as usize],
+        );
+        if fin && r.nc().get(f::TF) && t_fin.is_none() {
+            t_fin = Some(seen);
+        }
+
+        if fin && r.nc().get(f::MF) && m == 6 && m6_fin.is_none() {
+            m6_fin = Some(seen);
+        }
+        if t_fin.is_some() && m6_fin.is_none() {
+            assert_eq!(seen.4, 0, "no tool in the spindle before M6");
+        }
+        if fin && r.nc().get(f::MF) && m == 19 && m19_fin.is_none() {
+            m19_fin = Some(seen);
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    assert_eq!(pockets, (1..=12).collect::<Vec<u8>>(), "the short way, CW");
+    let (pocket, locked, ..) = t_fin.expect("FIN for T12");
+    assert_eq!((pocket, locked), (Some(12), true));
+    let (pocket, locked, rpm, angle, _) = m6_fin.expect("FIN for M6");
+    assert_eq!((pocket, locked), (Some(12), true));
+    assert_eq!(
+        (rpm, angle),
+        (0.0, 0.0),
+        "the spindle stands oriented for the change"
+    );
+    let (_, _, rpm, angle, tool) = m19_fin.expect("FIN for M19");
+    assert_eq!((rpm, angle), (0.0, 0.0), "M19 from 800 rpm");
+    assert_eq!(tool, 12, "tool 12 in the spindle for the NC");
+    assert!(r.message("A3.2").is_none() && r.message("A0.1").is_none());
+    // Where T changes at once (the launch config), the tool is in the spindle at T's FIN,
+    // and the manual's `T1 D1` programs run unchanged.
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let mut r = Rig::on(cfg.clone(), "T20 D1 S500 M3\nG0 X10\nM30\n", Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    assert!(r.run_until(30.0, |r| r.program_done()), "{:?}", r.events);
+    assert_eq!(r.turret_station(), Some(20));
+    assert_eq!(r.gi.bytes[g::NTOL as usize], 20);
+    assert!(r.fb.spindle_rpm > 400.0, "T did not stop the spindle");
+    // Beyond the magazine: the tool-number alarm, and the program stops.
+    let mut r = Rig::on(cfg, "T30\nG0 X10\nM30\n", Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    assert!(!r.run_until(5.0, |r| r.program_done()));
+    assert!(r.message("A3.2").is_some(), "{:?}", r.events);
+}

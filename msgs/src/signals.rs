@@ -289,6 +289,11 @@ pub mod x {
     pub const LIMIT_MINUS: Bit = bit(0, 2);
     pub const LIMIT_PLUS: Bit = bit(0, 4);
     pub const CHUCK_UNCLAMPED: Bit = bit(0, 5);
+    /// The spindle drive stands at its orientation angle (M19; D94).
+    pub const SPINDLE_ORIENTED: Bit = bit(0, 7);
+    /// The turret's station or the magazine's pocket, binary (0: between), for a magazine
+    /// of more stations than the eight sensors (D94).
+    pub const STATION_CODE: u16 = 7;
     /// Emergency stop, normally closed: 1 = released.
     pub const ESP_N: Bit = bit(1, 0);
     /// Turret position sensors, tool 1 … 8.
@@ -367,6 +372,9 @@ pub mod y {
     pub const TURRET_CCW: Bit = bit(2, 6);
     pub const SPINDLE_CW: Bit = bit(3, 0);
     pub const SPINDLE_CCW: Bit = bit(3, 1);
+    /// Orient the spindle: with neither direction on, the drive positions it at its
+    /// orientation angle and holds it there (M19; D94).
+    pub const SPINDLE_ORIENT: Bit = bit(3, 2);
     /// Releases the turret lock (0 = locked: a turret without power stays locked).
     pub const TURRET_UNLOCK: Bit = bit(4, 0);
     pub const DOOR_OPEN: Bit = bit(4, 2);

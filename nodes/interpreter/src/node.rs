@@ -39,6 +39,7 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     setup.second_reference = cfg.second_reference();
     setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
     setup.tool_change_macro = cfg.machine.tool_change_macro;
+    setup.tool_change_with_m6 = cfg.machine.tool_change_with_m6;
     setup.contour_tolerance = cfg.machine.contour_tolerance;
     setup.calculator_decimal_point = cfg
         .machine

@@ -22,7 +22,11 @@ pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
         spindle_acceleration: cfg.sim.spindle_acceleration,
         at_speed_tolerance: cfg.sim.at_speed_tolerance,
         devices: DeviceConfig {
-            turret_stations: cfg.sim.turret_stations,
+            turret_stations: if cfg.sim.tool_magazine {
+                crate::sim::devices::MAGAZINE_POCKETS
+            } else {
+                cfg.sim.turret_stations
+            },
             coolant_delay: cfg.sim.coolant_delay,
             ..DeviceConfig::default()
         },

@@ -6,6 +6,10 @@
 
 use cnc_msgs::signals::{x, y, SignalTable, XImage, YImage};
 
+/// Pockets of the mill's drum magazine (`sim.tool_magazine`), which indexes as the turret
+/// does; the standard ladder's magazine rungs count on the same number (D94).
+pub const MAGAZINE_POCKETS: u8 = 24;
+
 /// Device timings, s, and the turret's size.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DeviceConfig {
@@ -177,6 +181,8 @@ impl Devices {
         {
             xi.set(*bit, station == Some(k as u8 + 1));
         }
+        // The station (magazine pocket) as a binary code, 0 between stations.
+        xi.bytes[usize::from(x::STATION_CODE)] = station.unwrap_or(0);
         xi.set(x::TURRET_LOCKED, self.turret_lock >= 1.0);
         xi.set(x::CHUCK_CLAMPED, self.chuck.at_one());
         xi.set(x::CHUCK_UNCLAMPED, self.chuck.at_zero());

@@ -183,9 +183,25 @@ impl SimLathe {
         };
         let brake = if y.get(y::SPINDLE_BRAKE) { 3.0 } else { 1.0 };
         let step = self.cfg.spindle_acceleration * brake * dt;
+        let command = if self.orienting(y) {
+            // Position control: towards the orientation angle the short way, at most the
+            // orientation speed, slowing in proportion to what is left.
+            let rest = angle_to(self.spindle_angle, ORIENT_ANGLE);
+            (rest / 360.0 * 60.0 / ORIENT_TIME_CONSTANT).clamp(-ORIENT_RPM, ORIENT_RPM)
+        } else {
+            command
+        };
         self.spindle_rpm += (command - self.spindle_rpm).clamp(-step, step);
         self.spindle_angle =
             (self.spindle_angle + self.spindle_rpm / 60.0 * 360.0 * dt).rem_euclid(360.0);
+        if self.orienting(y)
+            && angle_to(self.spindle_angle, ORIENT_ANGLE).abs() < 0.05
+            && self.spindle_rpm.abs() < 1.0
+        {
+            // In position: the drive holds it there.
+            self.spindle_angle = ORIENT_ANGLE;
+            self.spindle_rpm = 0.0;
+        }
         self.devices.step(y, dt);
         let mut fb = ServoFeedback {
             seq: setpoint.seq,
@@ -239,8 +255,38 @@ impl SimLathe {
             x::SPINDLE_AT_SPEED,
             (self.spindle_rpm - commanded).abs() <= tol,
         );
+        xi.set(
+            x::SPINDLE_ORIENTED,
+            self.orienting(y) && self.spindle_rpm == 0.0 && self.spindle_angle == ORIENT_ANGLE,
+        );
         self.devices.sensors(&mut xi);
         xi
+    }
+}
+
+/// The spindle drive's orientation (M19): its angle (the manual's SD43240 default), its
+/// top speed and how fast it closes in, s.
+const ORIENT_ANGLE: f64 = 0.0;
+const ORIENT_RPM: f64 = 30.0;
+const ORIENT_TIME_CONSTANT: f64 = 0.05;
+
+/// The signed shortest turn from angle `a` to `b`, degrees in (−180, 180].
+fn angle_to(a: f64, b: f64) -> f64 {
+    let d = (b - a).rem_euclid(360.0);
+    if d > 180.0 {
+        d - 360.0
+    } else {
+        d
+    }
+}
+
+impl SimLathe {
+    /// The drive orients: asked to, with no direction commanded and no emergency stop.
+    fn orienting(&self, yi: &YImage) -> bool {
+        yi.get(y::SPINDLE_ORIENT)
+            && !yi.get(y::SPINDLE_CW)
+            && !yi.get(y::SPINDLE_CCW)
+            && !self.emergency_stop
     }
 }
 
@@ -328,6 +374,38 @@ mod tests {
         }
         assert_eq!(m.spindle_rpm(), 0.0);
         assert!(!m.x_image(&y).get(x::ESP_N));
+    }
+
+    #[test]
+    fn orientation_stops_the_spindle_at_its_angle_and_holds_it() {
+        let mut m = sim();
+        let mut y = YImage {
+            spindle_rpm: 600.0,
+            ..Default::default()
+        };
+        y.set(y::SPINDLE_CW, true);
+        let sp = ServoSetpoint::default();
+        for _ in 0..200 {
+            m.step(&sp, &y, 0.004);
+        }
+        // Orientation asked with the spindle still commanded: it goes on turning.
+        y.set(y::SPINDLE_ORIENT, true);
+        m.step(&sp, &y, 0.004);
+        assert!(m.spindle_rpm() > 500.0);
+        assert!(!m.x_image(&y).get(x::SPINDLE_ORIENTED));
+        y.set(y::SPINDLE_CW, false);
+        let mut ticks = 0;
+        while !m.x_image(&y).get(x::SPINDLE_ORIENTED) {
+            m.step(&sp, &y, 0.004);
+            ticks += 1;
+            assert!(ticks < 2000, "oriented within 8 s");
+            assert!(m.spindle_rpm().abs() <= 600.0 + 1e-9);
+        }
+        let fb = m.step(&sp, &y, 0.004);
+        assert_eq!((fb.spindle_rpm, fb.spindle_angle_deg), (0.0, ORIENT_ANGLE));
+        // Released: no longer oriented.
+        y.set(y::SPINDLE_ORIENT, false);
+        assert!(!m.x_image(&y).get(x::SPINDLE_ORIENTED));
     }
 
     #[test]

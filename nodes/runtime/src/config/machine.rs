@@ -49,6 +49,10 @@ pub struct MachineConfig {
     /// macro; absent: T goes to the PLC.
     #[serde(default)]
     pub tool_change_macro: Option<u32>,
+    /// T only preselects the tool and M6 changes it (the 802D's machine data for a mill
+    /// with a magazine); false: T changes the tool at once (D94).
+    #[serde(default)]
+    pub tool_change_with_m6: bool,
     /// Where parameters written from the cell (SetParameter) are stored; they are applied over
     /// this file at start (decisions D44), relative to the config file's folder. Absent:
     /// parameters cannot be written.

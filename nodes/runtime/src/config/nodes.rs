@@ -269,6 +269,11 @@ pub struct SimConfig {
     /// Stations of the electric turret (4, 6 or 8).
     #[serde(default = "default_turret_stations")]
     pub turret_stations: u8,
+    /// A mill's drum tool magazine of 24 pockets instead of the turret: it indexes as the
+    /// turret does and reports its pocket as a binary code on X7; the standard ladder runs it
+    /// with T preselection and M6 when the builder sets K1.2 (decision D94).
+    #[serde(default)]
+    pub tool_magazine: bool,
     /// Whether allowed clients may set the simulated machine's inputs (`sim/input`: emergency
     /// stop, forced door, stuck turret, keys). A machine whose io is real hardware has no such
     /// topic: set false, and the bridge does not even subscribe to it.
@@ -301,6 +306,7 @@ impl Default for SimConfig {
             at_speed_tolerance: default_at_speed(),
             coolant_delay: default_coolant_delay(),
             turret_stations: default_turret_stations(),
+            tool_magazine: false,
             client_inputs: true,
         }
     }
