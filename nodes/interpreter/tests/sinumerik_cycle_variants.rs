@@ -251,33 +251,14 @@ fn f108(vari: u32, as1: u32, as2: u32) -> String {
     )
 }
 
-/// The contour of fixture 108 (`sinumerik_milling::contour_107`): X150 Y160 → X230 with a
-/// 10 mm chamfer → Y80 with a 10 mm chamfer → X125 → Y135 → clockwise R25 back.
-fn contour_108() -> Vec<(f64, f64)> {
-    let leg = 10.0 / 2f64.sqrt();
-    let mut pts = vec![
-        (150.0, 160.0),
-        (230.0 - leg, 160.0),
-        (230.0, 160.0 - leg),
-        (230.0, 80.0 + leg),
-        (230.0 - leg, 80.0),
-        (125.0, 80.0),
-    ];
-    pts.extend((0..90).map(|k| {
-        let a = (180.0 - k as f64).to_radians();
-        (150.0 + 25.0 * a.cos(), 135.0 + 25.0 * a.sin())
-    }));
-    pts
-}
-
 /// The stock of fixture 108's contour roughed 1 mm out to Z176.5 in 3 levels.
 fn assert_roughed(r: &Run) {
-    let out = outside_of(contour_108());
+    let out = outside_of(contour_107());
     let mut stock = Stock::new((180.0, 120.0), 90.0, 200.0, 7.0, move |p| 1.0 - out(p));
     stock.follow(&r.out, [100.0, 200.0, 250.0]);
     assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
     assert_within(stock.reach, 0.0, "the contour 1 mm out");
-    let out = outside_of(contour_108());
+    let out = outside_of(contour_107());
     let (lo, hi) = stock.floor_where(|q| (1.01..=8.0).contains(&out(q)));
     assert_within(lo, 176.5, "down to Z175 + 1.5");
     assert_within(hi, 176.5, "all round");

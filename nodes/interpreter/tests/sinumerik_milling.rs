@@ -649,27 +649,6 @@ fn f113_slot2_mills_three_slots_along_the_circle() {
     assert_eq!(r.alarm().0, 61104);
 }
 
-/// The contour of fixtures 107 and 108, worked out here: X150 Y160 → X230 with a 10 mm
-/// chamfer → Y80 with a 10 mm chamfer → X125 → Y135 → clockwise R25 about X150 Y135 back to
-/// X150 Y160; its corners, the arc every degree (0.001 mm from the true arc).
-fn contour_107() -> Vec<(f64, f64)> {
-    let leg = 10.0 / 2f64.sqrt();
-    let mut pts = vec![
-        (150.0, 160.0),
-        (230.0 - leg, 160.0),
-        (230.0, 160.0 - leg),
-        (230.0, 80.0 + leg),
-        (230.0 - leg, 80.0),
-        (125.0, 80.0),
-    ];
-    // From (125, 135) round by the top to (150, 160), clockwise about (150, 135).
-    pts.extend((0..90).map(|k| {
-        let a = (180.0 - k as f64).to_radians();
-        (150.0 + 25.0 * a.cos(), 135.0 + 25.0 * a.sin())
-    }));
-    pts
-}
-
 #[test]
 fn f107_f108_cycle72_mills_round_the_contour_from_a_subprogram_or_labels() {
     // CYCLE72(…, 250, 200, 3, 175, 10, 1, 1.5, 800, 400, VARI, 41, 2, 20, 1000, 2, 20): the
