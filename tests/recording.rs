@@ -141,6 +141,17 @@ fn a_recorded_cycle_reads_back_in_rosbags_and_mcap_with_every_message_published(
     std::thread::sleep(Duration::from_millis(1500));
     let r = client.load_program("part.nc", PROGRAM).unwrap();
     assert!(r.accepted, "{}", r.message);
+    // The mode switch to AUTO: the interpreter passes the mode to motion (the motion command
+    // topic).
+    let r = client
+        .service::<cnc_msgs::srv::SetMode>("set_mode")
+        .and_then(|s| {
+            s.call(cnc_msgs::srv::SetModeRequest {
+                mode: MachineState::MODE_AUTO,
+            })
+        })
+        .unwrap();
+    assert!(r.accepted, "{}", r.message);
     let r = client.start_program("part.nc").unwrap();
     assert!(r.accepted, "{}", r.message);
     wait_until(&mut client, Duration::from_secs(60), |c| {

@@ -68,6 +68,7 @@ def main():
     w_cmd, w_block = writer("_internal/program_command", "ProgramCommand"), writer("_internal/motion_blocks", "MotionBlock")
     w_over, w_alarm = writer("_internal/panel_overrides", "Overrides"), writer("alarm_events", "AlarmEvent")
     w_input = writer("sim/input", "SimInput")
+    w_motion = writer("_internal/motion_command", "ProgramCommand")
 
     def block(run_id, seq, kind, end, feed=0.0):
         return block_t(run_id=run_id, seq=seq, program="O0666", line=seq, kind=kind, end=end, center=[],
@@ -79,6 +80,8 @@ def main():
     for i in range(20):  # over two seconds: writes before discovery matched a reader are lost
         w_cmd.write(command_t(id=900 + i, command=1, program="evil.nc", text=PROGRAM))
         w_cmd.write(command_t(id=950 + i, command=2, program="evil.nc", text=""))
+        w_motion.write(command_t(id=970 + i, command=16, program="", text="X + 5000 0"))  # jog
+        w_motion.write(command_t(id=990 + i, command=14, program="", text=""))  # reference return
         w_block.write(block(1, 1 + i, 0, [150.0, 90.0]))
         w_block.write(block(2**64 - 1, 1, 0, [150.0, 90.0]))
         w_over.write(overrides_t(feed_percent=255, spindle_percent=255, rapid_percent=255))

@@ -2,7 +2,8 @@
 //! runs, the credit-based block stream to motion, the machine state) to DDS and the memory file.
 //!
 //! Commands arrive from hmi_bridge on `_internal/program_command`, each answered on
-//! `_internal/command_result`. During a run, at most `capacity` unfinished blocks are in flight:
+//! `_internal/command_result`; what motion must do (reference return, jog, mode, cycle stop)
+//! goes to it on `_internal/motion_command`. During a run, at most `capacity` unfinished blocks are in flight:
 //! motion's `done_seq` returns the credit.
 
 use std::collections::BTreeMap;
@@ -164,7 +165,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
     let commands = ros.subscription::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
     let results = ros.publisher::<CommandResult>(&topics::COMMAND_RESULT)?;
-    let to_motion_cmd = ros.publisher::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
+    let to_motion_cmd = ros.publisher::<ProgramCommand>(&topics::MOTION_COMMAND)?;
     let blocks = ros.publisher::<MotionBlock>(&topics::MOTION_BLOCKS)?;
     let status_sub = ros.subscription::<MotionStatus>(&topics::MOTION_STATUS)?;
     let axes_sub = ros.subscription::<AxisState>(&topics::AXES)?;

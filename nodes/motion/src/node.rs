@@ -103,7 +103,10 @@ fn dds_loop(
 ) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "motion")?;
     let blocks = ros.subscription::<MotionBlock>(&topics::MOTION_BLOCKS)?;
+    // The operator's commands from the bridge (feed hold, cycle start, reset) and the
+    // interpreter's own (reference return, jog, mode, cycle stop).
     let commands = ros.subscription::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
+    let motion_commands = ros.subscription::<ProgramCommand>(&topics::MOTION_COMMAND)?;
     let status_pub = ros.publisher::<MotionStatus>(&topics::MOTION_STATUS)?;
     let axes_pub = ros.publisher::<AxisState>(&topics::AXES)?;
     let stats_pub = ros.publisher::<ServoStats>(&topics::SERVO_STATS)?;
@@ -140,7 +143,11 @@ fn dds_loop(
                 }
             }
         }
-        while let Ok(Some(c)) = commands.take() {
+        let take = || match commands.take() {
+            Ok(Some(c)) => Some(c),
+            _ => motion_commands.take().ok().flatten(),
+        };
+        while let Some(c) = take() {
             idle = false;
             if c.command == ProgramCommand::RESET {
                 for number in std::mem::take(&mut raised) {

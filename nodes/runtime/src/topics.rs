@@ -113,6 +113,15 @@ pub const PROGRAM_COMMAND: Topic = topic(
     "cnc_msgs/msg/ProgramCommand",
     Delivery::Commands,
 );
+/// The interpreter's commands to motion (reference return, jog, mode, cycle stop) on a
+/// stream of their own, with one writer: the bridge repeats its commands on
+/// [`PROGRAM_COMMAND`] until answered, and those copies could crowd one of these out of a
+/// reader's buffer there.
+pub const MOTION_COMMAND: Topic = topic(
+    "_internal/motion_command",
+    "cnc_msgs/msg/ProgramCommand",
+    Delivery::Commands,
+);
 pub const COMMAND_RESULT: Topic = topic(
     "_internal/command_result",
     "cnc_msgs/msg/CommandResult",
@@ -152,6 +161,7 @@ pub const ALL: &[Topic] = &[
     SIM_INPUT_CHECKED,
     ROBOT_SIGNALS,
     PROGRAM_COMMAND,
+    MOTION_COMMAND,
     COMMAND_RESULT,
     MOTION_BLOCKS,
     MOTION_STATUS,
