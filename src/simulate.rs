@@ -68,6 +68,9 @@ pub struct Simulation {
     pub stats: TraceStats,
     /// Motion's CPU time per servo tick, ns (with `Options::timing`).
     pub tick_nanos: Vec<u64>,
+    /// Program stops (M0, M1 with optional stop on), each ended at once by cycle start as an
+    /// operator with nothing to do at them would: the cycle time leaves out their waiting.
+    pub program_stops: usize,
 }
 
 /// Programmed feed moves near the one being cut, to measure how far the setpoints leave them.
@@ -197,6 +200,7 @@ pub fn simulate(
     };
     let mut stats = TraceStats::default();
     let mut tick_nanos = Vec::new();
+    let mut program_stops = 0;
     // The last two setpoints, for velocity and acceleration.
     let (mut p1, mut p2) = (start.clone(), start.clone());
     loop {
@@ -226,6 +230,10 @@ pub fn simulate(
             return Err(format!(
                 "program still running after {MAX_SIMULATED_SECONDS} s of simulated time"
             ));
+        }
+        if motion.state() == RunState::Hold {
+            motion.cycle_start();
+            program_stops += 1;
         }
         // The simulated PLC answers every strobe at once and the spindle is at speed.
         let fi = *motion.f_image();
@@ -296,6 +304,7 @@ pub fn simulate(
         commands: stream.sent() as usize,
         stats,
         tick_nanos,
+        program_stops,
     })
 }
 
@@ -313,6 +322,12 @@ pub fn report(sim: &Simulation) -> String {
         out.push_str(&format!(
             "feed moves: {:.3} s, {:.3} s at the programmed feed without acceleration\n",
             st.cutting_time, st.ideal_cutting_time
+        ));
+    }
+    if sim.program_stops > 0 {
+        out.push_str(&format!(
+            "program stops: {}, each ended at once by cycle start\n",
+            sim.program_stops
         ));
     }
     if !sim.tick_nanos.is_empty() {

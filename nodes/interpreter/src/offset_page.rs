@@ -5,6 +5,7 @@
 
 use crate::fanuc::lathe::MAX_OFFSET;
 use crate::setup::{Memory, ToolOffset};
+use crate::Dialect;
 
 /// Largest offset value accepted, mm (the address table's 4+3 digits).
 pub const LIMIT_MM: f64 = 9999.999;
@@ -45,15 +46,24 @@ fn value(word: &str, what: &str) -> Result<f64, String> {
 }
 
 /// Sets tool offset `number` from `x z wear_x wear_z radius tip`.
-pub fn set_tool(memory: &mut Memory, number: &str, text: &str) -> Result<String, String> {
+/// The page is `dialect`'s: 1–99 on the lathes (alarm 62 beyond), 1–200 on FANUC 0-M,
+/// T×10+D on the 802D.
+pub fn set_tool(
+    memory: &mut Memory,
+    dialect: Dialect,
+    number: &str,
+    text: &str,
+) -> Result<String, String> {
     let n: u32 = number
         .trim()
         .parse()
-        .ok()
-        .filter(|n| (1..=MAX_OFFSET).contains(n))
-        .ok_or_else(|| {
-            format!("offset number {number:?} out of range 1-{MAX_OFFSET} (alarm 62)")
-        })?;
+        .map_err(|_| format!("offset number {number:?} is not a number"))?;
+    if dialect.is_lathe() && !(1..=MAX_OFFSET).contains(&n) {
+        return Err(format!(
+            "offset number {number:?} out of range 1-{MAX_OFFSET} (alarm 62)"
+        ));
+    }
+    cnc_runtime::tool_table::check_entry(dialect.name(), n)?;
     let words: Vec<&str> = text.split_whitespace().collect();
     let [x, z, wx, wz, r, tip] = words[..] else {
         return Err(format!(
@@ -126,7 +136,13 @@ mod tests {
     fn a_tool_row_is_set_read_back_and_a_bad_row_changes_nothing() {
         let mut m = Memory::default();
         assert_eq!(
-            set_tool(&mut m, "3", "-120.5 40 0.02 -0.01 0.4 3").unwrap(),
+            set_tool(
+                &mut m,
+                Dialect::HuaxingLathe,
+                "3",
+                "-120.5 40 0.02 -0.01 0.4 3"
+            )
+            .unwrap(),
             "tool offset 3 set"
         );
         let page = format(&m, &['X', 'Z']);
@@ -144,9 +160,39 @@ mod tests {
             ("3", "0 0 0 0 -0.4 3"),
             ("3", "0 0 0 0 0.4 10"),
         ] {
-            assert!(set_tool(&mut m, n, text).is_err(), "{n} {text}");
+            assert!(
+                set_tool(&mut m, Dialect::HuaxingLathe, n, text).is_err(),
+                "{n} {text}"
+            );
         }
         assert_eq!(m, before);
+    }
+
+    #[test]
+    fn each_dialect_has_its_own_entries() {
+        let mut m = Memory::default();
+        let row = "0 60 0 0 6 0";
+        // The 802D: T20 D1 is entry 201, T32000 D9 the last; D0 is no edge.
+        for n in ["201", "320009"] {
+            assert!(
+                set_tool(&mut m, Dialect::Sinumerik802d, n, row).is_ok(),
+                "{n}"
+            );
+        }
+        for n in ["200", "5", "320010", "-1"] {
+            assert!(
+                set_tool(&mut m, Dialect::Sinumerik802d, n, row).is_err(),
+                "{n}"
+            );
+        }
+        // FANUC 0-M: H and D 1–200; the lathes 1–99.
+        assert!(set_tool(&mut m, Dialect::FanucMill, "150", row).is_ok());
+        assert!(set_tool(&mut m, Dialect::FanucMill, "201", row).is_err());
+        assert!(set_tool(&mut m, Dialect::Gtc2eLathe, "150", row).is_err());
+        assert_eq!(
+            m.tools.keys().copied().collect::<Vec<_>>(),
+            [150, 201, 320009]
+        );
     }
 
     #[test]

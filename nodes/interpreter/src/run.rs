@@ -441,7 +441,7 @@ impl RunCore {
                 self.run = None;
                 let mut edited = self.memory.clone();
                 let message = if c.command == ProgramCommand::SET_TOOL_OFFSET {
-                    offset_page::set_tool(&mut edited, &c.program, &c.text)
+                    offset_page::set_tool(&mut edited, self.dialect, &c.program, &c.text)
                 } else {
                     offset_page::set_work(&mut edited, &c.program, &c.text, &self.base.axes)
                 }?;

@@ -37,7 +37,8 @@ impl Memory {
         self.kept
             .retain(|&n, v| Memory::is_kept(n) && v.is_finite());
         self.tools.retain(|n, t| {
-            (1..=cnc_runtime::tool_table::MAX_TOOL_NUMBER).contains(n)
+            // Entries the offset page or a program of any dialect could have stored.
+            (1..=cnc_runtime::tool_table::MAX_EDGE_ENTRY).contains(n)
                 && [t.x, t.z, t.wear_x, t.wear_z, t.radius]
                     .iter()
                     .all(|v| v.is_finite())

@@ -42,7 +42,7 @@ const CYCLES: [(&str, usize); 22] = [
 ];
 
 /// The sim_mill_802d's travel (`launch_configs/sim_mill_802d.yaml`).
-const TRAVEL: [(f64, f64); 3] = [(-500.0, 500.0), (-400.0, 400.0), (-400.0, 200.0)];
+const TRAVEL: [(f64, f64); 3] = [(-500.0, 500.0), (-400.0, 400.0), (-400.0, 400.0)];
 
 /// Commands one call may produce before the run is cut (a cycle makes at most 200,000).
 const LIMIT: usize = 400_000;

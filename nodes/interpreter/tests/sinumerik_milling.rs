@@ -659,7 +659,13 @@ fn f107_f108_cycle72_mills_round_the_contour_from_a_subprogram_or_labels() {
     let sub = sub.split_once('\n').unwrap().1;
     let mut lib = Library::new();
     lib.insert_named("EX72CONTOUR", "EX72CONTOUR.SPF", sub);
-    for (program, library) in [(main.to_string(), lib), (fixture("108"), Library::new())] {
+    // The listing as printed, in the transfer format: its EX72CONTOUR section is the
+    // subprogram (D95).
+    for (program, library) in [
+        (main.to_string(), lib),
+        (fixture("108"), Library::new()),
+        (fixture("107"), Library::new()),
+    ] {
         let r = run_with(&program, with_edge(31, 7.0), library).ok();
         let out = outside_of(contour_107());
         let mut stock = Stock::new((180.0, 120.0), 90.0, 200.0, 7.0, move |p| 1.0 - out(p));

@@ -108,6 +108,14 @@ impl Library {
             .or_insert_with(|| (file.to_string(), Arc::from(text)));
     }
 
+    /// Adds a program under its name, in place of one stored under it before.
+    pub fn replace_named(&mut self, name: &str, file: &str, text: &str) {
+        self.named.insert(
+            name.to_ascii_uppercase(),
+            (file.to_string(), Arc::from(text)),
+        );
+    }
+
     /// The program called `name` (any case): what errors call it, and its text.
     pub fn get_named(&self, name: &str) -> Option<(&str, Arc<str>)> {
         self.named

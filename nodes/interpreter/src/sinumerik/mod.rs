@@ -28,6 +28,7 @@ mod slots;
 mod spigot;
 mod thread_mill;
 mod tool;
+mod transfer;
 pub mod vars;
 
 use std::sync::Arc;
@@ -147,7 +148,13 @@ impl Sinumerik {
         }
     }
 
-    pub fn new(text: &str, setup: Setup, library: Library) -> Sinumerik {
+    pub fn new(text: &str, setup: Setup, mut library: Library) -> Sinumerik {
+        // A transfer listing's later programs are stored under their names, in place of
+        // stored ones, as reading the listing in stores them (D95).
+        let (text, sections) = transfer::split(text);
+        for s in sections {
+            library.replace_named(&s.name, &s.file, s.text);
+        }
         let mut core = Core::new(Sinumerik::rules(), text, setup, library);
         // G500 at program start: no settable zero offset (§9.1.6 table, `*`).
         core.work_system = NO_WORK_OFFSET;

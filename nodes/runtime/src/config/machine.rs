@@ -455,10 +455,11 @@ impl MachineConfig {
             let finite = [t.x, t.z, t.wear_x, t.wear_z, t.radius]
                 .iter()
                 .all(|v| v.is_finite() && v.abs() <= 10_000.0);
-            let max = crate::tool_table::MAX_TOOL_NUMBER;
-            if !(1..=max).contains(n) || !finite || t.radius < 0.0 || t.tip > 9 {
+            crate::tool_table::check_entry(&self.dialect, *n)
+                .map_err(|e| format!("machine.tools[{n}]: {e}"))?;
+            if !finite || t.radius < 0.0 || t.tip > 9 {
                 return Err(format!(
-                    "machine.tools[{n}]: offset 1..{max}, finite values within ±10000, radius ≥ 0, tip 0..9"
+                    "machine.tools[{n}]: finite values within ±10000, radius ≥ 0, tip 0..9"
                 ));
             }
         }
