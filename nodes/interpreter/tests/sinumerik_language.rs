@@ -198,3 +198,72 @@ fn g74_takes_the_axes_named_to_their_reference_points_at_rapid() {
     let (_, e) = run("G74\n");
     assert_eq!(e.map(|e| e.number), Some(12080));
 }
+
+#[test]
+fn offn_widens_the_compensated_offset_and_past_the_centre_changes_its_side() {
+    // T1 D1 of radius 5; the contour runs up X0 with G41 (the cutter left of it, on −X).
+    // OFFN adds to the radius; a negative OFFN beyond the radius puts the path on the other
+    // side (§9.15, D96).
+    let mut s = mill();
+    s.offsets.tools.insert(
+        11,
+        cnc_interpreter_core::ToolOffset {
+            radius: 5.0,
+            ..Default::default()
+        },
+    );
+    let program = |offn: &str, extra: &str| {
+        format!(
+            "T1 D1\nG0 X-20 Y0 Z5\n{offn}\nG1 G41 X0 Y0 F500\n{extra}Y40\nX40\nG40 X60 Y60\nM2\n"
+        )
+    };
+    let start = |text: &str| -> Vec<f64> {
+        let mut front = Sinumerik::new(text, s.clone(), Library::new());
+        let mut out = Vec::new();
+        while let Some(c) = next_command(&mut front).unwrap_or_else(|e| panic!("{e:?}")) {
+            out.push(c.command);
+        }
+        // The start-up move ends perpendicular to the first contour element at Y0.
+        ends(&out)[1].clone()
+    };
+    for (offn, x) in [
+        ("", -5.0),
+        ("OFFN=2", -7.0),
+        ("OFFN=-7", 2.0),
+        ("OFFN=-5", 0.0),
+    ] {
+        let end = start(&program(offn, ""));
+        assert!(near(&end, &[x, 0.0, 5.0]), "{offn}: {end:?}");
+    }
+    // Modal until changed; the same value again under compensation is no change.
+    assert!(near(
+        &start(&program("OFFN=2", "OFFN=2\n")),
+        &[-7.0, 0.0, 5.0]
+    ));
+    // A change while compensation is active is not built: 12140, before the machine moves
+    // on the changed path.
+    let mut front = Sinumerik::new(&program("OFFN=2", "OFFN=3\n"), s.clone(), Library::new());
+    let e = loop {
+        match next_command(&mut front) {
+            Ok(Some(_)) => {}
+            Ok(None) => panic!("ran"),
+            Err(e) => break e,
+        }
+    };
+    assert_eq!((e.number, e.line), (12140, 5), "{e:?}");
+    assert!(e.text.contains("OFFN"), "{}", e.text);
+    let (_, e) = run("OFFN=1EX6\nM2\n");
+    assert_eq!(e.map(|e| e.number), Some(17020));
+    // Neither is a D change (12140) nor a G41↔G42 switch (10752) under compensation.
+    for (extra, number) in [("D2\n", 12140), ("G42 X1\n", 10752)] {
+        let mut front = Sinumerik::new(&program("", extra), s.clone(), Library::new());
+        let e = loop {
+            match next_command(&mut front) {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("{extra} ran"),
+                Err(e) => break e,
+            }
+        };
+        assert_eq!((e.number, e.line), (number, 5), "{e:?}");
+    }
+}

@@ -108,6 +108,8 @@ pub struct Sinumerik {
     program_text: Option<Arc<str>>,
     /// SF=: the thread's start angle after the spindle's index pulse, degrees (modal).
     thread_angle: f64,
+    /// OFFN=, the contour's normal offset added to the cutter radius of G41/G42 (§9.15).
+    contour_offset: f64,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -192,6 +194,7 @@ impl Sinumerik {
             ang: None,
             program_text: None,
             thread_angle: 0.0,
+            contour_offset: 0.0,
         };
         front.apply_length();
         front

@@ -42,6 +42,9 @@ impl Sinumerik {
             }
             self.thread_angle = sf;
         }
+        if let Some(offn) = w.get("OFFN") {
+            self.set_contour_offset(offn)?;
+        }
         if w.has_g(4) {
             return self.dwell(w).map(|()| true);
         }

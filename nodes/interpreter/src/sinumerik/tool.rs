@@ -121,7 +121,11 @@ impl Sinumerik {
             return Ok(());
         };
         if let Some(c) = &self.core.comp {
-            if c.side() != side {
+            // The side compensation runs on, which a negative OFFN may have turned.
+            let flipped = self
+                .offset_entry()
+                .is_some_and(|e| e.radius + self.contour_offset < 0.0);
+            if (c.side() != side) != flipped {
                 return Err(self.fault(
                     Fault::CompDirection,
                     "a switch between G41 and G42 without G40 is not built: G40 first",
@@ -149,9 +153,34 @@ impl Sinumerik {
                 ))
             }
         };
+        // OFFN widens the offset (an allowance, half a slot's width); past the centre line
+        // the path lies on the other side, which is how the manual switches G41↔G42 with a
+        // negative OFFN (D96).
+        let offset = entry.radius + self.contour_offset;
+        let side = match side {
+            Side::Left if offset < 0.0 => Side::Right,
+            Side::Right if offset < 0.0 => Side::Left,
+            s => s,
+        };
         // Compensation runs in the program's coordinates: the radius there is the tool's
         // divided by the frame's scale, so the machine path keeps the tool's radius.
         self.core
-            .start_comp(side, entry.radius / factor, 0, Startup::ToNextElement)
+            .start_comp(side, offset.abs() / factor, 0, Startup::ToNextElement)
+    }
+
+    /// OFFN=: taken up by the next start of compensation; a change while it is active is
+    /// not built (as a D change there is not).
+    pub(super) fn set_contour_offset(&mut self, offn: f64) -> Result<(), ProgramError> {
+        if !offn.is_finite() || offn.abs() > 10_000.0 {
+            return Err(self.fault(Fault::OutOfRange, "OFFN= is within ±10000 mm"));
+        }
+        if self.core.comp.is_some() && offn != self.contour_offset {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "an OFFN change under radius compensation is not built yet: G40 first",
+            ));
+        }
+        self.contour_offset = offn;
+        Ok(())
     }
 }
