@@ -112,6 +112,7 @@ ros_message! {
         line: u32,
         emergency_stop: bool,
         alarm_active: bool,
+        message: String,
     }
 }
 

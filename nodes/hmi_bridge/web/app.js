@@ -68,6 +68,9 @@ const handlers = {
       $("program").textContent = s.program || "-";
       $("line").textContent = s.line;
       $("estop").hidden = !s.emergency_stop;
+      // The program's message to the operator (MSG), as the control's message line shows it.
+      $("message").textContent = s.message || "";
+      $("message").hidden = !s.message;
       if (s.program && s.program !== listingName) {
         listingName = s.program;
         send({ op: "read", name: s.program });

@@ -41,6 +41,12 @@ impl Interpreter {
         next_command(&mut *self.front)
     }
 
+    /// The operator messages read since the last call, each with the number of commands
+    /// before it ([`cnc_interpreter_core::Core::operator_message`]).
+    pub fn take_messages(&mut self) -> Vec<(u64, String)> {
+        std::mem::take(&mut self.front.core_mut().operator_messages)
+    }
+
     /// The kept variables and the offset page as the program has left them, for the shell to
     /// store.
     pub fn memory(&self) -> Memory {

@@ -328,6 +328,7 @@ fn report_state(state: &mut StateReporter, view: StateView, latest: Option<&Prog
             line: view.line,
             emergency_stop: view.emergency_stop,
             alarm_active: view.alarm_active,
+            message: view.message.clone(),
         });
         state.last = Some(view);
     }

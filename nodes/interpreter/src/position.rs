@@ -143,6 +143,7 @@ mod tests {
             line,
             emergency_stop: false,
             alarm_active: false,
+            message: String::new(),
         }
     }
 

@@ -46,6 +46,8 @@ pub struct ProgramRun {
     sent: u64,
     /// Sequence number of the program end, once sent.
     end: Option<u64>,
+    /// Operator messages read, each with the sequence number after which it shows.
+    messages: VecDeque<(u64, String)>,
 }
 
 impl ProgramRun {
@@ -57,6 +59,7 @@ impl ProgramRun {
             preamble: 0,
             sent: 0,
             end: None,
+            messages: VecDeque::new(),
         }
     }
 
@@ -73,6 +76,28 @@ impl ProgramRun {
             preamble,
             sent: 0,
             end: None,
+            messages: VecDeque::new(),
+        }
+    }
+
+    /// The newest operator message due once motion has finished block `done`, if one is:
+    /// a message shows when the commands before it are done, as the block it stands in runs.
+    pub fn message_due(&mut self, done: u64) -> Option<String> {
+        let mut due = None;
+        while self.messages.front().is_some_and(|(seq, _)| *seq <= done) {
+            due = self.messages.pop_front().map(|(_, text)| text);
+        }
+        due
+    }
+
+    /// Files the interpreter's new messages by sequence number: the interpreter's `n`th
+    /// command is this run's `n + preamble − skipped`th (a restart's search ran the skipped
+    /// ones without motion and the preamble came first).
+    fn file_messages(&mut self) {
+        let shift = self.preamble as i64 - self.skipped as i64;
+        for (before, text) in self.interp.take_messages() {
+            let seq = (before as i64 + shift).max(0) as u64;
+            self.messages.push_back((seq, text));
         }
     }
 
@@ -115,6 +140,7 @@ impl ProgramRun {
                 None => break,
             }
         }
+        self.file_messages();
         Ok(count)
     }
 
@@ -172,6 +198,8 @@ pub struct StateView {
     pub line: u32,
     pub emergency_stop: bool,
     pub alarm_active: bool,
+    /// The program's message to the operator (SINUMERIK `MSG`); empty: none.
+    pub message: String,
 }
 
 struct Run {
@@ -189,6 +217,9 @@ struct Run {
 /// The interpreter node's logic.
 pub struct RunCore {
     dialect: Dialect,
+    /// The program's message to the operator (MSG), shown until the next one or the end
+    /// of the run.
+    message: String,
     /// The machine as the launch config describes it; each start sets the start position and
     /// the memory.
     base: Setup,
@@ -245,6 +276,7 @@ impl RunCore {
             mode: MachineState::MODE_AUTO,
             program_name: String::new(),
             stop_command_id: 0,
+            message: String::new(),
             memory,
             effects: Vec::new(),
             approach: Approach::default_for(&base),
@@ -468,6 +500,7 @@ impl RunCore {
             ProgramCommand::RESET => {
                 self.remember();
                 self.run = None;
+                self.message.clear();
                 // Program alarms are cleared by reset; alarms whose cause persists (emergency
                 // stop) stay until their source clears them.
                 for (source, number) in self.active_alarms.clone() {
@@ -660,6 +693,7 @@ impl RunCore {
             }
         };
         self.run_counter += 1;
+        self.message.clear();
         self.run = Some(Run {
             id: self.run_counter,
             program: name.clone(),
@@ -732,6 +766,9 @@ impl RunCore {
                         effects.push(Effect::Block(msg));
                     },
                 );
+                if let Some(m) = r.stream.message_due(done) {
+                    self.message = m;
+                }
                 match sent {
                     Ok(n) => busy = n > 0,
                     Err(e) => {
@@ -771,6 +808,7 @@ impl RunCore {
             let complete = self.status.run_id == r.id && r.stream.completed(self.status.done_seq);
             if complete && self.execution == MachineState::ACTIVE {
                 self.execution = MachineState::PROGRAM_COMPLETED;
+                self.message.clear();
                 self.remember();
                 self.run = None;
             }
@@ -864,6 +902,7 @@ impl RunCore {
                 .iter()
                 .any(|(s, n)| s == "plc" && *n == 65),
             alarm_active: !self.active_alarms.is_empty(),
+            message: self.message.clone(),
         }
     }
 

@@ -604,3 +604,60 @@ fn an_interrupted_run_restarts_at_its_block_with_the_variables_it_started_with()
     );
     assert!(!r.accepted && r.message.contains("edited"), "{}", r.message);
 }
+
+#[test]
+fn an_802d_message_shows_as_its_block_runs_until_the_next_one_or_the_end() {
+    let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
+    let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
+    let part = "MSG(\"ROUGHING\")\nG0 X10\nG1 X20 F100\nMSG(\"FINISHING \"<<2)\nG1 X30\n\
+                MSG()\nG1 X40\nM2\n";
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PART.MPF", part).accepted);
+    c.axes(&[0.0; 3]);
+    assert!(command(&mut c, 2, ProgramCommand::START, "PART.MPF", "").accepted);
+    // Every block goes to motion at once; the messages wait for motion.
+    c.motion_status(status(1001, 0, 100, MotionStatus::STATE_RUNNING));
+    c.step();
+    let sent = c.take_effects();
+    let seq_of_line = |line: u32| {
+        blocks(&sent)
+            .iter()
+            .find(|b| b.line == line)
+            .map(|b| b.seq)
+            .unwrap()
+    };
+    let (x10, x20, x30, end) = (
+        seq_of_line(2),
+        seq_of_line(3),
+        seq_of_line(5),
+        blocks(&sent).last().map(|b| b.seq).unwrap(),
+    );
+    let mut shown = Vec::new();
+    for done in 0..end {
+        c.motion_status(status(1001, done, 100, MotionStatus::STATE_RUNNING));
+        c.step();
+        shown.push(c.state().message);
+    }
+    // Before the first move is done, its message shows; the second once X20 is reached, as
+    // its block follows; `MSG()` clears it once X30 is reached.
+    assert_eq!(shown[x10 as usize - 1], "ROUGHING");
+    assert_eq!(shown[x20 as usize - 1], "ROUGHING");
+    assert_eq!(shown[x20 as usize], "FINISHING 2");
+    assert_eq!(shown[x30 as usize - 1], "FINISHING 2");
+    assert_eq!(shown[x30 as usize], "");
+    // A message at the end is gone with the run.
+    let part = "G0 X10\nMSG(\"CHECK THE PART\")\nM2\n";
+    assert!(command(&mut c, 3, ProgramCommand::LOAD, "B.MPF", part).accepted);
+    c.motion_status(status(1001, end, 100, MotionStatus::STATE_IDLE));
+    c.step();
+    assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
+    assert!(command(&mut c, 4, ProgramCommand::START, "B.MPF", "").accepted);
+    c.step();
+    let last = blocks(&c.take_effects()).last().map(|b| b.seq).unwrap();
+    c.motion_status(status(1002, last - 1, 100, MotionStatus::STATE_RUNNING));
+    c.step();
+    assert_eq!(c.state().message, "CHECK THE PART");
+    c.motion_status(status(1002, last, 100, MotionStatus::STATE_IDLE));
+    c.step();
+    assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
+    assert_eq!(c.state().message, "");
+}

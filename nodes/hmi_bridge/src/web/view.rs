@@ -255,6 +255,7 @@ impl View {
                 "line": m.line,
                 "emergency_stop": m.emergency_stop,
                 "alarm": m.alarm_active,
+                "message": m.message,
             })
         });
         let feed = self.current_block().map_or(0.0, |b| b.feed);

@@ -32,6 +32,7 @@ pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>
                     *h -= 1;
                 }
                 core.silent_blocks = 0;
+                core.emitted += 1;
                 return Ok(Some(c));
             }
         }

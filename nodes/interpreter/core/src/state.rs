@@ -137,6 +137,11 @@ pub struct Core {
     pub(crate) silent_blocks: u32,
     /// A program end has been read.
     pub saw_end: bool,
+    /// Commands handed out by [`crate::next_command`] so far.
+    pub emitted: u64,
+    /// Messages for the operator (SINUMERIK `MSG`), each with the number of commands that
+    /// come before it: it shows once the machine has finished those.
+    pub operator_messages: Vec<(u64, String)>,
 }
 
 impl Core {
@@ -178,6 +183,8 @@ impl Core {
             error: None,
             silent_blocks: 0,
             saw_end: false,
+            emitted: 0,
+            operator_messages: Vec::new(),
             rules,
             setup,
             library,
@@ -307,6 +314,12 @@ impl Core {
     // ------------------------------------------------------------------ the stream
 
     /// Queues a command on the line being run.
+    /// A message for the operator, in its place among the commands.
+    pub fn operator_message(&mut self, text: String) {
+        let before = self.emitted + self.pending.len() as u64;
+        self.operator_messages.push((before, text));
+    }
+
     pub fn push(&mut self, command: Command) {
         self.pending.push_back(Canon {
             line: self.line,

@@ -445,7 +445,8 @@ impl Sinumerik {
             };
             // The display shows 65 characters (§9.1.6).
             let shown: String = text.chars().take(65).collect();
-            self.messages.push((self.core.line, shown));
+            self.messages.push((self.core.line, shown.clone()));
+            self.core.operator_message(shown);
             return Ok(());
         }
         if is_cycle(name) {
