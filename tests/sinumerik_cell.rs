@@ -134,6 +134,7 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
                N20 G0 X50 Y50 Z60\n\
                N30 CYCLE86(10, 0, 2, -6, , 0.5, 3, -1, -1, 1, 45)\n\
                N40 G0 X100 Y50\n\
+               N45 MSG(\"BORE AT X\"<<100<<\": RETRACT THE BAR, THEN START\")\n\
                N50 CYCLE87(10, 0, 2, -6, , 3)\n\
                N60 POCKET4(10, 0, 1, -4, 14, 150, 50, 2, 0, 0, 600, 200, 0, 11, 0)\n\
                N70 G0 X0 Y0 Z100\n\
@@ -163,6 +164,12 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
         })
     });
     assert!(ok, "the spindle stands at the M0: {:?}", client.spindle);
+    // The program's message to the operator stands on the machine state (D97).
+    let message = client.state.as_ref().map(|s| s.message.clone());
+    assert_eq!(
+        message.as_deref(),
+        Some("BORE AT X100: RETRACT THE BAR, THEN START")
+    );
     // Cycle start goes on: out of the bore, the pocket, the end.
     let r = client.start_program("").unwrap();
     assert!(r.accepted, "{}", r.message);
@@ -171,6 +178,8 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
         Duration::from_secs(180),
         [0.0, 0.0, 100.0 + length],
     );
+    // The end of the run ends the message.
+    assert_eq!(client.state.as_ref().map(|s| s.message.as_str()), Some(""));
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
 }

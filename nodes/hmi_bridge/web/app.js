@@ -69,8 +69,8 @@ const handlers = {
       $("line").textContent = s.line;
       $("estop").hidden = !s.emergency_stop;
       // The program's message to the operator (MSG), as the control's message line shows it.
-      $("message").textContent = s.message || "";
-      $("message").hidden = !s.message;
+      $("program-message").textContent = s.message || "";
+      $("program-message").hidden = !s.message;
       if (s.program && s.program !== listingName) {
         listingName = s.program;
         send({ op: "read", name: s.program });
