@@ -812,16 +812,24 @@ fn the_mill_magazine_preselects_with_t_changes_with_m6_and_m19_orients() {
     assert_eq!(tool, 12, "tool 12 in the spindle for the NC");
     assert!(r.message("A3.2").is_none() && r.message("A0.1").is_none());
     // Where T changes at once (the launch config), the tool is in the spindle at T's FIN,
-    // and the manual's `T1 D1` programs run unchanged.
+    // and the manual's `T1 D1` programs run unchanged; their M6 (fixture 109) is no tool
+    // change there and leaves the spindle turning.
     let cfg = config("sim_mill_802d");
     let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
-    let mut r = Rig::on(cfg.clone(), "T20 D1 S500 M3\nG0 X10\nM30\n", Some(&kept));
+    let mut r = Rig::on(
+        cfg.clone(),
+        "T20 D1 S500 M3\nM6\nG0 X10\nM30\n",
+        Some(&kept),
+    );
     r.run_until(0.1, |_| false);
     r.started = true;
     assert!(r.run_until(30.0, |r| r.program_done()), "{:?}", r.events);
     assert_eq!(r.turret_station(), Some(20));
     assert_eq!(r.gi.bytes[g::NTOL as usize], 20);
-    assert!(r.fb.spindle_rpm > 400.0, "T did not stop the spindle");
+    assert!(
+        r.fb.spindle_rpm > 400.0,
+        "neither T nor M6 stopped the spindle"
+    );
     // Beyond the magazine: the tool-number alarm, and the program stops.
     let mut r = Rig::on(cfg, "T30\nG0 X10\nM30\n", Some(&kept));
     r.run_until(0.1, |_| false);
