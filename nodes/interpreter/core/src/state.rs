@@ -139,7 +139,7 @@ pub struct Core {
     pub saw_end: bool,
     /// Commands handed out by [`crate::next_command`] so far.
     pub emitted: u64,
-    /// Messages for the operator (SINUMERIK `MSG`), each with the number of commands that
+    /// Messages a program shows the operator, each with the number of commands that
     /// come before it: it shows once the machine has finished those.
     pub operator_messages: Vec<(u64, String)>,
 }
