@@ -4,6 +4,22 @@
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// `cnc` with `args` from the repository's folder: whether it succeeded, and its stdout
+/// followed by its stderr.
+fn cnc(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(args)
+        .output()
+        .unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), text)
+}
+
 /// Runs `cnc run` on the program; the run must end by itself within 120 s (a hang fails
 /// here instead of passing as a non-zero exit).
 fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, String) {
@@ -142,17 +158,8 @@ fn check_uses_the_offset_page_of_the_launch_config() {
         env!("CARGO_MANIFEST_DIR"),
         "/../shared/fixtures/000/053_tnrc_outer_G42.nc"
     );
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["check", program, "--trace"])
-        .output()
-        .unwrap();
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(out.status.success() && text.contains("no alarm"), "{text}");
+    let (ok, text) = cnc(&["check", program, "--trace"]);
+    assert!(ok && text.contains("no alarm"), "{text}");
     // The start-up move ends off the programmed X26 Z131, and outer corners get R0.4 arcs.
     assert!(!text.contains("LINEAR X26.0000 Z131.0000"), "{text}");
     assert!(text.contains("CX29.2000 CZ128.6000"), "{text}");
@@ -231,31 +238,17 @@ fn the_802d_manuals_cycle_examples_run_as_printed_on_the_built_in_mill() {
     assert_eq!(listings.len(), 26);
     for path in listings {
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-            .args(["simulate", "--config", "sim_mill_802d"])
-            .arg(&path)
-            .output()
-            .unwrap();
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let listing = path.to_string_lossy();
+        let (ok, text) = cnc(&["simulate", "--config", "sim_mill_802d", &listing]);
         let expected_alarm = match &name[..3] {
             "103" => Some("alarm 12080 at line 12"),
             "117" => Some("alarm 12550 at line 11: DP is not defined"),
             _ => None,
         };
         match expected_alarm {
-            Some(alarm) => assert!(
-                !out.status.success() && text.contains(alarm),
-                "{name}: {text}"
-            ),
+            Some(alarm) => assert!(!ok && text.contains(alarm), "{name}: {text}"),
             None => {
-                assert!(
-                    out.status.success() && text.contains("cycle time: "),
-                    "{name}: {text}"
-                );
+                assert!(ok && text.contains("cycle time: "), "{name}: {text}");
                 let stops = ["100", "101"].contains(&&name[..3]);
                 assert_eq!(text.contains("program stops: 1,"), stops, "{name}: {text}");
             }
