@@ -440,6 +440,58 @@ fn f057_with_m6_the_new_tool_and_its_edge_take_effect_at_m6() {
     assert_eq!(r.front.tool_edge(), (4, 3));
 }
 
+/// 035 (§9.3.15): G42 with a cutter of radius 5 right of a clockwise arc (the cutter inside,
+/// radius 15) and a counter-clockwise one (outside, radius 25), then after N70 CFTCP another
+/// clockwise arc (appended). CFC is also the program-start setting (D98).
+#[test]
+fn f035_cfc_holds_f_on_the_contour_of_compensated_arcs_and_cftcp_at_the_centre() {
+    let arc_feeds = |n20: &str| -> Vec<(f64, f64)> {
+        let text = format!(
+            "T1 D1\nG0 X0 Y-20 Z5\n{}N80 G2 X140 Y0 I20 J0\nN90 G40 G1 X160 Y-20\nM2\n",
+            filled(
+                "035",
+                &[
+                    "N10 G1 G42 X0 Y0 F500",
+                    n20,
+                    "N30 G2 X40 Y0 I20 J0 F350",
+                    "N40 G3 X80 Y0 I20 J0",
+                    "N50 G1 X100",
+                ],
+            )
+        );
+        let r = run_with(&text, with_edge(11, 5.0), Library::new()).ok();
+        r.out
+            .iter()
+            .filter_map(|c| match c {
+                Command::Arc { center, feed, .. } => Some((center[0], *feed)),
+                _ => None,
+            })
+            .collect()
+    };
+    let want = [
+        // N30 inside: 350 · 15/20; N40 outside: 350 · 25/20.
+        (20.0, 262.5),
+        (60.0, 437.5),
+        // N80's outer corner arc (radius 5 about X100 Y0) and N80 itself: at the centre.
+        (100.0, 350.0),
+        (120.0, 350.0),
+    ];
+    // As the manual writes it, and with CFC left to the program start.
+    for n20 in ["N20 CFC", "N20"] {
+        let got = arc_feeds(n20);
+        assert_eq!(got.len(), want.len(), "{n20}: {got:?}");
+        for ((c, f), (wc, wf)) in got.iter().zip(want) {
+            assert!(
+                (c - wc).abs() < 1e-9 && (f - wf).abs() < 1e-9,
+                "{n20}: {got:?}"
+            );
+        }
+    }
+    // CFTCP from the start: every arc at the programmed feed.
+    let got = arc_feeds("N20 CFTCP");
+    assert!(got.iter().all(|(_, f)| (f - 350.0).abs() < 1e-9), "{got:?}");
+}
+
 /// TRC of fixtures 058–060 on one contour: P0 (0, 0), P1 (20, 10) where G42/G41 starts,
 /// the first contour element along +X to (60, 10), then G40 back to P2 (80, 40); cutter
 /// radius 10 (T1 D1).

@@ -123,6 +123,10 @@ pub struct RadiusComp {
     held: Option<Held>,
     /// Moves along the normal after the held element, in program order.
     stills: Vec<Still>,
+    /// The programmed feed holds on the contour, not at the cutter centre: an offset arc's
+    /// feed is scaled by its radius over the programmed one (the 802D's CFC, decision D98).
+    /// The front end sets it before each element; it may change while compensation runs.
+    pub feed_on_contour: bool,
 }
 
 /// The vector from the nose centre to the imaginary tip for tip direction 0–9, with Z to the
@@ -314,6 +318,24 @@ impl RadiusComp {
             startup: None,
             held: None,
             stills: Vec::new(),
+            feed_on_contour: false,
+        }
+    }
+
+    /// The feed the cutter centre runs an offset element at: under [`Self::feed_on_contour`]
+    /// an arc's feed is scaled by offset radius over programmed radius, so the contour runs at
+    /// the programmed feed (faster outside an arc, slower inside). Lines need no correction.
+    fn centre_feed(&self, path: &Elem, off: &Elem, kind: Kind) -> Kind {
+        match (self.feed_on_contour, path, off, kind) {
+            (true, Elem::Arc { a, c, .. }, Elem::Arc { a: oa, c: oc, .. }, Kind::Feed(f)) => {
+                let rho = len(sub(*a, *c));
+                if rho > EPS {
+                    Kind::Feed(f * len(sub(*oa, *oc)) / rho)
+                } else {
+                    kind
+                }
+            }
+            _ => kind,
         }
     }
 
@@ -370,6 +392,8 @@ impl RadiusComp {
         line: u32,
     ) -> Result<Vec<Out>, CompError> {
         let off = path.offset(self.offset)?;
+        // The element's own feed; a corner arc before it keeps the programmed one.
+        let cut = self.centre_feed(&path, &off, kind);
         let course = match path {
             Elem::Line { a, b } => Some(unit(sub(b, a))),
             Elem::Arc { .. } => None,
@@ -381,7 +405,7 @@ impl RadiusComp {
             from,
             course,
             depth,
-            kind,
+            kind: cut,
             line,
         };
         if let Start::Pending(startup, from) = self.start {
@@ -698,5 +722,55 @@ mod tests {
             1,
         );
         assert_eq!(e.unwrap_err(), CompError::ArcVanishes);
+    }
+
+    #[test]
+    fn with_feed_on_the_contour_an_offset_arc_is_scaled_and_a_corner_arc_is_not() {
+        // A line along +Z, then a clockwise arc of radius 10 turning left off it.
+        let line = Elem::Line {
+            a: p(-10.0, 0.0),
+            b: p(0.0, 0.0),
+        };
+        let arc = Elem::Arc {
+            a: p(0.0, 0.0),
+            b: p(20.0, 0.0),
+            c: p(10.0, 0.0),
+            ccw: false,
+        };
+        // Right of a clockwise arc is its inside (radius 8), left its outside (radius 12).
+        for (side, on, radius, feed) in [
+            (Side::Right, false, 8.0, 100.0),
+            (Side::Right, true, 8.0, 80.0),
+            (Side::Left, true, 12.0, 120.0),
+        ] {
+            let mut c = RadiusComp::new(side, 2.0, 0, p(-10.0, 0.0), Startup::Connect);
+            c.feed_on_contour = on;
+            let mut out = c.push(line, 0.0, Kind::Feed(100.0), 1).unwrap();
+            out.extend(c.push(arc, 0.0, Kind::Feed(100.0), 2).unwrap());
+            out.extend(c.flush());
+            let arcs: Vec<(f64, Kind)> = out
+                .iter()
+                .filter_map(|o| match o.path {
+                    Elem::Arc { a, c, .. } => Some((len(sub(a, c)), o.kind)),
+                    Elem::Line { .. } => None,
+                })
+                .collect();
+            let cut = arcs.iter().find(|(r, _)| (r - radius).abs() < 1e-9);
+            assert!(
+                matches!(cut, Some((_, Kind::Feed(f))) if (f - feed).abs() < 1e-9),
+                "{side:?} {on}: {out:?}"
+            );
+            // The outer corner's arc (radius 2, G42 only) runs at the programmed feed.
+            for (r, k) in &arcs {
+                if (r - 2.0).abs() < 1e-9 {
+                    assert_eq!(*k, Kind::Feed(100.0), "{out:?}");
+                }
+            }
+            assert_eq!(
+                arcs.len(),
+                if side == Side::Right { 2 } else { 1 },
+                "{out:?}"
+            );
+        }
     }
 }

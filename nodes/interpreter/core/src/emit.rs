@@ -310,8 +310,12 @@ impl Core {
                 _ => return Ok(()),
             }
         } else {
+            let on_contour = self.feed_on_contour;
             let pushed = match self.comp.as_mut() {
-                Some(comp) => comp.push(path, depth, ck, line),
+                Some(comp) => {
+                    comp.feed_on_contour = on_contour;
+                    comp.push(path, depth, ck, line)
+                }
                 None => Ok(Vec::new()),
             };
             pushed.map_err(|e| self.comp_fault(e))?

@@ -100,6 +100,9 @@ pub struct Core {
     pub feed: f64,
     pub feed_per_rev: bool,
     pub exact_stop_mode: bool,
+    /// Under radius compensation the feed holds on the programmed contour, not at the
+    /// cutter centre (decision D98).
+    pub feed_on_contour: bool,
     // The spindle.
     pub spindle: SpindleDir,
     /// Constant surface speed in force, with its rule.
@@ -163,6 +166,7 @@ impl Core {
             feed: rules.initial_feed,
             feed_per_rev: false,
             exact_stop_mode: false,
+            feed_on_contour: false,
             spindle: SpindleDir::Stopped,
             css: None,
             css_speed: 0.0,

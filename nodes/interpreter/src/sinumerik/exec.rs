@@ -117,9 +117,9 @@ const ADDRESSES: [&str; 18] = [
 ];
 
 /// Keywords this front end runs.
-const KEYWORDS: [&str; 20] = [
+const KEYWORDS: [&str; 21] = [
     "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
-    "STOPRE", "RET", "CFTCP", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM", "MCALL",
+    "STOPRE", "RET", "CFTCP", "CFC", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM", "MCALL",
     "WALIMON",
 ];
 
@@ -138,11 +138,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 30] = [
-    (
-        "CFC",
-        "feed correction on compensated circles is not built: F acts on the cutter centre (CFTCP)",
-    ),
+pub const NOT_BUILT: [(&str, &str); 29] = [
     (
         "SOFT",
         "the acceleration profile is the machine's (motion profile), not switched by the program",
@@ -657,6 +653,9 @@ impl Sinumerik {
                 "CT" => self.motion = Motion::Ct,
                 "WALIMON" => self.limits.monitored = true,
                 "WALIMOF" => self.limits.monitored = false,
+                // Feed on the contour of compensated arcs, or at the cutter centre (D98).
+                "CFC" => self.core.feed_on_contour = true,
+                "CFTCP" => self.core.feed_on_contour = false,
                 _ => {}
             }
         }
