@@ -47,6 +47,11 @@ pub enum Command {
     PathMode {
         exact_stop: bool,
     },
+    /// The acceleration profile of the moves that follow: jerk-limited (`true`, S-curve) or
+    /// acceleration-limited (`false`, trapezoidal). A run starts with the machine's own.
+    Profile {
+        jerk_limited: bool,
+    },
     /// An M, S or T function for the PLC, which answers with FIN.
     Aux(Aux),
     /// M02/M30: the program is finished; motion completes everything before it.
@@ -137,6 +142,10 @@ pub fn to_motion_block(
             m.kind = MotionBlock::KIND_PATH_MODE;
             m.flag = *exact_stop;
         }
+        Command::Profile { jerk_limited } => {
+            m.kind = MotionBlock::KIND_PROFILE;
+            m.flag = *jerk_limited;
+        }
         Command::Aux(aux) => {
             m.kind = MotionBlock::KIND_AUX;
             (m.aux_kind, m.aux_code, m.aux_value) = match *aux {
@@ -202,6 +211,9 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
         }
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
+        MotionBlock::KIND_PROFILE => Command::Profile {
+            jerk_limited: m.flag,
+        },
         MotionBlock::KIND_DWELL if m.dwell_seconds.is_finite() && m.dwell_seconds >= 0.0 => {
             Command::Dwell {
                 seconds: m.dwell_seconds,
@@ -257,6 +269,12 @@ mod tests {
                 plane: Some([2, 0]),
             },
             Command::Dwell { seconds: 1.5 },
+            Command::FeedMode { per_rev: true },
+            Command::PathMode { exact_stop: true },
+            Command::Profile { jerk_limited: true },
+            Command::Profile {
+                jerk_limited: false,
+            },
             Command::Aux(Aux::M(3)),
             Command::Aux(Aux::S(1200.0)),
             Command::Aux(Aux::T(101)),

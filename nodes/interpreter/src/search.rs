@@ -118,6 +118,8 @@ pub struct Collected {
     pub position: Option<Vec<f64>>,
     pub feed_per_rev: Option<bool>,
     pub exact_stop: Option<bool>,
+    /// The acceleration profile: jerk-limited or not.
+    pub jerk_limited: Option<bool>,
     /// The last T: on a lathe the turret's station, on a mill the tool put ready.
     pub tool: Option<i32>,
     /// The tool the last M06 put in a mill's spindle (the T before it).
@@ -142,6 +144,7 @@ impl Collected {
         match *c {
             Command::FeedMode { per_rev } => self.feed_per_rev = Some(per_rev),
             Command::PathMode { exact_stop } => self.exact_stop = Some(exact_stop),
+            Command::Profile { jerk_limited } => self.jerk_limited = Some(jerk_limited),
             Command::Aux(Aux::T(t)) => self.tool = Some(t),
             Command::Aux(Aux::S(s)) => self.speed = Some(s),
             Command::Aux(Aux::M(m)) => match m {
@@ -233,6 +236,9 @@ impl Collected {
         push(Command::PathMode {
             exact_stop: self.exact_stop.unwrap_or(false),
         });
+        if let Some(jerk_limited) = self.jerk_limited {
+            push(Command::Profile { jerk_limited });
+        }
         out
     }
 }

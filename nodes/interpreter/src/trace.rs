@@ -8,6 +8,7 @@
 //! N<line> THREAD X48.8571 Z-72.0000 LEAD2.0000 Q0.000
 //! N<line> DWELL 2.000
 //! N<line> M3 | S600.0 | T1 | FEED_PER_REV | FEED_PER_MIN | EXACT_STOP | BLENDING | END
+//! N<line> PROFILE_JERK_LIMITED | PROFILE_TRAPEZOIDAL
 //! ```
 //!
 //! `<line>` is the source line (1-based), end points are machine coordinates (X as diameter).
@@ -73,6 +74,11 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             "EXACT_STOP"
         } else {
             "BLENDING"
+        }),
+        Command::Profile { jerk_limited } => s.push_str(if *jerk_limited {
+            "PROFILE_JERK_LIMITED"
+        } else {
+            "PROFILE_TRAPEZOIDAL"
         }),
         Command::Aux(Aux::M(m)) => {
             let _ = write!(s, "M{m}");
@@ -308,6 +314,8 @@ impl LinuxCnc {
                 self.push(out, &call);
             }
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
+            // rs274 has no call for the acceleration profile: its planner's is fixed.
+            Command::Profile { .. } => {}
         }
     }
 }

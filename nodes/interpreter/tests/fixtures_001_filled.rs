@@ -492,6 +492,38 @@ fn f035_cfc_holds_f_on_the_contour_of_compensated_arcs_and_cftcp_at_the_centre()
     assert!(got.iter().all(|(_, f)| (f - 350.0).abs() < 1e-9), "{got:?}");
 }
 
+/// 038 (§9.3.17): SOFT makes N10's move jerk-limited, BRISK from N90 on trapezoidal again;
+/// each switch goes to motion before its block's move (D99).
+#[test]
+fn f038_soft_then_brisk_switch_the_profile_before_their_moves() {
+    let text = filled("038", &["N20 Y20", "N100 Y0"]);
+    let r = run(&text).ok();
+    let profile_or_move: Vec<String> = r
+        .out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Profile { jerk_limited } => Some(format!("soft {jerk_limited}")),
+            Command::Linear { end, feed } => {
+                Some(format!("X{} Y{} Z{} F{feed}", end[0], end[1], end[2]))
+            }
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        profile_or_move,
+        [
+            "soft true",
+            "X30 Y0 Z84 F650",
+            "X30 Y20 Z84 F650",
+            "soft false",
+            "X87 Y20 Z104 F650",
+            "X87 Y0 Z104 F650",
+        ],
+        "{:?}",
+        r.out
+    );
+}
+
 /// TRC of fixtures 058–060 on one contour: P0 (0, 0), P1 (20, 10) where G42/G41 starts,
 /// the first contour element along +X to (60, 10), then G40 back to P2 (80, 40); cutter
 /// radius 10 (T1 D1).

@@ -66,6 +66,8 @@ struct Planned {
     deviation: f64,
     /// The segment that stands for its block in the look-ahead count (not a blend or mode).
     counts: bool,
+    /// The acceleration profile it is cut with.
+    shape: Shape,
 }
 
 /// The sequence number of a finished block, reported by [`Planner::step`].
@@ -81,6 +83,8 @@ pub struct Planner {
     end: Point,
     blocks: usize,
     ahead: Vec<Ahead>,
+    /// The profile of segments appended from now on ([`Planner::set_shape`]).
+    shape: Shape,
 }
 
 impl Planner {
@@ -95,6 +99,7 @@ impl Planner {
             end: start,
             blocks: 0,
             ahead: Vec::with_capacity(cap),
+            shape: cfg.shape,
         }
     }
 
@@ -105,6 +110,17 @@ impl Planner {
         self.mover = Mover::default();
         self.end = start;
         self.blocks = 0;
+    }
+
+    /// The acceleration profile of the segments appended from now on (a program's switch,
+    /// decision D99). Where it changes the tool comes to rest between the two segments, so
+    /// no tick runs half in one profile and half in the other.
+    pub fn set_shape(&mut self, shape: Shape) {
+        self.shape = shape;
+    }
+
+    pub fn shape(&self) -> Shape {
+        self.shape
     }
 
     pub fn config(&self) -> &PlannerConfig {
@@ -182,7 +198,9 @@ impl Planner {
             let u1 = prev.seg.tangent(prev.length);
             let u2 = seg.tangent(0.0);
             let phi = deflection(&u1, &u2);
-            if phi < TANGENT {
+            if prev.shape != self.shape {
+                // A profile change is passed at rest.
+            } else if phi < TANGENT {
                 entry_limit = f64::INFINITY;
             } else if blend && prev.blend_end {
                 if let Some(new_seg) = self.try_blend(k, &seg, feed, deviation) {
@@ -278,12 +296,13 @@ impl Planner {
             blend_end: true,
             deviation: 0.0,
             counts: false,
+            shape: prev.shape,
         });
         Some(trimmed_next)
     }
 
     fn path_jerk(&self) -> f64 {
-        match self.cfg.shape {
+        match self.segs.front().map_or(self.shape, |p| p.shape) {
             Shape::Trapezoidal => f64::INFINITY,
             Shape::SCurve => self.segs.front().map_or(f64::INFINITY, |p| p.jerk),
         }
@@ -323,6 +342,7 @@ impl Planner {
             blend_end,
             deviation,
             counts: true,
+            shape: self.shape,
         });
         self.backward_pass();
     }
@@ -399,7 +419,7 @@ impl Planner {
             *out = self.end;
             return true;
         };
-        let jerk = match self.cfg.shape {
+        let jerk = match front.shape {
             Shape::Trapezoidal => f64::INFINITY,
             Shape::SCurve => front.jerk,
         };
@@ -445,7 +465,7 @@ impl Planner {
             acceleration: front.accel,
             jerk,
         };
-        let ds = self.mover.step(dt, self.cfg.shape, lim, hold, &self.ahead);
+        let ds = self.mover.step(dt, front.shape, lim, hold, &self.ahead);
         self.s += ds;
         while let Some(p) = self.segs.front().copied() {
             // The tool comes to rest at the end of this segment: the window ends there, or a

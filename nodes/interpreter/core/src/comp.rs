@@ -124,7 +124,7 @@ pub struct RadiusComp {
     /// Moves along the normal after the held element, in program order.
     stills: Vec<Still>,
     /// The programmed feed holds on the contour, not at the cutter centre: an offset arc's
-    /// feed is scaled by its radius over the programmed one (the 802D's CFC, decision D98).
+    /// feed is scaled by its radius over the programmed one (decision D98).
     /// The front end sets it before each element; it may change while compensation runs.
     pub feed_on_contour: bool,
 }

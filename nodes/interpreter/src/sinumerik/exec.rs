@@ -117,10 +117,10 @@ const ADDRESSES: [&str; 18] = [
 ];
 
 /// Keywords this front end runs.
-const KEYWORDS: [&str; 21] = [
+const KEYWORDS: [&str; 22] = [
     "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
-    "STOPRE", "RET", "CFTCP", "CFC", "BRISK", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM", "MCALL",
-    "WALIMON",
+    "STOPRE", "RET", "CFTCP", "CFC", "BRISK", "SOFT", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
+    "MCALL", "WALIMON",
 ];
 
 const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
@@ -138,11 +138,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 29] = [
-    (
-        "SOFT",
-        "the acceleration profile is the machine's (motion profile), not switched by the program",
-    ),
+pub const NOT_BUILT: [(&str, &str); 28] = [
     (
         "FFWON",
         "feedforward is the drives' setting, not switched by the program",
@@ -656,6 +652,10 @@ impl Sinumerik {
                 // Feed on the contour of compensated arcs, or at the cutter centre (D98).
                 "CFC" => self.core.feed_on_contour = true,
                 "CFTCP" => self.core.feed_on_contour = false,
+                // The planner's profiles: BRISK trapezoidal, SOFT jerk-limited (D99).
+                "BRISK" | "SOFT" => self.core.push(Command::Profile {
+                    jerk_limited: *k == "SOFT",
+                }),
                 _ => {}
             }
         }

@@ -81,8 +81,8 @@ impl Motion {
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),
-            // Feed and path mode were taken over when the block was popped.
-            Command::FeedMode { .. } | Command::PathMode { .. } => {
+            // Feed mode, path mode and profile were taken over when the block was popped.
+            Command::FeedMode { .. } | Command::PathMode { .. } | Command::Profile { .. } => {
                 Ok(Active::Dwell { remaining: 0.0 })
             }
             Command::Aux(code) => Ok(Active::Aux {

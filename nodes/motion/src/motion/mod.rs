@@ -18,7 +18,7 @@ use crate::config::MotionConfig;
 use crate::encoder::Encoder;
 use crate::path::{self, Point, Segment, MAX_AXES};
 use crate::planner::{Done, Planner};
-use crate::profile::{Ahead, Limits, Mover};
+use crate::profile::{Ahead, Limits, Mover, Shape};
 use crate::thread::{Piece, ThreadChain};
 
 pub use crate::alarm;
@@ -297,6 +297,8 @@ impl Motion {
             self.active = None;
             let here = self.commanded_point();
             self.planner.reset(here);
+            // A run starts in the machine's own profile (D99).
+            self.planner.set_shape(self.cfg.shape);
             self.accepted_seq = 0;
             self.done_seq = 0;
             self.feed_hold = false;
@@ -379,6 +381,7 @@ impl Motion {
         self.commanded.clone_from(&self.actual);
         let here = self.commanded_point();
         self.planner.reset(here);
+        self.planner.set_shape(self.cfg.shape);
     }
 
     pub fn run_id(&self) -> u64 {
@@ -589,6 +592,9 @@ impl Motion {
                 match block.kind {
                     Command::FeedMode { per_rev } => self.feed_per_rev = per_rev,
                     Command::PathMode { exact_stop } => self.exact_stop = exact_stop,
+                    Command::Profile { jerk_limited } => {
+                        self.planner.set_shape(profile_shape(jerk_limited));
+                    }
                     _ => {}
                 }
                 match self.activate(&block) {
@@ -779,7 +785,8 @@ impl Motion {
         let hold = self.feed_hold;
         let in_pos = self.in_position();
         let n = self.commanded.len().min(MAX_AXES);
-        let shape = self.cfg.shape;
+        // A rapid runs in the program's profile too (BRISK/SOFT act on every path move).
+        let shape = self.planner.shape();
         let Some((_, active)) = self.active.as_mut() else {
             return false;
         };
@@ -913,5 +920,14 @@ impl Motion {
             }
             Active::End => in_pos,
         }
+    }
+}
+
+/// The planner's profile for a program's switch: jerk-limited is the S-curve (decision D99).
+fn profile_shape(jerk_limited: bool) -> Shape {
+    if jerk_limited {
+        Shape::SCurve
+    } else {
+        Shape::Trapezoidal
     }
 }

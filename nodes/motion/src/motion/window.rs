@@ -70,6 +70,10 @@ impl Motion {
                     self.exact_stop = *exact_stop;
                     self.planner.push_marker(seq, line);
                 }
+                Command::Profile { jerk_limited } => {
+                    self.planner.set_shape(super::profile_shape(*jerk_limited));
+                    self.planner.push_marker(seq, line);
+                }
                 _ => break,
             }
             self.queue.pop_front();
