@@ -345,13 +345,20 @@ enum Copies {
     Never,
 }
 
+/// The least time a new client waits to match a server. Discovery on a busy host (a test run
+/// on two cores, a cell starting) took more than 10 s in CI although the server was up; a reply
+/// timeout shorter than this does not cut the match short.
+const DISCOVERY_WAIT: Duration = Duration::from_secs(30);
+
 /// Waits until this node has matched the service's server (its request reader and its reply
-/// writer), at most `timeout`. A request written before that match would be lost.
+/// writer), at most `timeout` (and at least [`DISCOVERY_WAIT`]). A request written before that
+/// match would be lost.
 fn wait_for_server<Req: ros2_client::Message + 'static, Resp: ros2_client::Message + 'static>(
     node: &ros2_client::Node,
     client: &Client<Req, Resp>,
     timeout: Duration,
 ) -> Result<(), String> {
+    let timeout = timeout.max(DISCOVERY_WAIT);
     let matched = smol::block_on(smol::future::or(
         async {
             client.wait_for_service(node).await;
