@@ -267,3 +267,21 @@ fn offn_widens_the_compensated_offset_and_past_the_centre_changes_its_side() {
         assert_eq!((e.number, e.line), (number, 5), "{e:?}");
     }
 }
+
+#[test]
+fn a_line_waiting_for_its_second_ang_block_at_the_end_or_return_is_an_alarm() {
+    // §9.5.2: `ANG=` alone makes the line wait for the block with the end point; a program
+    // ending or returning first would lose it.
+    for (text, line) in [
+        ("F100\nG1 X10 Y10\nN20 ANG=30\nM2\n", 4),
+        ("F100\nG1 X10 Y10\nN20 ANG=30\nM30\n", 4),
+        ("F100\nG1 X10 Y10\nN20 ANG=30\nRET\n", 4),
+    ] {
+        let (out, e) = run(text);
+        let e = e.unwrap_or_else(|| panic!("{text} ran: {out:?}"));
+        assert_eq!((e.number, e.line), (12080, line), "{text}: {e:?}");
+        assert!(e.text.contains("ANG"), "{}", e.text);
+    }
+    // Completed before the end, it runs.
+    ok("F100\nG1 X10 Y10\nN20 ANG=30\nN30 X60 Y20 ANG=-45\nM2\n");
+}

@@ -261,6 +261,7 @@ impl Sinumerik {
         }
         self.m_after(w)?;
         if w.key("RET") {
+            self.no_line_waits_for_ang()?;
             self.return_from_program();
         }
         if let Some(name) = &w.call {
@@ -712,6 +713,7 @@ impl Sinumerik {
             match m {
                 0 | 1 => self.core.aux(Aux::M(m as i32)),
                 2 | 30 | 17 => {
+                    self.no_line_waits_for_ang()?;
                     if self.core.depth() > 1 {
                         self.return_from_program();
                     } else if m == 17 {
@@ -728,6 +730,19 @@ impl Sinumerik {
                 }
                 _ => {}
             }
+        }
+        Ok(())
+    }
+
+    /// A program may not end or return while a line given by its angle alone (`ANG=`, §9.5.2)
+    /// waits for the block that completes it: the line would be lost.
+    fn no_line_waits_for_ang(&self) -> Result<(), ProgramError> {
+        if self.ang.is_some() {
+            return Err(self.fault(
+                Fault::MissingWord,
+                "ANG: the line given by its angle alone waits for a block with the end point \
+                 and its own ANG; the program ends or returns first",
+            ));
         }
         Ok(())
     }
