@@ -661,3 +661,36 @@ fn an_802d_message_shows_as_its_block_runs_until_the_next_one_or_the_end() {
     assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
     assert_eq!(c.state().message, "");
 }
+
+#[test]
+fn an_802d_part_is_counted_in_memory_before_its_m30_goes_to_motion() {
+    // D82 with D59: $AC_TOTAL_PARTS (kept entry 11000) goes up at M30 and is stored (write
+    // ahead) before the blocks of the run go to motion.
+    let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
+    let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PART.MPF", "G0 X10\nM30\n").accepted);
+    c.axes(&[0.0; 3]);
+    let mut done = 0;
+    for (k, run_id) in [(1.0, 1001), (2.0, 1002)] {
+        let id = 2 + run_id - 1001;
+        assert!(command(&mut c, id, ProgramCommand::START, "PART.MPF", "").accepted);
+        c.motion_status(status(run_id, 0, 100, MotionStatus::STATE_RUNNING));
+        c.step();
+        let effects = c.take_effects();
+        let store = effects
+            .iter()
+            .position(|e| matches!(e, Effect::StoreMemory))
+            .expect("the count is stored");
+        let first_block = effects
+            .iter()
+            .position(|e| matches!(e, Effect::Block(_)))
+            .expect("blocks go to motion");
+        assert!(store < first_block, "{effects:?}");
+        assert_eq!(c.memory().kept.get(&11_000), Some(&k));
+        done = blocks(&effects).last().map(|b| b.seq).unwrap();
+        c.motion_status(status(run_id, done, 100, MotionStatus::STATE_IDLE));
+        c.step();
+        assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
+    }
+    assert!(done > 0);
+}

@@ -285,3 +285,32 @@ fn a_line_waiting_for_its_second_ang_block_at_the_end_or_return_is_an_alarm() {
     // Completed before the end, it runs.
     ok("F100\nG1 X10 Y10\nN20 ANG=30\nN30 X60 Y20 ANG=-45\nM2\n");
 }
+
+#[test]
+fn m30_counts_the_part_in_the_total_and_actual_counters() {
+    use cnc_interpreter_core::FrontEnd;
+    // §9.12.2, D82: $AC_TOTAL_PARTS, $AC_REQUIRED_PARTS, $AC_ACTUAL_PARTS are kept entries
+    // 11000–11002 of the machine's memory. A subprogram's M2 returns and counts nothing.
+    let counters = |total: f64, required: f64, actual: f64, text: &str| -> [f64; 3] {
+        let mut s = mill();
+        s.kept
+            .extend([(11_000, total), (11_001, required), (11_002, actual)]);
+        let mut lib = Library::new();
+        lib.insert_named("SUB1", "SUB1.SPF", "G0 X2\nM2\n");
+        let mut front = Sinumerik::new(text, s, lib);
+        while next_command(&mut front)
+            .unwrap_or_else(|e| panic!("{e:?}"))
+            .is_some()
+        {}
+        let get = |k| front.core().common.get(&k).copied().unwrap_or(0.0);
+        [get(11_000), get(11_001), get(11_002)]
+    };
+    assert_eq!(
+        counters(7.0, 0.0, 2.0, "G0 X1\nSUB1\nM30\n"),
+        [8.0, 0.0, 3.0]
+    );
+    assert_eq!(counters(7.0, 5.0, 3.0, "G0 X1\nM2\n"), [8.0, 5.0, 4.0]);
+    // Reaching the required count starts the actual count again.
+    assert_eq!(counters(7.0, 5.0, 4.0, "G0 X1\nM2\n"), [8.0, 5.0, 0.0]);
+    assert_eq!(counters(999_999_999.0, 0.0, 0.0, "M30\n"), [0.0, 0.0, 1.0]);
+}

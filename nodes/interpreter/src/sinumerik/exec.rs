@@ -722,6 +722,7 @@ impl Sinumerik {
                             "M17 ends a subprogram; the main program ends with M2 or M30",
                         ));
                     } else {
+                        self.count_part();
                         self.core.saw_end = true;
                         self.core.spindle = SpindleDir::Stopped;
                         self.core.aux(Aux::M(m as i32));

@@ -488,6 +488,27 @@ impl Sinumerik {
     }
 }
 
+impl Sinumerik {
+    /// M2/M30 of the main program finishes a workpiece (§9.12.2, decision D82): the total and
+    /// the actual count go up by one; the actual count starts again from 0 once it reaches a
+    /// required count above 0. Both stay within 0…999 999 999.
+    pub(super) fn count_part(&mut self) {
+        let [Some(total), Some(required), Some(actual)] =
+            ["$AC_TOTAL_PARTS", "$AC_REQUIRED_PARTS", "$AC_ACTUAL_PARTS"].map(counter_key)
+        else {
+            return;
+        };
+        let get = |me: &Self, k: i64| me.core.common.get(&k).copied().unwrap_or(0.0);
+        let next = |n: f64| if n >= 999_999_999.0 { 0.0 } else { n + 1.0 };
+        let t = next(get(self, total));
+        self.core.common.insert(total, t);
+        let need = get(self, required);
+        let a = next(get(self, actual));
+        let a = if need > 0.0 && a >= need { 0.0 } else { a };
+        self.core.common.insert(actual, a);
+    }
+}
+
 /// Where the part counters and timers of §9.12 live in the core's common store.
 fn counter_key(name: &str) -> Option<i64> {
     let names = [
