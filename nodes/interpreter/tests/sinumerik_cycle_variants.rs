@@ -72,14 +72,7 @@ fn pocket3_reciprocating_insertion_slopes_along_the_long_axis_within_rad1() {
         Library::new(),
     )
     .ok();
-    let mut stock = Stock::new(
-        (10.0, -5.0),
-        35.0,
-        0.0,
-        5.0,
-        rounded_rect((10.0, -5.0), 24.5, 14.5, 5.5, 30.0),
-    );
-    stock.follow(&r.out, [10.0, -5.0, 10.0]);
+    let stock = turned_pocket(&r.out, 0.5);
     assert_eq!(stock.rapid_cuts, 0, "no rapid into material");
     assert_within(stock.reach, 0.0, "the wall 0.5 inside");
     let (lo, hi, min) = stock.floor_within(0.01);
@@ -185,14 +178,7 @@ fn pocket_finishing_without_an_edge_allowance_takes_only_the_floor() {
     };
     let text = format!("{HEAD}{}{}", p3(11), p3(12));
     let r = run_with(&text, with_edge(11, 5.0), Library::new()).ok();
-    let mut stock = Stock::new(
-        (10.0, -5.0),
-        35.0,
-        0.0,
-        5.0,
-        rounded_rect((10.0, -5.0), 25.0, 15.0, 6.0, 30.0),
-    );
-    stock.follow(&r.out, [10.0, -5.0, 10.0]);
+    let stock = turned_pocket(&r.out, 0.0);
     assert_eq!(stock.rapid_cuts, 0);
     assert_within(stock.reach, 0.0, "the wall on size");
     let (lo, hi, _) = stock.floor_within(0.01);

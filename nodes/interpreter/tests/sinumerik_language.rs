@@ -7,6 +7,9 @@ use cnc_interpreter::sinumerik::{Sinumerik, NOT_BUILT, NOT_BUILT_G};
 use cnc_interpreter::{Aux, Command, Library, Setup};
 use cnc_interpreter_core::{next_command, ProgramError};
 
+#[path = "support/sinumerik.rs"]
+mod support;
+
 fn mill() -> Setup {
     Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3])
 }
@@ -204,14 +207,7 @@ fn offn_widens_the_compensated_offset_and_past_the_centre_changes_its_side() {
     // T1 D1 of radius 5; the contour runs up X0 with G41 (the cutter left of it, on −X).
     // OFFN adds to the radius; a negative OFFN beyond the radius puts the path on the other
     // side (§9.15, D96).
-    let mut s = mill();
-    s.offsets.tools.insert(
-        11,
-        cnc_interpreter_core::ToolOffset {
-            radius: 5.0,
-            ..Default::default()
-        },
-    );
+    let s = support::with_edge(11, 5.0);
     let program = |offn: &str, extra: &str| {
         format!(
             "T1 D1\nG0 X-20 Y0 Z5\n{offn}\nG1 G41 X0 Y0 F500\n{extra}Y40\nX40\nG40 X60 Y60\nM2\n"

@@ -341,14 +341,7 @@ fn pocket3_turned_helical_then_finished_on_size() {
         format!("POCKET3(10, 0, 1, -8, 50, 30, 6, 10, -5, 30, 3, 0.5, 0.3, 400, 150, 3, {vari}, 6, , , , 3, 1.5)\n")
     };
     let r = run_with(&format!("{head}{}", call(21)), cutter5(), Library::new()).ok();
-    let mut stock = Stock::new(
-        (10.0, -5.0),
-        35.0,
-        0.0,
-        5.0,
-        rounded_rect((10.0, -5.0), 24.5, 14.5, 5.5, 30.0),
-    );
-    stock.follow(&r.out, [10.0, -5.0, 10.0]);
+    let stock = turned_pocket(&r.out, 0.5);
     assert_eq!(stock.rapid_cuts, 0);
     assert_within(stock.reach, 0.0, "roughed wall");
     let (lo, hi, _) = stock.floor_within(0.01);
@@ -356,14 +349,7 @@ fn pocket3_turned_helical_then_finished_on_size() {
     assert_within(hi, -7.7, "everywhere");
     let text = format!("{head}{}{}", call(21), call(22));
     let r = run_with(&text, cutter5(), Library::new()).ok();
-    let mut stock = Stock::new(
-        (10.0, -5.0),
-        35.0,
-        0.0,
-        5.0,
-        rounded_rect((10.0, -5.0), 25.0, 15.0, 6.0, 30.0),
-    );
-    stock.follow(&r.out, [10.0, -5.0, 10.0]);
+    let stock = turned_pocket(&r.out, 0.0);
     assert_eq!(stock.rapid_cuts, 0);
     assert_within(stock.reach, 0.0, "finished wall");
     let (lo, hi, min) = stock.floor_within(0.01);

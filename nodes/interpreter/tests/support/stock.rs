@@ -357,3 +357,19 @@ pub fn contour_107() -> Vec<(f64, f64)> {
     }));
     pts
 }
+
+/// The stock of the POCKET3 examples' pocket (50 × 30 about X10 Y−5, turned 30°, corners R6,
+/// cut with a tool of radius 5 from Z10): its wall `allowance` inside the drawn one, after
+/// the moves of `out`.
+pub fn turned_pocket(out: &[Command], allowance: f64) -> Stock {
+    let a = allowance;
+    let mut stock = Stock::new(
+        (10.0, -5.0),
+        35.0,
+        0.0,
+        5.0,
+        rounded_rect((10.0, -5.0), 25.0 - a, 15.0 - a, 6.0 - a, 30.0),
+    );
+    stock.follow(out, [10.0, -5.0, 10.0]);
+    stock
+}
