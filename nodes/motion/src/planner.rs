@@ -302,9 +302,9 @@ impl Planner {
     }
 
     fn path_jerk(&self) -> f64 {
-        match self.segs.front().map_or(self.shape, |p| p.shape) {
-            Shape::Trapezoidal => f64::INFINITY,
-            Shape::SCurve => self.segs.front().map_or(f64::INFINITY, |p| p.jerk),
+        match self.segs.front() {
+            Some(p) if p.shape == Shape::SCurve => p.jerk,
+            _ => f64::INFINITY,
         }
     }
 

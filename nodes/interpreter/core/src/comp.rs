@@ -123,10 +123,6 @@ pub struct RadiusComp {
     held: Option<Held>,
     /// Moves along the normal after the held element, in program order.
     stills: Vec<Still>,
-    /// The programmed feed holds on the contour, not at the cutter centre: an offset arc's
-    /// feed is scaled by its radius over the programmed one (decision D98).
-    /// The front end sets it before each element; it may change while compensation runs.
-    pub feed_on_contour: bool,
 }
 
 /// The vector from the nose centre to the imaginary tip for tip direction 0–9, with Z to the
@@ -318,15 +314,15 @@ impl RadiusComp {
             startup: None,
             held: None,
             stills: Vec::new(),
-            feed_on_contour: false,
         }
     }
 
-    /// The feed the cutter centre runs an offset element at: under [`Self::feed_on_contour`]
-    /// an arc's feed is scaled by offset radius over programmed radius, so the contour runs at
-    /// the programmed feed (faster outside an arc, slower inside). Lines need no correction.
-    fn centre_feed(&self, path: &Elem, off: &Elem, kind: Kind) -> Kind {
-        match (self.feed_on_contour, path, off, kind) {
+    /// The feed the cutter centre runs an offset element at: with the feed held on the
+    /// contour (decision D98) an arc's feed is scaled by offset radius over programmed radius,
+    /// so the contour runs at the programmed feed (faster outside an arc, slower inside).
+    /// Lines need no correction.
+    fn centre_feed(on_contour: bool, path: &Elem, off: &Elem, kind: Kind) -> Kind {
+        match (on_contour, path, off, kind) {
             (true, Elem::Arc { a, c, .. }, Elem::Arc { a: oa, c: oc, .. }, Kind::Feed(f)) => {
                 let rho = len(sub(*a, *c));
                 if rho > EPS {
@@ -383,17 +379,19 @@ impl RadiusComp {
     }
 
     /// Takes the next programmed element, ending at `depth` along the normal; returns the
-    /// moves now certain.
+    /// moves now certain. `on_contour`: the element's feed holds on the programmed contour,
+    /// not at the cutter centre (the front end's modal switch, D98).
     pub fn push(
         &mut self,
         path: Elem,
         depth: f64,
         kind: Kind,
         line: u32,
+        on_contour: bool,
     ) -> Result<Vec<Out>, CompError> {
         let off = path.offset(self.offset)?;
         // The element's own feed; a corner arc before it keeps the programmed one.
-        let cut = self.centre_feed(&path, &off, kind);
+        let cut = Self::centre_feed(on_contour, &path, &off, kind);
         let course = match path {
             Elem::Line { a, b } => Some(unit(sub(b, a))),
             Elem::Arc { .. } => None,
@@ -632,6 +630,7 @@ mod tests {
                 0.0,
                 f,
                 1,
+                false,
             )
             .unwrap();
         // The connecting move lands on the controlled point of the offset start: r stays 15.
@@ -645,6 +644,7 @@ mod tests {
                 0.0,
                 f,
                 2,
+                false,
             )
             .unwrap();
         // Inner corner (the shoulder): the nose centre stops at Z−19, touching the face at
@@ -668,6 +668,7 @@ mod tests {
             0.0,
             f,
             1,
+            false,
         )
         .unwrap();
         // Up (+X) then toward +Z: a right turn, so the left offset is outside.
@@ -680,6 +681,7 @@ mod tests {
                 0.0,
                 f,
                 2,
+                false,
             )
             .unwrap();
         assert_eq!(out.len(), 2, "{out:?}");
@@ -692,6 +694,7 @@ mod tests {
                 0.0,
                 f,
                 3,
+                false,
             )
             .unwrap();
         let all: Vec<Out> = out.into_iter().chain(out2).collect();
@@ -720,6 +723,7 @@ mod tests {
             0.0,
             Kind::Feed(1.0),
             1,
+            false,
         );
         assert_eq!(e.unwrap_err(), CompError::ArcVanishes);
     }
@@ -744,9 +748,8 @@ mod tests {
             (Side::Left, true, 12.0, 120.0),
         ] {
             let mut c = RadiusComp::new(side, 2.0, 0, p(-10.0, 0.0), Startup::Connect);
-            c.feed_on_contour = on;
-            let mut out = c.push(line, 0.0, Kind::Feed(100.0), 1).unwrap();
-            out.extend(c.push(arc, 0.0, Kind::Feed(100.0), 2).unwrap());
+            let mut out = c.push(line, 0.0, Kind::Feed(100.0), 1, on).unwrap();
+            out.extend(c.push(arc, 0.0, Kind::Feed(100.0), 2, on).unwrap());
             out.extend(c.flush());
             let arcs: Vec<(f64, Kind)> = out
                 .iter()

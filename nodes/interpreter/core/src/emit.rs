@@ -312,10 +312,7 @@ impl Core {
         } else {
             let on_contour = self.feed_on_contour;
             let pushed = match self.comp.as_mut() {
-                Some(comp) => {
-                    comp.feed_on_contour = on_contour;
-                    comp.push(path, depth, ck, line)
-                }
+                Some(comp) => comp.push(path, depth, ck, line, on_contour),
                 None => Ok(Vec::new()),
             };
             pushed.map_err(|e| self.comp_fault(e))?

@@ -536,7 +536,7 @@ impl Fanuc<Huaxing> {
                 return Ok(out_elems);
             }
             outs.extend(
-                comp.push(*e, 0.0, comp::Kind::Feed(1.0), 0)
+                comp.push(*e, 0.0, comp::Kind::Feed(1.0), 0, false)
                     .map_err(|x| self.core.comp_fault(x))?,
             );
         }
