@@ -239,7 +239,11 @@ pub fn wait(
     done: impl FnMut(&cnc::client::CellClient) -> bool,
 ) {
     let (ok, _) = client.wait_until(timeout, done);
-    assert!(ok, "{what}: state {:?}", client.state);
+    assert!(
+        ok,
+        "{what}: state {:?}, alarms {:?}",
+        client.state, client.alarms
+    );
 }
 
 /// An empty folder `name` in the temp directory, for one test's files.

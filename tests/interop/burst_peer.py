@@ -34,7 +34,7 @@ SERVICES = [
 
 
 def main():
-    session = Session({"machine_state": "MachineState"})
+    session = Session({"machine_state": "MachineState", "alarms": "ActiveAlarms"})
     peer, check, wait = session.peer, session.check, session.wait
     state = lambda: peer.latest["machine_state"]
     check(wait(lambda: state() is not None and state().execution_name != "WAIT", 30), "machine ready")
@@ -100,9 +100,14 @@ def main():
              if service == "get_parameters" and reply.accepted]
     check(all(len(r.names) > 0 for r in reads), "every answered read carries its data")
 
+    def active():
+        a = peer.latest["alarms"]
+        return "; ".join(f"{x.number} {x.source} line {x.line}: {x.text}"
+                         for x in (a.alarms if a is not None else []))
+
     check(wait(lambda: state().execution_name == "PROGRAM_COMPLETED", 90),
-          f"the program ran to its end: {state().execution_name}")
-    check(not state().alarm_active, "no alarm")
+          f"the program ran to its end: {state().execution_name} (alarms: {active() or 'none'})")
+    check(not state().alarm_active, f"no alarm ({active() or 'none'})")
     return session.exit_code()
 
 

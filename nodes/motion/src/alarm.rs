@@ -32,6 +32,9 @@ pub const REFERENCE_NOT_DONE: u32 = 224;
 /// A reference return that found no dog or index mark within the axis's travel (not in the
 /// manuals: D68).
 pub const REFERENCE_FAILED: u32 = 1094;
+/// A reference return motion could not start (axes moving, alarm, emergency stop, servo
+/// off): a warning with the reason, so a cycle start that moved nothing says why (D68).
+pub const REFERENCE_REFUSED: u32 = 1095;
 /// An axis on its + overtravel switch (`000` alarm 40, "+ hardware limit").
 pub const OVERTRAVEL_PLUS: u32 = 40;
 /// An axis on its − overtravel switch (`000` alarm 66, "limit alarm": its tables have no

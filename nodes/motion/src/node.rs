@@ -53,6 +53,8 @@ enum Report {
         (u32, u32),
     ),
     Alarm(u32, String, u32),
+    /// A warning raised with its reason (`Some`) or cleared (`None`).
+    Warning(u32, Option<String>),
     Stats(ServoStats),
 }
 
@@ -189,6 +191,15 @@ fn dds_loop(
                     0,
                 )),
                 Ok(Report::Late(None)) => alarms.clear(alarm::SERVO_LATE),
+                Ok(Report::Warning(number, Some(text))) => {
+                    raised.insert(number);
+                    alarms.raise(alarms.alarm(number, Alarm::SEVERITY_WARNING, &text, "", 0))
+                }
+                Ok(Report::Warning(number, None)) => {
+                    if raised.remove(&number) {
+                        alarms.clear(number);
+                    }
+                }
                 Ok(Report::Axes(commanded, actual, setpoint, locked, referenced, limits)) => {
                     let n = axes.len();
                     let axes = axes
@@ -376,10 +387,17 @@ fn servo_loop(
                 }
                 Input::Command(ProgramCommand::START) => motion.cycle_start(),
                 Input::Command(ProgramCommand::REFERENCE_RETURN) => {
-                    match motion.reference_return() {
-                        Ok(m) => log::info!("motion: {m}"),
-                        Err(e) => log::warn!("motion: {e}"),
-                    }
+                    let warning = match motion.reference_return() {
+                        Ok(m) => {
+                            log::info!("motion: {m}");
+                            None
+                        }
+                        Err(e) => {
+                            log::warn!("motion: {e}");
+                            Some(e)
+                        }
+                    };
+                    let _ = reports.send(Report::Warning(alarm::REFERENCE_REFUSED, warning));
                 }
                 Input::Jog(axis, direction, feed, increment) => {
                     let result = if direction == 0 {
