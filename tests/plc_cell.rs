@@ -837,3 +837,54 @@ fn the_mill_magazine_preselects_with_t_changes_with_m6_and_m19_orients() {
     assert!(!r.run_until(5.0, |r| r.program_done()));
     assert!(r.message("A3.2").is_some(), "{:?}", r.events);
 }
+
+/// SPOS through the whole chain (D100): the 802D front end, motion's M19 with the stop
+/// position in F30–F35, the ladder copying it to Y8–Y13 with the strobe, the simulated drive
+/// positioning and holding, the ladder's FIN on SPINDLE_ORIENTED. At each FIN the spindle
+/// stands at its angle, having turned only the way the program asked.
+#[test]
+fn spos_positions_the_simulated_spindle_each_way_through_the_ladder() {
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let program = "SPOS=14.3\nS800 M3\nG0 X10\nSPOS=ACN(300)\nG0 X20\nSPOS=IC(-720.5)\n\
+                   SPOS=ACP(290)\nM3\nG0 X30\nM30\n";
+    let mut r = Rig::on(cfg, program, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    // The degrees turned (unwrapped) and, at each M19's FIN, (angle, rpm, turned so far).
+    let (mut turned, mut last) = (0.0f64, r.fb.spindle_angle_deg);
+    let mut fins = Vec::new();
+    let mut was_fin = false;
+    let ok = r.run_until(120.0, |r| {
+        let a = r.fb.spindle_angle_deg;
+        let mut d = (a - last).rem_euclid(360.0);
+        if d > 180.0 {
+            d -= 360.0;
+        }
+        turned += d;
+        last = a;
+        let fin = r.gi.get(g::FIN) && r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;
+        if fin && !was_fin {
+            fins.push((a, r.fb.spindle_rpm, turned));
+        }
+        was_fin = fin;
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!("{fins:?} at {:.2} s", r.t);
+    assert_eq!(fins.len(), 4, "{fins:?}");
+    let angles: Vec<f64> = fins.iter().map(|f| f.0).collect();
+    let want = [14.3, 300.0, (300.0 - 720.5f64).rem_euclid(360.0), 290.0];
+    for (got, want) in angles.iter().zip(want) {
+        assert!((got - want).abs() < 1e-6, "{angles:?}");
+    }
+    assert!(
+        fins.iter().all(|f| f.1 == 0.0),
+        "standing at each FIN: {fins:?}"
+    );
+    // IC(−720.5): two turns and half a degree back; ACP(290) from 299.5: 350.5° forward.
+    assert!((fins[2].2 - fins[1].2 + 720.5).abs() < 1e-6, "{fins:?}");
+    assert!((fins[3].2 - fins[2].2 - 350.5).abs() < 1e-6, "{fins:?}");
+    // M3 turns it again: the position control let go.
+    assert!(r.fb.spindle_rpm > 700.0, "{}", r.fb.spindle_rpm);
+}

@@ -6,7 +6,8 @@
 //! where the manual's program ends. Issue 24, must-show 4: a job of the 802D's cycles (a
 //! bore with an oriented stop, a bore with M5 and M0, a circular pocket) runs through the
 //! PLC; at CYCLE87's M0 the machine holds at the bore's bottom with the spindle stopped, and a
-//! cycle start from the supervisor runs it to its end. Run by `scripts/test.sh` inside a
+//! cycle start from the supervisor runs it on; SPOS positions the spindle, which the
+//! spindle topic shows at the next M0 (D100). Run by `scripts/test.sh` inside a
 //! network namespace.
 
 use std::time::Duration;
@@ -138,6 +139,8 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
                N50 CYCLE87(10, 0, 2, -6, , 3)\n\
                N60 POCKET4(10, 0, 1, -4, 14, 150, 50, 2, 0, 0, 600, 200, 0, 11, 0)\n\
                N70 G0 X0 Y0 Z100\n\
+               N72 SPOS=ACN(300)\n\
+               N74 M0\n\
                N80 M2\n";
     assert!(client.load_program("CYCLES.MPF", job).unwrap().accepted);
     let r = client.start_program("CYCLES.MPF").unwrap();
@@ -170,7 +173,23 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
         message.as_deref(),
         Some("BORE AT X100: RETRACT THE BAR, THEN START")
     );
-    // Cycle start goes on: out of the bore, the pocket, the end.
+    // Cycle start goes on: out of the bore, the pocket, then SPOS: the drive positions the
+    // spindle at 300° and holds it there through the M0 (D100).
+    let r = client.start_program("").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let (ok, _) = client.wait_until(Duration::from_secs(180), |c| {
+        c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::FEED_HOLD)
+            && c.spindle
+                .as_ref()
+                .is_some_and(|s| s.positioned && (s.position_deg - 300.0).abs() < 0.001)
+    });
+    assert!(
+        ok,
+        "the spindle positioned at the second M0: {:?}, alarms {:?}",
+        client.spindle, client.alarms
+    );
     let r = client.start_program("").unwrap();
     assert!(r.accepted, "{}", r.message);
     completes_at(

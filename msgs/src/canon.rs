@@ -76,6 +76,49 @@ pub enum Aux {
     M(i32),
     S(f64),
     T(i32),
+    /// Spindle positioning: the spindle leaves speed control and the drive holds it at an
+    /// angle, degrees (the M19 handshake with its stop position; decisions D100).
+    Orient {
+        degrees: f64,
+        way: Turn,
+    },
+}
+
+/// How a positioned spindle reaches its angle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Turn {
+    /// The shortest way from standstill; turning, on in the direction it turns.
+    Shortest = 0,
+    /// Turning the way M3 turns (positive angles).
+    Plus = 1,
+    /// Turning the way M4 turns.
+    Minus = 2,
+    /// `degrees` is a signed travel from where the spindle stands, any number of turns.
+    Incremental = 3,
+}
+
+impl Turn {
+    pub fn from_code(code: i32) -> Option<Turn> {
+        Some(match code {
+            0 => Turn::Shortest,
+            1 => Turn::Plus,
+            2 => Turn::Minus,
+            3 => Turn::Incremental,
+            _ => return None,
+        })
+    }
+
+    /// The largest travel one positioning may ask for, degrees (the manual's IC range).
+    pub const MAX_INCREMENT: f64 = 99_999.999;
+
+    /// Whether `degrees` is a target this way can take: 0 ≤ angle < 360 for the absolute
+    /// ways, a finite travel within [`Turn::MAX_INCREMENT`] for the incremental.
+    pub fn accepts(self, degrees: f64) -> bool {
+        match self {
+            Turn::Incremental => degrees.is_finite() && degrees.abs() <= Turn::MAX_INCREMENT,
+            _ => (0.0..360.0).contains(&degrees),
+        }
+    }
 }
 
 /// The wire form of `command`, block `seq` of run `run_id`, from `program` line `line`.
@@ -152,6 +195,7 @@ pub fn to_motion_block(
                 Aux::M(code) => (MotionBlock::AUX_M, code, 0.0),
                 Aux::S(value) => (MotionBlock::AUX_S, 0, value),
                 Aux::T(code) => (MotionBlock::AUX_T, code, 0.0),
+                Aux::Orient { degrees, way } => (MotionBlock::AUX_ORIENT, way as i32, degrees),
             };
         }
         Command::ProgramEnd => m.kind = MotionBlock::KIND_PROGRAM_END,
@@ -228,9 +272,21 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
                 Aux::S(m.aux_value)
             }
             MotionBlock::AUX_T => Aux::T(m.aux_code),
+            MotionBlock::AUX_ORIENT => match Turn::from_code(m.aux_code) {
+                Some(way) if way.accepts(m.aux_value) => Aux::Orient {
+                    degrees: m.aux_value,
+                    way,
+                },
+                _ => {
+                    return Err(format!(
+                        "spindle position {} ({}) is no angle the spindle can take",
+                        m.aux_value, m.aux_code
+                    ))
+                }
+            },
             other => {
                 return Err(format!(
-                    "aux kind {other} with value {} is not an M, S or T function",
+                    "aux kind {other} with value {} is not an M, S, T or spindle position",
                     m.aux_value
                 ))
             }
@@ -278,6 +334,14 @@ mod tests {
             Command::Aux(Aux::M(3)),
             Command::Aux(Aux::S(1200.0)),
             Command::Aux(Aux::T(101)),
+            Command::Aux(Aux::Orient {
+                degrees: 14.3,
+                way: Turn::Shortest,
+            }),
+            Command::Aux(Aux::Orient {
+                degrees: -720.5,
+                way: Turn::Incremental,
+            }),
             Command::ProgramEnd,
         ];
         for c in commands {
@@ -321,6 +385,20 @@ mod tests {
         for bad_plane in [vec![0], vec![1, 1], vec![0, 1, 2]] {
             arc.plane.clone_from(&bad_plane);
             assert!(from_motion_block(&arc).is_err(), "plane {bad_plane:?}");
+        }
+        let mut o = to_motion_block(
+            1,
+            1,
+            "",
+            1,
+            &Command::Aux(Aux::Orient {
+                degrees: 0.0,
+                way: Turn::Plus,
+            }),
+        );
+        for (way, degrees) in [(1, 360.0), (0, -0.5), (2, f64::NAN), (3, 1e6), (4, 10.0)] {
+            (o.aux_code, o.aux_value) = (way, degrees);
+            assert!(from_motion_block(&o).is_err(), "way {way} {degrees}");
         }
     }
 }

@@ -166,6 +166,8 @@ ros_message! {
         load: f32,
         override_percent: f32,
         at_speed: bool,
+        positioned: bool,
+        position_deg: f64,
     }
 }
 
@@ -228,6 +230,7 @@ ros_message! {
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,
+            AUX_ORIENT: u8 = 4,
         }
         run_id: u64,
         seq: u64,

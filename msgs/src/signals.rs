@@ -113,7 +113,9 @@ image!(
     /// Machine → PLC.
     XImage, "cnc_msgs::XImage", X_BYTES, {
         /// Spindle speed from the encoder, rpm (negative counter-clockwise), for display.
-        spindle_actual_rpm: f64
+        spindle_actual_rpm: f64,
+        /// The spindle's angle from the encoder, degrees (0 ≤ angle < 360), for display.
+        spindle_angle_deg: f64
     }
 );
 image!(
@@ -213,6 +215,13 @@ pub mod f {
     pub const S_CODE: usize = 22;
     /// The target tool of the T code (3 for `T0303`), 4 bytes binary.
     pub const T_CODE: usize = 26;
+    /// The spindle's stop position for M19, sent with every M code (0 unless positioned:
+    /// SPOS): the angle in 0.001° (4 bytes binary), the way ([`crate::canon::Turn`]) and a
+    /// count that changes with every positioning, so the ladder passes the three bytes on
+    /// to the drive as one (D100).
+    pub const ORIENT_ANGLE: usize = 30;
+    pub const ORIENT_WAY: usize = 34;
+    pub const ORIENT_COUNT: usize = 35;
 }
 
 /// G signals the NC reads (`000` App.2, inventory §9.5).
@@ -383,6 +392,11 @@ pub mod y {
     pub const READY_FOR_LOAD: Bit = bit(5, 0);
     /// Cell: the last cycle ended with M30/M02.
     pub const CYCLE_COMPLETE: Bit = bit(5, 1);
+    /// The spindle drive's stop position while SPINDLE_ORIENT holds: F30–F35 as the ladder
+    /// copied them (angle 0.001°, way, count; D100).
+    pub const ORIENT_ANGLE: usize = 8;
+    pub const ORIENT_WAY: usize = 12;
+    pub const ORIENT_COUNT: usize = 13;
 }
 
 #[cfg(test)]

@@ -255,7 +255,7 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
 #[test]
 fn cdr_of_spindle_state_has_the_ros_layout() {
     // Same bytes a ROS 2 C++ node writes for this message: Time (8), f64 (8), f64 (8), u8,
-    // pad to 4, f32, f32, bool.
+    // pad to 4, f32, f32, bool, bool, pad to 8, f64.
     let msg = SpindleState {
         stamp: Time { sec: 1, nanosec: 2 },
         commanded_rpm: 600.0,
@@ -264,6 +264,8 @@ fn cdr_of_spindle_state_has_the_ros_layout() {
         load: 0.25,
         override_percent: 100.0,
         at_speed: true,
+        positioned: false,
+        position_deg: 14.3,
     };
     let bytes = cdr_encoding::to_vec::<_, byteorder::LittleEndian>(&msg).expect("cdr");
     let mut expected = vec![];
@@ -275,6 +277,9 @@ fn cdr_of_spindle_state_has_the_ros_layout() {
     expected.extend(0.25f32.to_le_bytes());
     expected.extend(100.0f32.to_le_bytes());
     expected.push(1);
+    // bool, pad to 8, f64.
+    expected.extend([0u8, 0, 0]);
+    expected.extend(14.3f64.to_le_bytes());
     assert_eq!(bytes, expected);
 }
 

@@ -7,7 +7,7 @@
 //! (the last of each that the skipped part programmed), then an approach to where the block
 //! starts, the retract axis first, as the machine's config says.
 
-use cnc_interpreter_core::Fault;
+use cnc_interpreter_core::{Fault, Turn};
 
 use crate::interpreter::MAX_CHECK_COMMANDS;
 use crate::{Aux, Canon, Command, Dialect, Interpreter, ProgramError, Setup};
@@ -125,8 +125,9 @@ pub struct Collected {
     /// The tool the last M06 put in a mill's spindle (the T before it).
     pub loaded: Option<i32>,
     pub speed: Option<f64>,
-    /// M03, M04, M05 or M19.
-    pub spindle: Option<i32>,
+    /// M03, M04, M05, M19 or a spindle position (an incremental one as M05: where it
+    /// left the spindle is not known before the machine runs; D100).
+    pub spindle: Option<Aux>,
     /// M07, M08 or M09.
     pub coolant: Option<i32>,
     /// M41–M44.
@@ -147,8 +148,15 @@ impl Collected {
             Command::Profile { jerk_limited } => self.jerk_limited = Some(jerk_limited),
             Command::Aux(Aux::T(t)) => self.tool = Some(t),
             Command::Aux(Aux::S(s)) => self.speed = Some(s),
+            Command::Aux(Aux::Orient {
+                way: Turn::Incremental,
+                ..
+            }) => {
+                self.spindle = Some(Aux::M(5));
+            }
+            Command::Aux(orient @ Aux::Orient { .. }) => self.spindle = Some(orient),
             Command::Aux(Aux::M(m)) => match m {
-                3 | 4 | 5 | 19 => self.spindle = Some(m),
+                3 | 4 | 5 | 19 => self.spindle = Some(Aux::M(m)),
                 7..=9 => self.coolant = Some(m),
                 41..=44 => self.gear = Some(m),
                 6 => self.loaded = self.tool,
@@ -192,7 +200,10 @@ impl Collected {
         if let Some(s) = self.speed {
             push(Command::Aux(Aux::S(s)));
         }
-        for m in [self.spindle, self.coolant].into_iter().flatten() {
+        if let Some(a) = self.spindle {
+            push(Command::Aux(a));
+        }
+        if let Some(m) = self.coolant {
             push(Command::Aux(Aux::M(m)));
         }
         if let Some(target) = self

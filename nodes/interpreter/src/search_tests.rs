@@ -198,3 +198,40 @@ fn main_lines_name_the_calling_line_inside_a_subprogram() {
         }
     );
 }
+
+/// A positioned spindle is given again before the restart block; one left by an incremental
+/// SPOS stands with M5, its angle not known before the machine runs (D100).
+#[test]
+fn the_restart_gives_the_last_spindle_position_and_an_incremental_one_as_m5() {
+    let orient = |degrees, way| Command::Aux(Aux::Orient { degrees, way });
+    for (skipped, want) in [
+        (
+            vec![Command::Aux(Aux::M(3)), orient(45.0, Turn::Minus)],
+            orient(45.0, Turn::Minus),
+        ),
+        (
+            vec![
+                orient(45.0, Turn::Shortest),
+                orient(-90.0, Turn::Incremental),
+            ],
+            Command::Aux(Aux::M(5)),
+        ),
+        (
+            vec![orient(45.0, Turn::Shortest), Command::Aux(Aux::M(4))],
+            Command::Aux(Aux::M(4)),
+        ),
+    ] {
+        let mut c = Collected::default();
+        for k in &skipped {
+            c.take(k);
+        }
+        let approach = Approach::default_for(&Setup::lathe([0.0, 0.0]));
+        let spindle: Vec<Command> = c
+            .preamble(&lathe_here(), &approach, 9, 9)
+            .into_iter()
+            .map(|p| p.command)
+            .filter(|k| matches!(k, Command::Aux(Aux::M(_) | Aux::Orient { .. })))
+            .collect();
+        assert_eq!(spindle, [want], "{skipped:?}");
+    }
+}

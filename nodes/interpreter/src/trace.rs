@@ -16,6 +16,7 @@
 use std::fmt::Write;
 
 use crate::canon::{Aux, Canon, Command};
+use cnc_interpreter_core::Turn;
 
 fn axes(out: &mut String, letters: &[char], values: &[f64], prefix: &str) {
     for (l, v) in letters.iter().zip(values) {
@@ -88,6 +89,9 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         }
         Command::Aux(Aux::T(t)) => {
             let _ = write!(s, "T{t}");
+        }
+        Command::Aux(Aux::Orient { degrees, way }) => {
+            let _ = write!(s, "SPINDLE_POSITION {degrees:.3} {way:?}");
         }
         Command::ProgramEnd => s.push_str("END"),
     }
@@ -313,6 +317,18 @@ impl LinuxCnc {
                 };
                 self.push(out, &call);
             }
+            // LinuxCNC's M19: the angle and 0 either way, 1 clockwise (M3), 2 counter-clockwise;
+            // it has no incremental positioning.
+            Command::Aux(Aux::Orient { degrees, way }) => match way {
+                Turn::Incremental => {
+                    self.push(out, &format!("COMMENT(\"SPOS=IC({degrees})\")"));
+                }
+                _ => {
+                    self.call(out, "ORIENT_SPINDLE(0, ");
+                    write_num(out, *degrees);
+                    out.push_str(&format!(", {})\n", *way as u8));
+                }
+            },
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
             // rs274 has no call for the acceleration profile: its planner's is fixed.
             Command::Profile { .. } => {}

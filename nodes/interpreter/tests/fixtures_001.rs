@@ -446,7 +446,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("027", Some((12080, 8)), "template"),
     ("028", Some((12080, 12)), "template"),
     ("029", Some((12080, 12)), "template"),
-    ("030", Some((12140, 10)), "SPOS"),
+    ("030", Some((12140, 11)), "G331"),
     ("031", Some((12140, 6)), "G75"),
     ("032", Some((12140, 7)), "probing"),
     ("033", Some((12140, 7)), "tangential control"),
@@ -467,7 +467,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("048", Some((12140, 6)), "machine data"),
     ("049", Some((12080, 8)), "template"),
     ("050", None, "G25 S, G26 S: spindle limits"),
-    ("051", Some((12140, 7)), "SPOS"),
+    ("051", Some((12080, 8)), "template"),
     ("052", Some((12080, 7)), "template"),
     ("053", Some((12080, 7)), "template"),
     (

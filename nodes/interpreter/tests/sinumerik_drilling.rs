@@ -24,6 +24,8 @@ enum Ev {
     Dwell(f64),
     M(i32),
     S(f64),
+    /// The oriented stop: the spindle positioned at an angle.
+    Orient(f64),
 }
 
 #[derive(Debug)]
@@ -82,6 +84,7 @@ fn holes(r: &Run, cycle_lines: &[u32], (h, v, d): (usize, usize, usize)) -> Vec<
             Command::Dwell { seconds } => Ev::Dwell(*seconds),
             Command::Aux(Aux::M(m)) => Ev::M(*m),
             Command::Aux(Aux::S(s)) => Ev::S(*s),
+            Command::Aux(Aux::Orient { degrees, .. }) => Ev::Orient(*degrees),
             _ => continue,
         };
         let at = (pos[h], pos[v]);
@@ -132,9 +135,10 @@ fn assert_levels(got: &[Ev], want: &[Ev]) {
     assert_eq!(got.len(), want.len(), "\n got {got:?}\nwant {want:?}");
     for (g, w) in got.iter().zip(want) {
         let same = match (g, w) {
-            (Ev::Rapid(a), Ev::Rapid(b)) | (Ev::Dwell(a), Ev::Dwell(b)) | (Ev::S(a), Ev::S(b)) => {
-                (a - b).abs() < 1e-6
-            }
+            (Ev::Rapid(a), Ev::Rapid(b))
+            | (Ev::Dwell(a), Ev::Dwell(b))
+            | (Ev::S(a), Ev::S(b))
+            | (Ev::Orient(a), Ev::Orient(b)) => (a - b).abs() < 1e-6,
             (Ev::Feed(a, f), Ev::Feed(b, g)) => (a - b).abs() < 1e-6 && (f - g).abs() < 1e-6,
             (Ev::M(a), Ev::M(b)) => a == b,
             _ => false,
@@ -225,7 +229,7 @@ fn f095_cycle84_orients_taps_m5_at_200_and_out_at_500_then_m3() {
         &hs[0].events,
         &[
             Rapid(38.0),
-            M(19),
+            Orient(90.0),
             S(200.0),
             M(3),
             Feed(6.0, 160.0),
@@ -303,7 +307,13 @@ fn f099_cycle86_orients_lifts_off_and_returns_over_the_hole() {
     assert_eq!(hs.len(), 1);
     assert_levels(
         &hs[0].events,
-        &[M(3), Rapid(110.0), Feed(77.0, 200.0), Dwell(2.0), M(19)],
+        &[
+            M(3),
+            Rapid(110.0),
+            Feed(77.0, 200.0),
+            Dwell(2.0),
+            Orient(45.0),
+        ],
     );
     let moves = r.moves();
     let n = moves.len();
@@ -422,7 +432,7 @@ fn f103_holes1_rows_drilled_then_tapped_under_mcall() {
     same_set(&hs[5..].iter().map(|h| h.at).collect::<Vec<_>>(), &second);
     for h in &hs[5..] {
         assert_eq!(h.feeds(), [(22.0, 1260.0), (104.0, 1260.0)]);
-        assert!(h.events.contains(&M(19)));
+        assert!(h.events.contains(&Orient(0.0)), "POSS omitted: 0°");
     }
     // From X30 Y105 the far end of the second row (the 5th hole) is nearer: it starts there.
     assert!(near(&[hs[5].at.0, hs[5].at.1], &[second[4].0, second[4].1]));

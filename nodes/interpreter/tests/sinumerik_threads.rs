@@ -1,12 +1,14 @@
-//! Issue 23: threads and tapping on the 802D mill: G33 with its lead as I/J/K and SF=
-//! (`001` §9.3.7, fixture 028), G63 tapping with a compensating chuck (§9.3.8, fixture 029),
-//! and G153 (§9.2.10). The fixtures are templates: their last line is a placeholder, filled
-//! here (`support::filled`), every printed line kept. Decision D93.
+//! Issue 23: threads, tapping and the positioned spindle on the 802D mill: G33 with its lead
+//! as I/J/K and SF= (`001` §9.3.7, fixture 028), G63 tapping with a compensating chuck
+//! (§9.3.8, fixture 029), SPOS (§9.4.3, fixture 051) and G153 (§9.2.10). The fixtures are
+//! templates: their placeholders are filled here (`support::filled`), every printed line
+//! kept. Decisions D93, D100.
 
 #[path = "support/sinumerik.rs"]
 mod support;
 
 use cnc_interpreter::{Aux, Command, Library};
+use cnc_interpreter_core::Turn;
 use support::*;
 
 /// The thread moves of a run as (end, lead, start angle).
@@ -128,4 +130,80 @@ fn g153_is_g53_without_a_basic_frame() {
     let b = run_with("G54 G0 X0 Y0\nG53 X10 Y20\n", s, Library::new()).ok();
     assert_eq!(a.out, b.out);
     assert_eq!(a.end(), vec![10.0, 20.0, 0.0]);
+}
+
+fn orient(degrees: f64, way: Turn) -> Command {
+    Command::Aux(Aux::Orient { degrees, way })
+}
+
+/// 051 (§9.4.3): N10 positions the spindle at 14.3°; N80 positions it at 25.6° with its
+/// axes (before them, D100) and N81 moves only after both. The placeholder is filled with
+/// the spindle turning at S800, so N80's positioning starts from M3.
+#[test]
+fn f051_spos_positions_the_spindle_before_the_axes_of_its_block_move() {
+    let text = filled("051", &["N20 S800 M3 G0 X10 Z100"]);
+    let r = run_with(&text, mill(), Library::new()).ok();
+    let first = index(&r, &orient(14.3, Turn::Shortest));
+    let second = index(&r, &orient(25.6, Turn::Shortest));
+    let m3 = index(&r, &Command::Aux(Aux::M(3)));
+    let n80 = index(
+        &r,
+        &Command::Rapid {
+            end: vec![89.0, 0.0, 300.0],
+        },
+    );
+    let n81 = index(
+        &r,
+        &Command::Rapid {
+            end: vec![200.0, 0.0, 300.0],
+        },
+    );
+    assert!(
+        first < m3 && m3 < second && second < n80 && n80 < n81,
+        "{:?}",
+        r.out
+    );
+    assert_eq!(r.lines[second], line_of(&text, "N80"));
+    assert_eq!(r.end(), vec![200.0, 0.0, 300.0]);
+}
+
+/// §9.4.3, §9.2.1 (AC/IC/DC/ACP/ACN): every form of SPOS; a value outside its range stops
+/// with the range alarm (17020, as SF= does) and the reason.
+#[test]
+fn spos_takes_each_way_and_refuses_an_angle_out_of_range() {
+    let r = run(
+        "SPOS=DC(33.1)\nSPOS=ACP(33.1)\nSPOS=ACN(33.1)\nSPOS=IC(-720.5)\nG91 SPOS=AC(10)\nSPOS=359.999\nR1=90 SPOS=R1/2\n",
+    )
+    .ok();
+    let spos: Vec<&Command> = r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Aux(Aux::Orient { .. })))
+        .collect();
+    assert_eq!(
+        spos,
+        [
+            &orient(33.1, Turn::Shortest),
+            &orient(33.1, Turn::Plus),
+            &orient(33.1, Turn::Minus),
+            &orient(-720.5, Turn::Incremental),
+            &orient(10.0, Turn::Shortest),
+            &orient(359.999, Turn::Shortest),
+            &orient(45.0, Turn::Shortest),
+        ]
+    );
+    for bad in [
+        "SPOS=360",
+        "SPOS=-1",
+        "SPOS=ACP(400)",
+        "SPOS=IC(100000)",
+        "SPOS=DC(-0.5)",
+    ] {
+        let r = run(&format!("G0 X1\n{bad}\n"));
+        let e = r.error.as_ref().unwrap_or_else(|| panic!("{bad} refused"));
+        assert_eq!((e.number, e.line), (17020, 2), "{bad}: {e:?}");
+        assert!(e.text.contains("spindle position"), "{bad}: {}", e.text);
+    }
+    // A rotary mode on an axis is still refused with its reason.
+    assert_eq!(run("X=DC(10)\n").alarm().0, 12140);
 }

@@ -1,6 +1,6 @@
 //! Blocks as motion keeps them: a canonical command (`cnc_msgs::canon`) plus where it came from.
 
-pub use cnc_msgs::canon::{Aux, Command};
+pub use cnc_msgs::canon::{Aux, Command, Turn};
 
 /// A queued block. Positions are in display units (X in diameter).
 #[derive(Debug, Clone, PartialEq)]

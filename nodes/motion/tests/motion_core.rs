@@ -834,3 +834,58 @@ fn aux_lock_keeps_m_s_and_t_from_the_plc_but_not_the_program_stops() {
         assert_eq!(m.state(), RunState::Hold, "aux lock {lock}");
     }
 }
+
+/// A spindle position goes to the PLC as M19 with its stop position in F30–F35 (angle in
+/// 0.001°, way, a count that changes with each positioning), M19 alone with 0 the shortest
+/// way, so the ladder can pass the bytes on to the drive (D100).
+#[test]
+fn a_spindle_position_is_m19_with_its_stop_position_in_the_f_image() {
+    use cnc_msgs::canon::Turn;
+    let mut m = Motion::new(mill(), &[0.0, 0.0, 0.0]);
+    let orient = |degrees, way| Command::Aux(Aux::Orient { degrees, way });
+    let kinds = [
+        orient(14.3, Turn::Shortest),
+        Command::Aux(Aux::M(19)),
+        orient(-720.5, Turn::Incremental),
+        orient(-720.5, Turn::Incremental),
+        orient(300.0, Turn::Minus),
+        Command::Aux(Aux::M(3)),
+        Command::ProgramEnd,
+    ];
+    for (k, kind) in kinds.into_iter().enumerate() {
+        m.push(block(k as u64 + 1, k as u32 + 1, kind));
+    }
+    let mut g = GImage::released();
+    let mut slides = m.setpoint().to_vec();
+    let mut seen = Vec::new();
+    for _ in 0..5_000 {
+        slides = m.tick(Some(&slides), &g).to_vec();
+        let fi = *m.f_image();
+        if fi.get(f::MF) && !g.get(g::FIN) {
+            seen.push((
+                fi.read_i32(f::M_CODE),
+                fi.read_i32(f::ORIENT_ANGLE),
+                fi.bytes[f::ORIENT_WAY],
+                fi.bytes[f::ORIENT_COUNT],
+            ));
+            g.set(g::FIN, true);
+        }
+        if !fi.get(f::MF) {
+            g.set(g::FIN, false);
+        }
+        if m.state() == RunState::Idle {
+            break;
+        }
+    }
+    assert_eq!(
+        seen,
+        [
+            (19, 14_300, 0, 1),
+            (19, 0, 0, 2),
+            (19, -720_500, 3, 3),
+            (19, -720_500, 3, 4),
+            (19, 300_000, 2, 5),
+            (3, 0, 0, 5),
+        ]
+    );
+}

@@ -385,12 +385,13 @@ fn handshake(yi: &cnc_msgs::signals::YImage, xi: &XImage, fi: &FImage) -> RobotH
     }
 }
 
-/// Spindle state on change (to the rpm) and at least every 100 scans.
+/// Spindle state on change (to the rpm; standing positioned, to the 0.001°) and at least
+/// every 100 scans.
 fn publish_spindle(
     publisher: &cnc_runtime::dds::Publisher<SpindleState>,
     yi: &cnc_msgs::signals::YImage,
     xi: &XImage,
-    last: &mut Option<(i64, u8, bool, i64)>,
+    last: &mut Option<(i64, u8, bool, i64, i64)>,
     scans: u64,
     override_percent: f32,
 ) {
@@ -405,11 +406,18 @@ fn publish_spindle(
         yi.spindle_rpm
     };
     let at_speed = xi.get(x::SPINDLE_AT_SPEED) && direction != SpindleState::DIRECTION_STOP;
+    let positioned = yi.get(y::SPINDLE_ORIENT) && xi.get(x::SPINDLE_ORIENTED);
     let key = (
         commanded.round() as i64,
         direction,
         at_speed,
         xi.spindle_actual_rpm.round() as i64,
+        // 1 + the angle in 0.001° while positioned (0 while not).
+        if positioned {
+            1 + (xi.spindle_angle_deg * 1000.0).round() as i64
+        } else {
+            0
+        },
     );
     if *last != Some(key) || scans.is_multiple_of(100) {
         *last = Some(key);
@@ -422,6 +430,8 @@ fn publish_spindle(
             load: 0.0,
             override_percent,
             at_speed,
+            positioned,
+            position_deg: xi.spindle_angle_deg,
         });
     }
 }

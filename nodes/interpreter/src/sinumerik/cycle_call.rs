@@ -6,7 +6,7 @@
 //! positions are in the work coordinates of the active frame. The milling cycles are not
 //! built yet (12140).
 
-use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleDir};
+use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleDir, Turn};
 
 use super::cutter_path::MAX_MOVES;
 use super::drilling::{self, CycleAlarm, DeepHole, Levels, Step};
@@ -318,6 +318,9 @@ impl Sinumerik {
         )?;
         let feed = self.core.feed;
         let dtb = c.or("DTB", 0.0);
+        // POSS is an angle: taken modulo 360° (D100).
+        let poss = c.or("POSS", 0.0).rem_euclid(360.0);
+        let poss = if poss < 360.0 { poss } else { 0.0 };
         let int = |p: &str| c.get(p).map(|v| v.round());
         Ok(match c.name {
             "CYCLE81" => drilling::drill(levels, feed, 0.0),
@@ -342,6 +345,7 @@ impl Sinumerik {
                 })?;
                 drilling::rigid_tap(
                     levels,
+                    poss,
                     pitch,
                     dtb,
                     int("SDAC").unwrap_or(0.0).max(0.0) as u32,
@@ -356,6 +360,7 @@ impl Sinumerik {
             }
             "CYCLE86" => drilling::bore_oriented(
                 levels,
+                poss,
                 feed,
                 dtb,
                 drilling::spindle_dir(int("SDIR"))?,
@@ -451,6 +456,14 @@ impl Sinumerik {
                     _ => {}
                 }
                 self.core.aux(Aux::M(m as i32));
+                Ok(())
+            }
+            Step::Orient(degrees) => {
+                self.core.spindle = SpindleDir::Stopped;
+                self.core.aux(Aux::Orient {
+                    degrees,
+                    way: Turn::Shortest,
+                });
                 Ok(())
             }
             Step::Speed(rpm) => {

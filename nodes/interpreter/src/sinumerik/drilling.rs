@@ -12,8 +12,10 @@ pub enum Step {
     /// The drilling axis to a level at a feed (mm/min).
     Feed(f64, f64),
     Dwell(f64),
-    /// An M function: 3/4/5 the spindle, 0 the program stop, 19 the oriented stop.
+    /// An M function: 3/4/5 the spindle, 0 the program stop.
     M(u32),
+    /// The oriented stop at POSS: the spindle positioned the shortest way (SPOS, D100).
+    Orient(f64),
     /// A spindle speed.
     Speed(f64),
     /// A rapid move in the plane by (1st, 2nd plane axis) and along the drilling axis by the
@@ -286,11 +288,12 @@ pub fn pitch(mpit: Option<f64>, pit: Option<f64>) -> Result<Option<f64>, CycleAl
 }
 
 /// CYCLE84, rigid tapping (§10.4.6), on a spindle whose speed the feed follows (D84): the
-/// oriented stop, the tap in at SST with the pitch's hand, the dwell, out to RFP+SDIS at
+/// oriented stop at POSS, the tap in at SST with the pitch's hand, the dwell, out to RFP+SDIS at
 /// SST1 turning the other way, then the speed before the call and SDAC's direction.
 #[allow(clippy::too_many_arguments)]
 pub fn rigid_tap(
     l: Levels,
+    poss: f64,
     pitch: f64,
     dtb: f64,
     sdac: u32,
@@ -310,7 +313,7 @@ pub fn rigid_tap(
     let sst1 = if sst1 > 0.0 { sst1 } else { sst };
     let (tap_in, tap_out) = if pitch > 0.0 { (3, 4) } else { (4, 3) };
     let lead = pitch.abs();
-    let mut s = vec![Step::Rapid(l.safety), Step::M(19)];
+    let mut s = vec![Step::Rapid(l.safety), Step::Orient(poss)];
     s.extend([
         Step::Speed(sst),
         Step::M(tap_in),
@@ -376,6 +379,7 @@ pub fn spindle_dir(sdir: Option<f64>) -> Result<u32, CycleAlarm> {
 /// hole, the spindle on again in SDIR.
 pub fn bore_oriented(
     l: Levels,
+    poss: f64,
     feed: f64,
     dtb: f64,
     sdir: u32,
@@ -390,7 +394,7 @@ pub fn bore_oriented(
         s.push(Step::Dwell(dtb));
     }
     s.extend([
-        Step::M(19),
+        Step::Orient(poss),
         Step::Lift(lift.0, lift.1, lift.2),
         Step::Rapid(l.safety),
         Step::Rapid(l.rtp),

@@ -7,7 +7,7 @@
 use std::borrow::Borrow;
 use std::sync::Arc;
 
-use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, SpindleDir};
+use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, SpindleDir, Turn};
 
 use super::block::{Block, Item};
 use super::cycle_call::{is_cycle, CycleCall};
@@ -20,8 +20,9 @@ pub enum Mode {
     Modal,
     Abs,
     Inc,
-    /// DC/ACP/ACN: absolute on a rotary axis, by the shortest way or in one direction.
-    Rotary,
+    /// DC/ACP/ACN: absolute on a rotary axis or the spindle, by the shortest way or in one
+    /// direction.
+    Rotary(Turn),
 }
 
 /// A block's few addresses in key order: a list kept from block to block, so sorting a
@@ -111,9 +112,9 @@ impl Words {
 }
 
 /// Multi-letter addresses the control reads with `=` (§9.1.3, §9.1.6).
-const ADDRESSES: [&str; 18] = [
+const ADDRESSES: [&str; 19] = [
     "CR", "AR", "AP", "RP", "TURN", "RPL", "I1", "J1", "K1", "SF", "CHF", "CHR", "RND", "RNDM",
-    "FRC", "FRCM", "ANG", "OFFN",
+    "FRC", "FRCM", "ANG", "OFFN", "SPOS",
 ];
 
 /// Keywords this front end runs.
@@ -138,7 +139,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 28] = [
+pub const NOT_BUILT: [(&str, &str); 27] = [
     (
         "FFWON",
         "feedforward is the drives' setting, not switched by the program",
@@ -160,7 +161,6 @@ pub const NOT_BUILT: [(&str, &str); 28] = [
         "probing is not built: the simulated mill has no probe",
     ),
     ("FXS", "travel to fixed stop is not built"),
-    ("SPOS", "spindle positioning is not built yet"),
     ("SETPIECE", "tool monitoring is not built"),
     ("RESETMON", "tool monitoring is not built"),
     ("FP", "G75 fixed point approach is not built yet"),
@@ -184,8 +184,8 @@ pub const NOT_BUILT: [(&str, &str); 28] = [
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
 pub const NOT_BUILT_G: [(u32, &str); 13] = [
-    (331, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
-    (332, "G331/G332 rigid tapping is not built yet (the simulated spindle is not position-controlled)"),
+    (331, "G331/G332 rigid tapping is not built: SPOS positions the spindle, but motion does not interpolate it with the axes; tap with G63 or CYCLE84"),
+    (332, "G331/G332 rigid tapping is not built: SPOS positions the spindle, but motion does not interpolate it with the axes; tap with G63 or CYCLE84"),
     (75, "G75 fixed point approach is not built yet"),
     (147, "smooth approach and retraction (WAB) is not built"),
     (148, "smooth approach and retraction (WAB) is not built"),
@@ -469,14 +469,16 @@ impl Sinumerik {
             let mode = match f.as_ref() {
                 "AC" => Some(Mode::Abs),
                 "IC" => Some(Mode::Inc),
-                "DC" | "ACP" | "ACN" => Some(Mode::Rotary),
+                "DC" => Some(Mode::Rotary(Turn::Shortest)),
+                "ACP" => Some(Mode::Rotary(Turn::Plus)),
+                "ACN" => Some(Mode::Rotary(Turn::Minus)),
                 _ => None,
             };
             if let Some(mode) = mode {
                 let [Some(arg)] = args.as_slice() else {
                     return Err(self.fault(Fault::MacroArgument, format!("{name}={f}(value)")));
                 };
-                if mode == Mode::Rotary {
+                if matches!(mode, Mode::Rotary(_)) && name != "SPOS" {
                     return Err(self.fault(
                         Fault::NotSupported,
                         format!("{name}={f}(…): rotary positioning modes are not built yet"),
@@ -698,6 +700,34 @@ impl Sinumerik {
                 _ => self.core.aux(Aux::M(m as i32)),
             }
         }
+        if let Some(&(v, mode)) = w.addr.get("SPOS") {
+            self.spindle_position(v, mode)?;
+        }
+        Ok(())
+    }
+
+    /// SPOS (§9.4.3): the spindle to an angle in position control, where it stays until
+    /// M3/M4/M5. It is positioned before the block's axes move, not beside them (D100).
+    /// `SPOS=a`, `AC(a)`, `DC(a)` the shortest way (turning: on in its direction), `ACP`/`ACN`
+    /// in one direction, 0 ≤ a < 360; `IC(d)` a signed travel of up to 99 999.999°.
+    fn spindle_position(&mut self, v: f64, mode: Mode) -> Result<(), ProgramError> {
+        let way = match mode {
+            Mode::Modal | Mode::Abs => Turn::Shortest,
+            Mode::Rotary(t) => t,
+            Mode::Inc => Turn::Incremental,
+        };
+        if !way.accepts(v) {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!(
+                    "SPOS={}: a spindle position is 0…359.999° (IC: a travel of at most ±{}°)",
+                    cnc_interpreter_core::show(v),
+                    Turn::MAX_INCREMENT
+                ),
+            ));
+        }
+        self.core.spindle = SpindleDir::Stopped;
+        self.core.aux(Aux::Orient { degrees: v, way });
         Ok(())
     }
 

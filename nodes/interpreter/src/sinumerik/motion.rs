@@ -166,7 +166,7 @@ impl Sinumerik {
             let linear = "XYZUVW".contains(self.core.setup.axes[i]);
             let v = if linear { v * unit } else { v };
             let absolute = match mode {
-                Mode::Abs | Mode::Rotary => true,
+                Mode::Abs | Mode::Rotary(_) => true,
                 Mode::Inc => false,
                 Mode::Modal => self.absolute,
             };
@@ -451,7 +451,7 @@ impl Sinumerik {
                     )
                 })?;
             let absolute = match mode {
-                Mode::Abs | Mode::Rotary => true,
+                Mode::Abs | Mode::Rotary(_) => true,
                 Mode::Inc => false,
                 Mode::Modal => self.absolute,
             };

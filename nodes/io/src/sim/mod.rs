@@ -8,11 +8,13 @@
 //! Pure: [`SimLathe::step`] advances the machine by `dt` seconds.
 
 pub mod devices;
+pub mod spindle_position;
 
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{x, y, SignalTable, XImage, YImage};
 
 pub use devices::{DeviceConfig, Devices};
+use spindle_position::{Positioning, StopCommand};
 
 /// Simulation parameters.
 #[derive(Debug, Clone, PartialEq)]
@@ -86,7 +88,11 @@ pub struct SimLathe {
     /// interpolation starts.
     last_setpoint: [f64; MAX_AXES],
     spindle_rpm: f64,
-    spindle_angle: f64,
+    /// Degrees the spindle has turned since power-on (unwrapped: a positioning's goal can
+    /// lie turns away); the encoder's angle is this modulo 360.
+    spindle_turned: f64,
+    /// The drive in position control: its stop position and goal.
+    positioning: Option<Positioning>,
     pub devices: Devices,
     emergency_stop: bool,
     x_seq: u64,
@@ -116,7 +122,8 @@ impl SimLathe {
             position,
             last_setpoint: position,
             spindle_rpm: 0.0,
-            spindle_angle: 0.0,
+            spindle_turned: 0.0,
+            positioning: None,
             emergency_stop: false,
             x_seq: 0,
             overtravel: (0, 0),
@@ -141,6 +148,11 @@ impl SimLathe {
 
     pub fn spindle_rpm(&self) -> f64 {
         self.spindle_rpm
+    }
+
+    /// The spindle's angle as its encoder shows it, 0 ≤ angle < 360°.
+    pub fn spindle_angle(&self) -> f64 {
+        self.spindle_turned.rem_euclid(360.0)
     }
 
     /// Advances by `dt`: drives follow `setpoint` when enabled; devices follow `y`.
@@ -182,25 +194,36 @@ impl SimLathe {
             spindle_command(y)
         };
         let brake = if y.get(y::SPINDLE_BRAKE) { 3.0 } else { 1.0 };
-        let step = self.cfg.spindle_acceleration * brake * dt;
-        let command = if self.orienting(y) {
-            // Position control: towards the orientation angle the short way, at most the
-            // orientation speed, slowing in proportion to what is left.
-            let rest = angle_to(self.spindle_angle, ORIENT_ANGLE);
-            (rest / 360.0 * 60.0 / ORIENT_TIME_CONSTANT).clamp(-ORIENT_RPM, ORIENT_RPM)
+        let acceleration = self.cfg.spindle_acceleration;
+        let step = acceleration * brake * dt;
+        // Position control (M19, SPOS): a new stop position (or a new count) starts a
+        // positioning from where the spindle is and how it turns.
+        self.positioning = if self.orienting(y) {
+            let command = StopCommand::of(y);
+            match self.positioning {
+                Some(p) if p.command == command => Some(p),
+                _ => Some(Positioning::start(
+                    command,
+                    self.spindle_turned,
+                    self.spindle_rpm,
+                    acceleration,
+                )),
+            }
         } else {
-            command
+            None
+        };
+        let command = match self.positioning {
+            Some(p) => p.speed(self.spindle_turned, acceleration),
+            None => command,
         };
         self.spindle_rpm += (command - self.spindle_rpm).clamp(-step, step);
-        self.spindle_angle =
-            (self.spindle_angle + self.spindle_rpm / 60.0 * 360.0 * dt).rem_euclid(360.0);
-        if self.orienting(y)
-            && angle_to(self.spindle_angle, ORIENT_ANGLE).abs() < 0.05
-            && self.spindle_rpm.abs() < 1.0
-        {
-            // In position: the drive holds it there.
-            self.spindle_angle = ORIENT_ANGLE;
-            self.spindle_rpm = 0.0;
+        self.spindle_turned += self.spindle_rpm / 60.0 * 360.0 * dt;
+        if let Some(p) = self.positioning {
+            if p.reached(self.spindle_turned, self.spindle_rpm) {
+                // In position: the drive holds it there.
+                self.spindle_turned = p.goal;
+                self.spindle_rpm = 0.0;
+            }
         }
         self.devices.step(y, dt);
         let mut fb = ServoFeedback {
@@ -208,7 +231,7 @@ impl SimLathe {
             setpoint_sent_ns: setpoint.sent_ns,
             axis_count: n as u32,
             spindle_rpm: self.spindle_rpm,
-            spindle_angle_deg: self.spindle_angle,
+            spindle_angle_deg: self.spindle_angle(),
             handwheel_count: self.handwheel_count,
             ..ServoFeedback::default()
         };
@@ -246,6 +269,7 @@ impl SimLathe {
         let mut xi = XImage {
             seq: self.x_seq,
             spindle_actual_rpm: self.spindle_rpm,
+            spindle_angle_deg: self.spindle_angle(),
             ..Default::default()
         };
         xi.set(x::ESP_N, !self.emergency_stop);
@@ -257,26 +281,14 @@ impl SimLathe {
         );
         xi.set(
             x::SPINDLE_ORIENTED,
-            self.orienting(y) && self.spindle_rpm == 0.0 && self.spindle_angle == ORIENT_ANGLE,
+            self.orienting(y)
+                && self.spindle_rpm == 0.0
+                && self.positioning.is_some_and(|p| {
+                    p.command == StopCommand::of(y) && p.goal == self.spindle_turned
+                }),
         );
         self.devices.sensors(&mut xi);
         xi
-    }
-}
-
-/// The spindle drive's orientation (M19): its angle (the manual's SD43240 default), its
-/// top speed and how fast it closes in, s.
-const ORIENT_ANGLE: f64 = 0.0;
-const ORIENT_RPM: f64 = 30.0;
-const ORIENT_TIME_CONSTANT: f64 = 0.05;
-
-/// The signed shortest turn from angle `a` to `b`, degrees in (−180, 180].
-fn angle_to(a: f64, b: f64) -> f64 {
-    let d = (b - a).rem_euclid(360.0);
-    if d > 180.0 {
-        d - 360.0
-    } else {
-        d
     }
 }
 
@@ -402,10 +414,97 @@ mod tests {
             assert!(m.spindle_rpm().abs() <= 600.0 + 1e-9);
         }
         let fb = m.step(&sp, &y, 0.004);
-        assert_eq!((fb.spindle_rpm, fb.spindle_angle_deg), (0.0, ORIENT_ANGLE));
+        assert_eq!((fb.spindle_rpm, fb.spindle_angle_deg), (0.0, 0.0));
         // Released: no longer oriented.
         y.set(y::SPINDLE_ORIENT, false);
         assert!(!m.x_image(&y).get(x::SPINDLE_ORIENTED));
+    }
+
+    /// Drives the spindle to the stop position in `y` (SPINDLE_ORIENT on): the angles it
+    /// passed, one per tick, until the PLC's input says oriented.
+    fn position(m: &mut SimLathe, y: &YImage) -> Vec<f64> {
+        let sp = ServoSetpoint::default();
+        let mut turned = vec![m.spindle_turned];
+        m.step(&sp, y, 0.004);
+        assert!(
+            !m.x_image(y).get(x::SPINDLE_ORIENTED),
+            "a new stop position is not reached at once"
+        );
+        while !m.x_image(y).get(x::SPINDLE_ORIENTED) {
+            turned.push(m.spindle_turned);
+            assert!(turned.len() < 20_000, "positioned within 80 s");
+            m.step(&sp, y, 0.004);
+        }
+        turned.push(m.spindle_turned);
+        turned
+    }
+
+    #[test]
+    fn spindle_positioning_takes_the_way_it_is_given() {
+        use cnc_msgs::canon::Turn;
+        let mut m = sim();
+        let mut y = YImage::default();
+        y.set(y::SPINDLE_ORIENT, true);
+        let stop = |y: &mut YImage, degrees: f64, way: Turn| {
+            y.write_i32(y::ORIENT_ANGLE, (degrees * 1000.0).round() as i32);
+            y.bytes[y::ORIENT_WAY] = way as u8;
+            y.bytes[y::ORIENT_COUNT] = y.bytes[y::ORIENT_COUNT].wrapping_add(1);
+        };
+        let rising = |t: &[f64]| t.windows(2).all(|w| w[1] >= w[0] - 1e-9);
+        let falling = |t: &[f64]| t.windows(2).all(|w| w[1] <= w[0] + 1e-9);
+        // SPOS=14.3 from 0: the short way forward, and no overshoot.
+        stop(&mut y, 14.3, Turn::Shortest);
+        let t = position(&mut m, &y);
+        assert!(rising(&t), "{t:?}");
+        assert_eq!(m.spindle_angle(), 14.3);
+        // SPOS=ACN(300): backwards 74.3°.
+        stop(&mut y, 300.0, Turn::Minus);
+        let t = position(&mut m, &y);
+        assert!(falling(&t) && (t[0] - t[t.len() - 1] - 74.3).abs() < 1e-9);
+        assert!((m.spindle_angle() - 300.0).abs() < 1e-9);
+        // SPOS=ACP(290): forward 350° though 10° back is nearer.
+        stop(&mut y, 290.0, Turn::Plus);
+        let t = position(&mut m, &y);
+        assert!(rising(&t) && (t[t.len() - 1] - t[0] - 350.0).abs() < 1e-9);
+        // SPOS=IC(-720.5), twice: two turns back and a half degree, each time.
+        for _ in 0..2 {
+            let before = m.spindle_angle();
+            stop(&mut y, -720.5, Turn::Incremental);
+            let t = position(&mut m, &y);
+            assert!(falling(&t) && (t[0] - t[t.len() - 1] - 720.5).abs() < 1e-9);
+            assert!((m.spindle_angle() - (before - 0.5).rem_euclid(360.0)).abs() < 1e-9);
+        }
+        // Held: the drive stays on it.
+        let at = m.spindle_angle();
+        for _ in 0..100 {
+            m.step(&ServoSetpoint::default(), &y, 0.004);
+        }
+        assert_eq!(m.spindle_angle(), at);
+        assert!(m.x_image(&y).get(x::SPINDLE_ORIENTED));
+    }
+
+    #[test]
+    fn positioned_from_m3_the_spindle_keeps_its_direction() {
+        let mut m = sim();
+        let mut y = YImage {
+            spindle_rpm: 600.0,
+            ..Default::default()
+        };
+        y.set(y::SPINDLE_CW, true);
+        let sp = ServoSetpoint::default();
+        for _ in 0..200 {
+            m.step(&sp, &y, 0.004);
+        }
+        y.set(y::SPINDLE_CW, false);
+        y.set(y::SPINDLE_ORIENT, true);
+        y.write_i32(y::ORIENT_ANGLE, 25_600);
+        y.bytes[y::ORIENT_COUNT] = 1;
+        let t = position(&mut m, &y);
+        assert!(
+            t.windows(2).all(|w| w[1] >= w[0] - 1e-9),
+            "never turned back"
+        );
+        assert!((m.spindle_angle() - 25.6).abs() < 1e-9);
     }
 
     #[test]

@@ -13,7 +13,7 @@ use std::f64::consts::TAU;
 use cnc_msgs::msg::MachineState;
 use cnc_msgs::signals::{f, g, FImage, GImage, SignalTable};
 
-use crate::block::{Aux, Block, Command};
+use crate::block::{Aux, Block, Command, Turn};
 use crate::config::MotionConfig;
 use crate::encoder::Encoder;
 use crate::path::{self, Point, Segment, MAX_AXES};
@@ -897,8 +897,19 @@ impl Motion {
                 }
                 *raised = true;
                 let fi = &mut self.f;
-                match *code {
+                // A spindle position is M19 with its stop position; M19 alone stops at 0,
+                // the shortest way (D100).
+                let (code, (degrees, way)) = match *code {
+                    Aux::Orient { degrees, way } => (Aux::M(19), (degrees, way)),
+                    other => (other, (0.0, Turn::Shortest)),
+                };
+                match code {
                     Aux::M(m) => {
+                        fi.write_i32(f::ORIENT_ANGLE, (degrees * 1000.0).round() as i32);
+                        fi.bytes[f::ORIENT_WAY] = way as u8;
+                        if m == 19 {
+                            fi.bytes[f::ORIENT_COUNT] = fi.bytes[f::ORIENT_COUNT].wrapping_add(1);
+                        }
                         fi.write_i32(f::M_CODE, m);
                         fi.set(f::DM00, m == 0);
                         fi.set(f::DM01, m == 1);
@@ -915,6 +926,7 @@ impl Motion {
                         fi.write_i32(f::T_CODE, t);
                         fi.set(f::TF, true);
                     }
+                    Aux::Orient { .. } => {} // sent as M19 above
                 }
                 false
             }
