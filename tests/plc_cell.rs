@@ -888,3 +888,68 @@ fn spos_positions_the_simulated_spindle_each_way_through_the_ladder() {
     // M3 turns it again: the position control let go.
     assert!(r.fb.spindle_rpm > 700.0, "{}", r.fb.spindle_rpm);
 }
+
+/// Rigid tapping through the whole chain (D101): G331 sends the tap's travel to the ladder as
+/// a positioning with its speed, the simulated drive turns the spindle through it, and the
+/// slide follows the spindle's angle at every servo tick, within what its drive lag and the
+/// setpoint's one period ahead allow; the tap ends exactly at its depth with the spindle
+/// standing, and G332 brings it out turning the other way.
+#[test]
+fn g331_and_g332_tap_with_the_slide_locked_to_the_simulated_spindle() {
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let z = cfg.axis_index("Z").unwrap();
+    let program =
+        "G0 X10 Y10 Z5\nSPOS=0\nG331 Z-25 K0.8 S600\nG4 F0.5\nG332 Z5 K0.8\nG0 Z50\nM30\n";
+    let mut r = Rig::on(cfg, program, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    // Unwrapped spindle angle; while a tap runs, the slide's distance from where the spindle
+    // puts it (0.8 mm a turn from where the tap began).
+    let (mut turned, mut last) = (0.0f64, r.fb.spindle_angle_deg);
+    let mut tap: Option<(f64, f64)> = None;
+    let (mut worst, mut ends, mut deepest) = (0.0f64, Vec::new(), f64::INFINITY);
+    let mut rising = 0usize;
+    let ok = r.run_until(120.0, |r| {
+        let a = r.fb.spindle_angle_deg;
+        let mut d = (a - last).rem_euclid(360.0);
+        if d > 180.0 {
+            d -= 360.0;
+        }
+        turned += d;
+        last = a;
+        let slide = r.fb.position[z];
+        deepest = deepest.min(slide);
+        let orienting = r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;
+        let tapping = orienting && r.nc().bytes[f::ORIENT_WAY] == 3;
+        match (tap, tapping) {
+            (None, true) => {
+                tap = Some((slide, turned));
+                rising += 1;
+            }
+            (Some((z0, t0)), true) => {
+                let sign = if rising == 1 { -1.0 } else { 1.0 };
+                let want = z0 + sign * (turned - t0).abs() / 360.0 * 0.8;
+                worst = worst.max((slide - want).abs());
+            }
+            (Some(_), false) => {
+                tap = None;
+                ends.push((slide, r.fb.spindle_rpm, turned));
+            }
+            (None, false) => {}
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!("taps end at {ends:?}, slide off the spindle's helix by at most {worst:.4} mm");
+    assert_eq!(ends.len(), 2, "{ends:?}");
+    // Down 30 mm and back: 37.5 turns each way, the spindle standing at each end.
+    let length = ends[0].0 - ends[1].0;
+    assert!((length + 30.0).abs() < 1e-3, "{ends:?}");
+    assert!(ends.iter().all(|e| e.1 == 0.0), "{ends:?}");
+    assert!((ends[0].2 - 37.5 * 360.0).abs() < 1e-3, "{ends:?}");
+    assert!(ends[1].2.abs() < 1e-3, "back where it began: {ends:?}");
+    // The slide never went below the depth, and kept to the spindle within its lag.
+    assert!(deepest >= ends[0].0 - 1e-3, "{deepest} below {}", ends[0].0);
+    assert!(worst < 0.1, "{worst}");
+}

@@ -4,11 +4,11 @@
 //! calls by name, starts it through the ROS 2 services, and reads the machine's topics: the
 //! program completes without alarm, the part is counted at its M2 (D82), and the axes stand
 //! where the manual's program ends. Issue 24, must-show 4: a job of the 802D's cycles (a
-//! bore with an oriented stop, a bore with M5 and M0, a circular pocket) runs through the
-//! PLC; at CYCLE87's M0 the machine holds at the bore's bottom with the spindle stopped, and a
-//! cycle start from the supervisor runs it on; SPOS positions the spindle, which the
-//! spindle topic shows at the next M0 (D100). Run by `scripts/test.sh` inside a
-//! network namespace.
+//! bore with an oriented stop, a bore with M5 and M0, a circular pocket, a rigid tap) runs
+//! through the PLC; at CYCLE87's M0 the machine holds at the bore's bottom with the spindle
+//! stopped, and a cycle start from the supervisor runs it on; SPOS positions the spindle,
+//! which the spindle topic shows at the next M0 (D100, D101). Run by `scripts/test.sh`
+//! inside a network namespace.
 
 use std::time::Duration;
 
@@ -138,6 +138,8 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
                N45 MSG(\"BORE AT X\"<<100<<\": RETRACT THE BAR, THEN START\")\n\
                N50 CYCLE87(10, 0, 2, -6, , 3)\n\
                N60 POCKET4(10, 0, 1, -4, 14, 150, 50, 2, 0, 0, 600, 200, 0, 11, 0)\n\
+               N62 G0 X100 Y100\n\
+               N64 CYCLE84(10, 0, 2, -6, , 0, 3, 5, , 90, 200, 500)\n\
                N70 G0 X0 Y0 Z100\n\
                N72 SPOS=ACN(300)\n\
                N74 M0\n\

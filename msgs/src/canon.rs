@@ -36,6 +36,14 @@ pub enum Command {
         lead: f64,
         start_angle: f64,
     },
+    /// Rigid tapping: the spindle, in position control, turns through `length of the long
+    /// axis / |lead|` revolutions at `rpm` (the way M3 turns for a positive `lead`) and the
+    /// axes follow its angle to `end`; the block ends with the spindle standing there.
+    Tap {
+        end: Vec<f64>,
+        lead: f64,
+        rpm: f64,
+    },
     Dwell {
         seconds: f64,
     },
@@ -65,7 +73,8 @@ impl Command {
             Command::Rapid { end }
             | Command::Linear { end, .. }
             | Command::Arc { end, .. }
-            | Command::Thread { end, .. } => Some(end),
+            | Command::Thread { end, .. }
+            | Command::Tap { end, .. } => Some(end),
             _ => None,
         }
     }
@@ -173,6 +182,12 @@ pub fn to_motion_block(
             m.lead = *lead;
             m.start_angle = *start_angle;
         }
+        Command::Tap { end, lead, rpm } => {
+            m.kind = MotionBlock::KIND_TAP;
+            m.end.clone_from(end);
+            m.lead = *lead;
+            m.aux_value = *rpm;
+        }
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
@@ -253,6 +268,20 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
                 start_angle: m.start_angle,
             }
         }
+        MotionBlock::KIND_TAP => {
+            let lead_ok = m.lead.is_finite() && m.lead != 0.0;
+            if !(lead_ok && m.aux_value.is_finite() && m.aux_value > 0.0) {
+                return Err(format!(
+                    "tapping lead {} or spindle speed {} is not valid",
+                    m.lead, m.aux_value
+                ));
+            }
+            Command::Tap {
+                end: m.end.clone(),
+                lead: m.lead,
+                rpm: m.aux_value,
+            }
+        }
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_PROFILE => Command::Profile {
@@ -325,6 +354,11 @@ mod tests {
                 plane: Some([2, 0]),
             },
             Command::Dwell { seconds: 1.5 },
+            Command::Tap {
+                end: vec![10.0, 10.0, -25.0],
+                lead: -0.8,
+                rpm: 600.0,
+            },
             Command::FeedMode { per_rev: true },
             Command::PathMode { exact_stop: true },
             Command::Profile { jerk_limited: true },
@@ -396,6 +430,21 @@ mod tests {
                 way: Turn::Plus,
             }),
         );
+        let mut t = to_motion_block(
+            1,
+            1,
+            "",
+            1,
+            &Command::Tap {
+                end: vec![0.0],
+                lead: 1.0,
+                rpm: 100.0,
+            },
+        );
+        for (lead, rpm) in [(0.0, 100.0), (f64::NAN, 100.0), (1.0, 0.0), (1.0, -5.0)] {
+            (t.lead, t.aux_value) = (lead, rpm);
+            assert!(from_motion_block(&t).is_err(), "lead {lead} rpm {rpm}");
+        }
         for (way, degrees) in [(1, 360.0), (0, -0.5), (2, f64::NAN), (3, 1e6), (4, 10.0)] {
             (o.aux_code, o.aux_value) = (way, degrees);
             assert!(from_motion_block(&o).is_err(), "way {way} {degrees}");

@@ -227,6 +227,7 @@ ros_message! {
             KIND_FEED_MODE: u8 = 8,
             KIND_PATH_MODE: u8 = 9,
             KIND_PROFILE: u8 = 10,
+            KIND_TAP: u8 = 11,
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,

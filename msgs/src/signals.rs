@@ -216,12 +216,14 @@ pub mod f {
     /// The target tool of the T code (3 for `T0303`), 4 bytes binary.
     pub const T_CODE: usize = 26;
     /// The spindle's stop position for M19, sent with every M code (0 unless positioned:
-    /// SPOS): the angle in 0.001° (4 bytes binary), the way ([`crate::canon::Turn`]) and a
-    /// count that changes with every positioning, so the ladder passes the three bytes on
-    /// to the drive as one (D100).
+    /// SPOS, rigid tapping): the angle in 0.001° (4 bytes binary), the way
+    /// ([`crate::canon::Turn`]), a count that changes with every positioning and the speed to
+    /// position at, rpm (4 bytes binary, 0: the drive's own), so the ladder passes F30–F39 on
+    /// to the drive as one (D100, D101).
     pub const ORIENT_ANGLE: usize = 30;
     pub const ORIENT_WAY: usize = 34;
     pub const ORIENT_COUNT: usize = 35;
+    pub const ORIENT_SPEED: usize = 36;
 }
 
 /// G signals the NC reads (`000` App.2, inventory §9.5).
@@ -392,11 +394,12 @@ pub mod y {
     pub const READY_FOR_LOAD: Bit = bit(5, 0);
     /// Cell: the last cycle ended with M30/M02.
     pub const CYCLE_COMPLETE: Bit = bit(5, 1);
-    /// The spindle drive's stop position while SPINDLE_ORIENT holds: F30–F35 as the ladder
-    /// copied them (angle 0.001°, way, count; D100).
+    /// The spindle drive's stop position while SPINDLE_ORIENT holds: F30–F39 as the ladder
+    /// copied them (angle 0.001°, way, count, speed rpm; D100, D101).
     pub const ORIENT_ANGLE: usize = 8;
     pub const ORIENT_WAY: usize = 12;
     pub const ORIENT_COUNT: usize = 13;
+    pub const ORIENT_SPEED: usize = 14;
 }
 
 #[cfg(test)]

@@ -63,6 +63,11 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             axes(&mut s, letters, end, "");
             let _ = write!(s, " LEAD{lead:.4} Q{start_angle:.3}");
         }
+        Command::Tap { end, lead, rpm } => {
+            s.push_str("TAP");
+            axes(&mut s, letters, end, "");
+            let _ = write!(s, " LEAD{lead:.4} S{rpm:.1}");
+        }
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
         }
@@ -274,6 +279,17 @@ impl LinuxCnc {
                 self.push(out, &format!("START_SPEED_FEED_SYNCH(0, {lead:.6}, 0)"));
                 self.six(out, "STRAIGHT_FEED(", end);
                 self.push(out, "STOP_SPEED_FEED_SYNCH()");
+            }
+            // LinuxCNC's G33.1: the end point in the plane's three axes.
+            Command::Tap { end, .. } => {
+                self.call(out, "RIGID_TAP(");
+                for k in 0..3 {
+                    if k > 0 {
+                        out.push_str(", ");
+                    }
+                    write_num(out, self.value(end, k));
+                }
+                out.push_str(")\n");
             }
             Command::Dwell { seconds } => {
                 self.call(out, "DWELL(");

@@ -390,10 +390,10 @@ fn the_code_table_marks_the_g_functions_not_built() {
     assert_eq!(d.g_code(20), Some(CodeStatus::Built));
     assert_eq!(d.g_code(5070), Some(CodeStatus::Built));
     assert_eq!(d.g_code(330), Some(CodeStatus::Built));
-    assert!(matches!(d.g_code(3310), Some(CodeStatus::Unsupported(w)) if w.contains("G331")));
-    assert!(matches!(d.g_code(4510), Some(CodeStatus::Unsupported(_))));
+    assert_eq!(d.g_code(3310), Some(CodeStatus::Built));
+    assert!(matches!(d.g_code(4510), Some(CodeStatus::Unsupported(w)) if w.contains("G451")));
     assert_eq!(d.g_code(5060), None);
-    let r = run("G331 Z-10 K1\n");
+    let r = run("G451 G1 X10\n");
     assert_eq!(r.alarm(), (12140, 1));
 }
 
@@ -446,7 +446,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("027", Some((12080, 8)), "template"),
     ("028", Some((12080, 12)), "template"),
     ("029", Some((12080, 12)), "template"),
-    ("030", Some((12140, 11)), "G331"),
+    ("030", Some((12080, 13)), "template"),
     ("031", Some((12140, 6)), "G75"),
     ("032", Some((12140, 7)), "probing"),
     ("033", Some((12140, 7)), "tangential control"),

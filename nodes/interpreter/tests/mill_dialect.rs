@@ -84,7 +84,7 @@ fn tapping_reverses_the_spindle_at_the_bottom_and_back_at_r() {
             "RAPID X5.0000 Y5.0000 Z10.0000",
         ]
     );
-    // Rigid tapping needs a position-controlled spindle.
+    // Rigid tapping (M29) is not built in this dialect.
     assert_eq!(alarm("M29 S500\nM30\n").number, 10);
 }
 

@@ -26,6 +26,8 @@ enum Ev {
     S(f64),
     /// The oriented stop: the spindle positioned at an angle.
     Orient(f64),
+    /// Rigid tapping to a level: the lead (signed) and the spindle speed.
+    Tap(f64, f64, f64),
 }
 
 #[derive(Debug)]
@@ -40,6 +42,8 @@ impl Hole {
             .iter()
             .filter_map(|e| match e {
                 Ev::Feed(l, f) => Some((*l, *f)),
+                // A tap's axis speed: the lead times the speed.
+                Ev::Tap(l, lead, rpm) => Some((*l, lead.abs() * rpm)),
                 _ => None,
             })
             .collect()
@@ -81,6 +85,12 @@ fn holes(r: &Run, cycle_lines: &[u32], (h, v, d): (usize, usize, usize)) -> Vec<
                     _ => Ev::Rapid(end[d]),
                 }
             }
+            Command::Tap { end, lead, rpm } => {
+                let across = (end[h] - pos[h]).abs() > 1e-6 || (end[v] - pos[v]).abs() > 1e-6;
+                assert!(!across, "a tap across the plane: {c:?}");
+                pos = end.clone();
+                Ev::Tap(end[d], *lead, *rpm)
+            }
             Command::Dwell { seconds } => Ev::Dwell(*seconds),
             Command::Aux(Aux::M(m)) => Ev::M(*m),
             Command::Aux(Aux::S(s)) => Ev::S(*s),
@@ -107,7 +117,11 @@ fn holes(r: &Run, cycle_lines: &[u32], (h, v, d): (usize, usize, usize)) -> Vec<
     }
     // Only positions where something was cut are holes (the NaN entries part the holes of
     // different cycle blocks at one position).
-    list.retain(|hl| hl.events.iter().any(|e| matches!(e, Ev::Feed(..))));
+    list.retain(|hl| {
+        hl.events
+            .iter()
+            .any(|e| matches!(e, Ev::Feed(..) | Ev::Tap(..)))
+    });
     list
 }
 
@@ -140,6 +154,9 @@ fn assert_levels(got: &[Ev], want: &[Ev]) {
             | (Ev::S(a), Ev::S(b))
             | (Ev::Orient(a), Ev::Orient(b)) => (a - b).abs() < 1e-6,
             (Ev::Feed(a, f), Ev::Feed(b, g)) => (a - b).abs() < 1e-6 && (f - g).abs() < 1e-6,
+            (Ev::Tap(a, l, s), Ev::Tap(b, m, t)) => {
+                (a - b).abs() < 1e-6 && (l - m).abs() < 1e-9 && (s - t).abs() < 1e-9
+            }
             (Ev::M(a), Ev::M(b)) => a == b,
             _ => false,
         };
@@ -223,19 +240,15 @@ fn f095_cycle84_orients_taps_m5_at_200_and_out_at_500_then_m3() {
     let hs = holes(&r, &cycle_lines(&fixture("095")), XYZ);
     assert_eq!(hs.len(), 1);
     use Ev::*;
-    // MPIT 5: M5 coarse, pitch 0.8 (ISO 261); right hand: in with M3, out with M4.
-    // SDIS 2 over RFP 36; DPR 30: Z6. Feeds 200 × 0.8 and 500 × 0.8 mm/min.
+    // MPIT 5: M5 coarse, pitch 0.8 (ISO 261); right hand: in the way M3 turns, out the other
+    // way (D101). SDIS 2 over RFP 36; DPR 30: Z6. Spindle 200 rpm in, 500 out.
     assert_levels(
         &hs[0].events,
         &[
             Rapid(38.0),
             Orient(90.0),
-            S(200.0),
-            M(3),
-            Feed(6.0, 160.0),
-            S(500.0),
-            M(4),
-            Feed(38.0, 400.0),
+            Tap(6.0, 0.8, 200.0),
+            Tap(38.0, -0.8, 500.0),
             Rapid(40.0),
             S(0.0),
             M(3),
@@ -432,6 +445,8 @@ fn f103_holes1_rows_drilled_then_tapped_under_mcall() {
     same_set(&hs[5..].iter().map(|h| h.at).collect::<Vec<_>>(), &second);
     for h in &hs[5..] {
         assert_eq!(h.feeds(), [(22.0, 1260.0), (104.0, 1260.0)]);
+        let taps = h.events.iter().filter(|e| matches!(e, Tap(..))).count();
+        assert_eq!(taps, 2, "in and out by rigid tapping: {:?}", h.events);
         assert!(h.events.contains(&Orient(0.0)), "POSS omitted: 0°");
     }
     // From X30 Y105 the far end of the second row (the 5th hole) is nearer: it starts there.

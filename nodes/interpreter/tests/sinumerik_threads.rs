@@ -207,3 +207,72 @@ fn spos_takes_each_way_and_refuses_an_angle_out_of_range() {
     // A rotary mode on an axis is still refused with its reason.
     assert_eq!(run("X=DC(10)\n").alarm().0, 12140);
 }
+
+fn taps(r: &Run) -> Vec<(Vec<f64>, f64, f64)> {
+    r.out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Tap { end, lead, rpm } => Some((end.clone(), *lead, *rpm)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// 030 (§9.3.9): SPOS=0 puts the spindle in position control, G331 taps M5 (K0.8, the way M3
+/// turns) to Z−25 at S600, G332 comes back to Z5 turning the other way at the same pitch
+/// (D101). The placeholder is filled with the rapid away.
+#[test]
+fn f030_g331_taps_to_z_minus_25_with_the_positioned_spindle_and_g332_reverses() {
+    let text = filled("030", &["N50 G0 X0 Y0 Z50"]);
+    let r = run_with(&text, mill(), Library::new()).ok();
+    let t = taps(&r);
+    assert_eq!(
+        t,
+        [
+            (vec![10.0, 10.0, -25.0], 0.8, 600.0),
+            (vec![10.0, 10.0, 5.0], -0.8, 600.0),
+        ]
+    );
+    let spos = index(&r, &orient(0.0, Turn::Shortest));
+    let down = r
+        .out
+        .iter()
+        .position(|c| matches!(c, Command::Tap { .. }))
+        .unwrap();
+    assert!(spos < down);
+    assert_eq!(r.lines[down], line_of(&text, "N20"));
+    // No M3/M4: the spindle turns only as the tap's positioning.
+    assert!(!r
+        .out
+        .iter()
+        .any(|c| matches!(c, Command::Aux(Aux::M(3 | 4)))));
+    assert_eq!(r.end(), vec![0.0, 0.0, 50.0]);
+}
+
+/// G331's K sign is its direction and G332 reverses the last G331's; both need the spindle
+/// in position control and S; a thread lead word of the long axis is required.
+#[test]
+fn g331_g332_directions_and_their_alarms() {
+    let r = run("SPOS=0\nG0 Z5\nG331 Z-10 K-1.25 S300\nG332 Z5 K1.25\nG70 G331 Z-0.5 K0.05\n").ok();
+    let t = taps(&r);
+    assert_eq!((t[0].1, t[0].2), (-1.25, 300.0));
+    assert_eq!((t[1].1, t[1].2), (1.25, 300.0));
+    assert!(
+        (t[2].1 - 0.05 * 25.4).abs() < 1e-12,
+        "G70: the lead in inches"
+    );
+    assert!(near(&t[2].0, &[0.0, 0.0, -12.7]));
+    // Without SPOS, after M3 let the spindle go, G332 with no G331 before it.
+    for (text, line) in [
+        ("G0 Z5\nG331 Z-10 K1 S300\n", 2),
+        ("SPOS=0\nS300 M3\nG331 Z-10 K1\n", 3),
+        ("SPOS=0\nS300\nG332 Z5 K1\n", 3),
+    ] {
+        let r = run(text);
+        let e = r.error.as_ref().expect("refused");
+        assert_eq!((e.number, e.line), (12080, line), "{text}: {e:?}");
+    }
+    // No S, no lead word of the long axis.
+    assert_eq!(run("SPOS=0\nG331 Z-10 K1\n").alarm().1, 2);
+    assert_eq!(run("SPOS=0\nS300\nG331 Z-10 I1\n").alarm(), (12080, 3));
+}

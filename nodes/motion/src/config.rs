@@ -29,6 +29,8 @@ pub struct MotionConfig {
     pub dry_run_feed: f64,
     /// Axis indices in the order the reference return takes them.
     pub reference_order: Vec<usize>,
+    /// The spindle's rating (`limits.spindle_max_rpm`): no tap turns it faster.
+    pub spindle_max_rpm: f64,
 }
 
 impl MotionConfig {
@@ -48,6 +50,7 @@ impl MotionConfig {
             feedback_lost_ticks: cfg.servo.feedback_lost_ticks,
             dry_run_feed: cfg.servo.dry_run_feed,
             reference_order: cfg.reference_order(),
+            spindle_max_rpm: cfg.limits.spindle_max_rpm,
         }
     }
 

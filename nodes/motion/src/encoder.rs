@@ -9,6 +9,9 @@ pub(crate) struct Encoder {
     pub(crate) angle: f64,
     /// Revolutions turned since start-up, in either direction.
     pub(crate) revs: f64,
+    /// Degrees turned since start-up, signed (+ the way M3 turns): where rigid tapping
+    /// reads the spindle.
+    pub(crate) turned: f64,
     /// Last raw angle and direction (+1 CW, −1 CCW).
     raw: Option<f64>,
     direction: f64,
@@ -29,6 +32,7 @@ impl Encoder {
         if let Some(prev) = self.raw {
             let delta = (raw_angle - prev + 180.0).rem_euclid(360.0) - 180.0;
             self.revs += delta * self.direction / 360.0;
+            self.turned += delta;
         }
         self.raw = Some(raw_angle);
         self.rpm = rpm;

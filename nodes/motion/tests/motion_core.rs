@@ -889,3 +889,91 @@ fn a_spindle_position_is_m19_with_its_stop_position_in_the_f_image() {
         ]
     );
 }
+
+/// Rigid tapping (D101): motion sends the tap's travel as an incremental positioning with its
+/// speed (M19, F30–F39), then sets the axis by the spindle's angle as the encoder reports it,
+/// whatever the spindle's acceleration; the PLC's FIN (the spindle standing at the end) ends
+/// the block with the axis exactly at its end. Refused: under aux lock, above the spindle's
+/// rating, and when the axis could not follow.
+#[test]
+fn a_tap_follows_the_spindles_angle_and_ends_with_its_positioning() {
+    let tap = |end: f64, lead: f64, rpm: f64| Command::Tap {
+        end: vec![0.0, 0.0, end],
+        lead,
+        rpm,
+    };
+    let mut m = Motion::new(mill(), &[0.0, 0.0, 0.0]);
+    m.push(block(1, 1, tap(-10.0, 1.25, 600.0)));
+    m.push(block(2, 2, Command::ProgramEnd));
+    let mut g = GImage::released();
+    let mut slides = m.setpoint().to_vec();
+    // The simulated spindle: unwrapped angle, speed; it ramps at 3000 rpm/s to the goal.
+    let (mut turned, mut rpm, mut goal) = (0.0f64, 0.0f64, None::<(f64, f64)>);
+    let mut worst: f64 = 0.0;
+    for _ in 0..10_000 {
+        m.spindle_feedback(rpm, turned.rem_euclid(360.0));
+        slides = m.tick(Some(&slides), &g).to_vec();
+        let fi = *m.f_image();
+        if fi.get(f::MF) && goal.is_none() {
+            assert_eq!(fi.read_i32(f::M_CODE), 19);
+            assert_eq!(fi.bytes[f::ORIENT_WAY], 3, "incremental");
+            assert_eq!(fi.read_i32(f::ORIENT_SPEED), 600);
+            goal = Some((
+                turned + f64::from(fi.read_i32(f::ORIENT_ANGLE)) / 1000.0,
+                turned,
+            ));
+        }
+        if let Some((to, from)) = goal {
+            // The axis where the spindle's angle puts it (the setpoint reads one period and
+            // the drive lag ahead, so allow what the spindle turns in that time).
+            let want = -(turned - from) / 360.0 * 1.25;
+            worst = worst.max((m.commanded_display()[2] - want).abs());
+            let rest = to - turned;
+            let cmd = rest.signum() * 600f64.min((3000.0 * rest.abs() / 3.0).sqrt());
+            rpm += (cmd - rpm).clamp(-12.0, 12.0);
+            turned += rpm / 60.0 * 360.0 * 0.004;
+            if (to - turned).abs() < 0.05 && rpm.abs() < 13.0 {
+                (turned, rpm) = (to, 0.0);
+                g.set(g::FIN, true);
+            }
+        }
+        if !fi.get(f::MF) {
+            g.set(g::FIN, false);
+        }
+        if m.state() == RunState::Idle {
+            break;
+        }
+    }
+    let (to, from) = goal.expect("the positioning was sent");
+    // 10 mm at 1.25 mm a turn: eight turns the way M3 turns (the lead's sign), the axis down.
+    assert!(
+        (to - from - 10.0 / 1.25 * 360.0).abs() < 1e-3,
+        "{}",
+        to - from
+    );
+    assert_eq!(m.state(), RunState::Idle);
+    assert_eq!(m.commanded_display()[2], -10.0);
+    // 600 rpm × 1.25 mm = 12.5 mm/s: one period and the lag ahead is at most 0.2 mm.
+    assert!(worst < 0.2, "the axis kept to the spindle: {worst}");
+
+    for (kind, lock, number) in [
+        (tap(-10.0, 1.25, 600.0), true, alarm::SPINDLE_NOT_TURNING),
+        (tap(-10.0, 1.25, 7000.0), false, alarm::BAD_BLOCK),
+        (tap(-10.0, 100.0, 6000.0), false, alarm::THREAD_RUN_IN),
+    ] {
+        let mut m = Motion::new(mill(), &[0.0, 0.0, 0.0]);
+        m.set_panel(Panel {
+            aux_lock: lock,
+            ..Panel::default()
+        });
+        m.push(block(1, 1, kind.clone()));
+        drive(&mut m, 100);
+        assert_eq!(m.state(), RunState::Alarm, "{kind:?}");
+        let raised: Vec<u32> = m
+            .take_events()
+            .into_iter()
+            .map(|MotionEvent::Alarm { number, .. }| number)
+            .collect();
+        assert_eq!(raised, [number], "{kind:?}");
+    }
+}

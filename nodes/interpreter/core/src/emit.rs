@@ -41,6 +41,12 @@ pub enum MoveKind {
         lead: f64,
         angle: f64,
     },
+    /// Rigid tapping: the positioned spindle turns at `rpm`, the sign of `lead` its
+    /// direction, and the axes follow its angle.
+    Tap {
+        lead: f64,
+        rpm: f64,
+    },
 }
 
 /// Largest feed per revolution, mm/rev.
@@ -87,6 +93,21 @@ impl Core {
                 }
                 0.0
             }
+            MoveKind::Tap { lead, rpm } => {
+                if !(lead != 0.0 && lead.is_finite()) {
+                    return Err(self.fault(
+                        Fault::ThreadLead,
+                        format!("tapping lead {lead} is not valid"),
+                    ));
+                }
+                if !(rpm > 0.0 && rpm.is_finite()) {
+                    return Err(self.fault(
+                        Fault::CssWithoutS,
+                        "rigid tapping needs a spindle speed S above 0",
+                    ));
+                }
+                0.0
+            }
         };
         if matches!(kind, MoveKind::Arc { .. }) {
             self.arc_under_frame()?;
@@ -121,6 +142,7 @@ impl Core {
                 lead,
                 start_angle: angle,
             },
+            MoveKind::Tap { lead, rpm } => Command::Tap { end: m, lead, rpm },
         };
         self.push(command);
         Ok(())
@@ -281,10 +303,10 @@ impl Core {
                 },
                 comp::Kind::Feed(feed),
             ),
-            MoveKind::Thread { .. } => {
+            MoveKind::Thread { .. } | MoveKind::Tap { .. } => {
                 return Err(self.fault(
                     Fault::CompInCycle,
-                    "thread cutting while tool-nose compensation is active",
+                    "thread cutting or tapping while tool-nose compensation is active",
                 ))
             }
         };

@@ -372,7 +372,9 @@ fn m_code(n: u32) -> Option<M<Nothing>> {
         20 | 300 => ProgramEnd,
         30 | 40 | 60 | 80 | 190 => AuxBefore,
         50 | 90 | 180 => AuxAfter,
-        290 => Unsupported("M29 rigid tapping needs a position-controlled spindle"),
+        290 => {
+            Unsupported("M29 rigid tapping is not built in this dialect (G84 taps with the feed)")
+        }
         980 => SubprogramCall,
         990 => SubprogramReturn,
         _ => return None,

@@ -452,13 +452,21 @@ impl Sinumerik {
                 match m {
                     3 => self.core.spindle = SpindleDir::Cw,
                     4 => self.core.spindle = SpindleDir::Ccw,
-                    5 | 19 => self.core.spindle = SpindleDir::Stopped,
+                    5 => self.core.spindle = SpindleDir::Stopped,
                     _ => {}
+                }
+                if matches!(m, 3..=5) {
+                    self.positioned = false;
                 }
                 self.core.aux(Aux::M(m as i32));
                 Ok(())
             }
+            Step::Tap(level, lead, rpm) => {
+                let end = along(self, level);
+                self.core.emit(&end, MoveKind::Tap { lead, rpm })
+            }
             Step::Orient(degrees) => {
+                self.positioned = true;
                 self.core.spindle = SpindleDir::Stopped;
                 self.core.aux(Aux::Orient {
                     degrees,

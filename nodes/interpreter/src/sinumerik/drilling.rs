@@ -16,6 +16,8 @@ pub enum Step {
     M(u32),
     /// The oriented stop at POSS: the spindle positioned the shortest way (SPOS, D100).
     Orient(f64),
+    /// Rigid tapping to a level: the lead (signed: + the way M3 turns) and the speed (D101).
+    Tap(f64, f64, f64),
     /// A spindle speed.
     Speed(f64),
     /// A rapid move in the plane by (1st, 2nd plane axis) and along the drilling axis by the
@@ -287,9 +289,10 @@ pub fn pitch(mpit: Option<f64>, pit: Option<f64>) -> Result<Option<f64>, CycleAl
     }
 }
 
-/// CYCLE84, rigid tapping (§10.4.6), on a spindle whose speed the feed follows (D84): the
-/// oriented stop at POSS, the tap in at SST with the pitch's hand, the dwell, out to RFP+SDIS at
-/// SST1 turning the other way, then the speed before the call and SDAC's direction.
+/// CYCLE84, rigid tapping (§10.4.6), as the manual describes it (D101): the oriented stop
+/// at POSS (SPOS), the tap in at SST with the pitch's hand (G331), the dwell, out to
+/// RFP+SDIS at SST1 turning the other way (G332), RTP at rapid, then the speed before the
+/// call and SDAC's direction.
 #[allow(clippy::too_many_arguments)]
 pub fn rigid_tap(
     l: Levels,
@@ -311,21 +314,16 @@ pub fn rigid_tap(
         return Err(alarm(61102, "SST, the tapping speed, is missing"));
     }
     let sst1 = if sst1 > 0.0 { sst1 } else { sst };
-    let (tap_in, tap_out) = if pitch > 0.0 { (3, 4) } else { (4, 3) };
-    let lead = pitch.abs();
-    let mut s = vec![Step::Rapid(l.safety), Step::Orient(poss)];
-    s.extend([
-        Step::Speed(sst),
-        Step::M(tap_in),
-        Step::Feed(l.bottom, sst * lead),
-    ]);
+    let mut s = vec![
+        Step::Rapid(l.safety),
+        Step::Orient(poss),
+        Step::Tap(l.bottom, pitch, sst),
+    ];
     if dtb > 0.0 {
         s.push(Step::Dwell(dtb));
     }
     s.extend([
-        Step::Speed(sst1),
-        Step::M(tap_out),
-        Step::Feed(l.safety, sst1 * lead),
+        Step::Tap(l.safety, -pitch, sst1),
         Step::Rapid(l.rtp),
         Step::Speed(rpm_before),
         Step::M(sdac),

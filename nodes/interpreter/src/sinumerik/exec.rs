@@ -183,9 +183,7 @@ pub const NOT_BUILT: [(&str, &str); 27] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 13] = [
-    (331, "G331/G332 rigid tapping is not built: SPOS positions the spindle, but motion does not interpolate it with the axes; tap with G63 or CYCLE84"),
-    (332, "G331/G332 rigid tapping is not built: SPOS positions the spindle, but motion does not interpolate it with the axes; tap with G63 or CYCLE84"),
+pub const NOT_BUILT_G: [(u32, &str); 11] = [
     (75, "G75 fixed point approach is not built yet"),
     (147, "smooth approach and retraction (WAB) is not built"),
     (148, "smooth approach and retraction (WAB) is not built"),
@@ -193,8 +191,14 @@ pub const NOT_BUILT_G: [(u32, &str); 13] = [
     (248, "smooth approach and retraction (WAB) is not built"),
     (347, "smooth approach and retraction (WAB) is not built"),
     (348, "smooth approach and retraction (WAB) is not built"),
-    (291, "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill"),
-    (451, "G451 (intersection at outer corners) is not built: G450 transition circles"),
+    (
+        291,
+        "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill",
+    ),
+    (
+        451,
+        "G451 (intersection at outer corners) is not built: G450 transition circles",
+    ),
     (62, "corner deceleration G62/G621 is not built"),
     (621, "corner deceleration G62/G621 is not built"),
 ];
@@ -618,6 +622,8 @@ impl Sinumerik {
                 2 => self.motion = Motion::Cw,
                 3 => self.motion = Motion::Ccw,
                 33 => self.motion = Motion::Thread,
+                331 => self.motion = Motion::TapIn,
+                332 => self.motion = Motion::TapOut,
                 17..=19 => self.set_plane(g as u8)?,
                 90 => self.absolute = true,
                 91 => self.absolute = false,
@@ -697,6 +703,10 @@ impl Sinumerik {
                 3 => self.spindle(SpindleDir::Cw, 3),
                 4 => self.spindle(SpindleDir::Ccw, 4),
                 5 => self.spindle(SpindleDir::Stopped, 5),
+                19 => {
+                    self.spindle(SpindleDir::Stopped, 19);
+                    self.positioned = true;
+                }
                 _ => self.core.aux(Aux::M(m as i32)),
             }
         }
@@ -727,12 +737,14 @@ impl Sinumerik {
             ));
         }
         self.core.spindle = SpindleDir::Stopped;
+        self.positioned = true;
         self.core.aux(Aux::Orient { degrees: v, way });
         Ok(())
     }
 
     fn spindle(&mut self, dir: SpindleDir, code: i32) {
         self.core.spindle = dir;
+        self.positioned = false;
         self.core.aux(Aux::M(code));
     }
 
@@ -755,6 +767,7 @@ impl Sinumerik {
                         self.count_part();
                         self.core.saw_end = true;
                         self.core.spindle = SpindleDir::Stopped;
+                        self.positioned = false;
                         self.core.aux(Aux::M(m as i32));
                         self.core.finish();
                     }

@@ -55,6 +55,10 @@ pub enum Motion {
     Ct,
     /// G33: a thread locked to the spindle.
     Thread,
+    /// G331 (in) and G332 (out, the spindle reversed): rigid tapping, the axes following
+    /// the positioned spindle (D101).
+    TapIn,
+    TapOut,
 }
 
 /// The 802D front end: the core plus the control's own modal state.
@@ -110,6 +114,10 @@ pub struct Sinumerik {
     thread_angle: f64,
     /// OFFN=, the contour's normal offset added to the cutter radius of G41/G42 (§9.15).
     contour_offset: f64,
+    /// The spindle is in position control (SPOS, M19, a tap) until M3/M4/M5 or the end.
+    positioned: bool,
+    /// The direction of the last G331 (+1 the way M3 turns), which G332 reverses; 0: none.
+    tap_hand: f64,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -197,6 +205,8 @@ impl Sinumerik {
             program_text: None,
             thread_angle: 0.0,
             contour_offset: 0.0,
+            positioned: false,
+            tap_hand: 0.0,
         };
         front.apply_length();
         front

@@ -180,7 +180,7 @@ impl Sinumerik {
             self.core.set_plane_point(&mut end, p);
         }
         self.start_compensation()?;
-        if self.motion == Motion::Thread || w.has_g(63) {
+        if matches!(self.motion, Motion::Thread | Motion::TapIn | Motion::TapOut) || w.has_g(63) {
             return self.thread_move(w, &here, &end);
         }
         let a = self.core.plane_point(&here)?;
@@ -236,8 +236,16 @@ impl Sinumerik {
     /// after the index pulse. G63 (§9.3.8, non-modal): tapping with a compensating chuck,
     /// where F must equal S × pitch and the overrides are out: the move is locked to the
     /// spindle at F/S per revolution (F under G95), which keeps both promises (D93).
+    /// G331/G332 (§9.3.9): rigid tapping with the spindle in position control (SPOS first),
+    /// the lead's sign the direction (+ as M3), G332 the other way of the last G331, at S;
+    /// F and the overrides are out (D101).
     fn thread_move(&mut self, w: &Words, here: &[f64], end: &[f64]) -> Result<(), ProgramError> {
-        let what = if w.has_g(63) { "G63" } else { "G33" };
+        let what = match self.motion {
+            _ if w.has_g(63) => "G63",
+            Motion::TapIn => "G331",
+            Motion::TapOut => "G332",
+            _ => "G33",
+        };
         for k in ["CR", "AR", "I1", "J1", "K1", "TURN", "AP", "RP", "ANG"] {
             if w.addr.contains_key(k) {
                 return Err(self.fault(
@@ -276,8 +284,9 @@ impl Sinumerik {
                 return Err(self.fault(Fault::FeedRange, "G63 needs S: the pitch is F/S"));
             }
         } else {
-            let letter = centre_letter(self.core.setup.axes[long])
-                .ok_or_else(|| self.fault(Fault::AxisAddress, "G33 threads along X, Y or Z"))?;
+            let letter = centre_letter(self.core.setup.axes[long]).ok_or_else(|| {
+                self.fault(Fault::AxisAddress, format!("{what} runs along X, Y or Z"))
+            })?;
             let word = letter.to_string();
             match w.get(&word) {
                 Some(k) => k * self.unit(),
@@ -285,18 +294,49 @@ impl Sinumerik {
                     return Err(self.fault(
                         Fault::MissingWord,
                         format!(
-                            "G33 needs the lead of its longest axis {} as {word}",
+                            "{what} needs the lead of its longest axis {} as {word}",
                             self.core.setup.axes[long]
                         ),
                     ))
                 }
             }
         };
-        let kind = MoveKind::Thread {
-            lead,
-            angle: self.thread_angle,
+        let kind = if matches!(what, "G331" | "G332") {
+            self.tap(what, lead)?
+        } else {
+            MoveKind::Thread {
+                lead,
+                angle: self.thread_angle,
+            }
         };
         self.core.emit(end, kind)
+    }
+
+    /// The tap of G331/G332 with the lead word `lead` (D101).
+    fn tap(&mut self, what: &str, lead: f64) -> Result<MoveKind, ProgramError> {
+        if !self.positioned {
+            return Err(self.fault(
+                Fault::MissingWord,
+                format!("{what} taps with the spindle in position control: program SPOS first"),
+            ));
+        }
+        let hand = if what == "G331" {
+            lead.signum()
+        } else if self.tap_hand != 0.0 {
+            -self.tap_hand
+        } else {
+            return Err(self.fault(
+                Fault::MissingWord,
+                "G332 retracts the tap of a G331, and none ran before it",
+            ));
+        };
+        if what == "G331" {
+            self.tap_hand = hand;
+        }
+        Ok(MoveKind::Tap {
+            lead: lead.abs() * hand,
+            rpm: self.core.rpm,
+        })
     }
 
     /// AP/RP of the block, or the last ones; IC makes them incremental.

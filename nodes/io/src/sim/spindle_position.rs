@@ -1,20 +1,21 @@
-//! The simulated spindle drive in position control (M19, SPOS; decisions D100): where the
-//! PLC's SPINDLE_ORIENT holds, the drive takes the stop position the ladder copied into
-//! Y8–Y13 (angle in 0.001°, way, count), turns to it and holds it.
+//! The simulated spindle drive in position control (M19, SPOS, rigid tapping; decisions
+//! D100, D101): where the PLC's SPINDLE_ORIENT holds, the drive takes the stop position the
+//! ladder copied into Y8–Y17 (angle in 0.001°, way, count, speed), turns to it and holds it.
 
 use cnc_msgs::canon::Turn;
 use cnc_msgs::signals::{y, SignalTable, YImage};
 
-/// The positioning speed (the machine data's "speed in position control"), rpm.
+/// The positioning speed (the machine data's "speed in position control"), rpm, where the
+/// NC sends none.
 pub const POSITIONING_RPM: f64 = 500.0;
 /// How fast the drive closes in on the last degrees, s.
 const TIME_CONSTANT: f64 = 0.05;
 /// In position: this close, degrees, and slower than 1 rpm.
 const IN_POSITION: f64 = 0.05;
 
-/// One stop position as the PLC commands it: angle (0.001°), way, count.
+/// One stop position as the PLC commands it: angle (0.001°), way, count, speed (rpm).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct StopCommand(i32, u8, u8);
+pub struct StopCommand(i32, u8, u8, i32);
 
 impl StopCommand {
     pub fn of(yi: &YImage) -> StopCommand {
@@ -22,7 +23,17 @@ impl StopCommand {
             yi.read_i32(y::ORIENT_ANGLE),
             yi.bytes[y::ORIENT_WAY],
             yi.bytes[y::ORIENT_COUNT],
+            yi.read_i32(y::ORIENT_SPEED),
         )
+    }
+
+    /// The speed to position at: the NC's, else the drive's own.
+    fn top_speed(self) -> f64 {
+        if self.3 > 0 {
+            f64::from(self.3)
+        } else {
+            POSITIONING_RPM
+        }
     }
 
     fn degrees(self) -> f64 {
@@ -76,14 +87,14 @@ impl Positioning {
     }
 
     /// The speed the drive commands this period: as fast as it can still stop on the goal
-    /// (braking at `acceleration`), at most [`POSITIONING_RPM`], the last degrees closing in
+    /// (braking at `acceleration`), at most the command's speed, the last degrees closing in
     /// exponentially.
     pub fn speed(&self, turned: f64, acceleration: f64) -> f64 {
         let rest = self.goal - turned;
         // Degrees to stop from n rpm at a rpm/s: 3·n²/a, so n = √(a·rest/3); 90 % of it.
         let braking = 0.9 * (acceleration.max(0.0) * rest.abs() / 3.0).sqrt();
         let closing = rest.abs() / 360.0 * 60.0 / TIME_CONSTANT;
-        rest.signum() * POSITIONING_RPM.min(braking).min(closing)
+        rest.signum() * self.command.top_speed().min(braking).min(closing)
     }
 
     /// Whether the spindle stands on the goal.
@@ -97,7 +108,7 @@ mod tests {
     use super::*;
 
     fn command(degrees: f64, way: Turn) -> StopCommand {
-        StopCommand((degrees * 1000.0).round() as i32, way as u8, 1)
+        StopCommand((degrees * 1000.0).round() as i32, way as u8, 1, 0)
     }
 
     #[test]
@@ -134,5 +145,11 @@ mod tests {
         assert!((p.speed(3590.0, 3000.0) - 100.0 / 3.0).abs() < 1e-9);
         assert!(p.speed(3600.5, 3000.0) < 0.0);
         assert!(p.reached(3600.01, 0.5) && !p.reached(3600.2, 0.0) && !p.reached(3600.0, 2.0));
+        // A speed from the NC (rigid tapping's S) replaces the drive's own.
+        let p = Positioning {
+            command: StopCommand(3_600_000, Turn::Incremental as u8, 2, 600),
+            goal: 3600.0,
+        };
+        assert_eq!(p.speed(0.0, 3000.0), 600.0);
     }
 }

@@ -78,6 +78,7 @@ impl Motion {
                     shift: *start_angle,
                 })
             }
+            Command::Tap { .. } => Ok(Active::Tap(self.tap_for(block, &start)?)),
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),

@@ -30,6 +30,7 @@ pub mod jog;
 mod overtravel;
 mod panel;
 mod reference;
+mod tapping;
 mod window;
 
 pub use reference::ReferenceInputs;
@@ -74,6 +75,8 @@ enum Active {
     Dwell {
         remaining: f64,
     },
+    /// Rigid tapping: the axes follow the positioned spindle (D101).
+    Tap(tapping::Tap),
     /// Waits for the axes to settle, then sends the strobe and waits for FIN.
     Aux {
         code: Aux,
@@ -813,6 +816,14 @@ impl Motion {
                 }
                 end
             }
+            Active::Tap(tap) => {
+                let mut t = *tap;
+                let done = self.tap_tick(&mut t, plc, in_pos);
+                if let Some((_, Active::Tap(tap))) = self.active.as_mut() {
+                    *tap = t;
+                }
+                done
+            }
             Active::Path => {
                 let mut out = [0.0; MAX_AXES];
                 self.finished.clear();
@@ -897,19 +908,17 @@ impl Motion {
                 }
                 *raised = true;
                 let fi = &mut self.f;
-                // A spindle position is M19 with its stop position; M19 alone stops at 0,
-                // the shortest way (D100).
-                let (code, (degrees, way)) = match *code {
-                    Aux::Orient { degrees, way } => (Aux::M(19), (degrees, way)),
-                    other => (other, (0.0, Turn::Shortest)),
-                };
-                match code {
+                match *code {
+                    // A spindle position is M19 with its stop position; M19 alone stops at
+                    // 0, the shortest way (D100).
+                    Aux::Orient { degrees, way } => {
+                        tapping::strobe_stop_position(fi, degrees, way, 0.0);
+                    }
+                    Aux::M(19) => tapping::strobe_stop_position(fi, 0.0, Turn::Shortest, 0.0),
                     Aux::M(m) => {
-                        fi.write_i32(f::ORIENT_ANGLE, (degrees * 1000.0).round() as i32);
-                        fi.bytes[f::ORIENT_WAY] = way as u8;
-                        if m == 19 {
-                            fi.bytes[f::ORIENT_COUNT] = fi.bytes[f::ORIENT_COUNT].wrapping_add(1);
-                        }
+                        fi.write_i32(f::ORIENT_ANGLE, 0);
+                        fi.bytes[f::ORIENT_WAY] = 0;
+                        fi.write_i32(f::ORIENT_SPEED, 0);
                         fi.write_i32(f::M_CODE, m);
                         fi.set(f::DM00, m == 0);
                         fi.set(f::DM01, m == 1);
@@ -926,7 +935,6 @@ impl Motion {
                         fi.write_i32(f::T_CODE, t);
                         fi.set(f::TF, true);
                     }
-                    Aux::Orient { .. } => {} // sent as M19 above
                 }
                 false
             }

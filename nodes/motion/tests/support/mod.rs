@@ -38,6 +38,7 @@ pub fn lathe() -> MotionConfig {
         feedback_lost_ticks: 3,
         dry_run_feed: 1000.0,
         reference_order: vec![0, 1],
+        spindle_max_rpm: 6000.0,
     }
 }
 
