@@ -38,6 +38,7 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     let mut setup = Setup::new(&letters, &cfg.diameter_axes(), start);
     setup.reference = cfg.home();
     setup.second_reference = cfg.second_reference();
+    setup.fixed_points = cfg.fixed_points();
     setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
     setup.tool_change_macro = cfg.machine.tool_change_macro;
     setup.tool_change_with_m6 = cfg.machine.tool_change_with_m6;

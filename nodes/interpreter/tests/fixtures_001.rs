@@ -447,7 +447,11 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("028", Some((12080, 12)), "template"),
     ("029", Some((12080, 12)), "template"),
     ("030", Some((12080, 13)), "template"),
-    ("031", Some((12140, 6)), "G75"),
+    (
+        "031",
+        Some((17020, 6)),
+        "this test's mill has no fixed points: f031_… runs it on sim_mill_802d",
+    ),
     ("032", Some((12140, 7)), "probing"),
     ("033", Some((12140, 7)), "tangential control"),
     ("034", Some((12080, 8)), "template"),

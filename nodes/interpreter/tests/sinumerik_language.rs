@@ -310,3 +310,77 @@ fn m30_counts_the_part_in_the_total_and_actual_counters() {
     assert_eq!(counters(7.0, 5.0, 4.0, "G0 X1\nM2\n"), [8.0, 5.0, 0.0]);
     assert_eq!(counters(999_999_999.0, 0.0, 0.0, "M30\n"), [0.0, 0.0, 1.0]);
 }
+
+/// 031 (§9.3.10) on `launch_configs/sim_mill_802d.yaml`: G75 FP=1 takes Z to fixed point 1,
+/// FP=2 X and Y to fixed point 2 (the tool change position), at rapid in machine
+/// coordinates whatever the offsets; FP defaults to 1; a point the machine data lacks, an FP
+/// outside 1…4 and FP without G75 stop the block (D102).
+#[test]
+fn f031_g75_approaches_the_fixed_points_of_the_machine_data() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../launch_configs/sim_mill_802d.yaml"
+    );
+    let cfg = cnc_runtime::LaunchConfig::from_yaml(&std::fs::read_to_string(path).unwrap())
+        .expect("sim_mill_802d");
+    let mut setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
+    // A work offset and a frame, which G75 ignores.
+    setup
+        .offsets
+        .work
+        .insert(0, [('X', 100.0), ('Z', -50.0)].into_iter().collect());
+    let fixture = std::fs::read_dir(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/fixtures/001"
+    ))
+    .unwrap()
+    .map(|e| e.unwrap().path())
+    .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("031"))
+    .unwrap();
+    let text = format!(
+        "G54 TRANS Y7\nG0 X1 Y2 Z3\n{}",
+        std::fs::read_to_string(fixture).unwrap()
+    );
+    let mut front = Sinumerik::new(&text, setup.clone(), Library::new());
+    let mut out = Vec::new();
+    while let Some(c) = next_command(&mut front).unwrap() {
+        out.push(c.command);
+    }
+    let rapids: Vec<&[f64]> = out
+        .iter()
+        .filter_map(|c| match c {
+            Command::Rapid { end } => Some(end.as_slice()),
+            _ => None,
+        })
+        .collect();
+    let fp = cfg.fixed_points();
+    // X1 Y2 Z3 in G54 + TRANS: machine X101 Y9 Z−47; then Z to FP 1, then X and Y to FP 2.
+    assert_eq!(rapids[0], [101.0, 9.0, -47.0]);
+    assert_eq!(rapids[1], [101.0, 9.0, fp[2][0]]);
+    assert_eq!(rapids[2], [fp[0][1], fp[1][1], fp[2][0]]);
+    assert_eq!(rapids[2], [450.0, 350.0, 350.0]);
+    // FP omitted: fixed point 1.
+    let mut f = Sinumerik::new("G0 X20\nG75 X1=0\n", setup.clone(), Library::new());
+    let mut ends = Vec::new();
+    while let Some(c) = next_command(&mut f).unwrap() {
+        ends.extend(c.command.end().map(<[f64]>::to_vec));
+    }
+    assert_eq!(ends, [vec![20.0, 0.0, 150.0], vec![0.0, 0.0, 150.0]]);
+    for (bad, number) in [
+        ("G75 FP=3 Z1=0\n", 17020),
+        ("G75 FP=5 Z1=0\n", 17020),
+        ("G75 FP=1.5 Z1=0\n", 17020),
+        ("G75 FP=1\n", 12080),
+        ("G1 X10 F100 FP=1\n", 12080),
+    ] {
+        let mut f = Sinumerik::new(bad, setup.clone(), Library::new());
+        let e = loop {
+            match next_command(&mut f) {
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("{bad} ran"),
+                Err(e) => break e,
+            }
+        };
+        assert_eq!((e.number, e.line), (number, 1), "{bad}: {e:?}");
+    }
+}

@@ -59,6 +59,8 @@ pub struct Setup {
     pub reference: Vec<f64>,
     /// Machine coordinates of the second reference point (where a mill changes tools).
     pub second_reference: Vec<f64>,
+    /// Per axis, the machine's fixed points 1, 2, … (machine coordinates; none: empty).
+    pub fixed_points: Vec<Vec<f64>>,
     pub offsets: Offsets,
     /// Kept macro variables, by number.
     pub kept: BTreeMap<i64, f64>,
@@ -108,6 +110,7 @@ impl Setup {
                 .collect(),
             reference: start.clone(),
             second_reference: start.clone(),
+            fixed_points: vec![Vec::new(); start.len()],
             start,
             offsets: Offsets::default(),
             kept: BTreeMap::new(),

@@ -112,9 +112,9 @@ impl Words {
 }
 
 /// Multi-letter addresses the control reads with `=` (§9.1.3, §9.1.6).
-const ADDRESSES: [&str; 19] = [
+const ADDRESSES: [&str; 20] = [
     "CR", "AR", "AP", "RP", "TURN", "RPL", "I1", "J1", "K1", "SF", "CHF", "CHR", "RND", "RNDM",
-    "FRC", "FRCM", "ANG", "OFFN", "SPOS",
+    "FRC", "FRCM", "ANG", "OFFN", "SPOS", "FP",
 ];
 
 /// Keywords this front end runs.
@@ -139,7 +139,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 27] = [
+pub const NOT_BUILT: [(&str, &str); 26] = [
     (
         "FFWON",
         "feedforward is the drives' setting, not switched by the program",
@@ -163,7 +163,6 @@ pub const NOT_BUILT: [(&str, &str); 27] = [
     ("FXS", "travel to fixed stop is not built"),
     ("SETPIECE", "tool monitoring is not built"),
     ("RESETMON", "tool monitoring is not built"),
-    ("FP", "G75 fixed point approach is not built yet"),
     ("TANG", "tangential control is not built"),
     ("TANGON", "tangential control is not built"),
     ("TANGOF", "tangential control is not built"),
@@ -183,8 +182,7 @@ pub const NOT_BUILT: [(&str, &str); 27] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 11] = [
-    (75, "G75 fixed point approach is not built yet"),
+pub const NOT_BUILT_G: [(u32, &str); 10] = [
     (147, "smooth approach and retraction (WAB) is not built"),
     (148, "smooth approach and retraction (WAB) is not built"),
     (247, "smooth approach and retraction (WAB) is not built"),

@@ -52,7 +52,16 @@ impl Sinumerik {
             return Ok(true);
         }
         if w.has_g(74) {
-            return self.reference_approach(w).map(|()| true);
+            let reference = self.core.setup.reference.clone();
+            return self
+                .machine_point_approach(w, "G74", |i| reference.get(i).copied())
+                .map(|()| true);
+        }
+        if w.has_g(75) {
+            return self.fixed_point_approach(w).map(|()| true);
+        }
+        if w.addr.contains_key("FP") {
+            return Err(self.fault(Fault::IllegalWord, "FP= belongs to G75"));
         }
         if self.frame_instruction(w)? {
             return Ok(true);
@@ -64,23 +73,61 @@ impl Sinumerik {
         Ok(false)
     }
 
-    /// G74 (§9.3.23): each axis named (`X1=0`; the value is not used) to its reference
-    /// point at rapid, in machine coordinates; an own block, not under radius compensation.
-    fn reference_approach(&mut self, w: &Words) -> Result<(), ProgramError> {
+    /// G75 (§9.3.10): the axes named to fixed point FP=n (1–4, default 1) of the machine
+    /// data (D102).
+    fn fixed_point_approach(&mut self, w: &Words) -> Result<(), ProgramError> {
+        let n = match w.get("FP") {
+            None => 1,
+            Some(v) if v.fract() == 0.0 && (1.0..=4.0).contains(&v) => v as usize,
+            Some(v) => {
+                return Err(self.fault(
+                    Fault::OutOfRange,
+                    format!(
+                        "FP={}: the fixed points are 1…4",
+                        cnc_interpreter_core::show(v)
+                    ),
+                ))
+            }
+        };
+        let points = self.core.setup.fixed_points.clone();
+        self.machine_point_approach(w, "G75", |i| {
+            points.get(i).and_then(|p| p.get(n - 1)).copied()
+        })
+    }
+
+    /// G74 (§9.3.23) and G75: each axis named (`X1=0`; the value is not used) to its point
+    /// (`point` of the axis index: the reference or a fixed point) at rapid, each axis at its
+    /// own rate, in machine coordinates, no offset applied; an own block, not under radius
+    /// compensation. An axis without the point stops the block before anything moves.
+    fn machine_point_approach(
+        &mut self,
+        w: &Words,
+        what: &str,
+        point: impl Fn(usize) -> Option<f64>,
+    ) -> Result<(), ProgramError> {
         if self.core.comp.is_some() {
             return Err(self.fault(
                 Fault::CompInCycle,
-                "G74 while radius compensation is active: G40 first",
+                format!("{what} while radius compensation is active: G40 first"),
             ));
         }
         if w.axes.is_empty() {
-            return Err(self.fault(Fault::MissingWord, "G74 names the axes: X1=0 Y1=0 Z1=0"));
+            return Err(self.fault(
+                Fault::MissingWord,
+                format!("{what} names the axes: X1=0 Y1=0 Z1=0"),
+            ));
         }
         let mut target = self.core.pos.clone();
         for (&i, _) in w.axes.iter() {
-            if let Some(r) = self.core.setup.reference.get(i) {
-                target[i] = *r;
-            }
+            target[i] = point(i).ok_or_else(|| {
+                self.fault(
+                    Fault::OutOfRange,
+                    format!(
+                        "{what}: axis {} has no such point in the machine data",
+                        self.core.setup.axes[i]
+                    ),
+                )
+            })?;
         }
         self.core.push(Command::Rapid {
             end: target.clone(),

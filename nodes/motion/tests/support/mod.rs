@@ -21,6 +21,7 @@ pub fn lathe() -> MotionConfig {
         drive_lag: 0.008,
         home: 0.0,
         second_reference: None,
+        fixed_points: Vec::new(),
         reference: None,
         overtravel: None,
     };

@@ -217,6 +217,10 @@ pub struct AxisEntry {
     /// coordinates, display units; default: the reference point (`home`).
     #[serde(default)]
     pub second_reference: Option<f64>,
+    /// Fixed points 1–4 (SINUMERIK MD30600 `$MA_FIX_POINT_POS`, approached by G75 FP=n),
+    /// machine coordinates, display units (decisions D102).
+    #[serde(default)]
+    pub fixed_points: Vec<f64>,
     /// An incremental encoder with a deceleration dog and index marks: the axis must return
     /// to its reference point (`home`) after power-on (decisions D68). Absent: an absolute
     /// encoder, referenced at power-on.
@@ -407,6 +411,14 @@ impl MachineConfig {
                 && a.following_error.is_none_or(|f| f > 0.0);
             if !ok || a.home < a.min || a.home > a.max {
                 return Err(format!("axis {}: need min < home < max and positive velocity, acceleration, jerk, in_position", a.name));
+            }
+            if a.fixed_points.len() > 4
+                || a.fixed_points.iter().any(|p| !(a.min..=a.max).contains(p))
+            {
+                return Err(format!(
+                    "axis {}: fixed_points {:?}: at most 4, each within min..max",
+                    a.name, a.fixed_points
+                ));
             }
             if let Some(r) = a.second_reference.filter(|r| !(a.min..=a.max).contains(r)) {
                 return Err(format!(

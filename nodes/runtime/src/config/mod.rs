@@ -88,6 +88,15 @@ impl LaunchConfig {
             .collect()
     }
 
+    /// Each axis's fixed points (G75), machine coordinates, display units.
+    pub fn fixed_points(&self) -> Vec<Vec<f64>> {
+        self.machine
+            .axes
+            .iter()
+            .map(|a| a.fixed_points.clone())
+            .collect()
+    }
+
     pub fn home(&self) -> Vec<f64> {
         self.machine.axes.iter().map(|a| a.home).collect()
     }
@@ -132,5 +141,24 @@ mod tests {
         assert_eq!(cfg.second_reference(), [0.0, 0.0, 80.0]);
         let e = mill_with_second_reference("150.0").unwrap_err();
         assert!(e.contains("second_reference 150"), "{e}");
+    }
+
+    /// G75's fixed points (D102): at most four per axis, each within the axis's travel.
+    #[test]
+    fn fixed_points_are_at_most_four_within_the_travel() {
+        let with = |points: &str| {
+            let text = include_str!("../../../../launch_configs/sim_mill.yaml").replace(
+                "max: 100.0, home: 0.0,",
+                &format!("max: 100.0, home: 0.0, fixed_points: {points},"),
+            );
+            LaunchConfig::from_yaml(&text)
+        };
+        let cfg = with("[90.0, -10.0]").expect("within travel");
+        assert_eq!(cfg.fixed_points()[2], [90.0, -10.0]);
+        assert!(cfg.fixed_points()[0].is_empty());
+        for bad in ["[150.0]", "[1.0, 2.0, 3.0, 4.0, 5.0]"] {
+            let e = with(bad).unwrap_err();
+            assert!(e.contains("fixed_points"), "{bad}: {e}");
+        }
     }
 }
