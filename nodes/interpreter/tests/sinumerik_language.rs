@@ -384,3 +384,76 @@ fn f031_g75_approaches_the_fixed_points_of_the_machine_data() {
         assert_eq!((e.number, e.line), (number, 1), "{bad}: {e:?}");
     }
 }
+
+/// G450/G451 (§9.6.5, D103): outside a contour run clockwise with G41 (cutter radius 5), G450
+/// rounds each outer corner with an arc of the cutter's radius around it; G451 extends the
+/// offset lines to where they cross (5 mm out on each side of a right angle) and keeps the
+/// arc only where the contour turns by 100° or more (the 135° turn at X40 Y0 here).
+#[test]
+fn g451_meets_outer_corners_at_the_intersection_up_to_a_turn_of_100_degrees() {
+    let program = |corner: &str| {
+        format!(
+            "T1 D1\nG0 G17 X-20 Y-10 Z0\nG1 F300\n{corner} G41 X0 Y0\nY30\nX40\nY0\nX20 Y20\nG40 X20 Y50\nM2\n"
+        )
+    };
+    let run_corner = |corner: &str| {
+        let mut f = Sinumerik::new(
+            &program(corner),
+            support::with_edge(11, 5.0),
+            Library::new(),
+        );
+        let mut out = Vec::new();
+        while let Some(c) = next_command(&mut f).unwrap() {
+            out.push(c.command);
+        }
+        out
+    };
+    let arcs = |out: &[Command]| -> Vec<Vec<f64>> {
+        out.iter()
+            .filter_map(|c| match c {
+                Command::Arc { center, .. } => Some(center[..2].to_vec()),
+                _ => None,
+            })
+            .collect()
+    };
+    // G450: arcs around the three outer corners X0 Y30, X40 Y30, X40 Y0.
+    let g450 = run_corner("G450");
+    assert_eq!(
+        arcs(&g450),
+        [vec![0.0, 30.0], vec![40.0, 30.0], vec![40.0, 0.0]]
+    );
+    // G451: the right-angled corners at the crossings, the 135° one still an arc.
+    let g451 = run_corner("G451");
+    assert_eq!(arcs(&g451), [vec![40.0, 0.0]]);
+    let corners: Vec<Vec<f64>> = ends(&g451).into_iter().map(|e| e[..2].to_vec()).collect();
+    for want in [[-5.0, 35.0], [45.0, 35.0]] {
+        assert!(
+            corners.iter().any(|c| near(c, &want)),
+            "{want:?} in {corners:?}"
+        );
+    }
+    // The turn from Y down to X20 Y20 (135°) keeps the arc: nothing after the start point is
+    // placed out at the far crossing of the two offsets.
+    let far = corners[1..].iter().any(|c| c[0] > 46.0 || c[1] < -6.0);
+    assert!(!far, "{corners:?}");
+    // The manual's contour (fixture 061: lines and arcs) under G451: the same end, the line
+    // to arc corners met at the crossings too, so fewer corner arcs than under G450.
+    let text = support::fixture("061");
+    let count_arcs = |text: &str| {
+        let r = support::run_with(text, support::mill(), Library::new()).ok();
+        (
+            r.out
+                .iter()
+                .filter(|c| matches!(c, Command::Arc { .. }))
+                .count(),
+            r.end(),
+        )
+    };
+    let (with_circles, end) = count_arcs(&text);
+    let (with_crossings, end_451) = count_arcs(&text.replace("G450", "G451"));
+    assert_eq!(end, end_451);
+    assert!(
+        with_crossings < with_circles,
+        "{with_crossings} vs {with_circles}"
+    );
+}

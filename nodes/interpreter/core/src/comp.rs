@@ -8,7 +8,9 @@
 //! program: an element is held until the next one shows how the two meet (decision D30 in
 //! `docs/decisions.md`):
 //! - inner corner: both offset elements are cut back to their intersection;
-//! - outer corner: an arc of radius R around the corner joins them;
+//! - outer corner: an arc of radius R around the corner joins them, or (when the front end
+//!   asks) both offset elements are extended to their intersection while the contour turns
+//!   by less than [`OUTER_INTERSECTION_LIMIT`] (decision D103);
 //! - start-up: see [`Startup`];
 //! - cancel: the held element ends at its offset end, then a line to the uncompensated point.
 //!
@@ -21,6 +23,21 @@
 use crate::geometry::{Elem, Pt};
 
 const EPS: f64 = 1e-9;
+
+/// The turn of the contour, degrees, from which an outer corner gets the arc even where the
+/// front end asks for the intersection: a sharp corner's intersection lies far out and the
+/// cutter would travel there for nothing (decision D103).
+pub const OUTER_INTERSECTION_LIMIT: f64 = 100.0;
+
+/// What the front end's modal state asks of one element (decisions D98, D103).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ElementRules {
+    /// The feed holds on the programmed contour, not at the cutter centre.
+    pub feed_on_contour: bool,
+    /// Outer corners before this element meet at the offsets' intersection (below
+    /// [`OUTER_INTERSECTION_LIMIT`]) instead of an arc.
+    pub outer_intersection: bool,
+}
 
 /// Which side of the contour the nose runs on, looking along the direction of travel in the
 /// Z–X plane drawn with +Z to the right and +X up (decision D30).
@@ -379,19 +396,18 @@ impl RadiusComp {
     }
 
     /// Takes the next programmed element, ending at `depth` along the normal; returns the
-    /// moves now certain. `on_contour`: the element's feed holds on the programmed contour,
-    /// not at the cutter centre (the front end's modal switch, D98).
+    /// moves now certain. `rules`: the front end's modal switches for it (D98, D103).
     pub fn push(
         &mut self,
         path: Elem,
         depth: f64,
         kind: Kind,
         line: u32,
-        on_contour: bool,
+        rules: ElementRules,
     ) -> Result<Vec<Out>, CompError> {
         let off = path.offset(self.offset)?;
         // The element's own feed; a corner arc before it keeps the programmed one.
-        let cut = Self::centre_feed(on_contour, &path, &off, kind);
+        let cut = Self::centre_feed(rules.feed_on_contour, &path, &off, kind);
         let course = match path {
             Elem::Line { a, b } => Some(unit(sub(b, a))),
             Elem::Arc { .. } => None,
@@ -453,7 +469,7 @@ impl RadiusComp {
             self.held = Some(hold(off, None));
             return Ok(out);
         };
-        let next = self.join(held, path, off, kind, line, &mut out)?;
+        let next = self.join(held, path, off, kind, line, rules, &mut out)?;
         self.held = Some(hold(next, None));
         Ok(out)
     }
@@ -474,8 +490,9 @@ impl RadiusComp {
     }
 
     /// Joins the held offset element to the offset of `path`: queues the held element
-    /// (trimmed, and a corner arc after it when the corner is outside) and returns the next
-    /// offset element from where it starts.
+    /// (trimmed or extended, and a corner arc after it when the corner is outside) and
+    /// returns the next offset element from where it starts.
+    #[allow(clippy::too_many_arguments)]
     fn join(
         &mut self,
         held: Held,
@@ -483,6 +500,7 @@ impl RadiusComp {
         off: Elem,
         kind: Kind,
         line: u32,
+        rules: ElementRules,
         out: &mut Vec<Out>,
     ) -> Result<Elem, CompError> {
         // An offset element runs parallel to its programmed one: same tangents (a line's
@@ -500,6 +518,25 @@ impl RadiusComp {
         }
         // The nose is on the outside of the turn when it turns away from the offset side.
         let outside = turn * self.offset < 0.0 || along <= -1.0 + 1e-9;
+        let turned = turn.abs().atan2(along).to_degrees();
+        if outside && rules.outer_intersection && turned < OUTER_INTERSECTION_LIMIT {
+            // Both offsets extended to where they cross, the crossing nearest the corner.
+            let crossing = intersections(&held.path, &off).into_iter().min_by(|a, b| {
+                len(sub(*a, corner))
+                    .partial_cmp(&len(sub(*b, corner)))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            });
+            if let Some(x) = crossing {
+                self.release(
+                    Held {
+                        path: held.path.with_end(x),
+                        ..held
+                    },
+                    out,
+                )?;
+                return Ok(off.with_start(x));
+            }
+        }
         if outside {
             let arc = Elem::Arc {
                 a: held.path.end(),
@@ -630,7 +667,7 @@ mod tests {
                 0.0,
                 f,
                 1,
-                false,
+                ElementRules::default(),
             )
             .unwrap();
         // The connecting move lands on the controlled point of the offset start: r stays 15.
@@ -644,7 +681,7 @@ mod tests {
                 0.0,
                 f,
                 2,
-                false,
+                ElementRules::default(),
             )
             .unwrap();
         // Inner corner (the shoulder): the nose centre stops at Z−19, touching the face at
@@ -668,7 +705,7 @@ mod tests {
             0.0,
             f,
             1,
-            false,
+            ElementRules::default(),
         )
         .unwrap();
         // Up (+X) then toward +Z: a right turn, so the left offset is outside.
@@ -681,7 +718,7 @@ mod tests {
                 0.0,
                 f,
                 2,
-                false,
+                ElementRules::default(),
             )
             .unwrap();
         assert_eq!(out.len(), 2, "{out:?}");
@@ -694,7 +731,7 @@ mod tests {
                 0.0,
                 f,
                 3,
-                false,
+                ElementRules::default(),
             )
             .unwrap();
         let all: Vec<Out> = out.into_iter().chain(out2).collect();
@@ -707,6 +744,53 @@ mod tests {
                 assert!((len(sub(a, c)) - 3.0).abs() < 1e-9 && (len(sub(b, c)) - 3.0).abs() < 1e-9);
             }
         }
+    }
+
+    /// Outer corners by intersection (D103): below a turn of 100° the offsets are extended
+    /// to where they cross, no arc; from 100° on the arc again.
+    #[test]
+    fn outer_corners_meet_at_the_intersection_below_the_limit() {
+        let rules = ElementRules {
+            outer_intersection: true,
+            ..ElementRules::default()
+        };
+        let f = Kind::Feed(100.0);
+        let run = |second_end: Pt| {
+            let mut c = RadiusComp::new(Side::Left, 3.0, 0, p(0.0, 0.0), Startup::Connect);
+            let mut out = c
+                .push(
+                    Elem::Line {
+                        a: p(0.0, 0.0),
+                        b: p(0.0, 10.0),
+                    },
+                    0.0,
+                    f,
+                    1,
+                    rules,
+                )
+                .unwrap();
+            let second = Elem::Line {
+                a: p(0.0, 10.0),
+                b: second_end,
+            };
+            out.extend(c.push(second, 0.0, f, 2, rules).unwrap());
+            out.extend(c.flush());
+            out
+        };
+        // A right turn of 90°: the left offsets z = −3 and r = 13 cross at (−3, 13).
+        let out = run(p(20.0, 10.0));
+        assert!(
+            !out.iter().any(|o| matches!(o.path, Elem::Arc { .. })),
+            "{out:?}"
+        );
+        assert!(close(out[1].path.end(), p(-3.0, 13.0)), "{out:?}");
+        assert!(close(out[2].path.start(), p(-3.0, 13.0)), "{out:?}");
+        // A turn of 116.6° (toward (20, 0)): past the limit, the arc around the corner.
+        let out = run(p(20.0, 0.0));
+        assert!(
+            out.iter().any(|o| matches!(o.path, Elem::Arc { .. })),
+            "{out:?}"
+        );
     }
 
     #[test]
@@ -723,7 +807,7 @@ mod tests {
             0.0,
             Kind::Feed(1.0),
             1,
-            false,
+            ElementRules::default(),
         );
         assert_eq!(e.unwrap_err(), CompError::ArcVanishes);
     }
@@ -748,8 +832,12 @@ mod tests {
             (Side::Left, true, 12.0, 120.0),
         ] {
             let mut c = RadiusComp::new(side, 2.0, 0, p(-10.0, 0.0), Startup::Connect);
-            let mut out = c.push(line, 0.0, Kind::Feed(100.0), 1, on).unwrap();
-            out.extend(c.push(arc, 0.0, Kind::Feed(100.0), 2, on).unwrap());
+            let rules = ElementRules {
+                feed_on_contour: on,
+                ..ElementRules::default()
+            };
+            let mut out = c.push(line, 0.0, Kind::Feed(100.0), 1, rules).unwrap();
+            out.extend(c.push(arc, 0.0, Kind::Feed(100.0), 2, rules).unwrap());
             out.extend(c.flush());
             let arcs: Vec<(f64, Kind)> = out
                 .iter()

@@ -332,9 +332,12 @@ impl Core {
                 _ => return Ok(()),
             }
         } else {
-            let on_contour = self.feed_on_contour;
+            let rules = crate::comp::ElementRules {
+                feed_on_contour: self.feed_on_contour,
+                outer_intersection: self.outer_intersection,
+            };
             let pushed = match self.comp.as_mut() {
-                Some(comp) => comp.push(path, depth, ck, line, on_contour),
+                Some(comp) => comp.push(path, depth, ck, line, rules),
                 None => Ok(Vec::new()),
             };
             pushed.map_err(|e| self.comp_fault(e))?

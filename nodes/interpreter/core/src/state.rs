@@ -103,6 +103,9 @@ pub struct Core {
     /// Under radius compensation the feed holds on the programmed contour, not at the
     /// cutter centre (decision D98).
     pub feed_on_contour: bool,
+    /// Under radius compensation outer corners meet at the offsets' intersection (below the
+    /// limit of decision D103), not on an arc around the corner.
+    pub outer_intersection: bool,
     // The spindle.
     pub spindle: SpindleDir,
     /// Constant surface speed in force, with its rule.
@@ -167,6 +170,7 @@ impl Core {
             feed_per_rev: false,
             exact_stop_mode: false,
             feed_on_contour: false,
+            outer_intersection: false,
             spindle: SpindleDir::Stopped,
             css: None,
             css_speed: 0.0,

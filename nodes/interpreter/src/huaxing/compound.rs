@@ -536,8 +536,14 @@ impl Fanuc<Huaxing> {
                 return Ok(out_elems);
             }
             outs.extend(
-                comp.push(*e, 0.0, comp::Kind::Feed(1.0), 0, false)
-                    .map_err(|x| self.core.comp_fault(x))?,
+                comp.push(
+                    *e,
+                    0.0,
+                    comp::Kind::Feed(1.0),
+                    0,
+                    comp::ElementRules::default(),
+                )
+                .map_err(|x| self.core.comp_fault(x))?,
             );
         }
         outs.extend(comp.flush());

@@ -182,7 +182,7 @@ pub const NOT_BUILT: [(&str, &str); 26] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 10] = [
+pub const NOT_BUILT_G: [(u32, &str); 9] = [
     (147, "smooth approach and retraction (WAB) is not built"),
     (148, "smooth approach and retraction (WAB) is not built"),
     (247, "smooth approach and retraction (WAB) is not built"),
@@ -192,10 +192,6 @@ pub const NOT_BUILT_G: [(u32, &str); 10] = [
     (
         291,
         "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill",
-    ),
-    (
-        451,
-        "G451 (intersection at outer corners) is not built: G450 transition circles",
     ),
     (62, "corner deceleration G62/G621 is not built"),
     (621, "corner deceleration G62/G621 is not built"),
@@ -643,6 +639,8 @@ impl Sinumerik {
                         self.core.push(Command::PathMode { exact_stop: exact });
                     }
                 }
+                // The corners of radius compensation (§9.6.5, D103).
+                450 | 451 => self.core.outer_intersection = g == 451,
                 500 => self.set_work_offset(None),
                 // G54–G59 are the 1st–6th settable offsets, G507–G554 the 7th–54th (§9.2.10).
                 54..=59 => self.set_work_offset(Some((g - 54) as u8)),
