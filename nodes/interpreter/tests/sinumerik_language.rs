@@ -250,8 +250,8 @@ fn offn_widens_the_compensated_offset_and_past_the_centre_changes_its_side() {
     assert!(e.text.contains("OFFN"), "{}", e.text);
     let (_, e) = run("OFFN=1EX6\nM2\n");
     assert_eq!(e.map(|e| e.number), Some(17020));
-    // Neither is a D change (12140) nor a G41↔G42 switch (10752) under compensation.
-    for (extra, number) in [("D2\n", 12140), ("G42 X1\n", 10752)] {
+    // Nor is a D change under compensation (12140).
+    for (extra, number) in [("D2\n", 12140)] {
         let mut front = Sinumerik::new(&program("", extra), s.clone(), Library::new());
         let e = loop {
             match next_command(&mut front) {
@@ -456,4 +456,55 @@ fn g451_meets_outer_corners_at_the_intersection_up_to_a_turn_of_100_degrees() {
         with_crossings < with_circles,
         "{with_crossings} vs {with_circles}"
     );
+}
+
+/// §9.6.7 (D104): G42 after G41 (or G41 again) without G40: the last element of the old
+/// compensation ends normal to its end point, a line goes to the next element's offset
+/// start on the new side, normal to it, and compensation goes on there.
+#[test]
+fn g41_to_g42_or_g41_again_ends_normal_and_starts_normal_without_g40() {
+    let program = |again: &str| {
+        format!(
+            "T1 D1\nG0 X-20 Y-10 Z0\nG1 F300 G41 X0 Y0\nY30\n{again} X40\nY0\nG40 X60 Y-10\nM2\n"
+        )
+    };
+    let corners = |again: &str| {
+        let mut f = Sinumerik::new(&program(again), support::with_edge(11, 5.0), Library::new());
+        let mut out = Vec::new();
+        while let Some(c) = next_command(&mut f).unwrap() {
+            out.push(c.command);
+        }
+        assert!(
+            !out.iter().any(|c| matches!(c, Command::Arc { .. })) || again == "G41",
+            "{out:?}"
+        );
+        ends(&out)
+            .into_iter()
+            .map(|e| [e[0], e[1]])
+            .collect::<Vec<_>>()
+    };
+    // Up X0 on the left (X−5) to Y30, normal there; then on the right of the way to X40
+    // (Y25), from its start normal to it (X0 Y25); the corner at X40 Y30 is inside on the
+    // right (X35 Y25); G40 from the last element's end.
+    let switched = corners("G42");
+    let want = [
+        [-5.0, 30.0],
+        [0.0, 25.0],
+        [35.0, 25.0],
+        [35.0, 0.0],
+        [60.0, -10.0],
+    ];
+    for w in want {
+        assert!(
+            switched.iter().any(|c| near(c, &w)),
+            "{w:?} in {switched:?}"
+        );
+    }
+    let at = |p: [f64; 2]| switched.iter().position(|c| near(c, &p)).unwrap();
+    assert!(at([-5.0, 30.0]) + 1 == at([0.0, 25.0]), "{switched:?}");
+    // G41 again: normal at X−5 Y30, then to X0 Y35, the left of the way to X40.
+    let again = corners("G41");
+    let at = |p: [f64; 2]| again.iter().position(|c| near(c, &p));
+    let (end, start) = (at([-5.0, 30.0]), at([0.0, 35.0]));
+    assert!(end.is_some() && start == end.map(|e| e + 1), "{again:?}");
 }

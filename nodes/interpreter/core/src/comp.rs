@@ -12,7 +12,9 @@
 //!   asks) both offset elements are extended to their intersection while the contour turns
 //!   by less than [`OUTER_INTERSECTION_LIMIT`] (decision D103);
 //! - start-up: see [`Startup`];
-//! - cancel: the held element ends at its offset end, then a line to the uncompensated point.
+//! - cancel: the held element ends at its offset end, then a line to the uncompensated point;
+//! - restart (a new side or radius without a cancel): the held element ends at its offset
+//!   end, then a line to the next element's new offset start (decision D104).
 //!
 //! On the mill the same geometry serves cutter radius compensation (tip 0: the programmed
 //! point is the cutter's centre line). Moves along the plane's normal (Z in G17) with no
@@ -134,6 +136,8 @@ pub struct RadiusComp {
     offset: f64,
     /// From nose centre to imaginary tip.
     tip: Pt,
+    /// The tip direction `tip` was made from (a restart makes it again for its radius).
+    tip_direction: u8,
     start: Start,
     /// The [`Startup::ToNextElement`] start-up element, waiting for the element after it.
     startup: Option<(Pt, Elem, f64, Kind, u32)>,
@@ -327,6 +331,7 @@ impl RadiusComp {
         RadiusComp {
             offset,
             tip: tip_vector(tip, radius),
+            tip_direction: tip,
             start: Start::Pending(startup, from),
             startup: None,
             held: None,
@@ -567,6 +572,21 @@ impl RadiusComp {
             out,
         )?;
         Ok(off.with_start(x))
+    }
+
+    /// A new compensation on `side` with `radius` without a cancel (the same side again, the
+    /// other side, a new radius): the held element ends normal to its end (no corner), and
+    /// the next element pushed starts from there with a line to its new offset start.
+    /// Returns the moves now certain; `here`: the controlled point when nothing was held.
+    pub fn restart(&mut self, side: Side, radius: f64, here: Pt) -> Vec<Out> {
+        let out = self.flush();
+        let from = out
+            .last()
+            .map(|o| o.path.end())
+            .or_else(|| self.startup_point())
+            .unwrap_or(here);
+        *self = RadiusComp::new(side, radius, self.tip_direction, from, Startup::Connect);
+        out
     }
 
     /// Cancel (G40): the held element to its offset end, then a line to `target`

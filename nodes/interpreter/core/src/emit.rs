@@ -237,6 +237,7 @@ impl Core {
         let from = self.plane_point(&self.work_position())?;
         self.comp = Some(RadiusComp::new(side, radius, tip, from, startup));
         self.comp_cancel = false;
+        self.comp_restart = None;
         Ok(())
     }
 
@@ -336,8 +337,20 @@ impl Core {
                 feed_on_contour: self.feed_on_contour,
                 outer_intersection: self.outer_intersection,
             };
+            let restart = self.comp_restart.take();
             let pushed = match self.comp.as_mut() {
-                Some(comp) => comp.push(path, depth, ck, line, rules),
+                Some(comp) => {
+                    // A new side or radius: the old ends normal to its last element, this
+                    // element starts the new (D104).
+                    let mut outs = match restart {
+                        Some((side, radius)) => comp.restart(side, radius, from),
+                        None => Vec::new(),
+                    };
+                    comp.push(path, depth, ck, line, rules).map(|more| {
+                        outs.extend(more);
+                        outs
+                    })
+                }
                 None => Ok(Vec::new()),
             };
             pushed.map_err(|e| self.comp_fault(e))?

@@ -122,6 +122,9 @@ pub struct Core {
     pub comp: Option<RadiusComp>,
     /// Compensation ends with the next move.
     pub comp_cancel: bool,
+    /// Compensation starts over on this side with this radius at the next move, without a
+    /// cancel (decision D104).
+    pub comp_restart: Option<(crate::comp::Side, f64)>,
     pub corner: Option<Corner>,
     pub chip_break: Option<ChipBreak>,
     /// While compensation holds an element back, commands from this index of `pending` on
@@ -179,6 +182,7 @@ impl Core {
             max_rpm: None,
             comp: None,
             comp_cancel: false,
+            comp_restart: None,
             corner: None,
             chip_break: None,
             hold_at: None,

@@ -84,6 +84,9 @@ pub struct Sinumerik {
     preselected: Option<u32>,
     /// G41/G42 asked for; started with the next move.
     comp_side: Option<Side>,
+    /// G41/G42 programmed again while compensation runs: it starts over with the next move
+    /// (§9.6.7, D104).
+    comp_again: bool,
     /// The path's direction at the end of the last move in the plane (CT continues it).
     tangent: Option<Pt>,
     /// Each program level's own `DEF` variables, innermost last.
@@ -189,6 +192,7 @@ impl Sinumerik {
             edge: u32::from(tool > 0),
             preselected: None,
             comp_side: None,
+            comp_again: false,
             tangent: None,
             scopes: vec![Scope::new()],
             may_define: vec![true],

@@ -58,6 +58,7 @@ impl Sinumerik {
                 if g == 40 && self.core.comp.is_some() {
                     self.core.comp_cancel = true;
                 }
+                self.comp_again = g != 40 && self.core.comp.is_some();
             }
         }
         Ok(())
@@ -120,17 +121,7 @@ impl Sinumerik {
         let Some(side) = self.comp_side else {
             return Ok(());
         };
-        if let Some(c) = &self.core.comp {
-            // The side compensation runs on, which a negative OFFN may have turned.
-            let flipped = self
-                .offset_entry()
-                .is_some_and(|e| e.radius + self.contour_offset < 0.0);
-            if (c.side() != side) != flipped {
-                return Err(self.fault(
-                    Fault::CompDirection,
-                    "a switch between G41 and G42 without G40 is not built: G40 first",
-                ));
-            }
+        if self.core.comp.is_some() && !std::mem::take(&mut self.comp_again) {
             return Ok(());
         }
         if !matches!(self.motion, Motion::Rapid | Motion::Line) {
@@ -164,8 +155,15 @@ impl Sinumerik {
         };
         // Compensation runs in the program's coordinates: the radius there is the tool's
         // divided by the frame's scale, so the machine path keeps the tool's radius.
+        let radius = offset.abs() / factor;
+        if self.core.comp.is_some() {
+            // G41/G42 again without G40 (the same side or the other): the old ends normal to
+            // its last element, the new starts normal to this one (§9.6.7, D104).
+            self.core.comp_restart = Some((side, radius));
+            return Ok(());
+        }
         self.core
-            .start_comp(side, offset.abs() / factor, 0, Startup::ToNextElement)
+            .start_comp(side, radius, 0, Startup::ToNextElement)
     }
 
     /// OFFN=: taken up by the next start of compensation; a change while it is active is
