@@ -236,32 +236,65 @@ fn offn_widens_the_compensated_offset_and_past_the_centre_changes_its_side() {
         &start(&program("OFFN=2", "OFFN=2\n")),
         &[-7.0, 0.0, 5.0]
     ));
-    // A change while compensation is active is not built: 12140, before the machine moves
-    // on the changed path.
-    let mut front = Sinumerik::new(&program("OFFN=2", "OFFN=3\n"), s.clone(), Library::new());
-    let e = loop {
-        match next_command(&mut front) {
-            Ok(Some(_)) => {}
-            Ok(None) => panic!("ran"),
-            Err(e) => break e,
-        }
-    };
-    assert_eq!((e.number, e.line), (12140, 5), "{e:?}");
-    assert!(e.text.contains("OFFN"), "{}", e.text);
     let (_, e) = run("OFFN=1EX6\nM2\n");
     assert_eq!(e.map(|e| e.number), Some(17020));
-    // Nor is a D change under compensation (12140).
-    for (extra, number) in [("D2\n", 12140)] {
-        let mut front = Sinumerik::new(&program("", extra), s.clone(), Library::new());
-        let e = loop {
+}
+
+/// §9.6.7 "补偿号的更换" (D105): a new edge (D) or OFFN under compensation changes the
+/// radius along the next move in the plane, from the old at its start to the new at its
+/// end, and holds after it; carried by an arc it is refused (12140), and one that would put
+/// the path past the contour (changing sides) is the compensation-direction alarm 10752.
+#[test]
+fn a_new_edge_or_offn_under_compensation_changes_the_radius_along_the_next_line() {
+    let mut s = support::with_edge(11, 5.0);
+    s.offsets.tools.insert(
+        12,
+        cnc_interpreter_core::ToolOffset {
+            radius: 3.0,
+            ..Default::default()
+        },
+    );
+    // Up X0 with G41 (the cutter on −X) from Y0 to Y40, then along +X at Y40.
+    let program = |change: &str, up: &str| {
+        format!("T1 D1\nG0 X-20 Y0 Z5\nG1 G41 X0 Y0 F500\n{change}\n{up}\nX40\nG40 X60 Y60\nM2\n")
+    };
+    let run_ends = |text: &str| -> Result<Vec<Vec<f64>>, (u32, u32)> {
+        let mut front = Sinumerik::new(text, s.clone(), Library::new());
+        let mut out = Vec::new();
+        loop {
             match next_command(&mut front) {
-                Ok(Some(_)) => {}
-                Ok(None) => panic!("{extra} ran"),
-                Err(e) => break e,
+                Ok(Some(c)) => out.push(c.command),
+                Ok(None) => return Ok(ends(&out)),
+                Err(e) => return Err((e.number, e.line)),
             }
-        };
-        assert_eq!((e.number, e.line), (number, 5), "{e:?}");
+        }
+    };
+    for (change, at_start, at_end) in [
+        ("D2", -5.0, -3.0),
+        ("OFFN=3", -5.0, -8.0),
+        ("OFFN=0", -5.0, -5.0),
+    ] {
+        let ends = run_ends(&program(change, "Y40")).unwrap_or_else(|e| panic!("{change}: {e:?}"));
+        // The start-up move ends normal to the first element at the old radius; the line up
+        // ends at the new one, and the element along X40 is offset by it.
+        assert!(near(&ends[1], &[at_start, 0.0, 5.0]), "{change}: {ends:?}");
+        let up = ends.iter().find(|e| (e[1] - 40.0).abs() < 1e-6).unwrap();
+        assert!(near(up, &[at_end, 40.0, 5.0]), "{change}: {ends:?}");
+        let r = -at_end;
+        assert!(
+            ends.iter().any(|e| near(e, &[40.0, 40.0 + r, 5.0])),
+            "{change}: {ends:?}"
+        );
     }
+    // Carried by an arc: refused with the reason; past the contour: 10752.
+    assert_eq!(
+        run_ends(&program("D2", "G2 X0 Y40 I0 J20")).unwrap_err(),
+        (12140, 5)
+    );
+    assert_eq!(
+        run_ends(&program("OFFN=-10", "Y40")).unwrap_err(),
+        (10752, 4)
+    );
 }
 
 #[test]

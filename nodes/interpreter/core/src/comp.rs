@@ -100,6 +100,8 @@ pub enum CompError {
     /// Trimmed at both corners, an offset line would run against its programmed direction:
     /// the tool would cut into the contour (the interference check of ISO controls).
     Interference,
+    /// A new radius was asked for with an arc as the element that carries the change.
+    RadiusChangeOnArc,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -138,6 +140,8 @@ pub struct RadiusComp {
     tip: Pt,
     /// The tip direction `tip` was made from (a restart makes it again for its radius).
     tip_direction: u8,
+    /// A new radius the next element changes to along its length (decision D105).
+    radius_to: Option<f64>,
     start: Start,
     /// The [`Startup::ToNextElement`] start-up element, waiting for the element after it.
     startup: Option<(Pt, Elem, f64, Kind, u32)>,
@@ -332,6 +336,7 @@ impl RadiusComp {
             offset,
             tip: tip_vector(tip, radius),
             tip_direction: tip,
+            radius_to: None,
             start: Start::Pending(startup, from),
             startup: None,
             held: None,
@@ -410,7 +415,29 @@ impl RadiusComp {
         line: u32,
         rules: ElementRules,
     ) -> Result<Vec<Out>, CompError> {
-        let off = path.offset(self.offset)?;
+        let starting = matches!(self.start, Start::Pending(..));
+        let off = match self.radius_to.take() {
+            // Before the first element the new radius holds from the start.
+            Some(r) if starting => {
+                self.set_radius(r);
+                path.offset(self.offset)?
+            }
+            // The offset grows or shrinks along the line, from the old radius at its start
+            // to the new at its end (decision D105).
+            Some(r) => {
+                let Elem::Line { a, b } = path else {
+                    return Err(CompError::RadiusChangeOnArc);
+                };
+                let n = left(unit(sub(b, a)));
+                let from = add(a, scale(n, self.offset));
+                self.set_radius(r);
+                Elem::Line {
+                    a: from,
+                    b: add(b, scale(n, self.offset)),
+                }
+            }
+            None => path.offset(self.offset)?,
+        };
         // The element's own feed; a corner arc before it keeps the programmed one.
         let cut = Self::centre_feed(rules.feed_on_contour, &path, &off, kind);
         let course = match path {
@@ -572,6 +599,21 @@ impl RadiusComp {
             out,
         )?;
         Ok(off.with_start(x))
+    }
+
+    /// A new radius (a new cutting edge under compensation): the next element changes from
+    /// the old radius at its start to this one at its end, and the elements after it run
+    /// with it (decision D105). The side stays.
+    pub fn change_radius(&mut self, radius: f64) {
+        self.radius_to = Some(radius.abs());
+    }
+
+    fn set_radius(&mut self, radius: f64) {
+        self.offset = match self.side() {
+            Side::Left => radius,
+            Side::Right => -radius,
+        };
+        self.tip = tip_vector(self.tip_direction, radius);
     }
 
     /// A new compensation on `side` with `radius` without a cancel (the same side again, the

@@ -257,6 +257,11 @@ impl Core {
                 Fault::CompStartNotLine,
                 "it cannot start in an arc: start it in a G00/G01 block",
             ),
+            CompError::RadiusChangeOnArc => (
+                Fault::NotSupported,
+                "a new tool radius changes along a straight block: program the new edge before a \
+                 G1 block, not an arc",
+            ),
             CompError::Interference => (
                 Fault::CompInterference,
                 "the tool would cut into the contour here (interference)",

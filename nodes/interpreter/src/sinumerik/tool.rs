@@ -41,12 +41,7 @@ impl Sinumerik {
             }
             self.edge = d as u32;
             self.apply_length();
-            if self.core.comp.is_some() {
-                return Err(self.fault(
-                    Fault::NotSupported,
-                    "a D change under radius compensation is not built yet: G40 first",
-                ));
-            }
+            self.change_compensation_radius()?;
         }
         for g in [40, 41, 42] {
             if w.has_g(g) {
@@ -127,6 +122,30 @@ impl Sinumerik {
         if !matches!(self.motion, Motion::Rapid | Motion::Line) {
             return Err(self.fault(Fault::CompStartNotLine, "G41/G42 start in a G0 or G1 block"));
         }
+        let offset = self.compensation_offset()?;
+        // OFFN widens the offset (an allowance, half a slot's width); past the centre line
+        // the path lies on the other side, which is how the manual switches G41↔G42 with a
+        // negative OFFN (D96).
+        let side = match side {
+            Side::Left if offset < 0.0 => Side::Right,
+            Side::Right if offset < 0.0 => Side::Left,
+            s => s,
+        };
+        let radius = offset.abs();
+        if self.core.comp.is_some() {
+            // G41/G42 again without G40 (the same side or the other): the old ends normal to
+            // its last element, the new starts normal to this one (§9.6.7, D104).
+            self.core.comp_restart = Some((side, radius));
+            return Ok(());
+        }
+        self.core
+            .start_comp(side, radius, 0, Startup::ToNextElement)
+    }
+
+    /// The signed offset of compensation in the program's coordinates: the active edge's
+    /// radius plus OFFN, divided by the frame's scale (so the machine path keeps the tool's
+    /// radius); negative: past the centre line, on the other side.
+    fn compensation_offset(&self) -> Result<f64, ProgramError> {
         let entry = self.offset_entry().ok_or_else(|| {
             self.fault(
                 Fault::CompRadiusZero,
@@ -144,41 +163,44 @@ impl Sinumerik {
                 ))
             }
         };
-        // OFFN widens the offset (an allowance, half a slot's width); past the centre line
-        // the path lies on the other side, which is how the manual switches G41↔G42 with a
-        // negative OFFN (D96).
-        let offset = entry.radius + self.contour_offset;
-        let side = match side {
-            Side::Left if offset < 0.0 => Side::Right,
-            Side::Right if offset < 0.0 => Side::Left,
-            s => s,
-        };
-        // Compensation runs in the program's coordinates: the radius there is the tool's
-        // divided by the frame's scale, so the machine path keeps the tool's radius.
-        let radius = offset.abs() / factor;
-        if self.core.comp.is_some() {
-            // G41/G42 again without G40 (the same side or the other): the old ends normal to
-            // its last element, the new starts normal to this one (§9.6.7, D104).
-            self.core.comp_restart = Some((side, radius));
-            return Ok(());
-        }
-        self.core
-            .start_comp(side, radius, 0, Startup::ToNextElement)
+        Ok((entry.radius + self.contour_offset) / factor)
     }
 
-    /// OFFN=: taken up by the next start of compensation; a change while it is active is
-    /// not built (as a D change there is not).
+    /// A new edge or OFFN while compensation runs (§9.6.7 "补偿号的更换"): the new radius
+    /// takes effect along the next move in the plane, from the old at its start to the new
+    /// at its end (D105). Past the centre line it would change sides: refused.
+    fn change_compensation_radius(&mut self) -> Result<(), ProgramError> {
+        if self.core.comp.is_none() {
+            return Ok(());
+        }
+        let offset = self.compensation_offset()?;
+        let side = self.core.comp.as_ref().map(|c| c.side());
+        let started = self.comp_side;
+        let same_side = (offset >= 0.0) == (side == started);
+        if !same_side {
+            return Err(self.fault(
+                Fault::CompDirection,
+                "the new radius and OFFN put the path past the contour, on the other side: \
+                 change sides with G41/G42",
+            ));
+        }
+        if let Some(c) = self.core.comp.as_mut() {
+            c.change_radius(offset.abs());
+        }
+        Ok(())
+    }
+
+    /// OFFN=: taken up by the next start of compensation, or under compensation along the
+    /// next move (D105).
     pub(super) fn set_contour_offset(&mut self, offn: f64) -> Result<(), ProgramError> {
         if !offn.is_finite() || offn.abs() > 10_000.0 {
             return Err(self.fault(Fault::OutOfRange, "OFFN= is within ±10000 mm"));
         }
-        if self.core.comp.is_some() && offn != self.contour_offset {
-            return Err(self.fault(
-                Fault::NotSupported,
-                "an OFFN change under radius compensation is not built yet: G40 first",
-            ));
-        }
+        let changed = offn != self.contour_offset;
         self.contour_offset = offn;
+        if changed {
+            self.change_compensation_radius()?;
+        }
         Ok(())
     }
 }
