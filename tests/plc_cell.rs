@@ -953,3 +953,44 @@ fn g331_and_g332_tap_with_the_slide_locked_to_the_simulated_spindle() {
     assert!(deepest >= ends[0].0 - 1e-3, "{deepest} below {}", ends[0].0);
     assert!(worst < 0.1, "{worst}");
 }
+
+/// Fixture 040 (§9.3.19, D106) through motion and the simulated drives: FFWON before a
+/// move at F900 takes the following error (an axis's distance from its commanded position,
+/// which a drive with an 8 ms lag makes 0.105 mm on X at 13.1 mm/s) to almost nothing; the same
+/// program with FFWOF keeps it. The template's placeholders filled: the move and one back.
+#[test]
+fn f040_ffwon_takes_the_following_error_to_almost_nothing() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
+    let path = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("040"))
+        .unwrap();
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("N20 G1 X... Y... Z... F900", "N20 G1 X200 Y100 Z100 F900")
+        .replace("\n...\n", "\nN30 X0 Y0 Z150\n")
+        + "M30\n";
+    let worst = |text: &str| {
+        let cfg = config("sim_mill_802d");
+        let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+        let mut r = Rig::on(cfg, text, Some(&kept));
+        r.run_until(0.1, |_| false);
+        r.started = true;
+        let mut worst = 0.0f64;
+        let ok = r.run_until(120.0, |r| {
+            for (c, a) in r.motion.commanded().iter().zip(&r.fb.position) {
+                worst = worst.max((c - a).abs());
+            }
+            r.program_done()
+        });
+        assert!(ok, "program did not finish; events {:?}", r.events);
+        worst
+    };
+    let with = worst(&text);
+    let without = worst(&text.replace("N10 FFWON", "N10 FFWOF"));
+    println!("largest following error: {with:.5} mm with FFWON, {without:.5} mm without");
+    // X runs at 15 mm/s × 200/229 = 13.1 mm/s: 8 ms behind is 0.105 mm.
+    assert!(without > 0.09, "{without}");
+    assert!(with < without / 10.0, "{with} vs {without}");
+}

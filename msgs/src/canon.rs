@@ -60,6 +60,12 @@ pub enum Command {
     Profile {
         jerk_limited: bool,
     },
+    /// Feedforward of the drives on or off for the moves that follow: the axes' velocity
+    /// times their drive lag is added to the setpoint, so the slides follow the path with
+    /// (nearly) no following error. A run starts with it off.
+    Feedforward {
+        on: bool,
+    },
     /// An M, S or T function for the PLC, which answers with FIN.
     Aux(Aux),
     /// M02/M30: the program is finished; motion completes everything before it.
@@ -204,6 +210,10 @@ pub fn to_motion_block(
             m.kind = MotionBlock::KIND_PROFILE;
             m.flag = *jerk_limited;
         }
+        Command::Feedforward { on } => {
+            m.kind = MotionBlock::KIND_FEEDFORWARD;
+            m.flag = *on;
+        }
         Command::Aux(aux) => {
             m.kind = MotionBlock::KIND_AUX;
             (m.aux_kind, m.aux_code, m.aux_value) = match *aux {
@@ -287,6 +297,7 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
         MotionBlock::KIND_PROFILE => Command::Profile {
             jerk_limited: m.flag,
         },
+        MotionBlock::KIND_FEEDFORWARD => Command::Feedforward { on: m.flag },
         MotionBlock::KIND_DWELL if m.dwell_seconds.is_finite() && m.dwell_seconds >= 0.0 => {
             Command::Dwell {
                 seconds: m.dwell_seconds,
@@ -365,6 +376,8 @@ mod tests {
             Command::Profile {
                 jerk_limited: false,
             },
+            Command::Feedforward { on: true },
+            Command::Feedforward { on: false },
             Command::Aux(Aux::M(3)),
             Command::Aux(Aux::S(1200.0)),
             Command::Aux(Aux::T(101)),

@@ -120,6 +120,8 @@ pub struct Collected {
     pub exact_stop: Option<bool>,
     /// The acceleration profile: jerk-limited or not.
     pub jerk_limited: Option<bool>,
+    /// The drives' feedforward: on or off.
+    pub feedforward: Option<bool>,
     /// The last T: on a lathe the turret's station, on a mill the tool put ready.
     pub tool: Option<i32>,
     /// The tool the last M06 put in a mill's spindle (the T before it).
@@ -146,6 +148,7 @@ impl Collected {
             Command::FeedMode { per_rev } => self.feed_per_rev = Some(per_rev),
             Command::PathMode { exact_stop } => self.exact_stop = Some(exact_stop),
             Command::Profile { jerk_limited } => self.jerk_limited = Some(jerk_limited),
+            Command::Feedforward { on } => self.feedforward = Some(on),
             Command::Aux(Aux::T(t)) => self.tool = Some(t),
             Command::Aux(Aux::S(s)) => self.speed = Some(s),
             Command::Aux(Aux::Orient {
@@ -249,6 +252,9 @@ impl Collected {
         });
         if let Some(jerk_limited) = self.jerk_limited {
             push(Command::Profile { jerk_limited });
+        }
+        if let Some(on) = self.feedforward {
+            push(Command::Feedforward { on });
         }
         out
     }

@@ -86,6 +86,11 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         } else {
             "PROFILE_TRAPEZOIDAL"
         }),
+        Command::Feedforward { on } => s.push_str(if *on {
+            "FEEDFORWARD_ON"
+        } else {
+            "FEEDFORWARD_OFF"
+        }),
         Command::Aux(Aux::M(m)) => {
             let _ = write!(s, "M{m}");
         }
@@ -346,8 +351,9 @@ impl LinuxCnc {
                 }
             },
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
-            // rs274 has no call for the acceleration profile: its planner's is fixed.
-            Command::Profile { .. } => {}
+            // rs274 has no call for the acceleration profile (its planner's is fixed) nor for
+            // the drives' feedforward.
+            Command::Profile { .. } | Command::Feedforward { .. } => {}
         }
     }
 }

@@ -461,7 +461,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("037", Some((12080, 7)), "template"),
     ("038", Some((12080, 8)), "template"),
     ("039", Some((12140, 7)), "ACC"),
-    ("040", Some((12140, 7)), "feedforward"),
+    ("040", Some((12080, 8)), "template"),
     ("041", Some((12140, 10)), "the compressor"),
     ("042", Some((12550, 7)), "the 3-axis mill has no A"),
     ("043", Some((12080, 11)), "template"),

@@ -977,3 +977,51 @@ fn a_tap_follows_the_spindles_angle_and_ends_with_its_positioning() {
         assert_eq!(raised, [number], "{kind:?}");
     }
 }
+
+/// FFWON (D106): while a block moves the axes the drives get the commanded position plus the
+/// axis's velocity times its drive lag; at rest, after FFWOF and after a reset they get the
+/// commanded position itself.
+#[test]
+fn feedforward_leads_the_setpoint_by_velocity_times_lag_only_while_moving() {
+    let mut m = Motion::new(mill(), &[0.0, 0.0, 0.0]);
+    let lag = mill().axes[0].drive_lag;
+    assert!(lag > 0.0);
+    let kinds = [
+        Command::Feedforward { on: true },
+        Command::Linear {
+            end: vec![100.0, 0.0, 0.0],
+            feed: 3000.0,
+        },
+        Command::Feedforward { on: false },
+        Command::Linear {
+            end: vec![0.0, 0.0, 0.0],
+            feed: 3000.0,
+        },
+        Command::ProgramEnd,
+    ];
+    for (k, kind) in kinds.into_iter().enumerate() {
+        m.push(block(k as u64 + 1, k as u32 + 1, kind));
+    }
+    let g = GImage::released();
+    let mut slides = m.setpoint().to_vec();
+    let (mut led, mut plain) = (0.0f64, 0.0f64);
+    for _ in 0..20_000 {
+        let before = m.commanded().to_vec();
+        slides = m.tick(Some(&slides), &g).to_vec();
+        let v = (m.commanded()[0] - before[0]) / 0.004;
+        let lead = slides[0] - m.commanded()[0];
+        if v > 49.9 {
+            // 50 mm/s out: the lead is v × lag.
+            assert!((lead - v * lag).abs() < 1e-9, "{lead} at {v}");
+            led = led.max(lead);
+        }
+        if v < -49.9 {
+            plain = plain.max(lead.abs());
+        }
+        if m.state() == RunState::Idle {
+            break;
+        }
+    }
+    assert!(led > 0.0 && plain == 0.0, "{led} {plain}");
+    assert_eq!(slides, m.commanded());
+}

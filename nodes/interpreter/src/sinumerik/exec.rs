@@ -118,10 +118,10 @@ const ADDRESSES: [&str; 20] = [
 ];
 
 /// Keywords this front end runs.
-const KEYWORDS: [&str; 22] = [
+const KEYWORDS: [&str; 23] = [
     "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
     "STOPRE", "RET", "CFTCP", "CFC", "BRISK", "SOFT", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
-    "MCALL", "WALIMON",
+    "MCALL", "WALIMON", "FFWON",
 ];
 
 const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
@@ -139,11 +139,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 26] = [
-    (
-        "FFWON",
-        "feedforward is the drives' setting, not switched by the program",
-    ),
+pub const NOT_BUILT: [(&str, &str); 25] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
@@ -661,6 +657,8 @@ impl Sinumerik {
                 "BRISK" | "SOFT" => self.core.push(Command::Profile {
                     jerk_limited: *k == "SOFT",
                 }),
+                // The drives' feedforward (D106).
+                "FFWON" | "FFWOF" => self.core.push(Command::Feedforward { on: *k == "FFWON" }),
                 _ => {}
             }
         }

@@ -82,10 +82,12 @@ impl Motion {
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),
-            // Feed mode, path mode and profile were taken over when the block was popped.
-            Command::FeedMode { .. } | Command::PathMode { .. } | Command::Profile { .. } => {
-                Ok(Active::Dwell { remaining: 0.0 })
-            }
+            // Feed mode, path mode, profile and feedforward were taken over when the block
+            // was popped.
+            Command::FeedMode { .. }
+            | Command::PathMode { .. }
+            | Command::Profile { .. }
+            | Command::Feedforward { .. } => Ok(Active::Dwell { remaining: 0.0 }),
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
                 raised: false,

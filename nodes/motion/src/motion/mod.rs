@@ -25,6 +25,7 @@ pub use crate::alarm;
 pub use panel::Panel;
 
 mod activate;
+mod feedforward;
 pub mod handwheel;
 pub mod jog;
 mod overtravel;
@@ -110,6 +111,10 @@ pub struct Motion {
     /// The setpoint the drives get: the commanded position, or under machine lock where the
     /// slides stood when the lock was taken.
     drive: Vec<f64>,
+    /// Last tick's `drive`, for the feedforward's velocity.
+    last_drive: Vec<f64>,
+    /// FFWON: the drives get the feedforward lead (D106).
+    feedforward: bool,
     /// The axes machine lock holds, a bit per axis: all of them under machine lock, some
     /// under an axis lock (the mill's Z-axis lock); the switches are taken at rest only.
     locked: u32,
@@ -232,6 +237,8 @@ impl Motion {
             active: None,
             actual: commanded.clone(),
             drive: commanded.clone(),
+            last_drive: commanded.clone(),
+            feedforward: false,
             locked: 0,
             commanded,
             feed_hold: false,
@@ -300,8 +307,9 @@ impl Motion {
             self.active = None;
             let here = self.commanded_point();
             self.planner.reset(here);
-            // A run starts in the machine's own profile (D99).
+            // A run starts in the machine's own profile (D99), without feedforward (D106).
             self.planner.set_shape(self.cfg.shape);
+            self.feedforward = false;
             self.accepted_seq = 0;
             self.done_seq = 0;
             self.feed_hold = false;
@@ -385,6 +393,7 @@ impl Motion {
         let here = self.commanded_point();
         self.planner.reset(here);
         self.planner.set_shape(self.cfg.shape);
+        self.feedforward = false;
     }
 
     pub fn run_id(&self) -> u64 {
@@ -476,14 +485,7 @@ impl Motion {
     /// lock holds them.
     pub fn tick(&mut self, actual: Option<&[f64]>, plc: &GImage) -> &[f64] {
         self.tick_machine(actual, plc);
-        for ((e, d), s) in self
-            .encoder_setpoint
-            .iter_mut()
-            .zip(&self.drive)
-            .zip(&self.shift)
-        {
-            *e = d - s;
-        }
+        self.drive_output();
         &self.encoder_setpoint
     }
 
@@ -598,6 +600,7 @@ impl Motion {
                     Command::Profile { jerk_limited } => {
                         self.planner.set_shape(profile_shape(jerk_limited));
                     }
+                    Command::Feedforward { on } => self.feedforward = on,
                     _ => {}
                 }
                 match self.activate(&block) {

@@ -1,0 +1,37 @@
+//! Feedforward of the drives (FFWON/FFWOF; decisions D106). A drive trails a moving
+//! setpoint by its lag (velocity × time constant): the following error. With feedforward the
+//! setpoint each drive gets leads the commanded position by that much, so the slide stands on
+//! the commanded path and the following error is (nearly) zero. The lead is the axis's
+//! velocity over the last servo period, bounded by its rated speed, and is only added while a
+//! block moves the axes along the program's path, so a jump of the position (a reset taking
+//! the slides where they stand) never becomes a kick of the drive.
+
+use super::*;
+
+impl Motion {
+    /// The setpoints of this tick as the drives get them: the drive position less the
+    /// reference shift, plus the feedforward lead.
+    pub(super) fn drive_output(&mut self) {
+        let on = self.feedforward
+            && !self.servo_off
+            && matches!(
+                self.active,
+                Some((
+                    _,
+                    Active::Path | Active::Rapid { .. } | Active::Thread { .. } | Active::Tap(_)
+                ))
+            );
+        let period = self.cfg.period.max(1e-6);
+        for (i, a) in self.cfg.axes.iter().enumerate().take(self.drive.len()) {
+            let lead = if on {
+                let limit = a.max_velocity / 60.0;
+                let v = (self.drive[i] - self.last_drive[i]) / period;
+                v.clamp(-limit, limit) * a.drive_lag.max(0.0)
+            } else {
+                0.0
+            };
+            self.encoder_setpoint[i] = self.drive[i] + lead - self.shift[i];
+            self.last_drive[i] = self.drive[i];
+        }
+    }
+}
