@@ -994,3 +994,45 @@ fn f040_ffwon_takes_the_following_error_to_almost_nothing() {
     assert!(without > 0.09, "{without}");
     assert!(with < without / 10.0, "{with} vs {without}");
 }
+
+/// Fixture 063's H functions (§9.8, D107) through motion and the standard ladder: each goes
+/// to the PLC with the HF strobe, its address in F40 and its value in F44–F51, and the ladder
+/// gives FIN once settled, so the program runs to its end.
+#[test]
+fn f063_h_functions_reach_the_ladder_with_hf_and_get_fin() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
+    let path = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("063"))
+        .unwrap();
+    let text = std::fs::read_to_string(path).unwrap() + "M30\n";
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let mut r = Rig::on(cfg, &text, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let mut seen = Vec::new();
+    let mut was = false;
+    let ok = r.run_until(30.0, |r| {
+        let hf = r.nc().get(f::HF);
+        if hf && !was {
+            let mut v = [0u8; 8];
+            v.copy_from_slice(&r.nc().bytes[f::H_VALUE..f::H_VALUE + 8]);
+            seen.push((r.nc().read_i32(f::H_ADDRESS), f64::from_le_bytes(v)));
+        }
+        was = hf;
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    assert_eq!(
+        seen,
+        [
+            (1, 1.987),
+            (2, 978.123),
+            (3, 4.0),
+            (99, -8978.234),
+            (0, 5.0)
+        ]
+    );
+}

@@ -97,7 +97,16 @@ pub enum Aux {
         degrees: f64,
         way: Turn,
     },
+    /// A value for the PLC under an address (H0–H9999), its meaning the machine builder's
+    /// (the second auxiliary function's handshake; decisions D107).
+    H {
+        address: u16,
+        value: f64,
+    },
 }
+
+/// Highest H address.
+pub const MAX_H_ADDRESS: u16 = 9999;
 
 /// How a positioned spindle reaches its angle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -221,6 +230,7 @@ pub fn to_motion_block(
                 Aux::S(value) => (MotionBlock::AUX_S, 0, value),
                 Aux::T(code) => (MotionBlock::AUX_T, code, 0.0),
                 Aux::Orient { degrees, way } => (MotionBlock::AUX_ORIENT, way as i32, degrees),
+                Aux::H { address, value } => (MotionBlock::AUX_H, i32::from(address), value),
             };
         }
         Command::ProgramEnd => m.kind = MotionBlock::KIND_PROGRAM_END,
@@ -324,9 +334,21 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
                     ))
                 }
             },
+            MotionBlock::AUX_H => match u16::try_from(m.aux_code) {
+                Ok(address) if address <= MAX_H_ADDRESS && m.aux_value.is_finite() => Aux::H {
+                    address,
+                    value: m.aux_value,
+                },
+                _ => {
+                    return Err(format!(
+                        "H{}={} is no H function (H0–H9999, a finite value)",
+                        m.aux_code, m.aux_value
+                    ))
+                }
+            },
             other => {
                 return Err(format!(
-                    "aux kind {other} with value {} is not an M, S, T or spindle position",
+                    "aux kind {other} with value {} is not an M, S, T, H or spindle position",
                     m.aux_value
                 ))
             }
@@ -388,6 +410,10 @@ mod tests {
             Command::Aux(Aux::Orient {
                 degrees: -720.5,
                 way: Turn::Incremental,
+            }),
+            Command::Aux(Aux::H {
+                address: 99,
+                value: -8978.234,
             }),
             Command::ProgramEnd,
         ];

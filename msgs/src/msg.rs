@@ -233,6 +233,7 @@ ros_message! {
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,
             AUX_ORIENT: u8 = 4,
+            AUX_H: u8 = 5,
         }
         run_id: u64,
         seq: u64,

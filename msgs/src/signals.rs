@@ -203,6 +203,8 @@ pub mod f {
         bit(94, k as u8)
     }
     pub const TF: Bit = bit(7, 3);
+    /// The second auxiliary function's strobe (FANUC BF), carrying the H functions (D107).
+    pub const HF: Bit = bit(7, 7);
     pub const SF: Bit = bit(7, 2);
     pub const MF: Bit = bit(7, 0);
     pub const DM00: Bit = bit(9, 7);
@@ -224,6 +226,10 @@ pub mod f {
     pub const ORIENT_WAY: usize = 34;
     pub const ORIENT_COUNT: usize = 35;
     pub const ORIENT_SPEED: usize = 36;
+    /// The H function with HF: its address (4 bytes binary) and value (8 bytes, IEEE double,
+    /// least significant first; D107).
+    pub const H_ADDRESS: usize = 40;
+    pub const H_VALUE: usize = 44;
 }
 
 /// G signals the NC reads (`000` App.2, inventory §9.5).

@@ -103,6 +103,9 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         Command::Aux(Aux::Orient { degrees, way }) => {
             let _ = write!(s, "SPINDLE_POSITION {degrees:.3} {way:?}");
         }
+        Command::Aux(Aux::H { address, value }) => {
+            let _ = write!(s, "H{address}={value}");
+        }
         Command::ProgramEnd => s.push_str("END"),
     }
     s
@@ -350,6 +353,10 @@ impl LinuxCnc {
                     out.push_str(&format!(", {})\n", *way as u8));
                 }
             },
+            // rs274 has no second auxiliary function: a comment, as for an M code it does not know.
+            Command::Aux(Aux::H { address, value }) => {
+                self.push(out, &format!("COMMENT(\"H{address}={value}\")"));
+            }
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
             // rs274 has no call for the acceleration profile (its planner's is fixed) nor for
             // the drives' feedforward.

@@ -488,7 +488,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("060", Some((12080, 7)), "template"),
     ("061", None, ""),
     ("062", Some((12080, 7)), "template"),
-    ("063", Some((12140, 6)), "H functions"),
+    ("063", None, ""),
     ("064", None, ""),
     ("065", Some((14051, 7)), "R11/R12 with the R parameters 0"),
     ("066", Some((12080, 11)), "template"),

@@ -171,11 +171,45 @@ fn proc_names_the_program_in_its_first_block_only() {
 }
 
 #[test]
-fn h_words_and_machine_data_stop_with_12140() {
-    for text in ["H1=1.987\n", "G0 X1 H5\n", "$MA_FIX_POINT_POS[0]=1\n"] {
-        let (_, e) = run(text);
-        let e = e.unwrap_or_else(|| panic!("{text} ran"));
-        assert_eq!((e.number, e.line), (12140, 1), "{text}: {e}");
+fn machine_data_stop_with_12140() {
+    let (_, e) = run("$MA_FIX_POINT_POS[0]=1\n");
+    let e = e.expect("refused");
+    assert_eq!((e.number, e.line), (12140, 1), "{e}");
+}
+
+/// 063 (§9.8, D107) as printed: H functions go to the PLC with their values, before the
+/// block's move, at most three in a block; `H5` is H0=5.0.
+#[test]
+fn f063_h_functions_carry_their_values_to_the_plc_before_the_move() {
+    let text = support::fixture("063");
+    let r = support::run_with(&text, support::mill(), Library::new()).ok();
+    let h = |address, value| Command::Aux(Aux::H { address, value });
+    let shown: Vec<&Command> = r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Aux(Aux::H { .. }) | Command::Rapid { .. }))
+        .collect();
+    assert_eq!(
+        shown,
+        [
+            &h(1, 1.987),
+            &h(2, 978.123),
+            &h(3, 4.0),
+            &h(99, -8978.234),
+            &Command::Rapid {
+                end: vec![71.3, 0.0, 0.0]
+            },
+            &h(0, 5.0),
+        ]
+    );
+    for (bad, number) in [
+        ("H1=1 H2=2 H3=3 H4=4\n", 14750),
+        ("H10000=1\n", 17020),
+        ("R1=1/0 H1=R1\n", 14051),
+    ] {
+        let (_, e) = run(bad);
+        let e = e.unwrap_or_else(|| panic!("{bad} ran"));
+        assert_eq!((e.number, e.line), (number, 1), "{bad}: {e}");
     }
 }
 

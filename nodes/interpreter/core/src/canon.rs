@@ -1,7 +1,7 @@
 //! What the interpreter hands to motion: a canonical command (`cnc_msgs::canon`, shared with
 //! motion) with the source line it came from.
 
-pub use cnc_msgs::canon::{Aux, Command, Turn};
+pub use cnc_msgs::canon::{Aux, Command, Turn, MAX_H_ADDRESS};
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Canon {

@@ -33,7 +33,7 @@ pub mod text;
 pub mod transform;
 pub mod variables;
 
-pub use canon::{Aux, Canon, Command, Turn};
+pub use canon::{Aux, Canon, Command, Turn, MAX_H_ADDRESS};
 pub use driver::{next_command, FrontEnd};
 pub use emit::MoveKind;
 pub use error::{AlarmTable, Fault, ProgramError};

@@ -80,6 +80,8 @@ pub struct Words {
     pub addr: AddrMap<&'static str>,
     pub g: Vec<u32>,
     pub m: Vec<u32>,
+    /// H functions: address and value (§9.8).
+    pub h: Vec<(u16, f64)>,
     /// Keywords in the order written (`CIP`, `TRANS`, `STOPRE`…).
     pub keys: Vec<&'static str>,
     /// The program the block calls.
@@ -95,6 +97,7 @@ impl Words {
         self.addr.0.clear();
         self.g.clear();
         self.m.clear();
+        self.h.clear();
         self.keys.clear();
         self.call = None;
         self.cycle = None;
@@ -204,8 +207,6 @@ pub fn is_address(name: &str) -> bool {
         ]
         .contains(&name)
 }
-
-const H_NOT_BUILT: &str = "H functions are not built: the PLC here takes M, S and T";
 
 impl Sinumerik {
     /// Runs one parsed block.
@@ -321,7 +322,8 @@ impl Sinumerik {
             Item::Assign { name, index, value } => {
                 let axis = self.axis_of(name);
                 if name.starts_with('H') && name[1..].bytes().all(|b| b.is_ascii_digit()) {
-                    return Err(self.fault(Fault::NotSupported, H_NOT_BUILT));
+                    let v = self.number(value)?;
+                    return self.h_function(w, &name[1..], v);
                 }
                 if ["$MA_", "$MN_", "$MC_"].iter().any(|p| name.starts_with(p)) {
                     return Err(self.fault(
@@ -545,7 +547,8 @@ impl Sinumerik {
             'N' => {
                 return Err(self.fault(Fault::DataFormat, "the block number N must start the block"))
             }
-            'H' => return Err(self.fault(Fault::NotSupported, H_NOT_BUILT)),
+            // `H5` is H0=5.0 (§9.8).
+            'H' => self.h_function(w, "", value)?,
             'R' => {
                 return Err(self.fault(
                     Fault::DataFormat,
@@ -687,6 +690,31 @@ impl Sinumerik {
 
     /// M3/M4/M5, gear stages and the machine's own M functions, output before the motion
     /// (§9.7); at most 5 M per block.
+    /// An H function (§9.8): H0–H9999 with a value for the PLC, at most 3 in a block; the
+    /// address written as `digits` (none: H0). Output with the M functions before the move
+    /// (D107).
+    fn h_function(&self, w: &mut Words, digits: &str, value: f64) -> Result<(), ProgramError> {
+        let address = if digits.is_empty() {
+            Some(0)
+        } else {
+            digits.parse::<u16>().ok()
+        };
+        let Some(address) = address.filter(|a| *a <= cnc_interpreter_core::MAX_H_ADDRESS) else {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!("H{digits}: H functions are H0…H9999"),
+            ));
+        };
+        if !value.is_finite() {
+            return Err(self.fault(Fault::OutOfRange, format!("H{address}: value not finite")));
+        }
+        if w.h.len() == 3 {
+            return Err(self.fault(Fault::TooManyM, "more than 3 H functions in one block"));
+        }
+        w.h.push((address, value));
+        Ok(())
+    }
+
     fn m_before(&mut self, w: &Words) -> Result<(), ProgramError> {
         if w.m.len() > 5 {
             return Err(self.fault(Fault::TooManyM, "more than 5 M functions in one block"));
@@ -703,6 +731,9 @@ impl Sinumerik {
                 }
                 _ => self.core.aux(Aux::M(m as i32)),
             }
+        }
+        for &(address, value) in &w.h {
+            self.core.aux(Aux::H { address, value });
         }
         if let Some(&(v, mode)) = w.addr.get("SPOS") {
             self.spindle_position(v, mode)?;

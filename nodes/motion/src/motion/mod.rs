@@ -730,7 +730,16 @@ impl Motion {
     }
 
     fn clear_strobe(&mut self) {
-        for b in [f::MF, f::SF, f::TF, f::DM00, f::DM01, f::DM02, f::DM30] {
+        for b in [
+            f::MF,
+            f::SF,
+            f::TF,
+            f::HF,
+            f::DM00,
+            f::DM01,
+            f::DM02,
+            f::DM30,
+        ] {
             self.f.set(b, false);
         }
     }
@@ -937,6 +946,12 @@ impl Motion {
                     Aux::T(t) => {
                         fi.write_i32(f::T_CODE, t);
                         fi.set(f::TF, true);
+                    }
+                    // The second auxiliary function: address and value, HF (D107).
+                    Aux::H { address, value } => {
+                        fi.write_i32(f::H_ADDRESS, i32::from(address));
+                        fi.bytes[f::H_VALUE..f::H_VALUE + 8].copy_from_slice(&value.to_le_bytes());
+                        fi.set(f::HF, true);
                     }
                 }
                 false
