@@ -66,6 +66,12 @@ pub enum Command {
     Feedforward {
         on: bool,
     },
+    /// The acceleration of one axis (its index in the machine's order) for the moves that
+    /// follow, in percent of its rated acceleration (1–200). A run starts at 100 %.
+    Acceleration {
+        axis: u8,
+        percent: f64,
+    },
     /// An M, S or T function for the PLC, which answers with FIN.
     Aux(Aux),
     /// M02/M30: the program is finished; motion completes everything before it.
@@ -223,6 +229,11 @@ pub fn to_motion_block(
             m.kind = MotionBlock::KIND_FEEDFORWARD;
             m.flag = *on;
         }
+        Command::Acceleration { axis, percent } => {
+            m.kind = MotionBlock::KIND_ACCELERATION;
+            m.aux_code = i32::from(*axis);
+            m.aux_value = *percent;
+        }
         Command::Aux(aux) => {
             m.kind = MotionBlock::KIND_AUX;
             (m.aux_kind, m.aux_code, m.aux_value) = match *aux {
@@ -308,6 +319,18 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
             jerk_limited: m.flag,
         },
         MotionBlock::KIND_FEEDFORWARD => Command::Feedforward { on: m.flag },
+        MotionBlock::KIND_ACCELERATION => match u8::try_from(m.aux_code) {
+            Ok(axis) if (1.0..=200.0).contains(&m.aux_value) => Command::Acceleration {
+                axis,
+                percent: m.aux_value,
+            },
+            _ => {
+                return Err(format!(
+                    "acceleration {} % of axis {} is not 1…200 % of an axis",
+                    m.aux_value, m.aux_code
+                ))
+            }
+        },
         MotionBlock::KIND_DWELL if m.dwell_seconds.is_finite() && m.dwell_seconds >= 0.0 => {
             Command::Dwell {
                 seconds: m.dwell_seconds,
@@ -399,6 +422,10 @@ mod tests {
                 jerk_limited: false,
             },
             Command::Feedforward { on: true },
+            Command::Acceleration {
+                axis: 2,
+                percent: 80.0,
+            },
             Command::Feedforward { on: false },
             Command::Aux(Aux::M(3)),
             Command::Aux(Aux::S(1200.0)),

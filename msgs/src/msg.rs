@@ -229,6 +229,7 @@ ros_message! {
             KIND_PROFILE: u8 = 10,
             KIND_TAP: u8 = 11,
             KIND_FEEDFORWARD: u8 = 12,
+            KIND_ACCELERATION: u8 = 13,
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,

@@ -122,6 +122,8 @@ pub struct Collected {
     pub jerk_limited: Option<bool>,
     /// The drives' feedforward: on or off.
     pub feedforward: Option<bool>,
+    /// Acceleration overrides, the last per axis.
+    pub accelerations: Vec<(u8, f64)>,
     /// The last T: on a lathe the turret's station, on a mill the tool put ready.
     pub tool: Option<i32>,
     /// The tool the last M06 put in a mill's spindle (the T before it).
@@ -149,6 +151,10 @@ impl Collected {
             Command::PathMode { exact_stop } => self.exact_stop = Some(exact_stop),
             Command::Profile { jerk_limited } => self.jerk_limited = Some(jerk_limited),
             Command::Feedforward { on } => self.feedforward = Some(on),
+            Command::Acceleration { axis, percent } => {
+                self.accelerations.retain(|(a, _)| *a != axis);
+                self.accelerations.push((axis, percent));
+            }
             Command::Aux(Aux::T(t)) => self.tool = Some(t),
             Command::Aux(Aux::S(s)) => self.speed = Some(s),
             Command::Aux(Aux::Orient {
@@ -255,6 +261,9 @@ impl Collected {
         }
         if let Some(on) = self.feedforward {
             push(Command::Feedforward { on });
+        }
+        for &(axis, percent) in &self.accelerations {
+            push(Command::Acceleration { axis, percent });
         }
         out
     }

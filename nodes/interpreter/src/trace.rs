@@ -91,6 +91,10 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         } else {
             "FEEDFORWARD_OFF"
         }),
+        Command::Acceleration { axis, percent } => {
+            let letter = letters.get(usize::from(*axis)).copied().unwrap_or('?');
+            let _ = write!(s, "ACCELERATION {letter} {percent}%");
+        }
         Command::Aux(Aux::M(m)) => {
             let _ = write!(s, "M{m}");
         }
@@ -358,9 +362,11 @@ impl LinuxCnc {
                 self.push(out, &format!("COMMENT(\"H{address}={value}\")"));
             }
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
-            // rs274 has no call for the acceleration profile (its planner's is fixed) nor for
-            // the drives' feedforward.
-            Command::Profile { .. } | Command::Feedforward { .. } => {}
+            // rs274 has no call for the acceleration profile (its planner's is fixed), the
+            // drives' feedforward or an acceleration override.
+            Command::Profile { .. }
+            | Command::Feedforward { .. }
+            | Command::Acceleration { .. } => {}
         }
     }
 }

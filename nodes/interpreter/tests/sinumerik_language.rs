@@ -575,3 +575,44 @@ fn g41_to_g42_or_g41_again_ends_normal_and_starts_normal_without_g40() {
     let (end, start) = (at([-5.0, 30.0]), at([0.0, 35.0]));
     assert!(end.is_some() && start == end.map(|e| e + 1), "{again:?}");
 }
+
+/// 039 (§9.3.18, D108): ACC[X]=80 gives motion X's acceleration at 80 % before the next move,
+/// ACC[X]=100 back to the rated; out of 1…200 % 17020; ACC[S] (the spindle's) 12140 with
+/// the reason; an axis the machine lacks 14092.
+#[test]
+fn f039_acc_overrides_an_axis_acceleration_and_refuses_the_spindles() {
+    let text = support::filled("039", &["N30 G1 X100 F1000"]).replace("N20 ACC[S]=50", "N20");
+    let r = support::run_with(&text, support::mill(), Library::new()).ok();
+    let acc: Vec<&Command> = r
+        .out
+        .iter()
+        .filter(|c| matches!(c, Command::Acceleration { .. } | Command::Linear { .. }))
+        .collect();
+    assert_eq!(
+        acc,
+        [
+            &Command::Acceleration {
+                axis: 0,
+                percent: 80.0
+            },
+            &Command::Linear {
+                end: vec![100.0, 0.0, 0.0],
+                feed: 1000.0
+            },
+            &Command::Acceleration {
+                axis: 0,
+                percent: 100.0
+            },
+        ]
+    );
+    for (bad, number) in [
+        ("ACC[S]=50\n", 12140),
+        ("ACC[X]=0\n", 17020),
+        ("ACC[Z]=201\n", 17020),
+        ("ACC[A]=50\n", 14092),
+    ] {
+        let (_, e) = run(bad);
+        let e = e.unwrap_or_else(|| panic!("{bad} ran"));
+        assert_eq!((e.number, e.line), (number, 1), "{bad}: {e}");
+    }
+}

@@ -123,6 +123,14 @@ impl Planner {
         self.shape
     }
 
+    /// An axis's acceleration limit (slide travel, mm/s²) for the segments appended from now
+    /// on and for rapids (a program's acceleration override, decision D108).
+    pub fn set_acceleration(&mut self, axis: usize, acceleration: f64) {
+        if let Some(a) = self.cfg.limits.acceleration.get_mut(axis) {
+            *a = acceleration;
+        }
+    }
+
     pub fn config(&self) -> &PlannerConfig {
         &self.cfg
     }

@@ -1025,3 +1025,52 @@ fn feedforward_leads_the_setpoint_by_velocity_times_lag_only_while_moving() {
     assert!(led > 0.0 && plain == 0.0, "{led} {plain}");
     assert_eq!(slides, m.commanded());
 }
+
+/// ACC (D108): an axis's acceleration override holds for the moves after it; a new run starts
+/// at the rated acceleration again.
+#[test]
+fn an_acceleration_override_scales_the_axis_until_the_next_run() {
+    let peak = |m: &mut Motion, run_id: u64, kinds: Vec<Command>| {
+        for (k, kind) in kinds.into_iter().enumerate() {
+            m.push(Block {
+                run_id,
+                ..block(k as u64 + 1, k as u32 + 1, kind)
+            });
+        }
+        let d = drive(m, 20_000);
+        let v: Vec<f64> = d
+            .displayed
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]) / 0.004)
+            .collect();
+        v.windows(2)
+            .map(|w| ((w[1] - w[0]) / 0.004).abs())
+            .fold(0.0, f64::max)
+    };
+    let line = |x: f64| Command::Linear {
+        end: vec![x, 0.0, 0.0],
+        feed: 6000.0,
+    };
+    let rated = mill().axes[0].max_acceleration;
+    let mut m = Motion::new(mill(), &[0.0, 0.0, 0.0]);
+    let slow = peak(
+        &mut m,
+        1,
+        vec![
+            Command::Acceleration {
+                axis: 0,
+                percent: 50.0,
+            },
+            line(100.0),
+            Command::ProgramEnd,
+        ],
+    );
+    assert!(
+        (slow - 0.5 * rated).abs() < 0.02 * rated,
+        "{slow} of {rated}"
+    );
+    // The next run (a new run id) is at 100 % again.
+    assert_eq!(m.state(), RunState::Idle);
+    let full = peak(&mut m, 2, vec![line(0.0), Command::ProgramEnd]);
+    assert!((full - rated).abs() < 0.02 * rated, "{full} of {rated}");
+}

@@ -142,7 +142,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 25] = [
+pub const NOT_BUILT: [(&str, &str); 24] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
@@ -165,10 +165,6 @@ pub const NOT_BUILT: [(&str, &str); 25] = [
     ("TANG", "tangential control is not built"),
     ("TANGON", "tangential control is not built"),
     ("TANGOF", "tangential control is not built"),
-    (
-        "ACC",
-        "the acceleration override ACC is not built: the machine's limits hold",
-    ),
     ("MASLDEF", "master-slave coupling is not built"),
     ("MASLDEL", "master-slave coupling is not built"),
     ("MASLON", "master-slave coupling is not built"),
@@ -203,7 +199,7 @@ pub fn is_address(name: &str) -> bool {
         || NOT_BUILT.iter().any(|(k, _)| *k == name)
         || [
             "DEF", "IF", "GOTOF", "GOTOB", "MSG", "SET", "REP", "AC", "IC", "DC", "ACP", "ACN",
-            "PROC",
+            "PROC", "ACC",
         ]
         .contains(&name)
 }
@@ -324,6 +320,9 @@ impl Sinumerik {
                 if name.starts_with('H') && name[1..].bytes().all(|b| b.is_ascii_digit()) {
                     let v = self.number(value)?;
                     return self.h_function(w, &name[1..], v);
+                }
+                if name == "ACC" {
+                    return self.acceleration_override(index, value);
                 }
                 if ["$MA_", "$MN_", "$MC_"].iter().any(|p| name.starts_with(p)) {
                     return Err(self.fault(
@@ -690,6 +689,38 @@ impl Sinumerik {
 
     /// M3/M4/M5, gear stages and the machine's own M functions, output before the motion
     /// (§9.7); at most 5 M per block.
+    /// `ACC[axis]=percent` (§9.3.18): the axis's acceleration from the next block on, 1–200 %
+    /// of its rated value, until changed, reset or the program's end (D108). The spindle's
+    /// (`ACC[S]`) is the drive's own here: 12140 with the reason.
+    fn acceleration_override(&mut self, index: &[Expr], value: &Expr) -> Result<(), ProgramError> {
+        let [Expr::Axis(name)] = index else {
+            return Err(self.fault(Fault::MacroArgument, "ACC[axis]=percent names one axis"));
+        };
+        if name.starts_with('S') {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "ACC[S]: the spindle's acceleration is set in its drive, not by the program",
+            ));
+        }
+        let axis = self
+            .axis_of(name)
+            .ok_or_else(|| self.fault(Fault::NoSuchAxis, format!("ACC[{name}]: no such axis")))?;
+        let percent = self.number(value)?;
+        if !(1.0..=200.0).contains(&percent) {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!(
+                    "ACC[{name}]={}: the override is 1…200 %",
+                    cnc_interpreter_core::show(percent)
+                ),
+            ));
+        }
+        let axis = u8::try_from(axis)
+            .map_err(|_| self.fault(Fault::NoSuchAxis, format!("ACC[{name}]: no such axis")))?;
+        self.core.push(Command::Acceleration { axis, percent });
+        Ok(())
+    }
+
     /// An H function (§9.8): H0–H9999 with a value for the PLC, at most 3 in a block; the
     /// address written as `digits` (none: H0). Output with the M functions before the move
     /// (D107).

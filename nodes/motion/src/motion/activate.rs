@@ -87,7 +87,8 @@ impl Motion {
             Command::FeedMode { .. }
             | Command::PathMode { .. }
             | Command::Profile { .. }
-            | Command::Feedforward { .. } => Ok(Active::Dwell { remaining: 0.0 }),
+            | Command::Feedforward { .. }
+            | Command::Acceleration { .. } => Ok(Active::Dwell { remaining: 0.0 }),
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
                 raised: false,

@@ -1,4 +1,7 @@
-//! Feedforward of the drives (FFWON/FFWOF; decisions D106). A drive trails a moving
+//! Feedforward of the drives (FFWON/FFWOF; decisions D106) and the program's acceleration
+//! override (ACC; D108): the two settings a program makes on the axes' dynamics.
+//!
+//! Feedforward (D106). A drive trails a moving
 //! setpoint by its lag (velocity × time constant): the following error. With feedforward the
 //! setpoint each drive gets leads the commanded position by that much, so the slide stands on
 //! the commanded path and the following error is (nearly) zero. The lead is the axis's
@@ -32,6 +35,24 @@ impl Motion {
             };
             self.encoder_setpoint[i] = self.drive[i] + lead - self.shift[i];
             self.last_drive[i] = self.drive[i];
+        }
+    }
+
+    /// ACC: an axis at `share` of its rated acceleration from the next block on; the
+    /// look-ahead stops at the change, so no segment planned at the old value runs after it.
+    pub(super) fn set_acceleration_override(&mut self, axis: usize, share: f64) {
+        let rated = self.cfg.planner().limits.acceleration;
+        if let Some(a) = rated.get(axis).filter(|_| axis < self.cfg.axes.len()) {
+            self.planner
+                .set_acceleration(axis, a * share.clamp(0.01, 2.0));
+        }
+    }
+
+    /// Every axis at its rated acceleration (a run's start, reset).
+    pub(super) fn rated_accelerations(&mut self) {
+        let rated = self.cfg.planner().limits.acceleration;
+        for (i, a) in rated.iter().enumerate().take(self.cfg.axes.len()) {
+            self.planner.set_acceleration(i, *a);
         }
     }
 }

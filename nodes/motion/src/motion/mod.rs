@@ -307,9 +307,11 @@ impl Motion {
             self.active = None;
             let here = self.commanded_point();
             self.planner.reset(here);
-            // A run starts in the machine's own profile (D99), without feedforward (D106).
+            // A run starts in the machine's own profile (D99), without feedforward (D106),
+            // at the rated accelerations (D108).
             self.planner.set_shape(self.cfg.shape);
             self.feedforward = false;
+            self.rated_accelerations();
             self.accepted_seq = 0;
             self.done_seq = 0;
             self.feed_hold = false;
@@ -394,6 +396,7 @@ impl Motion {
         self.planner.reset(here);
         self.planner.set_shape(self.cfg.shape);
         self.feedforward = false;
+        self.rated_accelerations();
     }
 
     pub fn run_id(&self) -> u64 {
@@ -601,6 +604,9 @@ impl Motion {
                         self.planner.set_shape(profile_shape(jerk_limited));
                     }
                     Command::Feedforward { on } => self.feedforward = on,
+                    Command::Acceleration { axis, percent } => {
+                        self.set_acceleration_override(usize::from(axis), percent / 100.0);
+                    }
                     _ => {}
                 }
                 match self.activate(&block) {
