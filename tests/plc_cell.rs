@@ -838,6 +838,32 @@ fn the_mill_magazine_preselects_with_t_changes_with_m6_and_m19_orients() {
     assert!(r.message("A3.2").is_some(), "{:?}", r.events);
 }
 
+/// The spindle's angle unwrapped: the degrees it has turned, signed, from the encoder's
+/// 0–360° readings (less than half a turn between two of them).
+struct Turned {
+    degrees: f64,
+    last: f64,
+}
+
+impl Turned {
+    fn from(angle: f64) -> Turned {
+        Turned {
+            degrees: 0.0,
+            last: angle,
+        }
+    }
+
+    fn read(&mut self, angle: f64) -> f64 {
+        let mut d = (angle - self.last).rem_euclid(360.0);
+        if d > 180.0 {
+            d -= 360.0;
+        }
+        self.last = angle;
+        self.degrees += d;
+        self.degrees
+    }
+}
+
 /// SPOS through the whole chain (D100): the 802D front end, motion's M19 with the stop
 /// position in F30–F35, the ladder copying it to Y8–Y13 with the strobe, the simulated drive
 /// positioning and holding, the ladder's FIN on SPINDLE_ORIENTED. At each FIN the spindle
@@ -851,18 +877,13 @@ fn spos_positions_the_simulated_spindle_each_way_through_the_ladder() {
     let mut r = Rig::on(cfg, program, Some(&kept));
     r.run_until(0.1, |_| false);
     r.started = true;
-    // The degrees turned (unwrapped) and, at each M19's FIN, (angle, rpm, turned so far).
-    let (mut turned, mut last) = (0.0f64, r.fb.spindle_angle_deg);
+    // At each M19's FIN: (angle, rpm, degrees turned so far).
+    let mut spindle = Turned::from(r.fb.spindle_angle_deg);
     let mut fins = Vec::new();
     let mut was_fin = false;
     let ok = r.run_until(120.0, |r| {
         let a = r.fb.spindle_angle_deg;
-        let mut d = (a - last).rem_euclid(360.0);
-        if d > 180.0 {
-            d -= 360.0;
-        }
-        turned += d;
-        last = a;
+        let turned = spindle.read(a);
         let fin = r.gi.get(g::FIN) && r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;
         if fin && !was_fin {
             fins.push((a, r.fb.spindle_rpm, turned));
@@ -906,18 +927,12 @@ fn g331_and_g332_tap_with_the_slide_locked_to_the_simulated_spindle() {
     r.started = true;
     // Unwrapped spindle angle; while a tap runs, the slide's distance from where the spindle
     // puts it (0.8 mm a turn from where the tap began).
-    let (mut turned, mut last) = (0.0f64, r.fb.spindle_angle_deg);
+    let mut spindle = Turned::from(r.fb.spindle_angle_deg);
     let mut tap: Option<(f64, f64)> = None;
     let (mut worst, mut ends, mut deepest) = (0.0f64, Vec::new(), f64::INFINITY);
     let mut rising = 0usize;
     let ok = r.run_until(120.0, |r| {
-        let a = r.fb.spindle_angle_deg;
-        let mut d = (a - last).rem_euclid(360.0);
-        if d > 180.0 {
-            d -= 360.0;
-        }
-        turned += d;
-        last = a;
+        let turned = spindle.read(r.fb.spindle_angle_deg);
         let slide = r.fb.position[z];
         deepest = deepest.min(slide);
         let orienting = r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;

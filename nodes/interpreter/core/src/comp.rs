@@ -552,21 +552,9 @@ impl RadiusComp {
         let outside = turn * self.offset < 0.0 || along <= -1.0 + 1e-9;
         let turned = turn.abs().atan2(along).to_degrees();
         if outside && rules.outer_intersection && turned < OUTER_INTERSECTION_LIMIT {
-            // Both offsets extended to where they cross, the crossing nearest the corner.
-            let crossing = intersections(&held.path, &off).into_iter().min_by(|a, b| {
-                len(sub(*a, corner))
-                    .partial_cmp(&len(sub(*b, corner)))
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            });
-            if let Some(x) = crossing {
-                self.release(
-                    Held {
-                        path: held.path.with_end(x),
-                        ..held
-                    },
-                    out,
-                )?;
-                return Ok(off.with_start(x));
+            // Both offsets extended to where they cross.
+            if let Some(next) = self.meet_at_crossing(held, off, corner, out)? {
+                return Ok(next);
             }
         }
         if outside {
@@ -582,15 +570,28 @@ impl RadiusComp {
             out.push(self.out(arc, depth, kind, line));
             return Ok(off);
         }
-        // Inside: both are cut back to where they cross, the crossing nearest the corner.
-        let x = intersections(&held.path, &off)
-            .into_iter()
-            .min_by(|a, b| {
-                len(sub(*a, corner))
-                    .partial_cmp(&len(sub(*b, corner)))
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            })
-            .ok_or(CompError::NoIntersection)?;
+        // Inside: both are cut back to where they cross.
+        self.meet_at_crossing(held, off, corner, out)?
+            .ok_or(CompError::NoIntersection)
+    }
+
+    /// Ends the held element where it crosses `off` (the crossing nearest the programmed
+    /// `corner`), queues it, and returns `off` from there; `None` where they do not cross.
+    fn meet_at_crossing(
+        &mut self,
+        held: Held,
+        off: Elem,
+        corner: Pt,
+        out: &mut Vec<Out>,
+    ) -> Result<Option<Elem>, CompError> {
+        let crossing = intersections(&held.path, &off).into_iter().min_by(|a, b| {
+            len(sub(*a, corner))
+                .partial_cmp(&len(sub(*b, corner)))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        let Some(x) = crossing else {
+            return Ok(None);
+        };
         self.release(
             Held {
                 path: held.path.with_end(x),
@@ -598,7 +599,7 @@ impl RadiusComp {
             },
             out,
         )?;
-        Ok(off.with_start(x))
+        Ok(Some(off.with_start(x)))
     }
 
     /// A new radius (a new cutting edge under compensation): the next element changes from

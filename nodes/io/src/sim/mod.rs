@@ -388,18 +388,24 @@ mod tests {
         assert!(!m.x_image(&y).get(x::ESP_N));
     }
 
-    #[test]
-    fn orientation_stops_the_spindle_at_its_angle_and_holds_it() {
+    /// The simulated spindle at 600 rpm M3, with the image that keeps it there.
+    fn turning_at_600() -> (SimLathe, YImage) {
         let mut m = sim();
         let mut y = YImage {
             spindle_rpm: 600.0,
             ..Default::default()
         };
         y.set(y::SPINDLE_CW, true);
-        let sp = ServoSetpoint::default();
         for _ in 0..200 {
-            m.step(&sp, &y, 0.004);
+            m.step(&ServoSetpoint::default(), &y, 0.004);
         }
+        (m, y)
+    }
+
+    #[test]
+    fn orientation_stops_the_spindle_at_its_angle_and_holds_it() {
+        let (mut m, mut y) = turning_at_600();
+        let sp = ServoSetpoint::default();
         // Orientation asked with the spindle still commanded: it goes on turning.
         y.set(y::SPINDLE_ORIENT, true);
         m.step(&sp, &y, 0.004);
@@ -485,16 +491,7 @@ mod tests {
 
     #[test]
     fn positioned_from_m3_the_spindle_keeps_its_direction() {
-        let mut m = sim();
-        let mut y = YImage {
-            spindle_rpm: 600.0,
-            ..Default::default()
-        };
-        y.set(y::SPINDLE_CW, true);
-        let sp = ServoSetpoint::default();
-        for _ in 0..200 {
-            m.step(&sp, &y, 0.004);
-        }
+        let (mut m, mut y) = turning_at_600();
         y.set(y::SPINDLE_CW, false);
         y.set(y::SPINDLE_ORIENT, true);
         y.write_i32(y::ORIENT_ANGLE, 25_600);
