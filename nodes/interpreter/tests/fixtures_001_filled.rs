@@ -689,8 +689,13 @@ fn f042_the_fourth_axis_a_moves_with_rapid_with_a_feed_and_alone() {
     let r = run_with(&fixture("042"), s, Library::new()).ok();
     let m = r.moves();
     assert!(matches!(m[0], Command::Rapid { end } if near(end, &[10.0, 20.0, 30.0, 45.0])));
+    // F400 holds for X, Y, Z; A follows in the same time: the feed along all four axes is
+    // 400 × √(14 + 15²)/√14 (D109).
+    let along_all = 400.0 * (239.0f64 / 14.0).sqrt();
     assert!(
-        matches!(m[1], Command::Linear { end, feed } if near(end, &[12.0, 21.0, 33.0, 60.0]) && *feed == 400.0)
+        matches!(m[1], Command::Linear { end, feed } if near(end, &[12.0, 21.0, 33.0, 60.0]) && (*feed - along_all).abs() < 1e-9),
+        "{:?}",
+        m[1]
     );
     assert!(
         matches!(m[2], Command::Linear { end, feed } if near(end, &[12.0, 21.0, 33.0, 90.0]) && *feed == 3000.0)

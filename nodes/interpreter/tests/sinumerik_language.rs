@@ -616,3 +616,19 @@ fn f039_acc_overrides_an_axis_acceleration_and_refuses_the_spindles() {
         assert_eq!((e.number, e.line), (number, 1), "{bad}: {e}");
     }
 }
+
+/// DC, ACP and ACN on a rotary axis (§9.2.1, D109): the angle modulo 360° reached the
+/// shortest way, turning positive or negative, from wherever the axis stands (turns
+/// included); on a linear axis they are refused.
+#[test]
+fn dc_acp_acn_position_a_rotary_axis_by_its_way() {
+    let setup = cnc_interpreter::Setup::new(&['X', 'Y', 'Z', 'A'], &[false; 4], &[0.0; 4]);
+    let text = "G0 A370\nA=DC(45)\nA=ACP(10)\nA=ACN(350)\nA=DC(340)\nA=ACP(340)\nG91 A=ACN(340)\n";
+    let r = support::run_with(text, setup, Library::new()).ok();
+    let a: Vec<f64> = r.moves().iter().map(|c| c.end().unwrap()[3]).collect();
+    // 370 (10°) → 45 the short way up: 405; → ACP 10: 730; → ACN 350: 710; → DC 340 (from
+    // 350): 700; → ACP 340 (already there): 700; → ACN 340 (there): 700, G91 or not.
+    assert_eq!(a, [370.0, 405.0, 730.0, 710.0, 700.0, 700.0, 700.0]);
+    let (_, e) = run("X=DC(10)\n");
+    assert_eq!(e.map(|e| e.number), Some(12080));
+}

@@ -204,8 +204,8 @@ fn spos_takes_each_way_and_refuses_an_angle_out_of_range() {
         assert_eq!((e.number, e.line), (17020, 2), "{bad}: {e:?}");
         assert!(e.text.contains("spindle position"), "{bad}: {}", e.text);
     }
-    // A rotary mode on an axis is still refused with its reason.
-    assert_eq!(run("X=DC(10)\n").alarm().0, 12140);
+    // A rotary mode on a linear axis is refused with its reason (D109).
+    assert_eq!(run("X=DC(10)\n").alarm().0, 12080);
 }
 
 fn taps(r: &Run) -> Vec<(Vec<f64>, f64, f64)> {

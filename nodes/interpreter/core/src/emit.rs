@@ -167,6 +167,15 @@ impl Core {
             })
     }
 
+    /// The largest feed of the active unit (per minute or per revolution).
+    pub fn feed_limit(&self) -> f64 {
+        if self.feed_per_rev {
+            MAX_FEED_PER_REV
+        } else {
+            self.rules.max_feed
+        }
+    }
+
     /// A feed a cutting move can use: above 0 and within the control's range.
     pub fn check_feed(&self, feed: f64) -> Result<f64, ProgramError> {
         if feed.is_nan() || feed <= 0.0 {
@@ -175,11 +184,7 @@ impl Core {
                 "no feed programmed for a cutting move (F missing or 0)",
             ));
         }
-        let limit = if self.feed_per_rev {
-            MAX_FEED_PER_REV
-        } else {
-            self.rules.max_feed
-        };
+        let limit = self.feed_limit();
         if feed > limit {
             return Err(self.fault(
                 Fault::FeedRange,

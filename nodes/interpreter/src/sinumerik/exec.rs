@@ -473,10 +473,13 @@ impl Sinumerik {
                 let [Some(arg)] = args.as_slice() else {
                     return Err(self.fault(Fault::MacroArgument, format!("{name}={f}(value)")));
                 };
-                if matches!(mode, Mode::Rotary(_)) && name != "SPOS" {
+                let rotary = self.axis_of(name).is_some_and(|i| self.rotary_axis(i));
+                if matches!(mode, Mode::Rotary(_)) && name != "SPOS" && !rotary {
                     return Err(self.fault(
-                        Fault::NotSupported,
-                        format!("{name}={f}(…): rotary positioning modes are not built yet"),
+                        Fault::IllegalWord,
+                        format!(
+                            "{name}={f}(…): DC, ACP and ACN position rotary axes and the spindle"
+                        ),
                     ));
                 }
                 return Ok((self.number(arg)?, mode));

@@ -10,7 +10,7 @@ use std::f64::consts::TAU;
 use cnc_interpreter_core::geometry::{
     arc_sweep, center_from_radius, check_center, three_point, ArcError, Pt, ARC_TOLERANCE,
 };
-use cnc_interpreter_core::{Command, Fault, MoveKind, ProgramError, NO_WORK_OFFSET};
+use cnc_interpreter_core::{Command, Fault, MoveKind, ProgramError, Turn, NO_WORK_OFFSET};
 
 use super::contour::AngStep;
 use super::exec::{Mode, Words};
@@ -191,6 +191,38 @@ impl Sinumerik {
         }
     }
 
+    /// Whether machine axis `i` is a rotary axis (A, B, C: degrees).
+    pub(super) fn rotary_axis(&self, i: usize) -> bool {
+        self.core
+            .setup
+            .axes
+            .get(i)
+            .is_some_and(|c| "ABC".contains(*c))
+    }
+
+    /// The feed of a line from `here` to `end` along all its axes, so that F holds for the
+    /// linear axes and the rotary axes follow in the same time; a rotary axis alone runs at F
+    /// in degrees per minute (§9.3.21, D109). Motion takes a feed along all axes.
+    fn rotary_feed(&self, feed: f64, here: &[f64], end: &[f64]) -> f64 {
+        let (mut linear, mut rotary) = (0.0, 0.0);
+        for (i, (a, b)) in here.iter().zip(end).enumerate() {
+            let d = (b - a) * (b - a);
+            if self.rotary_axis(i) {
+                rotary += d;
+            } else {
+                linear += d;
+            }
+        }
+        if rotary > 0.0 && linear > 1e-18 {
+            // A short line with a long turn would ask for more than any feed: the control's
+            // largest, which the axes' own limits slow further.
+            let limit = self.core.feed_limit().max(feed);
+            (feed * ((linear + rotary) / linear).sqrt()).min(limit)
+        } else {
+            feed
+        }
+    }
+
     /// The block's move, if it has one.
     pub(super) fn motion_block(&mut self, w: &Words) -> Result<(), ProgramError> {
         let arc_words = ["I", "J", "K", "CR", "AR", "I1", "J1", "K1", "TURN"];
@@ -210,14 +242,15 @@ impl Sinumerik {
         let mut end = here.clone();
         let unit = self.unit();
         for (&i, &(v, mode)) in w.axes.iter() {
-            let linear = "XYZUVW".contains(self.core.setup.axes[i]);
+            let linear = !self.rotary_axis(i);
             let v = if linear { v * unit } else { v };
-            let absolute = match mode {
-                Mode::Abs | Mode::Rotary(_) => true,
-                Mode::Inc => false,
-                Mode::Modal => self.absolute,
+            end[i] = match mode {
+                Mode::Rotary(way) => rotary_target(here[i], v, way),
+                Mode::Abs => v,
+                Mode::Inc => here[i] + v,
+                Mode::Modal if self.absolute => v,
+                Mode::Modal => here[i] + v,
             };
-            end[i] = if absolute { v } else { here[i] + v };
         }
         let circle = matches!(self.motion, Motion::Cw | Motion::Ccw);
         if polar {
@@ -244,7 +277,7 @@ impl Sinumerik {
                 let kind = if self.motion == Motion::Rapid {
                     MoveKind::Rapid
                 } else {
-                    MoveKind::Feed(feed)
+                    MoveKind::Feed(self.rotary_feed(feed, &here, &end))
                 };
                 let a = match self.ang_end(w, &here, &mut end, kind)? {
                     AngStep::Wait => return Ok(()),
@@ -682,5 +715,19 @@ impl Sinumerik {
         let r = self.core.emit(&end, kind);
         (self.core.frame, self.core.work_system, self.core.shift) = saved;
         r
+    }
+}
+
+/// DC/ACP/ACN on a rotary axis standing at `here` (degrees, any number of turns): the position
+/// whose angle is `target` (taken modulo 360°), by the shortest way, the positive or the
+/// negative one (§9.2.1, D109).
+fn rotary_target(here: f64, target: f64, way: Turn) -> f64 {
+    let up = (target - here).rem_euclid(360.0);
+    match way {
+        Turn::Plus => here + up,
+        Turn::Minus if up > 0.0 => here + up - 360.0,
+        Turn::Minus => here,
+        _ if up <= 180.0 => here + up,
+        _ => here + up - 360.0,
     }
 }
