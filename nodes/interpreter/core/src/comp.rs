@@ -32,10 +32,13 @@ const EPS: f64 = 1e-9;
 pub const OUTER_INTERSECTION_LIMIT: f64 = 100.0;
 
 /// What the front end's modal state asks of one element (decisions D98, D103).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ElementRules {
     /// The feed holds on the programmed contour, not at the cutter centre.
     pub feed_on_contour: bool,
+    /// The largest feed of the control: a centre feed scaled up for the contour is held
+    /// there (the axes' limits slow it further; 0: no limit).
+    pub max_feed: f64,
     /// Outer corners before this element meet at the offsets' intersection (below
     /// [`OUTER_INTERSECTION_LIMIT`]) instead of an arc.
     pub outer_intersection: bool,
@@ -348,12 +351,18 @@ impl RadiusComp {
     /// contour (decision D98) an arc's feed is scaled by offset radius over programmed radius,
     /// so the contour runs at the programmed feed (faster outside an arc, slower inside).
     /// Lines need no correction.
-    fn centre_feed(on_contour: bool, path: &Elem, off: &Elem, kind: Kind) -> Kind {
-        match (on_contour, path, off, kind) {
+    fn centre_feed(rules: ElementRules, path: &Elem, off: &Elem, kind: Kind) -> Kind {
+        match (rules.feed_on_contour, path, off, kind) {
             (true, Elem::Arc { a, c, .. }, Elem::Arc { a: oa, c: oc, .. }, Kind::Feed(f)) => {
                 let rho = len(sub(*a, *c));
                 if rho > EPS {
-                    Kind::Feed(f * len(sub(*oa, *oc)) / rho)
+                    let scaled = f * len(sub(*oa, *oc)) / rho;
+                    let limit = if rules.max_feed > 0.0 {
+                        rules.max_feed.max(f)
+                    } else {
+                        f64::INFINITY
+                    };
+                    Kind::Feed(scaled.min(limit))
                 } else {
                     kind
                 }
@@ -439,7 +448,7 @@ impl RadiusComp {
             None => path.offset(self.offset)?,
         };
         // The element's own feed; a corner arc before it keeps the programmed one.
-        let cut = Self::centre_feed(rules.feed_on_contour, &path, &off, kind);
+        let cut = Self::centre_feed(rules, &path, &off, kind);
         let course = match path {
             Elem::Line { a, b } => Some(unit(sub(b, a))),
             Elem::Arc { .. } => None,
@@ -889,14 +898,17 @@ mod tests {
             ccw: false,
         };
         // Right of a clockwise arc is its inside (radius 8), left its outside (radius 12).
-        for (side, on, radius, feed) in [
-            (Side::Right, false, 8.0, 100.0),
-            (Side::Right, true, 8.0, 80.0),
-            (Side::Left, true, 12.0, 120.0),
+        // With a control limit of 110 the outside arc's 120 is held at 110.
+        for (side, on, radius, feed, max_feed) in [
+            (Side::Right, false, 8.0, 100.0, 0.0),
+            (Side::Right, true, 8.0, 80.0, 0.0),
+            (Side::Left, true, 12.0, 120.0, 0.0),
+            (Side::Left, true, 12.0, 110.0, 110.0),
         ] {
             let mut c = RadiusComp::new(side, 2.0, 0, p(-10.0, 0.0), Startup::Connect);
             let rules = ElementRules {
                 feed_on_contour: on,
+                max_feed,
                 ..ElementRules::default()
             };
             let mut out = c.push(line, 0.0, Kind::Feed(100.0), 1, rules).unwrap();

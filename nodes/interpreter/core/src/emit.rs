@@ -345,6 +345,7 @@ impl Core {
         } else {
             let rules = crate::comp::ElementRules {
                 feed_on_contour: self.feed_on_contour,
+                max_feed: self.feed_limit(),
                 outer_intersection: self.outer_intersection,
             };
             let restart = self.comp_restart.take();
