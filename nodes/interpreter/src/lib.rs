@@ -11,6 +11,7 @@
 
 pub mod dialect;
 pub mod error;
+pub mod external;
 pub mod fanuc;
 pub mod gtc2e;
 pub mod huaxing;

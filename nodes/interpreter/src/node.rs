@@ -280,6 +280,18 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         carry_out(&mut core);
         while let Ok(Some(c)) = commands.take() {
             busy = true;
+            if c.command == ProgramCommand::START
+                && !c.program.is_empty()
+                && !cfg.machine.external_drives.is_empty()
+            {
+                // The external drives as they are at this start (D110).
+                let (programs, problems) =
+                    crate::external::read_drives(&cfg.machine.external_drives);
+                for p in problems {
+                    log::warn!("interpreter: external drive: {p}");
+                }
+                core.set_external_programs(programs);
+            }
             let result = core.command(c);
             carry_out(&mut core);
             let _ = results.publish(result);

@@ -224,6 +224,8 @@ pub struct RunCore {
     /// the memory.
     base: Setup,
     programs: BTreeMap<String, String>,
+    /// The external drives' programs by their EXTCALL names, as read at the last start (D110).
+    external: BTreeMap<String, String>,
     /// Where stored programs are kept (a folder on disk in the cell).
     storage: Box<dyn ProgramStorage>,
     /// Program memory's capacity, bytes.
@@ -261,6 +263,7 @@ impl RunCore {
         RunCore {
             dialect,
             programs: BTreeMap::new(),
+            external: BTreeMap::new(),
             storage: Box::new(InRam),
             capacity: u64::MAX,
             run: None,
@@ -329,6 +332,11 @@ impl RunCore {
         self.storage = storage;
         self.capacity = capacity;
         self
+    }
+
+    /// The external drives' programs (EXTCALL), read by the shell before a start (D110).
+    pub fn set_external_programs(&mut self, programs: BTreeMap<String, String>) {
+        self.external = programs;
     }
 
     /// The effects asked for since the last call, in order.
@@ -676,8 +684,7 @@ impl RunCore {
         setup.offsets.work = self.memory.work.clone();
         // The cell runs programs as the operator would: M99 or G27 loops go on until stop.
         setup.single_pass = false;
-        let mut interp =
-            Interpreter::with_library(self.dialect, &text, setup, library(&self.programs));
+        let mut interp = Interpreter::with_library(self.dialect, &text, setup, self.library());
         let (stream, message) = match &target {
             None => (ProgramRun::new(interp), format!("{name} started")),
             Some(t) => {
@@ -960,15 +967,21 @@ fn mdi_refusal(mode: u8, running: bool, text: &str) -> Option<String> {
     }
 }
 
-/// Program memory as a subprogram library: every stored program by its O number (on its first
-/// line or in its name, `O0010`, `O0010.nc`) and by its name (`L10.SPF` as `L10`).
-fn library(programs: &BTreeMap<String, String>) -> Library {
-    let mut lib = Library::new();
-    for (name, text) in programs {
-        // A second program of a taken number stays callable by name only.
-        let _ = crate::library::add_program(&mut lib, name, text);
+impl RunCore {
+    /// Program memory as a subprogram library: every stored program by its O number (on its
+    /// first line or in its name, `O0010`, `O0010.nc`) and by its name (`L10.SPF` as `L10`);
+    /// the external drives' programs by their EXTCALL names only (`D:\UP\BOHRUNG`).
+    fn library(&self) -> Library {
+        let mut lib = Library::new();
+        for (name, text) in &self.programs {
+            // A second program of a taken number stays callable by name only.
+            let _ = crate::library::add_program(&mut lib, name, text);
+        }
+        for (name, text) in &self.external {
+            lib.insert_named(name, name, text);
+        }
+        lib
     }
-    lib
 }
 
 #[cfg(test)]

@@ -694,3 +694,48 @@ fn an_802d_part_is_counted_in_memory_before_its_m30_goes_to_motion() {
     }
     assert!(done > 0);
 }
+
+#[test]
+fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
+    // D110: the shell hands the drives' programs over before a start; EXTCALL finds them by
+    // their drive path, and a program not on a drive stops the run with 14011.
+    let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
+    let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
+    let main = "N10 G0 X1\nN20 EXTCALL (\"D:\\EXTERNE_UP\\BOHRUNG\")\nN30 G0 X3\nN40 M30\n";
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "MAIN.MPF", main).accepted);
+    c.axes(&[0.0; 3]);
+    c.set_external_programs(
+        [(
+            r"D:\EXTERNE_UP\BOHRUNG".to_string(),
+            "G1 X2 F100\nM17\n".to_string(),
+        )]
+        .into_iter()
+        .collect(),
+    );
+    assert!(command(&mut c, 2, ProgramCommand::START, "MAIN.MPF", "").accepted);
+    c.motion_status(status(1001, 0, 100, MotionStatus::STATE_RUNNING));
+    c.step();
+    let xs: Vec<f64> = blocks(&c.take_effects())
+        .iter()
+        .filter(|b| !b.end.is_empty())
+        .map(|b| b.end[0])
+        .collect();
+    assert_eq!(xs, [1.0, 2.0, 3.0]);
+    // Without the drive (unplugged before the start) the call stops with 14011.
+    let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
+    let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "MAIN.MPF", main).accepted);
+    c.axes(&[0.0; 3]);
+    assert!(command(&mut c, 2, ProgramCommand::START, "MAIN.MPF", "").accepted);
+    c.motion_status(status(1001, 0, 100, MotionStatus::STATE_RUNNING));
+    c.step();
+    let raised: Vec<u32> = c
+        .take_effects()
+        .iter()
+        .filter_map(|e| match e {
+            Effect::Raise { number, .. } => Some(*number),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(raised, [14011]);
+}

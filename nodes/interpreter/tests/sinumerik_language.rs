@@ -632,3 +632,39 @@ fn dc_acp_acn_position_a_rotary_axis_by_its_way() {
     let (_, e) = run("X=DC(10)\n");
     assert_eq!(e.map(|e| e.number), Some(12080));
 }
+
+/// 077–079 (§9.11.4, D110): MAIN calls BOHRUNG (079, its placeholders filled) on the CF card
+/// (D:) and, in 078, on the USB device (G:, the name printed with a trailing space); the
+/// external program runs where the call stands and MAIN goes on after its M17.
+#[test]
+fn f077_to_f079_extcall_runs_bohrung_from_the_external_drive() {
+    let bohrung = support::filled("079", &["N030 X=10 Z=-5", "N040 X20", "", ""]);
+    for (main, drive) in [("077", 'D'), ("078", 'G')] {
+        let text = support::filled(main, &["N020 G0 X0 Y0 Z5", "N040 G0 Z50"]);
+        let mut lib = Library::new();
+        let name = format!("{drive}:\\EXTERNE_UP\\BOHRUNG");
+        lib.insert_named(&name, &name, &bohrung);
+        let r = support::run_with(&text, support::mill(), lib).ok();
+        let ends: Vec<Vec<f64>> = r
+            .moves()
+            .iter()
+            .map(|c| c.end().unwrap().to_vec())
+            .collect();
+        assert_eq!(
+            ends,
+            [
+                vec![0.0, 0.0, 5.0],
+                vec![10.0, 0.0, -5.0],
+                vec![20.0, 0.0, -5.0],
+                vec![20.0, 0.0, 50.0]
+            ],
+            "{main}"
+        );
+    }
+    // Not on a drive, or no drive named: 14011 with the reason.
+    for bad in ["EXTCALL(\"D:\\NONE\")\n", "EXTCALL(\"BOHRUNG\")\n"] {
+        let (_, e) = run(bad);
+        let e = e.unwrap_or_else(|| panic!("{bad} ran"));
+        assert_eq!((e.number, e.line), (14011, 1), "{bad}: {e}");
+    }
+}

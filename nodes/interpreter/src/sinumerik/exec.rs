@@ -142,11 +142,10 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 24] = [
+pub const NOT_BUILT: [(&str, &str); 23] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
-    ("EXTCALL", "external programs are not built"),
     ("TRACYL", "the cylinder transformation is not built"),
     ("TRAFOOF", "no transformation is built"),
     ("TRAILON", "coupled motion is not built"),
@@ -440,6 +439,9 @@ impl Sinumerik {
         if is_cycle(name) {
             return self.cycle_item(w, name, args);
         }
+        if name == "EXTCALL" {
+            return self.external_call(w, args);
+        }
         if NOT_BUILT.iter().any(|(k, _)| *k == name) {
             return self.not_built(name);
         }
@@ -447,6 +449,36 @@ impl Sinumerik {
             Fault::NoSuchAddress,
             format!("{name}(…) is not defined: no function, cycle or procedure of this name"),
         ))
+    }
+
+    /// `EXTCALL("D:\FOLDER\NAME")` (§9.11.4): calls a program of an external drive, as the
+    /// launch config's drives held it at the program's start (D110). The path names the drive;
+    /// the setting data of a default path is not kept here.
+    fn external_call(&mut self, w: &mut Words, args: &[Option<Expr>]) -> Result<(), ProgramError> {
+        let path = match args {
+            [Some(e)] => self.value(e)?.text(),
+            _ => {
+                return Err(self.fault(
+                    Fault::MacroArgument,
+                    "EXTCALL(\"D:\\FOLDER\\NAME\") takes the program's path",
+                ))
+            }
+        };
+        let name = crate::external::external_name(&path);
+        if name.as_bytes().get(1) != Some(&b':') {
+            return Err(self.fault(
+                Fault::ProgramNotFound,
+                format!("EXTCALL {path}: name the drive and folder (D:\\…)"),
+            ));
+        }
+        if self.core.library.get_named(&name).is_none() {
+            return Err(self.fault(
+                Fault::ProgramNotFound,
+                format!("EXTCALL {path}: no such program on the external drives"),
+            ));
+        }
+        w.call = Some(name);
+        Ok(())
     }
 
     /// The machine axis an address names: a channel axis (`X`) or a machine axis (`X1`).

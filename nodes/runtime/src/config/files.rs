@@ -69,6 +69,11 @@ impl LaunchConfig {
                 *file = dir.join(&*file);
             }
         }
+        for folder in self.machine.external_drives.values_mut() {
+            if folder.is_relative() {
+                *folder = dir.join(&*folder);
+            }
+        }
         if self.recorder.directory.is_relative() {
             self.recorder.directory = dir.join(&self.recorder.directory);
         }

@@ -42,6 +42,11 @@ pub struct MachineConfig {
     /// folder ([`crate::program_store`]); absent: programs are kept for this run only.
     #[serde(default)]
     pub program_directory: Option<std::path::PathBuf>,
+    /// External drives for EXTCALL (the 802D's CF card `D:`, USB device `G:`): a drive letter
+    /// and its folder, relative to the config file's folder; read when a program starts, never
+    /// written (decisions D110).
+    #[serde(default)]
+    pub external_drives: BTreeMap<String, std::path::PathBuf>,
     /// The program memory's capacity in KiB (all programs together; alarm 70 when full).
     #[serde(default = "default_program_capacity")]
     pub program_capacity_kib: u64,
@@ -359,6 +364,15 @@ impl MachineConfig {
         {
             return Err(format!(
                 "machine.namespace {ns:?}: letters, digits and _ only, not starting with a digit"
+            ));
+        }
+        if let Some(bad) = self
+            .external_drives
+            .keys()
+            .find(|k| !(k.len() == 1 && k.bytes().all(|b| b.is_ascii_alphabetic())))
+        {
+            return Err(format!(
+                "machine.external_drives {bad:?}: a drive is one letter (D, G)"
             ));
         }
         let tol = self.contour_tolerance;

@@ -161,4 +161,24 @@ mod tests {
             assert!(e.contains("fixed_points"), "{bad}: {e}");
         }
     }
+
+    /// EXTCALL's drives (D110): one letter each, a folder taken from the config's folder.
+    #[test]
+    fn external_drives_are_letters_with_folders_from_the_configs_folder() {
+        let text = include_str!("../../../../launch_configs/sim_mill.yaml");
+        let with = |drives: &str| {
+            let t = text.replacen(
+                "machine:\n",
+                &format!("machine:\n  external_drives: {drives}\n"),
+                1,
+            );
+            LaunchConfig::from_yaml_in(&t, std::path::Path::new("/cfg"), None)
+        };
+        let cfg = with("{D: cf, G: /media/usb}").expect("drives");
+        let d = &cfg.machine.external_drives;
+        assert_eq!(d["D"], std::path::Path::new("/cfg/cf"));
+        assert_eq!(d["G"], std::path::Path::new("/media/usb"));
+        let e = with("{DD: cf}").unwrap_err();
+        assert!(e.contains("external_drives"), "{e}");
+    }
 }
