@@ -44,8 +44,14 @@ impl Frame {
         }
     }
 
+    /// Asked for every move: compares in place, without building an identity to compare with.
     pub fn is_identity(&self) -> bool {
-        self.translation.iter().all(|&t| t == 0.0) && self.linear == identity_matrix(self.n)
+        let n = self.n.max(1);
+        self.translation.iter().all(|&t| t == 0.0)
+            && self.linear.iter().enumerate().all(|(k, &v)| {
+                let diagonal = k / n == k % n;
+                v == if diagonal { 1.0 } else { 0.0 }
+            })
     }
 
     /// `L[row][col]`.
@@ -64,12 +70,13 @@ impl Frame {
 
     /// The point the frame maps to `q`.
     pub fn invert(&self, q: &[f64]) -> Vec<f64> {
-        let d: Vec<f64> = q
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| v - self.translation.get(i).copied().unwrap_or(0.0))
-            .collect();
-        mul(&self.inverse, self.n, &d)
+        let n = self.n;
+        let d = |c: usize| {
+            q.get(c).copied().unwrap_or(0.0) - self.translation.get(c).copied().unwrap_or(0.0)
+        };
+        (0..n)
+            .map(|r| (0..n).map(|c| self.inverse[r * n + c] * d(c)).sum())
+            .collect()
     }
 
     /// A translation by `v`, in the frame's own coordinates.

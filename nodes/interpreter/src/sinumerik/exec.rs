@@ -47,16 +47,17 @@ impl<K: Ord + Copy> AddrMap<K> {
             }
         }
     }
-    pub fn get<Q: Ord + ?Sized>(&self, k: &Q) -> Option<&(f64, Mode)>
+    /// A block holds a few addresses: a scan that rejects by length is faster than a binary
+    /// search comparing strings (most blocks ask for a dozen addresses they do not have).
+    #[inline]
+    pub fn get<Q: PartialEq + ?Sized>(&self, k: &Q) -> Option<&(f64, Mode)>
     where
         K: Borrow<Q>,
     {
-        self.0
-            .binary_search_by(|(x, _)| x.borrow().cmp(k))
-            .ok()
-            .map(|i| &self.0[i].1)
+        self.0.iter().find(|(x, _)| x.borrow() == k).map(|(_, v)| v)
     }
-    pub fn contains_key<Q: Ord + ?Sized>(&self, k: &Q) -> bool
+    #[inline]
+    pub fn contains_key<Q: PartialEq + ?Sized>(&self, k: &Q) -> bool
     where
         K: Borrow<Q>,
     {
@@ -79,6 +80,9 @@ pub struct Words {
     /// `S`, `T`, `D`, `P`…
     pub addr: AddrMap<&'static str>,
     pub g: Vec<u32>,
+    /// The same G functions as bits (G0–G1023), for `has_g`, which a block asks a few dozen
+    /// times.
+    g_bits: [u64; 16],
     pub m: Vec<u32>,
     /// H functions: address and value (§9.8).
     pub h: Vec<(u16, f64)>,
@@ -95,6 +99,11 @@ impl Words {
     fn clear(&mut self) {
         self.axes.0.clear();
         self.addr.0.clear();
+        for &g in &self.g {
+            if let Some(w) = self.g_bits.get_mut(g as usize / 64) {
+                *w = 0;
+            }
+        }
         self.g.clear();
         self.m.clear();
         self.h.clear();
@@ -103,8 +112,18 @@ impl Words {
         self.cycle = None;
     }
 
+    fn push_g(&mut self, n: u32) {
+        self.g.push(n);
+        if let Some(w) = self.g_bits.get_mut(n as usize / 64) {
+            *w |= 1 << (n % 64);
+        }
+    }
+
+    #[inline]
     pub fn has_g(&self, n: u32) -> bool {
-        self.g.contains(&n)
+        self.g_bits
+            .get(n as usize / 64)
+            .is_some_and(|w| w >> (n % 64) & 1 == 1)
     }
     pub fn key(&self, k: &str) -> bool {
         self.keys.contains(&k)
@@ -233,7 +252,9 @@ impl Sinumerik {
             self.item(item, w)?;
         }
         let from = self.core.queued();
-        let start = self.core.pos.clone();
+        // Where the block starts, for the work area check (a buffer kept from block to block).
+        let mut start = std::mem::take(&mut self.block_start);
+        start.clone_from(&self.core.pos);
         self.modal(w)?;
         self.feed_and_speed(w)?;
         self.tool_words(w)?;
@@ -245,7 +266,9 @@ impl Sinumerik {
             self.corner = None;
         }
         self.cycles(w, nonmodal)?;
-        self.check_work_area(from, &start)?;
+        let checked = self.check_work_area(from, &start);
+        self.block_start = start;
+        checked?;
         if w.has_g(9) {
             self.core.exact_stop_block(from);
         }
@@ -561,7 +584,7 @@ impl Sinumerik {
                         self.fault(Fault::UndefinedCode, format!("G{value} does not exist"))
                     );
                 }
-                w.g.push(value as u32);
+                w.push_g(value as u32);
             }
             'M' => {
                 if value.fract() != 0.0 || !(0.0..=99.0).contains(&value) {

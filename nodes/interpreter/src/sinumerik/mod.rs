@@ -117,6 +117,8 @@ pub struct Sinumerik {
     thread_angle: f64,
     /// OFFN=, the contour's normal offset added to the cutter radius of G41/G42 (§9.15).
     contour_offset: f64,
+    /// The machine position where the block in hand started (kept to spare an allocation).
+    block_start: Vec<f64>,
     /// The spindle is in position control (SPOS, M19, a tap) until M3/M4/M5 or the end.
     positioned: bool,
     /// The direction of the last G331 (+1 the way M3 turns), which G332 reverses; 0: none.
@@ -209,6 +211,7 @@ impl Sinumerik {
             program_text: None,
             thread_angle: 0.0,
             contour_offset: 0.0,
+            block_start: Vec::new(),
             positioned: false,
             tap_hand: 0.0,
         };
