@@ -91,21 +91,20 @@ impl Frame {
     /// frame's origin.
     pub fn rotate(&mut self, h: usize, v: usize, degrees: f64) {
         let (s, c) = degrees.to_radians().sin_cos();
-        let mut r = identity_matrix(self.n);
         let n = self.n;
         if h >= n || v >= n || h == v {
             return;
         }
-        r[h * n + h] = c;
-        r[h * n + v] = -s;
-        r[v * n + h] = s;
-        r[v * n + v] = c;
-        let mut ri = identity_matrix(n);
-        ri[h * n + h] = c;
-        ri[h * n + v] = s;
-        ri[v * n + h] = -s;
-        ri[v * n + v] = c;
-        self.compose(&r, &ri);
+        // linear × R (R turns h toward v) and R⁻¹ × inverse, in place: a rotation mixes only
+        // the two columns (rows) of its plane.
+        for k in 0..n {
+            let (a, b) = (self.linear[k * n + h], self.linear[k * n + v]);
+            self.linear[k * n + h] = a * c + b * s;
+            self.linear[k * n + v] = b * c - a * s;
+            let (p, q) = (self.inverse[h * n + k], self.inverse[v * n + k]);
+            self.inverse[h * n + k] = c * p + s * q;
+            self.inverse[v * n + k] = c * q - s * p;
+        }
     }
 
     /// Per-axis factors (negative mirrors); a factor of 0 is refused by the caller.
