@@ -118,9 +118,13 @@ impl Library {
 
     /// The program called `name` (any case): what errors call it, and its text.
     pub fn get_named(&self, name: &str) -> Option<(&str, Arc<str>)> {
-        self.named
-            .get(&name.to_ascii_uppercase())
-            .map(|(n, t)| (n.as_str(), t.clone()))
+        // Names are mostly written in capitals already: no copy to look them up.
+        let hit = if name.bytes().any(|b| b.is_ascii_lowercase()) {
+            self.named.get(&name.to_ascii_uppercase())
+        } else {
+            self.named.get(name)
+        };
+        hit.map(|(n, t)| (n.as_str(), t.clone()))
     }
 
     pub fn len(&self) -> usize {

@@ -65,7 +65,8 @@ pub enum Expr<'s> {
     /// An axis name as an index (`$AA_IW[X]`, `FXS[Z1]`).
     Axis(Cow<'s, str>),
     Neg(Box<Expr<'s>>),
-    Bin(&'static str, Box<Expr<'s>>, Box<Expr<'s>>),
+    /// An operator and its two operands (one allocation for both).
+    Bin(&'static str, Box<(Expr<'s>, Expr<'s>)>),
     Call(Cow<'s, str>, Vec<Option<Expr<'s>>>),
 }
 
@@ -134,7 +135,7 @@ impl<'a, 's> Parser<'a, 's> {
         let mut left = self.comparison()?;
         while self.eat_op("<<") {
             let right = self.comparison()?;
-            left = Expr::Bin("<<", Box::new(left), Box::new(right));
+            left = Expr::Bin("<<", Box::new((left, right)));
         }
         Ok(left)
     }
@@ -144,7 +145,7 @@ impl<'a, 's> Parser<'a, 's> {
         for op in ["==", "<>", "<=", ">=", "<", ">"] {
             if self.eat_op(op) {
                 let right = self.sum()?;
-                return Ok(Expr::Bin(op, Box::new(left), Box::new(right)));
+                return Ok(Expr::Bin(op, Box::new((left, right))));
             }
         }
         Ok(left)
@@ -161,7 +162,7 @@ impl<'a, 's> Parser<'a, 's> {
                 return Ok(left);
             };
             let right = self.term()?;
-            left = Expr::Bin(op, Box::new(left), Box::new(right));
+            left = Expr::Bin(op, Box::new((left, right)));
         }
     }
 
@@ -176,7 +177,7 @@ impl<'a, 's> Parser<'a, 's> {
                 return Ok(left);
             };
             let right = self.unary()?;
-            left = Expr::Bin(op, Box::new(left), Box::new(right));
+            left = Expr::Bin(op, Box::new((left, right)));
         }
     }
 
@@ -318,8 +319,9 @@ pub fn eval(e: &Expr, var: &Reader) -> Result<Val, EvalError> {
             }
         },
         Expr::Neg(a) => Val::Num(-eval(a, var)?.num()?),
-        Expr::Bin("<<", a, b) => Val::Str(eval(a, var)?.text() + &eval(b, var)?.text()),
-        Expr::Bin(op, a, b) => {
+        Expr::Bin("<<", ab) => Val::Str(eval(&ab.0, var)?.text() + &eval(&ab.1, var)?.text()),
+        Expr::Bin(op, ab) => {
+            let (a, b) = (&ab.0, &ab.1);
             let (a, b) = (eval(a, var)?, eval(b, var)?);
             if let (Val::Str(x), Val::Str(y)) = (&a, &b) {
                 return match *op {
