@@ -1,0 +1,224 @@
+//! The 802D mill's spindle and axes through the whole chain on the PLC rig (`rig/mod.rs`):
+//! SPOS positioned by the ladder and the simulated drive (D100), rigid tapping with the slide
+//! locked to the spindle (D101), FFWON's following error (D106), H functions with HF (D107).
+
+#[path = "rig/mod.rs"]
+mod rig;
+
+use cnc_msgs::signals::{f, g, SignalTable};
+use cnc_plc::memory::Retained;
+use rig::*;
+
+/// The spindle's angle unwrapped: the degrees it has turned, signed, from the encoder's
+/// 0–360° readings (less than half a turn between two of them).
+struct Turned {
+    degrees: f64,
+    last: f64,
+}
+
+impl Turned {
+    fn from(angle: f64) -> Turned {
+        Turned {
+            degrees: 0.0,
+            last: angle,
+        }
+    }
+
+    fn read(&mut self, angle: f64) -> f64 {
+        let mut d = (angle - self.last).rem_euclid(360.0);
+        if d > 180.0 {
+            d -= 360.0;
+        }
+        self.last = angle;
+        self.degrees += d;
+        self.degrees
+    }
+}
+
+/// SPOS through the whole chain (D100): the 802D front end, motion's M19 with the stop
+/// position in F30–F35, the ladder copying it to Y8–Y13 with the strobe, the simulated drive
+/// positioning and holding, the ladder's FIN on SPINDLE_ORIENTED. At each FIN the spindle
+/// stands at its angle, having turned only the way the program asked.
+#[test]
+fn spos_positions_the_simulated_spindle_each_way_through_the_ladder() {
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let program = "SPOS=14.3\nS800 M3\nG0 X10\nSPOS=ACN(300)\nG0 X20\nSPOS=IC(-720.5)\n\
+                   SPOS=ACP(290)\nM3\nG0 X30\nM30\n";
+    let mut r = Rig::on(cfg, program, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    // At each M19's FIN: (angle, rpm, degrees turned so far).
+    let mut spindle = Turned::from(r.fb.spindle_angle_deg);
+    let mut fins = Vec::new();
+    let mut was_fin = false;
+    let ok = r.run_until(120.0, |r| {
+        let a = r.fb.spindle_angle_deg;
+        let turned = spindle.read(a);
+        let fin = r.gi.get(g::FIN) && r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;
+        if fin && !was_fin {
+            fins.push((a, r.fb.spindle_rpm, turned));
+        }
+        was_fin = fin;
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!("{fins:?} at {:.2} s", r.t);
+    assert_eq!(fins.len(), 4, "{fins:?}");
+    let angles: Vec<f64> = fins.iter().map(|f| f.0).collect();
+    let want = [14.3, 300.0, (300.0 - 720.5f64).rem_euclid(360.0), 290.0];
+    for (got, want) in angles.iter().zip(want) {
+        assert!((got - want).abs() < 1e-6, "{angles:?}");
+    }
+    assert!(
+        fins.iter().all(|f| f.1 == 0.0),
+        "standing at each FIN: {fins:?}"
+    );
+    // IC(−720.5): two turns and half a degree back; ACP(290) from 299.5: 350.5° forward.
+    assert!((fins[2].2 - fins[1].2 + 720.5).abs() < 1e-6, "{fins:?}");
+    assert!((fins[3].2 - fins[2].2 - 350.5).abs() < 1e-6, "{fins:?}");
+    // M3 turns it again: the position control let go.
+    assert!(r.fb.spindle_rpm > 700.0, "{}", r.fb.spindle_rpm);
+}
+
+/// Rigid tapping through the whole chain (D101): G331 sends the tap's travel to the ladder as
+/// a positioning with its speed, the simulated drive turns the spindle through it, and the
+/// slide follows the spindle's angle at every servo tick, within what its drive lag and the
+/// setpoint's one period ahead allow; the tap ends exactly at its depth with the spindle
+/// standing, and G332 brings it out turning the other way.
+#[test]
+fn g331_and_g332_tap_with_the_slide_locked_to_the_simulated_spindle() {
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let z = cfg.axis_index("Z").unwrap();
+    let program =
+        "G0 X10 Y10 Z5\nSPOS=0\nG331 Z-25 K0.8 S600\nG4 F0.5\nG332 Z5 K0.8\nG0 Z50\nM30\n";
+    let mut r = Rig::on(cfg, program, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    // Unwrapped spindle angle; while a tap runs, the slide's distance from where the spindle
+    // puts it (0.8 mm a turn from where the tap began).
+    let mut spindle = Turned::from(r.fb.spindle_angle_deg);
+    let mut tap: Option<(f64, f64)> = None;
+    let (mut worst, mut ends, mut deepest) = (0.0f64, Vec::new(), f64::INFINITY);
+    let mut rising = 0usize;
+    let ok = r.run_until(120.0, |r| {
+        let turned = spindle.read(r.fb.spindle_angle_deg);
+        let slide = r.fb.position[z];
+        deepest = deepest.min(slide);
+        let orienting = r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;
+        let tapping = orienting && r.nc().bytes[f::ORIENT_WAY] == 3;
+        match (tap, tapping) {
+            (None, true) => {
+                tap = Some((slide, turned));
+                rising += 1;
+            }
+            (Some((z0, t0)), true) => {
+                let sign = if rising == 1 { -1.0 } else { 1.0 };
+                let want = z0 + sign * (turned - t0).abs() / 360.0 * 0.8;
+                worst = worst.max((slide - want).abs());
+            }
+            (Some(_), false) => {
+                tap = None;
+                ends.push((slide, r.fb.spindle_rpm, turned));
+            }
+            (None, false) => {}
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!("taps end at {ends:?}, slide off the spindle's helix by at most {worst:.4} mm");
+    assert_eq!(ends.len(), 2, "{ends:?}");
+    // Down 30 mm and back: 37.5 turns each way, the spindle standing at each end.
+    let length = ends[0].0 - ends[1].0;
+    assert!((length + 30.0).abs() < 1e-3, "{ends:?}");
+    assert!(ends.iter().all(|e| e.1 == 0.0), "{ends:?}");
+    assert!((ends[0].2 - 37.5 * 360.0).abs() < 1e-3, "{ends:?}");
+    assert!(ends[1].2.abs() < 1e-3, "back where it began: {ends:?}");
+    // The slide never went below the depth, and kept to the spindle within its lag.
+    assert!(deepest >= ends[0].0 - 1e-3, "{deepest} below {}", ends[0].0);
+    assert!(worst < 0.1, "{worst}");
+}
+
+/// Fixture 040 (§9.3.19, D106) through motion and the simulated drives: FFWON before a
+/// move at F900 takes the following error (an axis's distance from its commanded position,
+/// which a drive with an 8 ms lag makes 0.105 mm on X at 13.1 mm/s) to almost nothing; the same
+/// program with FFWOF keeps it. The template's placeholders filled: the move and one back.
+#[test]
+fn f040_ffwon_takes_the_following_error_to_almost_nothing() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
+    let path = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("040"))
+        .unwrap();
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("N20 G1 X... Y... Z... F900", "N20 G1 X200 Y100 Z100 F900")
+        .replace("\n...\n", "\nN30 X0 Y0 Z150\n")
+        + "M30\n";
+    let worst = |text: &str| {
+        let cfg = config("sim_mill_802d");
+        let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+        let mut r = Rig::on(cfg, text, Some(&kept));
+        r.run_until(0.1, |_| false);
+        r.started = true;
+        let mut worst = 0.0f64;
+        let ok = r.run_until(120.0, |r| {
+            for (c, a) in r.motion.commanded().iter().zip(&r.fb.position) {
+                worst = worst.max((c - a).abs());
+            }
+            r.program_done()
+        });
+        assert!(ok, "program did not finish; events {:?}", r.events);
+        worst
+    };
+    let with = worst(&text);
+    let without = worst(&text.replace("N10 FFWON", "N10 FFWOF"));
+    println!("largest following error: {with:.5} mm with FFWON, {without:.5} mm without");
+    // X runs at 15 mm/s × 200/229 = 13.1 mm/s: 8 ms behind is 0.105 mm.
+    assert!(without > 0.09, "{without}");
+    assert!(with < without / 10.0, "{with} vs {without}");
+}
+
+/// Fixture 063's H functions (§9.8, D107) through motion and the standard ladder: each goes
+/// to the PLC with the HF strobe, its address in F40 and its value in F44–F51, and the ladder
+/// gives FIN once settled, so the program runs to its end.
+#[test]
+fn f063_h_functions_reach_the_ladder_with_hf_and_get_fin() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
+    let path = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("063"))
+        .unwrap();
+    let text = std::fs::read_to_string(path).unwrap() + "M30\n";
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let mut r = Rig::on(cfg, &text, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let mut seen = Vec::new();
+    let mut was = false;
+    let ok = r.run_until(30.0, |r| {
+        let hf = r.nc().get(f::HF);
+        if hf && !was {
+            let mut v = [0u8; 8];
+            v.copy_from_slice(&r.nc().bytes[f::H_VALUE..f::H_VALUE + 8]);
+            seen.push((r.nc().read_i32(f::H_ADDRESS), f64::from_le_bytes(v)));
+        }
+        was = hf;
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    assert_eq!(
+        seen,
+        [
+            (1, 1.987),
+            (2, 978.123),
+            (3, 4.0),
+            (99, -8978.234),
+            (0, 5.0)
+        ]
+    );
+}
