@@ -241,24 +241,27 @@ impl Core {
     }
 
     /// Current position in work coordinates (X as diameter).
+    /// One allocation per call: asked for at every move.
     pub fn work_position(&self) -> Vec<f64> {
-        let p: Vec<f64> = (0..self.pos.len())
+        let mut p: Vec<f64> = (0..self.pos.len())
             .map(|i| self.pos[i] - self.origin(i))
             .collect();
-        if self.frame.is_identity() {
-            p
-        } else {
-            self.frame.invert(&p)
+        if !self.frame.is_identity() {
+            self.frame.invert_in_place(&mut p);
         }
+        p
     }
 
     pub fn to_machine(&self, work: &[f64]) -> Vec<f64> {
-        if self.frame.is_identity() {
-            (0..work.len()).map(|i| work[i] + self.origin(i)).collect()
+        let mut m = if self.frame.is_identity() {
+            work.to_vec()
         } else {
-            let f = self.frame.apply(work);
-            (0..f.len()).map(|i| f[i] + self.origin(i)).collect()
+            self.frame.apply(work)
+        };
+        for (i, x) in m.iter_mut().enumerate() {
+            *x += self.origin(i);
         }
+        m
     }
 
     /// The X and Z axes' indices (alarm when the machine lacks one).

@@ -79,6 +79,25 @@ impl Frame {
             .collect()
     }
 
+    /// [`Frame::invert`] into `q` itself (a frame of up to 16 axes needs no allocation).
+    pub fn invert_in_place(&self, q: &mut [f64]) {
+        let n = self.n;
+        if n > 16 || q.len() != n {
+            let p = self.invert(q);
+            for (dst, src) in q.iter_mut().zip(p) {
+                *dst = src;
+            }
+            return;
+        }
+        let mut d = [0.0; 16];
+        for (c, x) in d.iter_mut().enumerate().take(n) {
+            *x = q[c] - self.translation.get(c).copied().unwrap_or(0.0);
+        }
+        for (r, out) in q.iter_mut().enumerate() {
+            *out = (0..n).map(|c| self.inverse[r * n + c] * d[c]).sum();
+        }
+    }
+
     /// A translation by `v`, in the frame's own coordinates.
     pub fn translate(&mut self, v: &[f64]) {
         let d = mul(&self.linear, self.n, v);
