@@ -7,11 +7,11 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Deepest folder level read on a drive.
-const MAX_DEPTH: usize = 4;
-/// Largest program read, and largest sum of them per start: a drive is not program memory.
-const MAX_FILE_BYTES: u64 = 16 << 20;
-const MAX_TOTAL_BYTES: u64 = 256 << 20;
+use cnc_runtime::program_store::ProgramDir;
+
+/// The most read from all drives at one start: a drive is not program memory (each program
+/// keeps program memory's limit, 4 MiB, and its rules for names and folders).
+const MAX_TOTAL_BYTES: usize = 256 << 20;
 
 /// The name EXTCALL gives a program: `d:/Externe_UP/bohrung.spf ` → `D:\EXTERNE_UP\BOHRUNG`.
 pub fn external_name(path: &str) -> String {
@@ -24,75 +24,28 @@ pub fn external_name(path: &str) -> String {
     name
 }
 
-/// Every program on the drives (letter → folder) by its EXTCALL name, and what could not be
-/// read (a missing drive is no problem: nothing is plugged in).
+/// Every part program (`.SPF`, `.MPF`) on the drives (letter → folder) by its EXTCALL name,
+/// and what could not be read (a missing drive is no problem: nothing is plugged in). The
+/// folders are read as program memory is, but never tidied.
 pub fn read_drives<P: AsRef<Path>>(
     drives: &BTreeMap<String, P>,
 ) -> (BTreeMap<String, String>, Vec<String>) {
     let mut found = BTreeMap::new();
     let mut problems = Vec::new();
-    let mut total = 0;
+    let mut budget = MAX_TOTAL_BYTES;
     for (letter, root) in drives {
-        let prefix = format!("{}:", letter.trim().to_ascii_uppercase());
-        walk(
-            root.as_ref(),
-            &prefix,
-            0,
-            &mut total,
-            &mut found,
-            &mut problems,
-        );
-    }
-    (found, problems)
-}
-
-fn walk(
-    dir: &Path,
-    prefix: &str,
-    depth: usize,
-    total: &mut u64,
-    found: &mut BTreeMap<String, String>,
-    problems: &mut Vec<String>,
-) {
-    let entries = match std::fs::read_dir(dir) {
-        Ok(e) => e,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return,
-        Err(e) => return problems.push(format!("{}: {e}", dir.display())),
-    };
-    let mut entries: Vec<_> = entries.flatten().collect();
-    entries.sort_by_key(|e| e.file_name());
-    for entry in entries {
-        let file = entry.file_name().to_string_lossy().to_string();
-        let path = entry.path();
-        let name = format!("{prefix}\\{file}");
-        match entry.metadata() {
-            Ok(m) if m.is_dir() && depth < MAX_DEPTH => {
-                walk(&path, &name, depth + 1, total, found, problems)
+        let (programs, mut p) = ProgramDir::new(root.as_ref()).read_untouched(budget);
+        problems.append(&mut p);
+        for (name, text) in programs {
+            budget = budget.saturating_sub(text.len());
+            let upper = name.to_ascii_uppercase();
+            if upper.ends_with(".SPF") || upper.ends_with(".MPF") {
+                let path = format!("{}:\\{name}", letter.trim());
+                found.insert(external_name(&path), text);
             }
-            Ok(m) if m.is_file() => {
-                let upper = file.to_ascii_uppercase();
-                if !(upper.ends_with(".SPF") || upper.ends_with(".MPF")) {
-                    continue;
-                }
-                if m.len() > MAX_FILE_BYTES || *total + m.len() > MAX_TOTAL_BYTES {
-                    problems.push(format!("{}: too large to read", path.display()));
-                    continue;
-                }
-                match std::fs::read(&path) {
-                    Ok(bytes) => {
-                        *total += m.len();
-                        found.insert(
-                            external_name(&name),
-                            String::from_utf8_lossy(&bytes).into_owned(),
-                        );
-                    }
-                    Err(e) => problems.push(format!("{}: {e}", path.display())),
-                }
-            }
-            Ok(_) => {}
-            Err(e) => problems.push(format!("{}: {e}", path.display())),
         }
     }
+    (found, problems)
 }
 
 #[cfg(test)]
@@ -106,6 +59,8 @@ mod tests {
         std::fs::create_dir_all(root.join("Externe_UP")).unwrap();
         std::fs::write(root.join("Externe_UP/bohrung.spf"), "G1 X1\nM17\n").unwrap();
         std::fs::write(root.join("notes.txt"), "not a program").unwrap();
+        // What a cut-short write leaves in program memory is removed there; here it stays.
+        std::fs::write(root.join("old.tmp"), "someone else's").unwrap();
         let drives: BTreeMap<String, std::path::PathBuf> = [
             ("d".to_string(), root.clone()),
             ("G".to_string(), root.join("absent")),
@@ -122,6 +77,7 @@ mod tests {
         assert_eq!(external_name("g:/x/Main.mpf"), r"G:\X\MAIN");
         // Read, never written: the folder is as it was.
         assert!(root.join("notes.txt").exists());
+        assert!(root.join("old.tmp").exists());
         let _ = std::fs::remove_dir_all(&root);
     }
 }

@@ -122,24 +122,43 @@ impl ProgramDir {
     /// Every program in the folder, and what was left out and why (a file too large or
     /// badly named, a folder too deep). A missing folder is an empty memory.
     pub fn read_all(&self) -> (BTreeMap<String, String>, Vec<String>) {
-        let mut programs = BTreeMap::new();
-        let mut problems = Vec::new();
-        self.walk(&self.root, "", 0, &mut programs, &mut problems);
-        (programs, problems)
+        self.read(true, usize::MAX)
     }
 
-    fn walk(
-        &self,
-        dir: &Path,
-        prefix: &str,
-        depth: usize,
-        programs: &mut BTreeMap<String, String>,
-        problems: &mut Vec<String>,
-    ) {
+    /// The same, from a folder this controller does not own (an external drive): nothing is
+    /// removed, and reading stops once `budget` bytes are read (the rest is reported).
+    pub fn read_untouched(&self, budget: usize) -> (BTreeMap<String, String>, Vec<String>) {
+        self.read(false, budget)
+    }
+
+    fn read(&self, tidy: bool, budget: usize) -> (BTreeMap<String, String>, Vec<String>) {
+        let mut walk = Walk {
+            tidy,
+            budget,
+            programs: BTreeMap::new(),
+            problems: Vec::new(),
+        };
+        walk.folder(&self.root, "", 0);
+        (walk.programs, walk.problems)
+    }
+}
+
+/// One reading of a program folder.
+struct Walk {
+    /// Remove what a cut-short write left (only in the controller's own folder).
+    tidy: bool,
+    /// Bytes still to read.
+    budget: usize,
+    programs: BTreeMap<String, String>,
+    problems: Vec<String>,
+}
+
+impl Walk {
+    fn folder(&mut self, dir: &Path, prefix: &str, depth: usize) {
         let entries = match std::fs::read_dir(dir) {
             Ok(e) => e,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return,
-            Err(e) => return problems.push(format!("{}: {e}", dir.display())),
+            Err(e) => return self.problems.push(format!("{}: {e}", dir.display())),
         };
         let mut entries: Vec<_> = entries.flatten().collect();
         entries.sort_by_key(|e| e.file_name());
@@ -149,34 +168,46 @@ impl ProgramDir {
             let path = entry.path();
             // Left over by a write a crash cut short: the old file is still there.
             if file.ends_with(".tmp") {
-                let _ = std::fs::remove_file(&path);
+                if self.tidy {
+                    let _ = std::fs::remove_file(&path);
+                }
                 continue;
             }
             let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
             if is_dir && depth < MAX_FOLDER_DEPTH && valid_program_name(&name) {
-                self.walk(&path, &format!("{name}/"), depth + 1, programs, problems);
+                self.folder(&path, &format!("{name}/"), depth + 1);
                 continue;
             }
             if is_dir || !valid_program_name(&name) {
-                problems.push(format!("{}: not a program name, left out", path.display()));
+                self.problems
+                    .push(format!("{}: not a program name, left out", path.display()));
                 continue;
             }
             match std::fs::metadata(&path) {
-                Ok(m) if m.len() > MAX_PROGRAM_BYTES as u64 => problems.push(format!(
+                Ok(m) if m.len() > MAX_PROGRAM_BYTES as u64 => self.problems.push(format!(
                     "{}: {} bytes, limit {MAX_PROGRAM_BYTES}, left out",
                     path.display(),
                     m.len()
                 )),
+                Ok(m) if m.len() > self.budget as u64 => self.problems.push(format!(
+                    "{}: over the bytes to read, left out",
+                    path.display()
+                )),
                 _ => match std::fs::read_to_string(&path) {
                     Ok(text) => {
-                        programs.insert(name, text);
+                        self.budget = self.budget.saturating_sub(text.len());
+                        self.programs.insert(name, text);
                     }
-                    Err(e) => problems.push(format!("{}: {e}, left out", path.display())),
+                    Err(e) => self
+                        .problems
+                        .push(format!("{}: {e}, left out", path.display())),
                 },
             }
         }
     }
+}
 
+impl ProgramDir {
     /// Stores a program durably (its folders created).
     pub fn store(&self, name: &str, text: &str) -> Result<(), String> {
         crate::persist::write_atomic(&self.path(name)?, text)
