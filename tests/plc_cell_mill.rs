@@ -9,6 +9,27 @@ use cnc_msgs::signals::{f, g, SignalTable};
 use cnc_plc::memory::Retained;
 use rig::*;
 
+/// The simulated 802D mill at power-up running `program`, its cycle started.
+fn mill(program: &str) -> Rig {
+    let cfg = config("sim_mill_802d");
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let mut r = Rig::on(cfg, program, Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    r
+}
+
+/// The text of the 802D manual's fixture `number` (`../shared/fixtures/001`).
+fn fixture(number: &str) -> String {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
+    let path = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(number))
+        .unwrap();
+    std::fs::read_to_string(path).unwrap()
+}
+
 /// The spindle's angle unwrapped: the degrees it has turned, signed, from the encoder's
 /// 0–360° readings (less than half a turn between two of them).
 struct Turned {
@@ -41,13 +62,9 @@ impl Turned {
 /// stands at its angle, having turned only the way the program asked.
 #[test]
 fn spos_positions_the_simulated_spindle_each_way_through_the_ladder() {
-    let cfg = config("sim_mill_802d");
-    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
     let program = "SPOS=14.3\nS800 M3\nG0 X10\nSPOS=ACN(300)\nG0 X20\nSPOS=IC(-720.5)\n\
                    SPOS=ACP(290)\nM3\nG0 X30\nM30\n";
-    let mut r = Rig::on(cfg, program, Some(&kept));
-    r.run_until(0.1, |_| false);
-    r.started = true;
+    let mut r = mill(program);
     // At each M19's FIN: (angle, rpm, degrees turned so far).
     let mut spindle = Turned::from(r.fb.spindle_angle_deg);
     let mut fins = Vec::new();
@@ -88,14 +105,10 @@ fn spos_positions_the_simulated_spindle_each_way_through_the_ladder() {
 /// standing, and G332 brings it out turning the other way.
 #[test]
 fn g331_and_g332_tap_with_the_slide_locked_to_the_simulated_spindle() {
-    let cfg = config("sim_mill_802d");
-    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
-    let z = cfg.axis_index("Z").unwrap();
+    let z = config("sim_mill_802d").axis_index("Z").unwrap();
     let program =
         "G0 X10 Y10 Z5\nSPOS=0\nG331 Z-25 K0.8 S600\nG4 F0.5\nG332 Z5 K0.8\nG0 Z50\nM30\n";
-    let mut r = Rig::on(cfg, program, Some(&kept));
-    r.run_until(0.1, |_| false);
-    r.started = true;
+    let mut r = mill(program);
     // Unwrapped spindle angle; while a tap runs, the slide's distance from where the spindle
     // puts it (0.8 mm a turn from where the tap began).
     let mut spindle = Turned::from(r.fb.spindle_angle_deg);
@@ -146,23 +159,12 @@ fn g331_and_g332_tap_with_the_slide_locked_to_the_simulated_spindle() {
 /// program with FFWOF keeps it. The template's placeholders filled: the move and one back.
 #[test]
 fn f040_ffwon_takes_the_following_error_to_almost_nothing() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
-    let path = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("040"))
-        .unwrap();
-    let text = std::fs::read_to_string(path)
-        .unwrap()
+    let text = fixture("040")
         .replace("N20 G1 X... Y... Z... F900", "N20 G1 X200 Y100 Z100 F900")
         .replace("\n...\n", "\nN30 X0 Y0 Z150\n")
         + "M30\n";
     let worst = |text: &str| {
-        let cfg = config("sim_mill_802d");
-        let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
-        let mut r = Rig::on(cfg, text, Some(&kept));
-        r.run_until(0.1, |_| false);
-        r.started = true;
+        let mut r = mill(text);
         let mut worst = 0.0f64;
         let ok = r.run_until(120.0, |r| {
             for (c, a) in r.motion.commanded().iter().zip(&r.fb.position) {
@@ -186,18 +188,8 @@ fn f040_ffwon_takes_the_following_error_to_almost_nothing() {
 /// gives FIN once settled, so the program runs to its end.
 #[test]
 fn f063_h_functions_reach_the_ladder_with_hf_and_get_fin() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
-    let path = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with("063"))
-        .unwrap();
-    let text = std::fs::read_to_string(path).unwrap() + "M30\n";
-    let cfg = config("sim_mill_802d");
-    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
-    let mut r = Rig::on(cfg, &text, Some(&kept));
-    r.run_until(0.1, |_| false);
-    r.started = true;
+    let text = fixture("063") + "M30\n";
+    let mut r = mill(&text);
     let mut seen = Vec::new();
     let mut was = false;
     let ok = r.run_until(30.0, |r| {
