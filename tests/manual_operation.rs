@@ -144,6 +144,14 @@ fn from_power_on_a_start_is_refused_the_axes_find_their_reference_points_then_a_
         "moved {:?}",
         rig.moved
     );
+    // Under the alarm motion refuses a reference return, with the reason its shell raises as
+    // warning 1095 (D68).
+    let refused = rig
+        .motion
+        .reference_return()
+        .expect_err("refused under an alarm");
+    assert!(refused.contains("reset first"), "{refused}");
+    assert!(!rig.motion.referencing());
     rig.motion.reset();
     rig.alarms.clear();
     rig.run_until(30, |_| false);
