@@ -23,6 +23,18 @@ fn cnc(args: &[&str]) -> (bool, String) {
 /// Runs `cnc run` on the program; the run must end by itself within 120 s (a hang fails
 /// here instead of passing as a non-zero exit).
 fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, String) {
+    run_program_with(domain, name, text, cycles, |_, _| {})
+}
+
+/// [`run_program`], calling `during` with the process id and the time since the start while
+/// the run goes on.
+fn run_program_with(
+    domain: &str,
+    name: &str,
+    text: &str,
+    cycles: &str,
+    mut during: impl FnMut(u32, Duration),
+) -> (bool, String) {
     let dir = std::env::temp_dir().join(format!("cnc_cli_{}_{domain}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
@@ -51,11 +63,13 @@ fn run_program(domain: &str, name: &str, text: &str, cycles: &str) -> (bool, Str
         .spawn()
         .unwrap();
     // A hung run is a failure, not a hung test suite.
-    let deadline = Instant::now() + Duration::from_secs(120);
+    let started = Instant::now();
+    let deadline = started + Duration::from_secs(120);
     let status = loop {
         if let Some(status) = child.try_wait().unwrap() {
             break status;
         }
+        during(child.id(), started.elapsed());
         if Instant::now() > deadline {
             let _ = child.kill();
             let _ = child.wait();
@@ -102,6 +116,49 @@ fn run_exits_nonzero_on_an_alarm_with_number_and_line() {
     );
     assert!(!ok, "{out}");
     assert!(out.contains("alarm 11") && out.contains("line 3"), "{out}");
+}
+
+/// A cell whose whole process stands still for 0.7 s at a time (a busy host's stolen time, a
+/// debugger, `kill -STOP`) runs its cycles on: the PLC that had no chance to scan is not taken
+/// as silent (alarm 1092, decisions D41), and neither DDS's nor iceoryx2's waits end their node
+/// when the continued process's `epoll_wait` returns `EINTR`.
+#[test]
+fn a_process_that_stands_still_runs_on() {
+    let mut frozen = Vec::new();
+    let (ok, out) = run_program_with(
+        "44",
+        "still.nc",
+        "G00 X100 Z20\nS500 M03\nG01 Z-50 F600\nG00 Z20\nM05\nM30\n",
+        "2",
+        |pid, elapsed| {
+            let due = Duration::from_millis(3000 + 2500 * frozen.len() as u64);
+            if frozen.len() < 5 && elapsed >= due {
+                let pid = pid as libc::pid_t;
+                // SAFETY: signals to our own child, which is still running (not yet waited for).
+                unsafe { libc::kill(pid, libc::SIGSTOP) };
+                std::thread::sleep(Duration::from_millis(700));
+                unsafe { libc::kill(pid, libc::SIGCONT) };
+                frozen.push(elapsed);
+            }
+        },
+    );
+    assert!(
+        frozen.len() >= 3,
+        "the run ended before three stops:\n{out}"
+    );
+    assert!(ok, "{out}");
+    assert!(out.contains("cycles done 2"), "{out}");
+    assert!(!out.contains("1092"), "the PLC taken as silent:\n{out}");
+    // Motion saw the stops: its longest tick interval is one of them.
+    let max_interval = out
+        .lines()
+        .find_map(|l| l.split("min/p50/p99/max ").nth(1))
+        .and_then(|v| v.split(['/', ';']).nth(3))
+        .and_then(|v| v.trim().parse::<f64>().ok());
+    assert!(
+        max_interval.is_some_and(|us| us > 600_000.0),
+        "no stop in the servo statistics ({max_interval:?}):\n{out}"
+    );
 }
 
 #[test]

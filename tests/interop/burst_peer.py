@@ -13,6 +13,7 @@ import sys
 import time
 
 from cyclonedds.core import Policy, Qos
+from cyclonedds.internal import InvalidSample
 from cyclonedds.pub import DataWriter
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
@@ -68,7 +69,7 @@ def main():
     while len(replies) < len(sent) and time.time() < deadline:
         for service, _, _, r, _ in ends:
             for reply in r.take(N=256):
-                if list(reply.guid) != peer.guid or reply.seq_low not in sent:
+                if isinstance(reply, InvalidSample) or list(reply.guid) != peer.guid or reply.seq_low not in sent:
                     continue
                 if reply.seq_low in replies:
                     duplicates += 1

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import cyclonedds.idl.types as t
 from cyclonedds.core import Policy, Qos
+from cyclonedds.internal import InvalidSample
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.idl import IdlStruct
 from cyclonedds.pub import DataWriter
@@ -128,6 +129,8 @@ class Peer:
                 w.write(req_t(guid=self.guid, seq_high=0, seq_low=self.seq, **fields))
                 last = time.time()
             for reply in r.take(N=16):
+                if isinstance(reply, InvalidSample):
+                    continue
                 if list(reply.guid) == self.guid and reply.seq_low in sent:
                     return reply
             time.sleep(0.005)
@@ -161,6 +164,9 @@ class Session:
     def poll(self):
         for topic, r in self.readers.items():
             for sample in r.take(N=64):
+                # A writer gone (its node stopped) arrives as an InvalidSample: no state.
+                if isinstance(sample, InvalidSample):
+                    continue
                 self.peer.latest[topic] = sample
                 self.on_sample(topic, sample)
 

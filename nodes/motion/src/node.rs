@@ -246,22 +246,47 @@ fn dds_loop(
 }
 
 /// Whether the PLC keeps answering: motion takes its silence as an emergency stop.
-#[derive(Default)]
+///
+/// Silence is counted in time and in servo ticks: a whole process or host that stood still (a
+/// busy host's stolen time, `kill -STOP`) wakes with the clock far ahead and the PLC not yet
+/// scanned; the PLC is silent only if it missed its chances (decisions D41).
 struct PlcLink {
     last_heard: Option<u64>,
+    /// Servo ticks since the PLC last answered.
+    ticks_since: u64,
+    /// The ticks of [`PLC_TIMEOUT_NS`] at the servo period.
+    timeout_ticks: u64,
     reported: bool,
 }
 
 impl PlcLink {
+    fn new(period_ns: u64) -> PlcLink {
+        PlcLink {
+            last_heard: None,
+            ticks_since: 0,
+            timeout_ticks: (PLC_TIMEOUT_NS / period_ns.max(1)).max(1),
+            reported: false,
+        }
+    }
+
     fn heard(&mut self, now: u64) {
         self.last_heard = Some(now);
+        self.ticks_since = 0;
         self.reported = false;
     }
 
-    /// True once the PLC, having answered before, has been quiet for [`PLC_TIMEOUT_NS`].
+    /// Counts one servo tick without an answer.
+    fn tick(&mut self) {
+        self.ticks_since = self.ticks_since.saturating_add(1);
+    }
+
+    /// True once the PLC, having answered before, has been quiet for [`PLC_TIMEOUT_NS`] and
+    /// as many servo ticks.
     fn silent(&self, now: u64) -> bool {
-        self.last_heard
-            .is_some_and(|t| now.saturating_sub(t) > PLC_TIMEOUT_NS)
+        self.ticks_since >= self.timeout_ticks
+            && self
+                .last_heard
+                .is_some_and(|t| now.saturating_sub(t) > PLC_TIMEOUT_NS)
     }
 }
 
@@ -321,7 +346,7 @@ fn servo_loop(
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
     let mut g = GImage::default();
-    let mut plc = PlcLink::default();
+    let mut plc = PlcLink::new(period_ns);
     let mut stats = ServoStatistics {
         realtime: granted.is_realtime(),
         ..Default::default()
@@ -415,9 +440,12 @@ fn servo_loop(
                 Input::Command(_) => {}
             }
         }
-        if let Some(latest) = g_in.latest()? {
-            g = latest;
-            plc.heard(now);
+        match g_in.latest()? {
+            Some(latest) => {
+                g = latest;
+                plc.heard(now);
+            }
+            None => plc.tick(),
         }
         if plc.silent(now) {
             if !plc.reported {
@@ -552,17 +580,41 @@ fn servo_loop(
 mod tests {
     use super::*;
 
+    /// Ticks of 4 ms from `start` without an answer, with the time after the last one.
+    fn quiet_ticks(link: &mut PlcLink, start: u64, ticks: u64) -> u64 {
+        for _ in 0..ticks {
+            link.tick();
+        }
+        start + ticks * 4_000_000
+    }
+
     #[test]
     fn a_plc_that_stops_answering_is_silent_after_the_timeout() {
-        let mut link = PlcLink::default();
+        let mut link = PlcLink::new(4_000_000);
+        quiet_ticks(&mut link, 0, 1000);
         assert!(
             !link.silent(10_000_000_000),
             "never heard: starting, not silent"
         );
         link.heard(1_000_000_000);
-        assert!(!link.silent(1_000_000_000 + PLC_TIMEOUT_NS));
-        assert!(link.silent(1_000_000_001 + PLC_TIMEOUT_NS));
+        let now = quiet_ticks(&mut link, 1_000_000_000, 125);
+        assert_eq!(now, 1_000_000_000 + PLC_TIMEOUT_NS);
+        assert!(!link.silent(now));
+        assert!(link.silent(now + 1));
         link.heard(2_000_000_000);
         assert!(!link.silent(2_100_000_000));
+    }
+
+    /// A process that stood still for a second (the host busy elsewhere) wakes with the PLC not
+    /// yet scanned: that is no silence; the same second of ticks without an answer is.
+    #[test]
+    fn a_stall_of_the_whole_process_is_not_a_silent_plc() {
+        let mut link = PlcLink::new(4_000_000);
+        link.heard(1_000_000_000);
+        let now = quiet_ticks(&mut link, 2_000_000_000, 10);
+        assert!(!link.silent(now), "ten ticks after a stall of one second");
+        link.heard(now);
+        let later = quiet_ticks(&mut link, now, 126);
+        assert!(link.silent(later), "a PLC quiet for 126 ticks, 504 ms");
     }
 }

@@ -6,7 +6,7 @@
 use std::fmt::Debug;
 use std::time::Duration;
 
-use iceoryx2::port::listener::Listener;
+use iceoryx2::port::listener::{Listener, ListenerWaitError};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
@@ -179,9 +179,11 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Receiver<T> {
             }
             let left = deadline.saturating_duration_since(std::time::Instant::now());
             match &self.listener {
-                Some(l) if !left.is_zero() => {
-                    l.timed_wait(|_| {}, left).map_err(|e| err("wait", e))?;
-                }
+                Some(l) if !left.is_zero() => match l.timed_wait(|_| {}, left) {
+                    // A signal, or the process stopped and continued: wait on for what is left.
+                    Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
+                    Err(e) => return Err(err("wait", e)),
+                },
                 _ => return Ok(None),
             }
         }
