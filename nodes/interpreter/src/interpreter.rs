@@ -41,6 +41,11 @@ impl Interpreter {
         next_command(&mut *self.front)
     }
 
+    /// A block search starts or ends (what the program counts does not count during one).
+    pub fn set_searching(&mut self, on: bool) {
+        self.front.core_mut().searching = on;
+    }
+
     /// The operator messages read since the last call, each with the number of commands
     /// before it ([`cnc_interpreter_core::Core::operator_message`]).
     pub fn take_messages(&mut self) -> Vec<(u64, String)> {

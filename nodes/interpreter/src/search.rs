@@ -325,6 +325,20 @@ pub fn search(
         SearchTarget::Line(0) => return Err(not_found("line 0".into())),
         t => Some(target_line(text, t).ok_or_else(|| not_found(describe(t)))?),
     };
+    interp.set_searching(true);
+    let found = run_to(interp, (target, line), here, approach, &not_found);
+    interp.set_searching(false);
+    found
+}
+
+/// The search's run: commands up to the target, collected.
+fn run_to(
+    interp: &mut Interpreter,
+    (target, line): (&SearchTarget, Option<u32>),
+    here: &[f64],
+    approach: &Approach,
+    not_found: &dyn Fn(String) -> ProgramError,
+) -> Result<Restart, ProgramError> {
     let mut collected = Collected::default();
     let mut skipped: u64 = 0;
     loop {

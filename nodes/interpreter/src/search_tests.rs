@@ -235,3 +235,32 @@ fn the_restart_gives_the_last_spindle_position_and_an_incremental_one_as_m5() {
         assert_eq!(spindle, [want], "{skipped:?}");
     }
 }
+
+/// A block search runs SETPIECE without counting (`001` §9.13.3): the pieces were counted when
+/// the program ran up to there; the same program run from its top counts them once.
+#[test]
+fn setpiece_does_not_count_during_a_block_search() {
+    use crate::sinumerik::monitor::kept_key;
+    let text = "T1 D1\nSETPIECE(1)\nG1 X10 F500\nM30\n";
+    let mut setup = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
+    setup.offsets.tools.insert(11, Default::default());
+    let count = kept_key("$TC_MOP4", 1, 1).unwrap();
+    setup.kept.insert(kept_key("$TC_TP9", 1, 0).unwrap(), 2.0);
+    setup.kept.insert(count, 10.0);
+    let dialect = Dialect::Sinumerik802d;
+    let mut searched = Interpreter::new(dialect, text, setup.clone());
+    search(
+        dialect,
+        &mut searched,
+        text,
+        &SearchTarget::Line(3),
+        &[0.0; 3],
+        &Approach::default_for(&setup),
+    )
+    .expect("line 3 found");
+    while searched.next_command().unwrap().is_some() {}
+    assert_eq!(searched.memory().kept.get(&count), Some(&10.0));
+    let mut whole = Interpreter::new(dialect, text, setup);
+    while whole.next_command().unwrap().is_some() {}
+    assert_eq!(whole.memory().kept.get(&count), Some(&9.0));
+}

@@ -24,12 +24,14 @@ pub struct Memory {
 
 impl Memory {
     /// The macro variables kept across power-off: Huaxing's #200–#289, FANUC's #500–#999,
-    /// the 802D's R0–R299 and part counters (each control reads only its own).
+    /// the 802D's R0–R299, part counters and tool monitoring data (each control reads only
+    /// its own).
     pub fn is_kept(n: i64) -> bool {
         (200..=289).contains(&n)
             || (500..=999).contains(&n)
             || (10_000..=10_299).contains(&n)
             || (11_000..=11_008).contains(&n)
+            || crate::sinumerik::monitor::KEYS.contains(&n)
     }
 
     /// Only what a program may store there, with finite values.

@@ -5,6 +5,7 @@
 #[path = "support/sinumerik.rs"]
 mod support;
 
+use cnc_interpreter::sinumerik::expr::Val;
 use cnc_interpreter::{Aux, Command, Library};
 use support::*;
 
@@ -61,4 +62,156 @@ fn f081_the_part_count_reached_jumps_to_the_message_and_m0() {
     s.kept.insert(10_015, 8.0);
     let r = run_with(&text, s, Library::new());
     assert_eq!(r.alarm(), (12080, line_of(&text, "...")));
+}
+
+/// The mill with cutting edges `entries` (T×10+D) on its offset page besides T1 D1.
+fn with_edges(entries: &[u32]) -> cnc_interpreter::Setup {
+    let mut s = mill();
+    for e in entries {
+        s.offsets.tools.insert(*e, Default::default());
+    }
+    s
+}
+
+/// 082 (§9.13.3): SETPIECE(2) takes 2 off T1 D1's remaining count, SETPIECE(1) 1 off T2
+/// D2's; the second does not count T1 again. The counts are set where the manual has its
+/// first placeholder, as the offset page's monitoring screen would have them.
+#[test]
+fn f082_setpiece_counts_the_edges_used_since_the_last_one() {
+    let text = filled(
+        "082",
+        &[
+            "N20 $TC_TP9[1]=2 $TC_MOP4[1,1]=10 $TC_TP9[2]=2 $TC_MOP4[2,2]=5",
+            "G1 X50 F500",
+            "G1 X20",
+            "",
+        ],
+    );
+    let r = run_with(&text, with_edges(&[22]), Library::new()).ok();
+    assert_eq!(r.front.tool_datum("$TC_MOP4", 1, 1), 8.0);
+    assert_eq!(r.front.tool_datum("$TC_MOP4", 2, 2), 4.0);
+}
+
+/// 083 (§9.13.3): with M06 changes, one SETPIECE(1) after the spindle is emptied counts
+/// every tool changed in since the last: T1, T2 and T3 each lose one.
+#[test]
+fn f083_setpiece_after_m06_counts_every_tool_changed_in() {
+    let text = filled(
+        "083",
+        &[
+            "$TC_TP9[1]=2 $TC_MOP4[1,1]=10 $TC_TP9[2]=2 $TC_MOP4[2,1]=10 $TC_TP9[3]=2 $TC_MOP4[3,1]=10",
+            "G1 X10 F500",
+            "G1 X20",
+            "G1 X30",
+            "G0 X0",
+            "G0 Y0",
+        ],
+    );
+    let mut s = with_edges(&[21, 31]);
+    s.tool_change_with_m6 = true;
+    let r = run_with(&text, s, Library::new()).ok();
+    for t in 1..=3 {
+        assert_eq!(r.front.tool_datum("$TC_MOP4", t, 1), 9.0, "T{t}");
+    }
+}
+
+/// 084 (§9.13.3): a SETPIECE before each M06 counts only the tool in the spindle: T1 −1,
+/// T2 −2, T3 −0.
+#[test]
+fn f084_setpiece_before_each_change_counts_each_tool_its_own() {
+    let text = filled(
+        "084",
+        &[
+            "$TC_TP9[1]=2 $TC_MOP4[1,1]=10 $TC_TP9[2]=2 $TC_MOP4[2,1]=10 $TC_TP9[3]=2 $TC_MOP4[3,1]=10",
+            "G1 X10 F500",
+            "G1 X20",
+            "G1 X30",
+            "G0 X0",
+            "G0 Y0",
+        ],
+    );
+    let mut s = with_edges(&[21, 31]);
+    s.tool_change_with_m6 = true;
+    let r = run_with(&text, s, Library::new()).ok();
+    let left: Vec<f64> = (1..=3)
+        .map(|t| r.front.tool_datum("$TC_MOP4", t, 1))
+        .collect();
+    assert_eq!(left, [9.0, 8.0, 10.0]);
+}
+
+/// 085 (§9.13.3): RESETMON(state,12,1,2) sets T12 D1's remaining count back to its setpoint
+/// and reports 0; for a tool that does not exist, an edge it lacks, a tool without
+/// monitoring and a type not active, the manual's −2, −1, −3 and −4.
+#[test]
+fn f085_resetmon_sets_the_count_back_and_says_why_not() {
+    let run = |setting: &str| {
+        let text = filled("085", &[setting, ""]);
+        let r = run_with(&text, with_edges(&[121, 131]), Library::new()).ok();
+        let state = match r.front.variable("STATE").map(|v| v.values[0].clone()) {
+            Some(Val::Num(x)) => x,
+            other => panic!("state: {other:?}"),
+        };
+        (state, r.front.tool_datum("$TC_MOP4", 12, 1))
+    };
+    assert_eq!(
+        run("$TC_TP9[12]=2 $TC_MOP13[12,1]=50 $TC_MOP4[12,1]=3"),
+        (0.0, 50.0)
+    );
+    assert_eq!(run("$TC_MOP13[12,1]=50 $TC_MOP4[12,1]=3"), (-3.0, 3.0));
+    let other = |text: &str| {
+        let r = run_with(text, with_edges(&[121, 131]), Library::new()).ok();
+        match r.front.variable("STATE").map(|v| v.values[0].clone()) {
+            Some(Val::Num(x)) => x,
+            other => panic!("state: {other:?}"),
+        }
+    };
+    let set = "DEF INT state\n$TC_TP9[12]=2 $TC_TP9[13]=2\n";
+    assert_eq!(other(&format!("{set}RESETMON(state,14,1,2)\n")), -2.0);
+    assert_eq!(other(&format!("{set}RESETMON(state,12,5,2)\n")), -1.0);
+    assert_eq!(other(&format!("{set}RESETMON(state,12,1,1)\n")), -4.0);
+    assert_eq!(other(&format!("{set}RESETMON(state,0)\n")), 0.0);
+}
+
+/// 086 (§9.13.3): the workpiece loop counts T7 down from 700 one part at a time (an M0 per
+/// part); at 100 left the prewarning 6411 shows once; at 1 left the loop ends with the
+/// manual's message and M0, and RESETMON sets the count back to 700 with state 0, and the
+/// loop runs on.
+#[test]
+fn f086_the_piece_count_loop_warns_stops_and_starts_over() {
+    let text = filled("086", &["", "G0 X0 ; 退回"]);
+    let mut lib = Library::new();
+    lib.insert_named("BEARBEIT", "BEARBEIT.SPF", "G1 X10 F2000\nG0 X0\nM17\n");
+    let mut front = cnc_interpreter::sinumerik::Sinumerik::new(&text, with_edges(&[71]), lib);
+    let mut stops = 0;
+    let mut reset_seen = false;
+    for _ in 0..200_000 {
+        let c = cnc_interpreter_core::next_command(&mut front)
+            .expect("no alarm")
+            .expect("the loop does not end");
+        if c.command == Command::Aux(Aux::M(0)) {
+            stops += 1;
+        }
+        if front.message() == "刀具 T7 已磨损—请更换" && front.tool_datum("$TC_MOP4", 7, 1) == 700.0
+        {
+            reset_seen = true;
+            break;
+        }
+    }
+    assert!(reset_seen, "RESETMON never set T7 back");
+    // 699 parts, each with its M0, and the M0 for the tool change.
+    assert_eq!(stops, 700);
+    let warnings: Vec<&str> = front
+        .messages
+        .iter()
+        .map(|m| m.1.as_str())
+        .filter(|m| m.starts_with("6411"))
+        .collect();
+    assert_eq!(
+        warnings,
+        ["6411 tool 7 has reached its prewarning limit with D = 1"]
+    );
+    // RESETMON's state was 0: the program went back to ANF, not to its ALARM branch.
+    assert!(!front.messages.iter().any(|m| m.1.starts_with("故障")));
+    // RESETMON cleared the prewarning bit (16) the 6411 set.
+    assert_eq!(front.tool_datum("$TC_TP8", 7, 0), 0.0);
 }

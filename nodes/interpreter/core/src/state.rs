@@ -151,6 +151,9 @@ pub struct Core {
     /// Messages a program shows the operator, each with the number of commands that
     /// come before it: it shows once the machine has finished those.
     pub operator_messages: Vec<(u64, String)>,
+    /// A block search runs the program without motion: what the machine's work counts
+    /// (pieces on a tool) does not count again.
+    pub searching: bool,
 }
 
 impl Core {
@@ -197,6 +200,7 @@ impl Core {
             saw_end: false,
             emitted: 0,
             operator_messages: Vec::new(),
+            searching: false,
             rules,
             setup,
             library,

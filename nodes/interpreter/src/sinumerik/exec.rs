@@ -161,7 +161,7 @@ fn address_name(name: &str) -> Option<&'static str> {
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 23] = [
+pub const NOT_BUILT: [(&str, &str); 21] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
@@ -178,8 +178,6 @@ pub const NOT_BUILT: [(&str, &str); 23] = [
         "probing is not built: the simulated mill has no probe",
     ),
     ("FXS", "travel to fixed stop is not built"),
-    ("SETPIECE", "tool monitoring is not built"),
-    ("RESETMON", "tool monitoring is not built"),
     ("TANG", "tangential control is not built"),
     ("TANGON", "tangential control is not built"),
     ("TANGOF", "tangential control is not built"),
@@ -464,6 +462,12 @@ impl Sinumerik {
         }
         if name == "EXTCALL" {
             return self.external_call(w, args);
+        }
+        if name == "SETPIECE" {
+            return self.setpiece(args);
+        }
+        if name == "RESETMON" {
+            return self.resetmon(args);
         }
         if NOT_BUILT.iter().any(|(k, _)| *k == name) {
             return self.not_built(name);

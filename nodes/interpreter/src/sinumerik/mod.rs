@@ -21,6 +21,7 @@ mod frames;
 pub mod lex;
 mod limits;
 mod milling_calls;
+pub mod monitor;
 mod motion;
 mod pocket;
 mod rect_pocket;
@@ -82,6 +83,8 @@ pub struct Sinumerik {
     edge: u32,
     /// A T word waiting for M6 (when the machine changes tools with M6).
     preselected: Option<u32>,
+    /// The cutting edges used since the last SETPIECE (§9.13.3).
+    setpiece_memory: Vec<(u32, u32)>,
     /// G41/G42 asked for; started with the next move.
     comp_side: Option<Side>,
     /// G41/G42 programmed again while compensation runs: it starts over with the next move
@@ -193,6 +196,7 @@ impl Sinumerik {
             tool,
             edge: u32::from(tool > 0),
             preselected: None,
+            setpiece_memory: Vec::new(),
             comp_side: None,
             comp_again: false,
             tangent: None,
@@ -317,6 +321,9 @@ impl Sinumerik {
                 format!("{name} is not defined (no variable, address or keyword of this name)"),
             )
         };
+        if let Some(value) = self.monitor_read(name, idx) {
+            return value;
+        }
         match name {
             "$P_TOOLNO" => Ok(f64::from(self.tool)),
             "$P_TOOL" => Ok(f64::from(self.edge)),
@@ -406,6 +413,9 @@ impl Sinumerik {
             }
             self.core.common.insert(k, x);
             return Ok(());
+        }
+        if let Some(done) = self.monitor_write(name, idx, &v) {
+            return done;
         }
         if name.starts_with('$') {
             return Err(EvalError::new(

@@ -40,6 +40,7 @@ impl Sinumerik {
                 return Err(self.fault(Fault::ToolNumber, "D without an active tool: T first"));
             }
             self.edge = d as u32;
+            self.edge_loaded();
             self.apply_length();
             self.change_compensation_radius()?;
         }
@@ -67,8 +68,10 @@ impl Sinumerik {
                 "tool change while radius compensation is active: G40 first",
             ));
         }
+        self.check_not_disabled(t)?;
         self.tool = t;
         self.edge = u32::from(t > 0);
+        self.edge_loaded();
         self.apply_length();
         Ok(())
     }
