@@ -237,12 +237,23 @@ impl CellClient {
 
     /// A robot handshake request (`RobotRequestRequest::DOOR_OPEN` …).
     pub fn robot_request(&mut self, request: u8) -> Result<RobotRequestResponse, String> {
-        call(
-            &self.ros.node,
+        self.robot_request_unless(request, || false)
+    }
+
+    /// [`CellClient::robot_request`], no longer waited for once `give_up` says so (checked
+    /// every 50 ms): a robot does not stand idle for a machine the cell has lost.
+    pub fn robot_request_unless(
+        &mut self,
+        request: u8,
+        give_up: impl FnMut() -> bool,
+    ) -> Result<RobotRequestResponse, String> {
+        wait_for_server(&self.ros.node, &self.robot, self.timeout)?;
+        exchange_unless(
             self.timeout,
             &self.robot,
             RobotRequestRequest { request },
             Copies::Never,
+            give_up,
         )
     }
 
@@ -400,7 +411,22 @@ fn exchange<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Mess
     req: Req,
     copies: Copies,
 ) -> Result<Resp, String> {
+    exchange_unless(timeout, client, req, copies, || false)
+}
+
+/// [`exchange`], ended early (an error) once `give_up` says so.
+fn exchange_unless<
+    Req: ros2_client::Message + Clone + 'static,
+    Resp: ros2_client::Message + 'static,
+>(
+    timeout: Duration,
+    client: &Client<Req, Resp>,
+    req: Req,
+    copies: Copies,
+    mut give_up: impl FnMut() -> bool,
+) -> Result<Resp, String> {
     let deadline = Instant::now() + timeout;
+    let mut asked = Instant::now();
     let mut ids = Vec::new();
     let mut last_send: Option<Instant> = None;
     while Instant::now() < deadline {
@@ -418,6 +444,12 @@ fn exchange<Req: ros2_client::Message + Clone + 'static, Resp: ros2_client::Mess
         while let Ok(Some((id, resp))) = client.receive_response() {
             if ids.contains(&id) {
                 return Ok(resp);
+            }
+        }
+        if asked.elapsed() > Duration::from_millis(50) {
+            asked = Instant::now();
+            if give_up() {
+                return Err("no longer waited for: the machine is out of reach".into());
             }
         }
         std::thread::sleep(Duration::from_millis(2));

@@ -55,6 +55,11 @@ impl CellWatch {
         serves(self.last.as_ref(), silence, name)
     }
 
+    /// Whether the supervisor has machine `name` unreachable.
+    pub fn unreachable(&self, name: &str) -> bool {
+        lost(self.last.as_ref(), name)
+    }
+
     /// Whether the supervisor's order is complete.
     pub fn complete(&self) -> bool {
         self.last.as_ref().is_some_and(|s| s.complete)
@@ -95,6 +100,15 @@ fn serves(last: Option<&CellState>, silence: Option<Duration>, name: &str) -> bo
                 .iter()
                 .any(|m| m.name == name && m.status == CellMachine::PRODUCING)
         })
+}
+
+/// Whether the supervisor's last state has machine `name` unreachable.
+fn lost(last: Option<&CellState>, name: &str) -> bool {
+    last.is_some_and(|s| {
+        s.machines
+            .iter()
+            .any(|m| m.name == name && m.status == CellMachine::UNREACHABLE)
+    })
 }
 
 /// One request the robot made.
@@ -147,7 +161,18 @@ pub fn tend(
                     return Err(format!("no machine {i}"));
                 };
                 let at = Instant::now();
-                let (accepted, message) = match c.robot_request(code) {
+                // A machine the supervisor marks unreachable meanwhile is not waited for: the
+                // robot serves the others and asks again once it is back (the machine checks
+                // every request against its state, so asking again is safe).
+                let ns = c.namespace().to_string();
+                let mut watch = cell.as_deref_mut();
+                let answer = c.robot_request_unless(code, || {
+                    watch.as_deref_mut().is_some_and(|w| {
+                        w.poll();
+                        w.unreachable(&ns)
+                    })
+                });
+                let (accepted, message) = match answer {
                     Ok(r) => (r.accepted, r.message),
                     Err(e) => (false, e),
                 };
@@ -199,5 +224,9 @@ mod tests {
             Some(Duration::from_secs(6)),
             "lathe1"
         ));
+        // A request to lathe2 is no longer waited for; to lathe1 (or before any state) it is.
+        assert!(lost(Some(&state), "lathe2"));
+        assert!(!lost(Some(&state), "lathe1"));
+        assert!(!lost(None, "lathe2"));
     }
 }
