@@ -454,7 +454,11 @@ const AS_PRINTED: [AsPrinted; 88] = [
         "this test's mill has no fixed points: f031_… runs it on sim_mill_802d",
     ),
     ("032", Some((12140, 7)), "probing"),
-    ("033", Some((12140, 7)), "tangential control"),
+    (
+        "033",
+        Some((12140, 7)),
+        "not available on the milling technology",
+    ),
     ("034", Some((12080, 8)), "template"),
     ("035", Some((12080, 7)), "template"),
     ("036", Some((12080, 8)), "template"),

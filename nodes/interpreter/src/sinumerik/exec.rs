@@ -159,9 +159,13 @@ fn address_name(name: &str) -> Option<&'static str> {
     }
 }
 
+/// Tangential control is not for the milling technology (§9.3.13, decision D112).
+const TANG_ON_A_MILL: &str =
+    "tangential control is not available on the milling technology (the manual, §9.3.13)";
+
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 21] = [
+pub const NOT_BUILT: [(&str, &str); 23] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
@@ -178,9 +182,12 @@ pub const NOT_BUILT: [(&str, &str); 21] = [
         "probing is not built: the simulated mill has no probe",
     ),
     ("FXS", "travel to fixed stop is not built"),
-    ("TANG", "tangential control is not built"),
-    ("TANGON", "tangential control is not built"),
-    ("TANGOF", "tangential control is not built"),
+    // §9.3.13: "该功能不适用于铣削工艺" (D112).
+    ("TANG", TANG_ON_A_MILL),
+    ("TANGON", TANG_ON_A_MILL),
+    ("TANGOF", TANG_ON_A_MILL),
+    ("TLIFT", TANG_ON_A_MILL),
+    ("TANGDEL", TANG_ON_A_MILL),
     ("MASLDEF", "master-slave coupling is not built"),
     ("MASLDEL", "master-slave coupling is not built"),
     ("MASLON", "master-slave coupling is not built"),
