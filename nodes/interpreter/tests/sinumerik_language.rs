@@ -170,6 +170,30 @@ fn proc_names_the_program_in_its_first_block_only() {
     assert_eq!(e.map(|e| e.number), Some(12080));
 }
 
+/// `CALL NAME` (§9.1.6) calls, without parameters, the program or cycle whose name the
+/// variable holds; a name that is neither is 14011, a variable that does not exist 12550.
+#[test]
+fn call_runs_the_program_a_variable_names() {
+    let mut lib = Library::new();
+    lib.insert_named("SEITE", "SEITE.SPF", "G1 X7 F100\nRET\n");
+    let text = "DEF STRING[12] NEXT\nNEXT=\"seite\"\nCALL NEXT\nG0 X1\nM2\n";
+    let r = support::run_with(text, mill(), lib.clone()).ok();
+    assert_eq!(
+        ends(&r.out),
+        [vec![7.0, 0.0, 0.0], vec![1.0, 0.0, 0.0]],
+        "{:?}",
+        r.out
+    );
+    let r = support::run_with(
+        "DEF STRING[12] NEXT\nNEXT=\"NOSUCH\"\nCALL NEXT\n",
+        mill(),
+        lib,
+    );
+    assert_eq!(r.alarm(), (14011, 3), "{:?}", r.error);
+    let (_, e) = run("CALL NOVAR\n");
+    assert_eq!(e.map(|e| e.number), Some(12550));
+}
+
 #[test]
 fn machine_data_stop_with_12140() {
     let (_, e) = run("$MA_FIX_POINT_POS[0]=1\n");

@@ -43,6 +43,8 @@ pub enum Item<'s> {
         target: Cow<'s, str>,
     },
     Def(Def<'s>),
+    /// `CALL NAME`: the cycle or program whose name the variable `NAME` holds (§9.1.6).
+    Indirect(Cow<'s, str>),
 }
 
 /// `DEF type name[dims]=init, …` (§9.9.2).
@@ -174,6 +176,12 @@ fn name_item<'s>(p: &mut Parser<'_, 's>, n: Cow<'s, str>) -> Result<Item<'s>, St
                 p.at = p.toks.len();
             }
             return Ok(Item::Proc(name.clone(), params));
+        }
+        "CALL" => {
+            let Some(Tok::Name(name)) = p.take() else {
+                return Err("CALL needs the variable that holds the name".into());
+            };
+            return Ok(Item::Indirect(name.clone()));
         }
         "GOTOF" | "GOTOB" => {
             p.at -= 1;

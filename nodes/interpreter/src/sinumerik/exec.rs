@@ -394,8 +394,30 @@ impl Sinumerik {
                 }
             }
             Item::Call(name, args) => self.call_item(w, name, args)?,
+            Item::Indirect(var) => self.indirect_call(w, var)?,
         }
         Ok(())
+    }
+
+    /// `CALL NAME` (§9.1.6): a call without parameters of the cycle or program whose name the
+    /// variable holds.
+    fn indirect_call(&mut self, w: &mut Words, var: &str) -> Result<(), ProgramError> {
+        let name = self
+            .read(var, &[])
+            .map_err(|e| self.eval_error(e))?
+            .text()
+            .trim()
+            .to_ascii_uppercase();
+        if is_cycle(&name) {
+            self.cycle_item(w, &name, &[])
+        } else if self.core.library.get_named(&name).is_some() {
+            self.program_call(w, &name)
+        } else {
+            Err(self.fault(
+                Fault::ProgramNotFound,
+                format!("CALL {var}: no cycle or program {name:?}"),
+            ))
+        }
     }
 
     /// `PROC name`: accepted as the program's first block; a parameter list is not built.
