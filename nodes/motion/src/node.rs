@@ -450,9 +450,15 @@ fn servo_loop(
         if plc.silent(now) {
             if !plc.reported {
                 plc.reported = true;
+                let quiet_ms = plc
+                    .last_heard
+                    .map_or(0, |t| now.saturating_sub(t) / 1_000_000);
                 let _ = reports.send(Report::Alarm(
                     alarm::PLC_SILENT,
-                    "the PLC stopped answering: emergency stop".into(),
+                    format!(
+                        "the PLC stopped answering ({quiet_ms} ms, {} servo ticks without its                          signals): emergency stop",
+                        plc.ticks_since
+                    ),
                     motion.line(),
                 ));
             }
