@@ -92,12 +92,11 @@ fn f082_setpiece_counts_the_edges_used_since_the_last_one() {
     assert_eq!(r.front.tool_datum("$TC_MOP4", 2, 2), 4.0);
 }
 
-/// 083 (§9.13.3): with M06 changes, one SETPIECE(1) after the spindle is emptied counts
-/// every tool changed in since the last: T1, T2 and T3 each lose one.
-#[test]
-fn f083_setpiece_after_m06_counts_every_tool_changed_in() {
+/// Fixture 083 or 084 on a mill that changes tools with M6, T1–T3 each with D1 counted
+/// from 10: the first placeholder switches the counts on, the others machine.
+fn three_counted_tools(number: &str) -> Run {
     let text = filled(
-        "083",
+        number,
         &[
             "$TC_TP9[1]=2 $TC_MOP4[1,1]=10 $TC_TP9[2]=2 $TC_MOP4[2,1]=10 $TC_TP9[3]=2 $TC_MOP4[3,1]=10",
             "G1 X10 F500",
@@ -109,7 +108,14 @@ fn f083_setpiece_after_m06_counts_every_tool_changed_in() {
     );
     let mut s = with_edges(&[21, 31]);
     s.tool_change_with_m6 = true;
-    let r = run_with(&text, s, Library::new()).ok();
+    run_with(&text, s, Library::new()).ok()
+}
+
+/// 083 (§9.13.3): with M06 changes, one SETPIECE(1) after the spindle is emptied counts
+/// every tool changed in since the last: T1, T2 and T3 each lose one.
+#[test]
+fn f083_setpiece_after_m06_counts_every_tool_changed_in() {
+    let r = three_counted_tools("083");
     for t in 1..=3 {
         assert_eq!(r.front.tool_datum("$TC_MOP4", t, 1), 9.0, "T{t}");
     }
@@ -119,20 +125,7 @@ fn f083_setpiece_after_m06_counts_every_tool_changed_in() {
 /// T2 −2, T3 −0.
 #[test]
 fn f084_setpiece_before_each_change_counts_each_tool_its_own() {
-    let text = filled(
-        "084",
-        &[
-            "$TC_TP9[1]=2 $TC_MOP4[1,1]=10 $TC_TP9[2]=2 $TC_MOP4[2,1]=10 $TC_TP9[3]=2 $TC_MOP4[3,1]=10",
-            "G1 X10 F500",
-            "G1 X20",
-            "G1 X30",
-            "G0 X0",
-            "G0 Y0",
-        ],
-    );
-    let mut s = with_edges(&[21, 31]);
-    s.tool_change_with_m6 = true;
-    let r = run_with(&text, s, Library::new()).ok();
+    let r = three_counted_tools("084");
     let left: Vec<f64> = (1..=3)
         .map(|t| r.front.tool_datum("$TC_MOP4", t, 1))
         .collect();
