@@ -456,7 +456,7 @@ fn servo_loop(
                 let _ = reports.send(Report::Alarm(
                     alarm::PLC_SILENT,
                     format!(
-                        "the PLC stopped answering ({quiet_ms} ms, {} servo ticks without its                          signals): emergency stop",
+                        "the PLC stopped answering ({quiet_ms} ms, {} ticks without its signals): emergency stop",
                         plc.ticks_since
                     ),
                     motion.line(),

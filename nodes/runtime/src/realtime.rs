@@ -37,8 +37,8 @@ fn os_error() -> String {
 /// ordinary thread mapping a large segment (iceoryx2 growing a port for a 4 MiB program)
 /// fills it while it holds the process's memory-map lock, and a real-time loop that grows its
 /// heap meanwhile waits for it — measured 160–210 ms for 256 MiB, against 0.2 ms with
-/// `MCL_ONFAULT`, on this machine; under load long enough for motion to take the PLC for
-/// silent (alarm 1092, decisions D41).
+/// `MCL_ONFAULT`, on this machine; under load that can be long enough for motion to take the
+/// PLC for silent (alarm 1092, decisions D41).
 pub fn lock_memory() -> Result<(), String> {
     static RESULT: OnceLock<Result<(), String>> = OnceLock::new();
     RESULT
