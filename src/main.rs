@@ -744,6 +744,8 @@ fn supervise(
     // A cycle is complete when PROGRAM_COMPLETED follows the ACTIVE of this start.
     let mut seen_active = false;
     let mut cycle_running = false;
+    // The part count when the cycle started.
+    let mut parts_before = 0;
     let mut last_print = Instant::now();
     while !STOP.load(Ordering::SeqCst) {
         if let Some(node) = cell.failed_node() {
@@ -754,6 +756,7 @@ fn supervise(
                 if cycles != 0 && done >= cycles {
                     return Ok(());
                 }
+                parts_before = client.part_count.as_ref().map_or(0, |p| p.count);
                 let r = client.start_program(name)?;
                 if !r.accepted {
                     return Err(format!("start refused: {}", r.message));
@@ -766,6 +769,15 @@ fn supervise(
                     MachineState::PROGRAM_COMPLETED if seen_active => {
                         done += 1;
                         cycle_running = false;
+                        // The part count comes from the PLC once it is kept on disk, a little
+                        // after the state: the line shows it (a program that counts no part
+                        // waits the two seconds).
+                        let counted = |c: &CellClient| {
+                            c.part_count
+                                .as_ref()
+                                .is_some_and(|p| p.count > parts_before)
+                        };
+                        client.wait_until(Duration::from_secs(2), counted);
                         print_progress(&client, done);
                     }
                     MachineState::STOPPED if seen_active => {

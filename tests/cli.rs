@@ -100,6 +100,9 @@ fn run_exits_zero_after_its_cycles() {
         "ROS_DOMAIN_ID not honoured:\n{out}"
     );
     assert!(out.contains("cycles done 2"), "{out}");
+    // The line of each completed cycle shows its part counted.
+    assert!(out.contains("parts 1 | cycles done 1"), "{out}");
+    assert!(out.contains("parts 2 | cycles done 2"), "{out}");
     assert!(
         out.contains("servo loop (") && out.contains("round trip"),
         "no servo statistics at exit:\n{out}"
