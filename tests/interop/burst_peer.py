@@ -9,7 +9,6 @@ The counts are printed; the program still runs to its end with no alarm.
 Exit 0 when every check holds; otherwise print what failed and exit 1.
 """
 
-import sys
 import time
 
 from cyclonedds.core import Policy, Qos
@@ -19,7 +18,7 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-from cyclone_peer import Session
+from cyclone_peer import Session, run
 
 # About 15 s of cutting: the burst lands while it runs.
 LONG = "O0077\nG00 X60 Z5\nS600 M03\nG01 X50 F600\nZ-60 F200\nX60\nG00 Z5\nM05\nM30\n"
@@ -113,4 +112,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run(main)

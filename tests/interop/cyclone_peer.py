@@ -13,6 +13,7 @@ import os
 import pathlib
 import sys
 import time
+import traceback
 import types as pytypes
 from dataclasses import dataclass
 
@@ -233,5 +234,21 @@ def main():
     return session.exit_code()
 
 
+def run(main):
+    """Runs a peer's `main` and ends the process with its exit code at once, also after an
+    exception: Cyclone's teardown at interpreter exit was seen to hang after a traceback, and
+    the calling test then waited for the peer instead of failing."""
+    try:
+        code = main()
+    except SystemExit as e:
+        code = e.code if isinstance(e.code, int) else 1
+    except BaseException:
+        traceback.print_exc()
+        code = 1
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code if isinstance(code, int) else 0)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run(main)

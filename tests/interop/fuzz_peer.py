@@ -16,13 +16,12 @@ import os
 import pathlib
 import random
 import re
-import sys
 import time
 
 from cyclonedds.pub import DataWriter
 from cyclonedds.topic import Topic
 
-from cyclone_peer import SERVICE, Session, fields_of
+from cyclone_peer import SERVICE, Session, fields_of, run
 
 # sim_lathe.yaml's ratings: X (diameter) -2..300, Z -400..150, spindle 3000 rpm.
 TRAVEL = {"X": (-2.0, 300.0), "Z": (-400.0, 150.0)}
@@ -156,4 +155,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run(main)

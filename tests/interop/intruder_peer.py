@@ -13,7 +13,6 @@ The cell allows only /lathe1/supervisor. This bare participant announces no ROS 
 Exit 0 when every check holds; otherwise print what failed and exit 1.
 """
 
-import sys
 import time
 
 from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
@@ -22,7 +21,7 @@ from cyclonedds.pub import DataWriter
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-from cyclone_peer import Session
+from cyclone_peer import Session, run
 
 COMMANDS = Qos(Policy.Reliability.Reliable(duration(milliseconds=100)), Policy.Durability.Volatile,
                Policy.History.KeepLast(1024))
@@ -121,4 +120,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run(main)

@@ -11,9 +11,8 @@ completes too.
 Exit 0 when every check holds; otherwise print what failed and exit 1.
 """
 
-import sys
 
-from cyclone_peer import Session
+from cyclone_peer import Session, run
 
 DOOR_OPEN, DOOR_CLOSE, CHUCK_UNCLAMP, CHUCK_CLAMP, CLEAR, NOT_CLEAR, CYCLE_START = range(1, 8)
 
@@ -88,4 +87,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run(main)
