@@ -95,20 +95,21 @@ pub fn serve_cell(
 /// ago it came.
 fn serves(last: Option<&CellState>, silence: Option<Duration>, name: &str) -> bool {
     silence.is_some_and(|d| d < SUPERVISOR_SILENCE)
-        && last.is_some_and(|s| {
-            s.machines
-                .iter()
-                .any(|m| m.name == name && m.status == CellMachine::PRODUCING)
-        })
+        && status_of(last, name) == Some(CellMachine::PRODUCING)
 }
 
 /// Whether the supervisor's last state has machine `name` unreachable.
 fn lost(last: Option<&CellState>, name: &str) -> bool {
-    last.is_some_and(|s| {
-        s.machines
-            .iter()
-            .any(|m| m.name == name && m.status == CellMachine::UNREACHABLE)
-    })
+    status_of(last, name) == Some(CellMachine::UNREACHABLE)
+}
+
+/// Machine `name`'s status in the supervisor's last state.
+fn status_of(last: Option<&CellState>, name: &str) -> Option<u8> {
+    last?
+        .machines
+        .iter()
+        .find(|m| m.name == name)
+        .map(|m| m.status)
 }
 
 /// One request the robot made.

@@ -33,6 +33,15 @@ const DATA: [&str; 8] = [
 /// Keys of the kept store that hold monitoring data (the shell keeps them).
 pub const KEYS: std::ops::RangeInclusive<i64> = BASE..=BASE + DATA.len() as i64 * SPAN - 1;
 
+/// Positions in [`DATA`].
+const TP8: usize = 0;
+const TP9: usize = 1;
+const MOP2: usize = 3;
+const MOP3: usize = 4;
+const MOP4: usize = 5;
+const MOP11: usize = 6;
+const MOP13: usize = 7;
+
 /// `$TC_TP8` bits (§9.13.1).
 const ACTIVE: i64 = 1;
 const DISABLED: i64 = 4;
@@ -101,8 +110,7 @@ impl Sinumerik {
             Ok(x as u32)
         };
         let (t, d) = match (idx, per_tool) {
-            ([t], true) => (whole(t, "tool", 32_000.0)?, 0),
-            ([t, _], true) => (whole(t, "tool", 32_000.0)?, 0),
+            ([t] | [t, _], true) => (whole(t, "tool", 32_000.0)?, 0),
             ([t, d], false) => (whole(t, "tool", 32_000.0)?, whole(d, "edge", 9.0)?),
             _ => {
                 let form = if per_tool { "[t]" } else { "[t,d]" };
@@ -131,7 +139,7 @@ impl Sinumerik {
         Some(self.monitored_edge(name, idx).map(|(t, d)| {
             let v = self.datum(k, t, d);
             // Bit 0 of the state is the tool in the spindle now.
-            match k == 0 && t == self.tool {
+            match k == TP8 && t == self.tool {
                 true => (v as i64 | ACTIVE) as f64,
                 false => v,
             }
@@ -147,38 +155,35 @@ impl Sinumerik {
         v: &Val,
     ) -> Option<Result<(), EvalError>> {
         let k = index_of(name)?;
-        let result = (|| {
-            let (t, d) = self.monitored_edge(name, idx)?;
-            let mut x = v.num()?;
-            if !x.is_finite() || x.abs() > 1.0e9 {
-                return Err(EvalError::new(Fault::OutOfRange, format!("{name}: {x}")));
+        Some(self.write_datum(k, name, idx, v))
+    }
+
+    fn write_datum(&mut self, k: usize, name: &str, idx: &[Val], v: &Val) -> Result<(), EvalError> {
+        let (t, d) = self.monitored_edge(name, idx)?;
+        let mut x = v.num()?;
+        if !x.is_finite() || x.abs() > 1.0e9 {
+            return Err(EvalError::new(Fault::OutOfRange, format!("{name}: {x}")));
+        }
+        if matches!(k, TP8 | TP9 | MOP3 | MOP4 | MOP13) {
+            x = x.round();
+        }
+        if k == TP9 {
+            if !(0.0..=3.0).contains(&x) {
+                return Err(EvalError::new(
+                    Fault::OutOfRange,
+                    "$TC_TP9: 0 none, 1 life, 2 count",
+                ));
             }
-            let integer = matches!(
-                name,
-                "$TC_TP8" | "$TC_TP9" | "$TC_MOP3" | "$TC_MOP4" | "$TC_MOP13"
-            );
-            if integer {
-                x = x.round();
+            if x as i64 & LIFE != 0 {
+                return Err(EvalError::new(
+                    Fault::NotSupported,
+                    "$TC_TP9: tool life monitoring is not built (the life counts in G1/G2/G3 \
+                     time, which motion would have to measure): count monitoring is 2",
+                ));
             }
-            if name == "$TC_TP9" {
-                if !(0.0..=3.0).contains(&x) {
-                    return Err(EvalError::new(
-                        Fault::OutOfRange,
-                        "$TC_TP9: 0 none, 1 life, 2 count",
-                    ));
-                }
-                if x as i64 & LIFE != 0 {
-                    return Err(EvalError::new(
-                        Fault::NotSupported,
-                        "$TC_TP9: tool life monitoring is not built (the life counts in G1/G2/G3 \
-                         time, which motion would have to measure): count monitoring is 2",
-                    ));
-                }
-            }
-            self.set_datum(k, t, d, x);
-            Ok(())
-        })();
-        Some(result)
+        }
+        self.set_datum(k, t, d, x);
+        Ok(())
     }
 
     /// A cutting edge became active: SETPIECE will count it (§9.13.3, "SETPIECE memory").
@@ -191,7 +196,7 @@ impl Sinumerik {
 
     /// A disabled tool cannot be selected (§9.13.2).
     pub(super) fn check_not_disabled(&self, t: u32) -> Result<(), ProgramError> {
-        let state = self.datum(0, t, 0) as i64;
+        let state = self.datum(TP8, t, 0) as i64;
         if t > 0 && state & DISABLED != 0 {
             return Err(self.fault(
                 Fault::ToolNumber,
@@ -243,13 +248,13 @@ impl Sinumerik {
             return Ok(());
         }
         for (t, d) in edges {
-            if self.datum(1, t, 0) as i64 & COUNT == 0 {
+            if self.datum(TP9, t, 0) as i64 & COUNT == 0 {
                 continue;
             }
-            let left = self.datum(5, t, d) - n;
-            self.set_datum(5, t, d, left);
-            let state = self.datum(0, t, 0) as i64;
-            let warn = self.datum(4, t, d);
+            let left = self.datum(MOP4, t, d) - n;
+            self.set_datum(MOP4, t, d, left);
+            let state = self.datum(TP8, t, 0) as i64;
+            let warn = self.datum(MOP3, t, d);
             let (flag, number, text) = if left <= 0.0 {
                 (DISABLED, LIMIT_REACHED, "has reached its monitoring limit")
             } else if warn > 0.0 && left <= warn {
@@ -262,7 +267,7 @@ impl Sinumerik {
                 continue;
             };
             if state & flag == 0 {
-                self.set_datum(0, t, 0, (state | flag) as f64);
+                self.set_datum(TP8, t, 0, (state | flag) as f64);
                 let shown = format!("{number} tool {t} {text} with D = {d}");
                 self.messages.push((self.core.line, shown.clone()));
                 self.core.operator_message(shown);
@@ -318,7 +323,7 @@ impl Sinumerik {
                     .tools
                     .keys()
                     .map(|e| e / 10)
-                    .filter(|t| self.datum(1, *t, 0) != 0.0)
+                    .filter(|t| self.datum(TP9, *t, 0) != 0.0)
                     .collect();
                 all.dedup();
                 if all.is_empty() {
@@ -328,12 +333,12 @@ impl Sinumerik {
             }
             t if self.edges_of(t).is_empty() => return -2.0,
             t if d > 0 && !self.edges_of(t).contains(&d) => return -1.0,
-            t if self.datum(1, t, 0) == 0.0 => return -3.0,
+            t if self.datum(TP9, t, 0) == 0.0 => return -3.0,
             t => vec![t],
         };
         let mut done = false;
         for t in tools {
-            let types = self.datum(1, t, 0) as i64;
+            let types = self.datum(TP9, t, 0) as i64;
             let mask = if mon == 0 { types } else { mon & types };
             if mask == 0 {
                 continue;
@@ -344,14 +349,14 @@ impl Sinumerik {
             };
             for d in edges {
                 if mask & COUNT != 0 {
-                    self.set_datum(5, t, d, self.datum(7, t, d));
+                    self.set_datum(MOP4, t, d, self.datum(MOP13, t, d));
                 }
                 if mask & LIFE != 0 {
-                    self.set_datum(3, t, d, self.datum(6, t, d));
+                    self.set_datum(MOP2, t, d, self.datum(MOP11, t, d));
                 }
             }
-            let state = self.datum(0, t, 0) as i64;
-            self.set_datum(0, t, 0, (state & !(DISABLED | PREWARNING)) as f64);
+            let state = self.datum(TP8, t, 0) as i64;
+            self.set_datum(TP8, t, 0, (state & !(DISABLED | PREWARNING)) as f64);
             done = true;
         }
         if done {
