@@ -29,6 +29,7 @@ fn main() -> Result<(), String> {
         interfaces: vec![address
             .parse::<IpAddr>()
             .map_err(|_| format!("interface address {address:?}"))?],
+        security: None,
     };
     let parts: u32 = parts.parse().map_err(|_| format!("parts {parts:?}"))?;
     let mut arm = Vec::new();

@@ -4,6 +4,8 @@
 #
 #   step        present when                    else
 #   system      `ip` and Python's venv work     apt: iproute2 python3-venv
+#   openssl     OpenSSL's headers for DDS       apt: libssl-dev pkg-config (the build of
+#               Security (rustdds, `openssl`)        rustdds's security feature links OpenSSL)
 #   chromium    `chromium` is on PATH           apt: chromium (the browser of tests/web_hmi.rs)
 #   node        `node` and `npm` are on PATH    apt: nodejs npm (a machine of the CI's kind has
 #                                               both from NodeSource, whose nodejs conflicts
@@ -25,6 +27,7 @@ export DEBIAN_FRONTEND=noninteractive
 # The apt steps: name, the commands that prove the piece present, the packages.
 APT_STEPS=(
     "system|ip python3-venv|iproute2 python3-venv"
+    "openssl|openssl-dev|libssl-dev pkg-config"
     "chromium|chromium|chromium"
     "node|node npm|nodejs npm"
     "rs274|rs274|linuxcnc-uspace"
@@ -55,6 +58,7 @@ run_step() {
 present() {
     case "$1" in
         python3-venv) python3 -c "import venv, ensurepip" 2>/dev/null ;;
+        openssl-dev) pkg-config --exists openssl 2>/dev/null ;;
         *) command -v "$1" >/dev/null ;;
     esac
 }

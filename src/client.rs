@@ -19,14 +19,14 @@ pub struct CellClient {
     namespace: String,
     /// How long a service call waits for its reply.
     timeout: Duration,
-    load: Client<LoadProgramRequest, LoadProgramResponse>,
-    start: Client<StartProgramRequest, StartProgramResponse>,
-    stop: Client<StopRequest, StopResponse>,
-    reset: Client<ResetRequest, ResetResponse>,
-    robot: Client<RobotRequestRequest, RobotRequestResponse>,
-    list: Client<ListProgramsRequest, ListProgramsResponse>,
-    delete: Client<DeleteProgramRequest, DeleteProgramResponse>,
-    overrides: Client<SetOverridesRequest, SetOverridesResponse>,
+    load: Door<LoadProgramRequest, LoadProgramResponse>,
+    start: Door<StartProgramRequest, StartProgramResponse>,
+    stop: Door<StopRequest, StopResponse>,
+    reset: Door<ResetRequest, ResetResponse>,
+    robot: Door<RobotRequestRequest, RobotRequestResponse>,
+    list: Door<ListProgramsRequest, ListProgramsResponse>,
+    delete: Door<DeleteProgramRequest, DeleteProgramResponse>,
+    overrides: Door<SetOverridesRequest, SetOverridesResponse>,
     machine: Subscription<MachineState>,
     spindle_sub: Subscription<SpindleState>,
     parts: Subscription<PartCount>,
@@ -45,6 +45,17 @@ pub struct CellClient {
     /// When a sample of any state topic last came (`axes` comes 25 times a second): how a
     /// supervisor knows the machine is still there.
     pub heard_at: Option<Instant>,
+}
+
+/// A service client, or why this client has none: under DDS Security an identity is refused
+/// the request writer of a service its permissions do not grant (the robot's `start_program`),
+/// and the call says so instead of the client failing as a whole.
+type Door<Req, Resp> = Result<Client<Req, Resp>, String>;
+
+fn door<Req: ros2_client::Message, Resp: ros2_client::Message>(
+    d: &Door<Req, Resp>,
+) -> Result<&Client<Req, Resp>, String> {
+    d.as_ref().map_err(Clone::clone)
 }
 
 fn client<S: RosService>(
@@ -74,16 +85,16 @@ impl CellClient {
         name: &str,
         mapping: ServiceMapping,
     ) -> Result<Self, String> {
-        let mut ros = RosNode::new(net, ns, name)?;
+        let mut ros = RosNode::client(net, ns, name)?;
         Ok(CellClient {
-            load: client::<LoadProgram>(&mut ros, mapping, ns, "load_program")?,
-            start: client::<StartProgram>(&mut ros, mapping, ns, "start_program")?,
-            stop: client::<Stop>(&mut ros, mapping, ns, "stop")?,
-            reset: client::<Reset>(&mut ros, mapping, ns, "reset")?,
-            robot: client::<RobotRequest>(&mut ros, mapping, ns, "robot_request")?,
-            list: client::<ListPrograms>(&mut ros, mapping, ns, "list_programs")?,
-            delete: client::<DeleteProgram>(&mut ros, mapping, ns, "delete_program")?,
-            overrides: client::<SetOverrides>(&mut ros, mapping, ns, "set_overrides")?,
+            load: client::<LoadProgram>(&mut ros, mapping, ns, "load_program"),
+            start: client::<StartProgram>(&mut ros, mapping, ns, "start_program"),
+            stop: client::<Stop>(&mut ros, mapping, ns, "stop"),
+            reset: client::<Reset>(&mut ros, mapping, ns, "reset"),
+            robot: client::<RobotRequest>(&mut ros, mapping, ns, "robot_request"),
+            list: client::<ListPrograms>(&mut ros, mapping, ns, "list_programs"),
+            delete: client::<DeleteProgram>(&mut ros, mapping, ns, "delete_program"),
+            overrides: client::<SetOverrides>(&mut ros, mapping, ns, "set_overrides"),
             // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
             // within a millisecond, and a depth-1 reader would see only STOPPED.
             machine: ros.dds_subscription_with_qos(
@@ -199,7 +210,7 @@ impl CellClient {
         call(
             &self.ros.node,
             self.timeout,
-            &self.load,
+            door(&self.load)?,
             LoadProgramRequest {
                 name: name.into(),
                 text: text.into(),
@@ -211,7 +222,7 @@ impl CellClient {
         call(
             &self.ros.node,
             self.timeout,
-            &self.start,
+            door(&self.start)?,
             StartProgramRequest { name: name.into() },
             Copies::Never,
         )
@@ -220,7 +231,7 @@ impl CellClient {
         call(
             &self.ros.node,
             self.timeout,
-            &self.stop,
+            door(&self.stop)?,
             StopRequest { mode },
             Copies::Allowed,
         )
@@ -229,7 +240,7 @@ impl CellClient {
         call(
             &self.ros.node,
             self.timeout,
-            &self.reset,
+            door(&self.reset)?,
             ResetRequest::default(),
             Copies::Allowed,
         )
@@ -247,10 +258,11 @@ impl CellClient {
         request: u8,
         give_up: impl FnMut() -> bool,
     ) -> Result<RobotRequestResponse, String> {
-        wait_for_server(&self.ros.node, &self.robot, self.timeout)?;
+        let robot = door(&self.robot)?;
+        wait_for_server(&self.ros.node, robot, self.timeout)?;
         exchange_unless(
             self.timeout,
-            &self.robot,
+            robot,
             RobotRequestRequest { request },
             Copies::Never,
             give_up,
@@ -261,7 +273,7 @@ impl CellClient {
         call(
             &self.ros.node,
             self.timeout,
-            &self.list,
+            door(&self.list)?,
             ListProgramsRequest::default(),
             Copies::Allowed,
         )
@@ -270,7 +282,7 @@ impl CellClient {
         call(
             &self.ros.node,
             self.timeout,
-            &self.delete,
+            door(&self.delete)?,
             DeleteProgramRequest { name: name.into() },
             Copies::Never,
         )
@@ -285,7 +297,7 @@ impl CellClient {
         call(
             &self.ros.node,
             self.timeout,
-            &self.overrides,
+            door(&self.overrides)?,
             SetOverridesRequest {
                 feed_percent,
                 spindle_percent,

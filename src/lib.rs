@@ -5,6 +5,7 @@ pub mod bench_paths;
 pub mod cell;
 pub mod cell_launch;
 pub mod client;
+pub mod keystore;
 pub mod machines;
 pub mod robot;
 pub mod robot_node;

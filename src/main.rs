@@ -106,6 +106,11 @@ enum Verb {
         #[arg(long, global = true)]
         config: Option<PathBuf>,
     },
+    /// DDS Security for a cell.
+    Security {
+        #[command(subcommand)]
+        action: SecurityVerb,
+    },
     /// Tamper evidence of recordings.
     Audit {
         #[command(subcommand)]
@@ -146,6 +151,19 @@ enum OperatorVerb {
     Remove { name: String },
     /// List the operators.
     List,
+}
+
+#[derive(Subcommand)]
+enum SecurityVerb {
+    /// Make the cell's keystore (SROS2 layout): one authority, and an enclave for each
+    /// machine (`/<machine>`), `/cell/supervisor`, `/cell/robot` and `/cell/observer`, each with
+    /// its certificate, key and signed permissions. Refused if the folder exists.
+    Init {
+        keystore: PathBuf,
+        /// A machine's namespace (`lathe1`); repeat for each machine of the cell.
+        #[arg(long = "machine", required = true)]
+        machines: Vec<String>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -287,6 +305,20 @@ fn main() -> ExitCode {
             action: AuditVerb::Verify { bag },
         }) => audit_verify(&bag),
         Some(Verb::Operator { action, config }) => operator(action, config.as_deref()),
+        Some(Verb::Security {
+            action: SecurityVerb::Init { keystore, machines },
+        }) => cnc::keystore::cell_enclaves(&machines)
+            .and_then(|enclaves| cnc::keystore::init(&keystore, &enclaves))
+            .map(|folders| {
+                println!(
+                    "keystore {}: {} enclaves",
+                    keystore.display(),
+                    folders.len()
+                );
+                for f in folders {
+                    println!("  {}", f.display());
+                }
+            }),
         Some(Verb::Replay {
             bag,
             config,
@@ -726,8 +758,9 @@ fn supervise(
     program: Option<NamedProgram>,
     cycles: u32,
 ) -> Result<(), String> {
+    // The launcher starts programs as the cell's supervisor would (its DDS Security identity).
     let mut client = CellClient::new(
-        &cfg.network,
+        &cfg.network.with_default_enclave("/cell/supervisor")?,
         &cfg.machine.namespace,
         "cnc_cli",
         ServiceMapping::Enhanced,

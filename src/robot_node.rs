@@ -30,7 +30,7 @@ const SUPERVISOR_SILENCE: Duration = Duration::from_secs(5);
 
 impl CellWatch {
     pub fn new(net: &NetworkConfig, who: &str) -> Result<CellWatch, String> {
-        let mut node = RosNode::new(net, CELL_NAMESPACE, who)?;
+        let mut node = RosNode::client(net, CELL_NAMESPACE, who)?;
         let state = node.dds_subscription(&CELL_STATE)?;
         Ok(CellWatch {
             _node: node,
@@ -77,6 +77,8 @@ pub fn serve_cell(
     swap_seconds: f64,
     deadline: Instant,
 ) -> Result<(Robot, Vec<Asked>), String> {
+    // Under DDS Security the robot is the cell's identity `/cell/robot`.
+    let net = &net.with_default_enclave("/cell/robot")?;
     let mut arm = Vec::new();
     for ns in names {
         let mut c = CellClient::new(net, ns, "robot", ros2_client::ServiceMapping::Enhanced)?

@@ -110,7 +110,9 @@ pub fn supervise(
     options: &Options,
     stop: &AtomicBool,
 ) -> Result<(CellState, Option<PathBuf>), String> {
-    let mut node = RosNode::new(net, CELL_NAMESPACE, "supervisor")?;
+    // Under DDS Security the supervisor is the cell's identity `/cell/supervisor`.
+    let net = &net.with_default_enclave("/cell/supervisor")?;
+    let mut node = RosNode::client(net, CELL_NAMESPACE, "supervisor")?;
     let state_pub: Publisher<CellState> = node.dds_publisher(&CELL_STATE)?;
     let decision_pub: Publisher<CommandEvent> = node.dds_publisher(&CELL_DECISIONS)?;
     let names: Vec<String> = order.lines.iter().map(|l| l.machine.clone()).collect();

@@ -106,6 +106,7 @@ impl Hosts {
         NetworkConfig {
             domain_id: Some(domain),
             interfaces: vec![IpAddr::from([10, 77, self.net, 1])],
+            security: None,
         }
     }
 

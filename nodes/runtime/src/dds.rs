@@ -15,7 +15,7 @@ use std::time::Duration;
 
 use cnc_msgs::RosMessage;
 
-use ros2_client::dds::rustdds::DomainParticipantBuilder;
+use ros2_client::dds::rustdds::{DomainParticipantBuilder, DomainParticipantSecurityConfigFiles};
 use ros2_client::dds::{Context, Node};
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{Message, MessageTypeName, Name, NodeName, NodeOptions, QosProfile};
@@ -41,24 +41,55 @@ pub struct RosNode {
 type Job = Box<dyn FnOnce() + Send>;
 
 /// Creates a participant in the configured domain that uses only the configured interfaces.
-/// ros2-client's `Context::new()` would always join domain 0 on every interface.
-pub fn context(net: &NetworkConfig) -> Result<Context, String> {
+/// ros2-client's `Context::new()` would always join domain 0 on every interface. With DDS
+/// Security on, the participant authenticates as its enclave (`enclave` when the config
+/// names none) and DDS enforces the enclave's permissions.
+pub fn context(net: &NetworkConfig, enclave: Option<&str>) -> Result<Context, String> {
     let domain = net.effective_domain_id()?;
-    let participant = DomainParticipantBuilder::new(domain)
-        .with_only_networks(net.interfaces.iter().copied())
+    let mut builder =
+        DomainParticipantBuilder::new(domain).with_only_networks(net.interfaces.iter().copied());
+    if let Some(security) = net.effective_security()? {
+        let dir = security.enclave_dir(enclave)?;
+        // Keys are stored unencrypted, readable by their owner only (as SROS2 stores them).
+        builder = builder.builtin_security(
+            DomainParticipantSecurityConfigFiles::with_ros_default_names(dir, String::new()),
+        );
+    }
+    let participant = builder
         .build()
         .map_err(|e| format!("DDS participant in domain {domain}: {e}"))?;
     Context::from_domain_participant(participant).map_err(|e| format!("ROS 2 context: {e}"))
 }
 
 impl RosNode {
-    /// Node `name` in namespace `/namespace`, with its spinner (discovery, parameters) running.
+    /// Node `name` of the machine in namespace `/namespace`, with its spinner (discovery,
+    /// parameters) running; under DDS Security it is the machine's identity, `/namespace`.
     pub fn new(net: &NetworkConfig, namespace: &str, name: &str) -> Result<Self, String> {
-        let context = context(net)?;
+        Self::with_options(net, namespace, name, Some(&format!("/{namespace}")), true)
+    }
+
+    /// A node of a client of the machines (the `cnc` client, the supervisor, the robot): it
+    /// serves no parameters, and under DDS Security it is the enclave its config or the
+    /// environment names.
+    pub fn client(net: &NetworkConfig, namespace: &str, name: &str) -> Result<Self, String> {
+        Self::with_options(net, namespace, name, None, false)
+    }
+
+    fn with_options(
+        net: &NetworkConfig,
+        namespace: &str,
+        name: &str,
+        enclave: Option<&str>,
+        parameter_services: bool,
+    ) -> Result<Self, String> {
+        let context = context(net, enclave)?;
         let node_name = NodeName::new(&format!("/{namespace}"), name)
             .map_err(|e| format!("node name {name}: {e:?}"))?;
+        let options = NodeOptions::new()
+            .enable_rosout(true)
+            .start_parameter_services(parameter_services);
         let mut node = context
-            .new_node(node_name, NodeOptions::new().enable_rosout(true))
+            .new_node(node_name, options)
             .map_err(|e| format!("node {name}: {e:?}"))?;
         match node.spinner() {
             Ok(spinner) => {

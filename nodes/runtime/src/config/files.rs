@@ -77,6 +77,11 @@ impl LaunchConfig {
         if self.recorder.directory.is_relative() {
             self.recorder.directory = dir.join(&self.recorder.directory);
         }
+        if let Some(sec) = &mut self.network.security {
+            if sec.keystore.is_relative() {
+                sec.keystore = dir.join(&sec.keystore);
+            }
+        }
     }
 
     /// The files this config writes, as `(what, path)`, for the user to know where they are.

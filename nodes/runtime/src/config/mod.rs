@@ -181,4 +181,44 @@ mod tests {
         let e = with("{DD: cf}").unwrap_err();
         assert!(e.contains("external_drives"), "{e}");
     }
+
+    /// DDS Security (D113): the keystore from the config's folder; an enclave is a path of
+    /// names with its credentials present, else refused with the reason.
+    #[test]
+    fn a_keystore_is_found_from_the_config_and_an_enclave_needs_its_files() {
+        let text = include_str!("../../../../launch_configs/sim_lathe.yaml").replacen(
+            "network:\n",
+            "network:\n  security: {keystore: ks}\n",
+            1,
+        );
+        let dir = std::env::temp_dir().join(format!("cnc_ks_cfg_{}", std::process::id()));
+        let cfg = LaunchConfig::from_yaml_in(&text, &dir, None).expect("config");
+        let sec = cfg
+            .network
+            .effective_security()
+            .unwrap()
+            .expect("security on");
+        assert_eq!(sec.keystore, dir.join("ks"));
+        assert_eq!(sec.enclave, None);
+        let e = sec.enclave_dir(None).unwrap_err();
+        assert!(e.contains("names no enclave"), "{e}");
+        for bad in ["/", "/../etc", "/a//b"] {
+            let e = sec.enclave_dir(Some(bad)).unwrap_err();
+            assert!(e.contains("not a path"), "{bad}: {e}");
+        }
+        let e = sec.enclave_dir(Some("/lathe1")).unwrap_err();
+        assert!(e.contains("cert.pem is missing"), "{e}");
+        let lathe = dir.join("ks/enclaves/lathe1");
+        std::fs::create_dir_all(&lathe).unwrap();
+        for f in ["cert.pem", "key.pem", "permissions.p7s", "governance.p7s"] {
+            std::fs::write(lathe.join(f), "x").unwrap();
+        }
+        assert_eq!(sec.enclave_dir(Some("/lathe1")).unwrap(), lathe);
+        let named = cfg.network.with_default_enclave("/cell/robot").unwrap();
+        assert_eq!(
+            named.security.and_then(|s| s.enclave).as_deref(),
+            Some("/cell/robot")
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

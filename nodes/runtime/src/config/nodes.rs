@@ -128,6 +128,52 @@ pub struct NetworkConfig {
     /// Addresses of the interfaces DDS uses for multicast and advertises. Default: loopback only.
     #[serde(default = "default_interfaces")]
     pub interfaces: Vec<IpAddr>,
+    /// DDS Security: absent, the cell's DDS traffic is open to anyone on the network (names
+    /// are claims); present, every participant authenticates with an enclave of the cell's
+    /// keystore and may do only what its permissions grant (`cnc security init`).
+    #[serde(default)]
+    pub security: Option<DdsSecurity>,
+}
+
+/// Where a participant's credentials are: an enclave of an SROS2-layout keystore.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DdsSecurity {
+    /// The keystore folder (`public/`, `private/`, `enclaves/`).
+    pub keystore: std::path::PathBuf,
+    /// The identity, e.g. `/lathe1` or `/cell/robot`. Absent: a machine's nodes take
+    /// `/<namespace>`; a client must name one.
+    #[serde(default)]
+    pub enclave: Option<String>,
+}
+
+impl DdsSecurity {
+    /// The enclave's folder, `enclave` taken when none is configured; refused with the reason
+    /// when the path is malformed or holds no credentials.
+    pub fn enclave_dir(&self, default: Option<&str>) -> Result<std::path::PathBuf, String> {
+        let enclave = self.enclave.as_deref().or(default).ok_or(
+            "DDS Security is on but this client names no enclave \
+             (network.security.enclave, or ROS_SECURITY_ENCLAVE_OVERRIDE)",
+        )?;
+        let rel = enclave.trim_start_matches('/');
+        if rel.is_empty()
+            || rel
+                .split('/')
+                .any(|s| s.is_empty() || s == "." || s == "..")
+        {
+            return Err(format!("enclave {enclave:?}: not a path like /lathe1"));
+        }
+        let dir = self.keystore.join("enclaves").join(rel);
+        for file in ["cert.pem", "key.pem", "permissions.p7s", "governance.p7s"] {
+            if !dir.join(file).is_file() {
+                return Err(format!(
+                    "enclave {enclave}: {} is missing (made by `cnc security init`)",
+                    dir.join(file).display()
+                ));
+            }
+        }
+        Ok(dir)
+    }
 }
 
 fn default_interfaces() -> Vec<IpAddr> {
@@ -139,11 +185,41 @@ impl Default for NetworkConfig {
         NetworkConfig {
             domain_id: None,
             interfaces: default_interfaces(),
+            security: None,
         }
     }
 }
 
 impl NetworkConfig {
+    /// DDS Security as configured, else as ROS 2 takes it from the environment
+    /// (`ROS_SECURITY_ENABLE=true`, `ROS_SECURITY_KEYSTORE`, `ROS_SECURITY_ENCLAVE_OVERRIDE`).
+    pub fn effective_security(&self) -> Result<Option<DdsSecurity>, String> {
+        if self.security.is_some() {
+            return Ok(self.security.clone());
+        }
+        let var = |n: &str| std::env::var(n).ok().filter(|v| !v.trim().is_empty());
+        if var("ROS_SECURITY_ENABLE").as_deref() != Some("true") {
+            return Ok(None);
+        }
+        let keystore = var("ROS_SECURITY_KEYSTORE")
+            .ok_or("ROS_SECURITY_ENABLE=true but ROS_SECURITY_KEYSTORE is not set")?;
+        Ok(Some(DdsSecurity {
+            keystore: keystore.into(),
+            enclave: var("ROS_SECURITY_ENCLAVE_OVERRIDE"),
+        }))
+    }
+
+    /// This config with `enclave` as the identity when security is on and none is named: the
+    /// cell's own nodes (supervisor, robot) take theirs.
+    pub fn with_default_enclave(&self, enclave: &str) -> Result<NetworkConfig, String> {
+        let mut net = self.clone();
+        if let Some(mut sec) = net.effective_security()? {
+            sec.enclave.get_or_insert_with(|| enclave.to_string());
+            net.security = Some(sec);
+        }
+        Ok(net)
+    }
+
     /// The domain to join: the config's, else `ROS_DOMAIN_ID`, else 0.
     pub fn effective_domain_id(&self) -> Result<u16, String> {
         if let Some(d) = self.domain_id {
