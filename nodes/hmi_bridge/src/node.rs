@@ -152,11 +152,12 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     let discovery = discovery_reader(&participant)?;
     let mut clients = Clients::default();
     let allowed = cfg.hmi.allowed_clients.clone();
-    if !allowed.iter().any(|p| p == "*") {
+    let secured = cfg.network.effective_security()?.is_some();
+    if !allowed.iter().any(|p| p == "*") && !secured {
         log::warn!(
             "hmi_bridge: hmi.allowed_clients {allowed:?} are node names that clients announce \
-             on ros_discovery_info: claims, not proof (no DDS Security); keep DDS on a network \
-             only the cell reaches"
+             on ros_discovery_info: claims, not proof (no DDS Security: network.security); \
+             keep DDS on a network only the cell reaches"
         );
     }
     // Every state change, in order (the bus keeps 64 per subscriber): the action follows the
