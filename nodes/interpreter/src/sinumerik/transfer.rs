@@ -17,7 +17,12 @@ pub struct Section<'a> {
 
 /// `line`'s program name and file name, if it is a transfer header.
 fn header(line: &str) -> Option<(String, String)> {
-    let word = line.trim().split([' ', '\t', ';']).next()?;
+    let line = line.trim_start();
+    // Most lines are blocks: one look at their first character.
+    if !line.starts_with('%') {
+        return None;
+    }
+    let word = line.trim_end().split([' ', '\t', ';']).next()?;
     let rest = word
         .get(..4)
         .filter(|p| p.eq_ignore_ascii_case("%_N_"))
@@ -41,7 +46,7 @@ pub fn split(text: &str) -> (&str, Vec<Section<'_>>) {
             } else {
                 seen_block = true; // the main program's own header
             }
-        } else if !line.trim().is_empty() && !line.trim_start().starts_with(';') {
+        } else if !seen_block && !line.trim().is_empty() && !line.trim_start().starts_with(';') {
             seen_block = true;
         }
         offset += line.len();
