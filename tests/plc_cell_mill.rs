@@ -183,6 +183,34 @@ fn f040_ffwon_takes_the_following_error_to_almost_nothing() {
     assert!(with < without / 10.0, "{with} vs {without}");
 }
 
+/// Fixture 039's `ACC[S]=50` (§9.3.18, D108) reaches the spindle drive: the spindle takes
+/// twice as long to reach its speed as without it.
+#[test]
+fn f039_acc_s_halves_the_spindles_acceleration() {
+    let text = fixture("039").replace("\n...\n", "\nN30 S1000 M3\nN40 G4 F3\n") + "M30\n";
+    // How long the spindle takes from turning (10 rpm) to 990 rpm.
+    let ramp = |text: &str| {
+        let mut r = mill(text);
+        let (mut began, mut reached) = (None, None);
+        let ok = r.run_until(60.0, |r| {
+            let rpm = r.fb.spindle_rpm;
+            if began.is_none() && rpm >= 10.0 {
+                began = Some(r.t);
+            }
+            if reached.is_none() && rpm >= 990.0 {
+                reached = Some(r.t);
+            }
+            r.program_done()
+        });
+        assert!(ok, "program did not finish; events {:?}", r.events);
+        reached.expect("990 rpm reached") - began.expect("the spindle turned")
+    };
+    let half = ramp(&text);
+    let rated = ramp(&text.replace("N20 ACC[S]=50", "N20"));
+    println!("10 to 990 rpm in {half:.3} s with ACC[S]=50, {rated:.3} s without");
+    assert!((half / rated - 2.0).abs() < 0.05, "{half} vs {rated}");
+}
+
 /// Fixture 063's H functions (§9.8, D107) through motion and the standard ladder: each goes
 /// to the PLC with the HF strobe, its address in F40 and its value in F44–F51, and the ladder
 /// gives FIN once settled, so the program runs to its end.

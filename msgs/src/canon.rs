@@ -5,6 +5,9 @@
 
 use crate::msg::MotionBlock;
 
+/// `Command::Acceleration`'s axis number for the spindle (`ACC[S]`).
+pub const SPINDLE_AXIS: u8 = u8::MAX;
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     /// Each axis at its own rapid rate (dog-leg path).
@@ -66,8 +69,9 @@ pub enum Command {
     Feedforward {
         on: bool,
     },
-    /// The acceleration of one axis (its index in the machine's order) for the moves that
-    /// follow, in percent of its rated acceleration (1–200). A run starts at 100 %.
+    /// The acceleration of one axis (its index in the machine's order, or [`SPINDLE_AXIS`] for
+    /// the spindle) for the moves that follow, in percent of its rated acceleration (1–200).
+    /// A run starts at 100 %.
     Acceleration {
         axis: u8,
         percent: f64,

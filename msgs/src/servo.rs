@@ -19,6 +19,9 @@ pub struct ServoSetpoint {
     pub axis_count: u32,
     /// 1 = drives enabled (servo on).
     pub enable: u32,
+    /// The spindle drive's acceleration, percent of its rated (`ACC[S]`, 1–200; 100 when no
+    /// program set it). The spindle is a drive on the same bus as the axes.
+    pub spindle_acceleration_percent: f64,
 }
 
 impl Default for ServoSetpoint {
@@ -29,6 +32,7 @@ impl Default for ServoSetpoint {
             position: [0.0; MAX_AXES],
             axis_count: 0,
             enable: 0,
+            spindle_acceleration_percent: 100.0,
         }
     }
 }

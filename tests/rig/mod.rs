@@ -101,6 +101,7 @@ impl Rig {
         self.motion.handwheel_input(self.fb.handwheel_count);
         let mut sp = ServoSetpoint {
             axis_count: self.n as u32,
+            spindle_acceleration_percent: self.motion.spindle_acceleration_percent(),
             ..Default::default()
         };
         sp.position[..self.n].copy_from_slice(self.motion.tick(Some(&actual[..self.n]), &self.gi));

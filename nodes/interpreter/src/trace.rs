@@ -92,7 +92,10 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             "FEEDFORWARD_OFF"
         }),
         Command::Acceleration { axis, percent } => {
-            let letter = letters.get(usize::from(*axis)).copied().unwrap_or('?');
+            let letter = match *axis {
+                cnc_msgs::canon::SPINDLE_AXIS => 'S',
+                a => letters.get(usize::from(a)).copied().unwrap_or('?'),
+            };
             let _ = write!(s, "ACCELERATION {letter} {percent}%");
         }
         Command::Aux(Aux::M(m)) => {

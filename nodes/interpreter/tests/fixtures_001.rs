@@ -464,7 +464,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("036", Some((12080, 8)), "template"),
     ("037", Some((12080, 7)), "template"),
     ("038", Some((12080, 8)), "template"),
-    ("039", Some((12140, 8)), "ACC[S]"),
+    ("039", Some((12080, 9)), "template"),
     ("040", Some((12080, 8)), "template"),
     ("041", Some((12140, 10)), "the compressor"),
     ("042", Some((12550, 7)), "the 3-axis mill has no A"),

@@ -601,11 +601,11 @@ fn g41_to_g42_or_g41_again_ends_normal_and_starts_normal_without_g40() {
 }
 
 /// 039 (§9.3.18, D108): ACC[X]=80 gives motion X's acceleration at 80 % before the next move,
-/// ACC[X]=100 back to the rated; out of 1…200 % 17020; ACC[S] (the spindle's) 12140 with
-/// the reason; an axis the machine lacks 14092.
+/// ACC[S]=50 the spindle's at 50 % (its axis number `SPINDLE_AXIS`), ACC[X]=100 back to the
+/// rated; out of 1…200 % 17020; an axis or spindle the machine lacks 14092.
 #[test]
-fn f039_acc_overrides_an_axis_acceleration_and_refuses_the_spindles() {
-    let text = support::filled("039", &["N30 G1 X100 F1000"]).replace("N20 ACC[S]=50", "N20");
+fn f039_acc_overrides_the_acceleration_of_an_axis_and_of_the_spindle() {
+    let text = support::filled("039", &["N30 G1 X100 F1000"]);
     let r = support::run_with(&text, support::mill(), Library::new()).ok();
     let acc: Vec<&Command> = r
         .out
@@ -619,6 +619,10 @@ fn f039_acc_overrides_an_axis_acceleration_and_refuses_the_spindles() {
                 axis: 0,
                 percent: 80.0
             },
+            &Command::Acceleration {
+                axis: cnc_msgs::canon::SPINDLE_AXIS,
+                percent: 50.0
+            },
             &Command::Linear {
                 end: vec![100.0, 0.0, 0.0],
                 feed: 1000.0
@@ -630,7 +634,8 @@ fn f039_acc_overrides_an_axis_acceleration_and_refuses_the_spindles() {
         ]
     );
     for (bad, number) in [
-        ("ACC[S]=50\n", 12140),
+        ("ACC[S]=0.5\n", 17020),
+        ("ACC[S2]=50\n", 14092),
         ("ACC[X]=0\n", 17020),
         ("ACC[Z]=201\n", 17020),
         ("ACC[A]=50\n", 14092),

@@ -486,6 +486,7 @@ fn servo_loop(
             position: setpoint,
             axis_count: n as u32,
             enable: u32::from(motion.servo_enabled()),
+            spindle_acceleration_percent: motion.spindle_acceleration_percent(),
         })?;
         // The answer to this setpoint, within half a period; a late answer to an earlier one
         // still updates the position but is not a round trip of this tick.

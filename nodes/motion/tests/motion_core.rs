@@ -1074,3 +1074,36 @@ fn an_acceleration_override_scales_the_axis_until_the_next_run() {
     let full = peak(&mut m, 2, vec![line(0.0), Command::ProgramEnd]);
     assert!((full - rated).abs() < 0.02 * rated, "{full} of {rated}");
 }
+
+/// ACC[S] (D108): the spindle drive's share goes out with every setpoint from its block on;
+/// the next run starts at 100 % again.
+#[test]
+fn the_spindle_acceleration_override_holds_until_the_next_run() {
+    let mut m = Motion::new(mill(), &[0.0, 0.0, 0.0]);
+    let kinds = [
+        Command::Acceleration {
+            axis: cnc_msgs::canon::SPINDLE_AXIS,
+            percent: 40.0,
+        },
+        Command::Linear {
+            end: vec![10.0, 0.0, 0.0],
+            feed: 6000.0,
+        },
+        Command::ProgramEnd,
+    ];
+    assert_eq!(m.spindle_acceleration_percent(), 100.0);
+    for (k, kind) in kinds.into_iter().enumerate() {
+        m.push(Block {
+            run_id: 1,
+            ..block(k as u64 + 1, k as u32 + 1, kind)
+        });
+    }
+    drive(&mut m, 5_000);
+    assert!((m.spindle_acceleration_percent() - 40.0).abs() < 1e-9);
+    m.push(Block {
+        run_id: 2,
+        ..block(1, 1, Command::ProgramEnd)
+    });
+    drive(&mut m, 100);
+    assert_eq!(m.spindle_acceleration_percent(), 100.0);
+}

@@ -778,24 +778,21 @@ impl Sinumerik {
         Ok(())
     }
 
-    /// M3/M4/M5, gear stages and the machine's own M functions, output before the motion
-    /// (§9.7); at most 5 M per block.
-    /// `ACC[axis]=percent` (§9.3.18): the axis's acceleration from the next block on, 1–200 %
-    /// of its rated value, until changed, reset or the program's end (D108). The spindle's
-    /// (`ACC[S]`) is the drive's own here: 12140 with the reason.
+    /// `ACC[axis]=percent` (§9.3.18): the axis's (or with `ACC[S]` the spindle's) acceleration
+    /// from the next block on, 1–200 % of its rated value, until changed, reset or the
+    /// program's end (D108).
     fn acceleration_override(&mut self, index: &[Expr], value: &Expr) -> Result<(), ProgramError> {
         let [Expr::Axis(name)] = index else {
             return Err(self.fault(Fault::MacroArgument, "ACC[axis]=percent names one axis"));
         };
-        if name.starts_with('S') {
-            return Err(self.fault(
-                Fault::NotSupported,
-                "ACC[S]: the spindle's acceleration is set in its drive, not by the program",
-            ));
-        }
-        let axis = self
-            .axis_of(name)
-            .ok_or_else(|| self.fault(Fault::NoSuchAxis, format!("ACC[{name}]: no such axis")))?;
+        // The 802D has one spindle: S, or S1 as its number.
+        let axis = if name == "S" || name == "S1" {
+            usize::from(cnc_msgs::canon::SPINDLE_AXIS)
+        } else {
+            self.axis_of(name).ok_or_else(|| {
+                self.fault(Fault::NoSuchAxis, format!("ACC[{name}]: no such axis"))
+            })?
+        };
         let percent = self.number(value)?;
         if !(1.0..=200.0).contains(&percent) {
             return Err(self.fault(

@@ -194,7 +194,14 @@ impl SimLathe {
             spindle_command(y)
         };
         let brake = if y.get(y::SPINDLE_BRAKE) { 3.0 } else { 1.0 };
-        let acceleration = self.cfg.spindle_acceleration;
+        // The drive's rated acceleration under the program's override (ACC[S], D108).
+        let share = setpoint.spindle_acceleration_percent / 100.0;
+        let share = if share.is_finite() {
+            share.clamp(0.01, 2.0)
+        } else {
+            1.0
+        };
+        let acceleration = self.cfg.spindle_acceleration * share;
         let step = acceleration * brake * dt;
         // Position control (M19, SPOS): a new stop position (or a new count) starts a
         // positioning from where the spindle is and how it turns.
@@ -386,6 +393,32 @@ mod tests {
         }
         assert_eq!(m.spindle_rpm(), 0.0);
         assert!(!m.x_image(&y).get(x::ESP_N));
+    }
+
+    /// ACC[S] (D108): the setpoint's share of the drive's rated acceleration; a value that is
+    /// no number leaves it rated.
+    #[test]
+    fn the_spindle_ramps_at_the_programmed_share_of_its_acceleration() {
+        let mut y = YImage {
+            spindle_rpm: 1000.0,
+            ..Default::default()
+        };
+        y.set(y::SPINDLE_CW, true);
+        for (percent, rpm) in [(50.0, 400.0), (150.0, 1000.0), (f64::NAN, 800.0)] {
+            let mut m = sim();
+            let sp = ServoSetpoint {
+                spindle_acceleration_percent: percent,
+                ..Default::default()
+            };
+            for _ in 0..100 {
+                m.step(&sp, &y, 0.004); // 0.4 s at 2000 rpm/s × share
+            }
+            assert!(
+                (m.spindle_rpm() - rpm).abs() < 1e-6,
+                "{percent} %: {}",
+                m.spindle_rpm()
+            );
+        }
     }
 
     /// The simulated spindle at 600 rpm M3, with the image that keeps it there.

@@ -41,6 +41,10 @@ impl Motion {
     /// ACC: an axis at `share` of its rated acceleration from the next block on; the
     /// look-ahead stops at the change, so no segment planned at the old value runs after it.
     pub(super) fn set_acceleration_override(&mut self, axis: usize, share: f64) {
+        if axis == usize::from(cnc_msgs::canon::SPINDLE_AXIS) {
+            self.spindle_acceleration = share.clamp(0.01, 2.0);
+            return;
+        }
         let rated = self.cfg.planner().limits.acceleration;
         if let Some(a) = rated.get(axis).filter(|_| axis < self.cfg.axes.len()) {
             self.planner
@@ -48,8 +52,15 @@ impl Motion {
         }
     }
 
-    /// Every axis at its rated acceleration (a run's start, reset).
+    /// The spindle drive's acceleration, percent of its rated (`ACC[S]`): sent to the drives
+    /// with every setpoint.
+    pub fn spindle_acceleration_percent(&self) -> f64 {
+        self.spindle_acceleration * 100.0
+    }
+
+    /// Every axis (and the spindle) at its rated acceleration (a run's start, reset).
     pub(super) fn rated_accelerations(&mut self) {
+        self.spindle_acceleration = 1.0;
         let rated = self.cfg.planner().limits.acceleration;
         for (i, a) in rated.iter().enumerate().take(self.cfg.axes.len()) {
             self.planner.set_acceleration(i, *a);

@@ -115,6 +115,8 @@ pub struct Motion {
     last_drive: Vec<f64>,
     /// FFWON: the drives get the feedforward lead (D106).
     feedforward: bool,
+    /// The spindle drive's acceleration, a share of its rated (`ACC[S]`, D108).
+    spindle_acceleration: f64,
     /// The axes machine lock holds, a bit per axis: all of them under machine lock, some
     /// under an axis lock (the mill's Z-axis lock); the switches are taken at rest only.
     locked: u32,
@@ -239,6 +241,7 @@ impl Motion {
             drive: commanded.clone(),
             last_drive: commanded.clone(),
             feedforward: false,
+            spindle_acceleration: 1.0,
             locked: 0,
             commanded,
             feed_hold: false,
