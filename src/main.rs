@@ -677,7 +677,8 @@ fn run_cell(path: &Path) -> Result<(), String> {
             eprintln!("cnc: robot: {e}");
         }
     });
-    let mut watch = CellWatch::new(&net, "cnc_cli")?;
+    // The terminal's view of the cell only reads: under DDS Security, the observer.
+    let mut watch = CellWatch::new(&net.with_default_enclave("/cell/observer")?, "cnc_cli")?;
     let mut shown = String::new();
     let outcome = loop {
         if STOP.load(Ordering::SeqCst) {

@@ -447,6 +447,17 @@ impl CryptoKeyFactory for CryptographicBuiltin {
         local_datawriter_crypto_handle,
       );
 
+    // cnc patch: the handle stands for the (remote participant, local endpoint) pair, so a
+    // second remote datareader of the same participant matched with the same local endpoint
+    // shares it and its keys: registered already, not an error (which left that datareader
+    // without a handle, and the local endpoint unable to send to it).
+    if self
+      .receiver_specific_encode_key_materials
+      .contains_key(&remote_datareader_crypto_handle)
+    {
+      return Ok(remote_datareader_crypto_handle);
+    }
+
     let receiver_specific_encode_key_materials = match common_encode_key_materials {
       CommonEncodeKeyMaterials::Volatile(use_256_bit_key) => {
         let volatile_key_materials =
@@ -582,6 +593,17 @@ impl CryptoKeyFactory for CryptographicBuiltin {
         remote_participant_crypto_handle,
         local_datareader_crypto_handle,
       );
+
+    // cnc patch: the handle stands for the (remote participant, local endpoint) pair, so a
+    // second remote datawriter of the same participant matched with the same local endpoint
+    // shares it and its keys: registered already, not an error (which left that datawriter
+    // without a handle, and the local endpoint unable to send to it).
+    if self
+      .receiver_specific_encode_key_materials
+      .contains_key(&remote_datawriter_crypto_handle)
+    {
+      return Ok(remote_datawriter_crypto_handle);
+    }
 
     let receiver_specific_encode_key_materials = match common_encode_key_materials {
       CommonEncodeKeyMaterials::Volatile(use_256_bit_key) => {
