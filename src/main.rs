@@ -619,6 +619,16 @@ fn run(config: Option<&Path>, program: Option<NamedProgram>, cycles: u32) -> Res
 fn run_cell(path: &Path) -> Result<(), String> {
     use cnc::robot_node::CellWatch;
     let launch = cnc::cell_launch::load(path)?;
+    for cfg in &launch.machines {
+        if cfg.network.effective_security()?.is_some() {
+            return Err(format!(
+                "{}: DDS Security is on: run each machine in its own process \
+                 (`cnc run <machine config>`); the one-process demo cell does not work under \
+                 security (docs/decisions.md, D113)",
+                cfg.machine.namespace
+            ));
+        }
+    }
     install_signal_handlers();
     let mut cells = Vec::new();
     for cfg in &launch.machines {

@@ -187,3 +187,41 @@ fn positions(c: &CellClient) -> Vec<(String, i64)> {
         })
         .unwrap_or_default()
 }
+
+/// A cell launch file whose machines run DDS Security is refused with the reason (D113): the
+/// one-process demo cell does not work under security.
+#[test]
+fn a_one_process_cell_under_security_is_refused_with_the_reason() {
+    let dir = common::fresh_dir("dds_security_cell");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let lathe = std::fs::read_to_string(root.join("launch_configs/sim_lathe.yaml"))
+        .expect("sim_lathe.yaml")
+        .replacen(
+            "network:\n",
+            "network:\n  security: {keystore: keystore}\n",
+            1,
+        );
+    std::fs::write(dir.join("sim_lathe.yaml"), lathe).expect("written");
+    std::fs::write(
+        dir.join("cell.yaml"),
+        std::fs::read_to_string(root.join("launch_configs/cell_two_lathes.yaml"))
+            .expect("cell file")
+            .replace(
+                "../examples/lathe/robot_part.nc",
+                &root.join("examples/lathe/robot_part.nc").to_string_lossy(),
+            ),
+    )
+    .expect("written");
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("run")
+        .arg(dir.join("cell.yaml"))
+        .output()
+        .expect("cnc runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("DDS Security is on: run each machine in its own process"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
