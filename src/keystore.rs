@@ -118,16 +118,12 @@ pub fn grants(role: &Role) -> (Vec<String>, Vec<String>) {
 /// protection kinds NONE, unlike SROS2's default): rustdds 0.15.1's cryptographic plugin
 /// delivered no sample between two participants on this machine (D113 in docs/decisions.md).
 pub fn governance_xml() -> String {
-    r#"<?xml version="1.0" encoding="UTF-8"?>
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_governance.xsd">
   <domain_access_rules>
     <domain_rule>
-      <domains>
-        <id_range>
-          <min>0</min>
-          <max>232</max>
-        </id_range>
-      </domains>
+{domains}
       <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
       <enable_join_access_control>true</enable_join_access_control>
       <discovery_protection_kind>NONE</discovery_protection_kind>
@@ -147,8 +143,28 @@ pub fn governance_xml() -> String {
     </domain_rule>
   </domain_access_rules>
 </dds>
-"#
-    .to_string()
+"#,
+        domains = domains(6),
+    )
+}
+
+/// The domains every document covers, 0–232 (all a ROS 2 domain id can be), indented by
+/// `indent` spaces.
+fn domains(indent: usize) -> String {
+    let lines = [
+        "<domains>",
+        "  <id_range>",
+        "    <min>0</min>",
+        "    <max>232</max>",
+        "  </id_range>",
+        "</domains>",
+    ];
+    let pad = " ".repeat(indent);
+    lines
+        .iter()
+        .map(|l| format!("{pad}{l}"))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// The permissions document of `enclave`, valid from `not_before` to `not_after`
@@ -171,12 +187,7 @@ pub fn permissions_xml(enclave: &Enclave, not_before: &str, not_after: &str) -> 
         <not_after>{not_after}</not_after>
       </validity>
       <allow_rule>
-        <domains>
-          <id_range>
-            <min>0</min>
-            <max>232</max>
-          </id_range>
-        </domains>
+{domains}
         <publish>
           <topics>
 {publish}          </topics>
@@ -192,6 +203,7 @@ pub fn permissions_xml(enclave: &Enclave, not_before: &str, not_after: &str) -> 
 </dds>
 "#,
         path = enclave.path,
+        domains = domains(8),
         publish = topics(&publish),
         subscribe = topics(&subscribe),
     )

@@ -180,6 +180,22 @@ class Session:
             time.sleep(0.01)
         return False
 
+    def endpoints(self, seconds):
+        """The machine's readers and writers (topic names under its namespace) that discovery
+        shows this participant within `seconds`, polling the state readers meanwhile."""
+        from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
+        subs = BuiltinDataReader(self.peer.dp, BuiltinTopicDcpsSubscription)
+        pubs = BuiltinDataReader(self.peer.dp, BuiltinTopicDcpsPublication)
+        readers, writers = set(), set()
+        end = time.time() + seconds
+        while time.time() < end:
+            self.poll()
+            readers.update(s.topic_name for s in subs.take(N=256))
+            writers.update(s.topic_name for s in pubs.take(N=256))
+            time.sleep(0.05)
+        mine = lambda names: sorted(n for n in names if f"/{self.peer.ns}/" in n)
+        return mine(readers), mine(writers)
+
     def exit_code(self):
         print(f"{len(self.failures)} failed", flush=True)
         return 1 if self.failures else 0

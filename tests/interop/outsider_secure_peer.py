@@ -11,7 +11,6 @@ The calling test checks that the machine did not move. Exit 0 when every check h
 
 import time
 
-from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
 from cyclonedds.core import Policy, Qos
 from cyclonedds.pub import DataWriter
 from cyclonedds.topic import Topic
@@ -26,22 +25,13 @@ PROGRAM = "O0666\nG00 X120 Z80\nS2000 M03\nG01 X0 F3000\nM30\n"
 def main():
     session = Session({"machine_state": "MachineState", "axes": "AxisState", "spindle": "SpindleState",
                        "part_count": "PartCount", "alarms": "ActiveAlarms"})
-    peer, check, poll = session.peer, session.check, session.poll
+    peer, check = session.peer, session.check
     ns = peer.ns
 
     # 1 and 2: listen, and look at discovery.
-    subs = BuiltinDataReader(peer.dp, BuiltinTopicDcpsSubscription)
-    pubs = BuiltinDataReader(peer.dp, BuiltinTopicDcpsPublication)
-    readers, writers = set(), set()
-    end = time.time() + LISTEN_SECONDS
-    while time.time() < end:
-        poll()
-        readers.update(s.topic_name for s in subs.take(N=256))
-        writers.update(s.topic_name for s in pubs.take(N=256))
-        time.sleep(0.05)
-    mine = lambda names: sorted(n for n in names if f"/{ns}/" in n)
-    print("machine readers seen:", mine(readers), flush=True)
-    print("machine writers seen:", mine(writers), flush=True)
+    readers, writers = session.endpoints(LISTEN_SECONDS)
+    print("machine readers seen:", readers, flush=True)
+    print("machine writers seen:", writers, flush=True)
     check(f"rt/{ns}/axes" not in writers and f"rq/{ns}/start_programRequest" not in readers,
           "discovery shows none of the machine's endpoints")
     heard = sorted(t for t, v in peer.latest.items() if v is not None)
