@@ -105,7 +105,15 @@ fn only_credentials_open_the_machine() {
                 .as_ref()
                 .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
     });
+    // The axes are telemetry: wait for a sample before taking where they stand.
+    common::wait(
+        &mut supervisor,
+        Duration::from_secs(30),
+        "axes heard",
+        |c| c.axes.is_some(),
+    );
     let axes_after_part = positions(&supervisor);
+    assert!(!axes_after_part.is_empty());
 
     // The robot's identity: robot_request is answered; start and load are refused by DDS
     // Security before anything is sent.
