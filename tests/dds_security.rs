@@ -35,6 +35,16 @@ fn client(net: &NetworkConfig, name: &str) -> CellClient {
         .with_timeout(Duration::from_secs(10))
 }
 
+/// A client with the identity `enclave`, once it hears the machine (at most `wait` seconds).
+fn hearing(keystore: &std::path::Path, enclave: &str, wait: u64) -> CellClient {
+    let name = enclave.rsplit('/').next().unwrap_or(enclave);
+    let mut c = client(&network(keystore, Some(enclave)), name);
+    if let Err(e) = c.wait_ready(Duration::from_secs(wait)) {
+        panic!("{enclave}: {e}");
+    }
+    c
+}
+
 /// Each node of the machine in a process of its own, killed when the test ends.
 struct Nodes(Vec<Child>);
 
@@ -87,10 +97,7 @@ fn only_credentials_open_the_machine() {
     }
 
     // The supervisor's identity: loads, starts, and the part is made.
-    let mut supervisor = client(&network(&keystore, Some("/cell/supervisor")), "supervisor");
-    supervisor
-        .wait_ready(Duration::from_secs(90))
-        .expect("the supervisor hears the machine");
+    let mut supervisor = hearing(&keystore, "/cell/supervisor", 90);
     let r = supervisor
         .load_program("secure.nc", common::SHORT_PART)
         .expect("load answered");
@@ -117,14 +124,12 @@ fn only_credentials_open_the_machine() {
 
     // The robot's identity: robot_request is answered; start and load are refused by DDS
     // Security before anything is sent.
-    let mut robot = client(&network(&keystore, Some("/cell/robot")), "robot");
-    robot
-        .wait_ready(Duration::from_secs(60))
-        .expect("the robot hears the machine");
+    let mut robot = hearing(&keystore, "/cell/robot", 60);
     let r = robot
         .robot_request(RobotRequestRequest::CLEAR)
         .expect("robot_request answered");
     println!("robot_request CLEAR: {} {}", r.accepted, r.message);
+    assert!(r.accepted, "{}", r.message);
     for (what, result) in [
         (
             "start_program",
@@ -140,10 +145,7 @@ fn only_credentials_open_the_machine() {
     }
 
     // An observer hears state and may call nothing, not even robot_request.
-    let mut observer = client(&network(&keystore, Some("/cell/observer")), "observer");
-    observer
-        .wait_ready(Duration::from_secs(60))
-        .expect("the observer hears the machine");
+    let mut observer = hearing(&keystore, "/cell/observer", 60);
     let e = observer
         .robot_request(RobotRequestRequest::CYCLE_START)
         .expect_err("an observer's robot_request");
