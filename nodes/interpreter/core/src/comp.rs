@@ -674,6 +674,11 @@ impl RadiusComp {
         }
     }
 
+    /// The radius the tool runs at now (a new radius takes effect along the next element).
+    pub fn radius(&self) -> f64 {
+        self.offset.abs()
+    }
+
     /// The source line of the element waiting for the next one.
     pub fn held_line(&self) -> Option<u32> {
         match (&self.startup, &self.held) {

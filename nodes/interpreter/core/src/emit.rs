@@ -25,6 +25,21 @@ use crate::rough::Move;
 use crate::show;
 use crate::state::Core;
 
+/// The commands queued after a kept place, waiting aside while it is filled
+/// ([`Core::open_place`]).
+#[derive(Debug)]
+pub struct Waiting {
+    at: usize,
+    later: std::collections::VecDeque<Canon>,
+}
+
+impl Waiting {
+    /// The queue index where the place's moves start.
+    pub fn at(&self) -> usize {
+        self.at
+    }
+}
+
 /// How a move is made.
 #[derive(Debug, Clone, Copy)]
 pub enum MoveKind {
@@ -371,10 +386,40 @@ impl Core {
 
     /// Where nothing may leave the queue yet: the earlier hold point.
     pub(crate) fn gate(&self) -> Option<usize> {
-        match (self.hold_at, self.corner_slot) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        [self.hold_at, self.corner_slot, self.reserved]
+            .into_iter()
+            .flatten()
+            .min()
+    }
+
+    /// Keeps the queue's present end for moves the front end can make only after a later
+    /// block (an approach that must end tangent to the element after it): what later blocks
+    /// queue meanwhile waits behind it. Nothing may be held (a corner or compensation's
+    /// element) while a place is kept: the front end checks [`Core::holding`] first.
+    pub fn reserve_place(&mut self) {
+        self.reserved = Some(self.pending.len());
+    }
+
+    /// Whether a path filter holds an element back.
+    pub fn holding(&self) -> bool {
+        self.hold_at.is_some() || self.corner_slot.is_some()
+    }
+
+    /// Opens the kept place: the commands queued after it wait aside (in [`Waiting`]) while
+    /// the front end emits the moves the place was for, then [`Core::put_back`] queues them
+    /// after those moves. An element a filter holds at the end then holds them back as it
+    /// holds any later command. `None` when no place is kept.
+    pub fn open_place(&mut self) -> Option<Waiting> {
+        let at = self.reserved.take()?.min(self.pending.len());
+        Some(Waiting {
+            at,
+            later: self.pending.split_off(at),
+        })
+    }
+
+    /// Queues the commands that waited aside behind the place's moves.
+    pub fn put_back(&mut self, waiting: Waiting) {
+        self.pending.extend(waiting.later);
     }
 
     /// Runs `f`, which queues the moves of an element that was held back, and moves what it
@@ -397,9 +442,13 @@ impl Core {
         for (k, c) in moved.into_iter().enumerate() {
             self.pending.insert(at + k, c);
         }
-        for h in [self.hold_at.as_mut(), self.corner_slot.as_mut()]
-            .into_iter()
-            .flatten()
+        for h in [
+            self.hold_at.as_mut(),
+            self.corner_slot.as_mut(),
+            self.reserved.as_mut(),
+        ]
+        .into_iter()
+        .flatten()
         {
             if *h >= at {
                 *h += n;

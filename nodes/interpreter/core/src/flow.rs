@@ -150,6 +150,7 @@ impl Core {
         }
         self.hold_at = None;
         self.corner_slot = None;
+        self.reserved = None;
         self.push(Command::ProgramEnd);
         self.done = true;
     }

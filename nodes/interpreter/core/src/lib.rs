@@ -35,7 +35,7 @@ pub mod variables;
 
 pub use canon::{Aux, Canon, Command, Turn, MAX_H_ADDRESS};
 pub use driver::{next_command, FrontEnd};
-pub use emit::MoveKind;
+pub use emit::{MoveKind, Waiting};
 pub use error::{AlarmTable, Fault, ProgramError};
 pub use flow::{CallLevel, Repeat};
 pub use setup::{Offsets, Setup, ToolOffset};

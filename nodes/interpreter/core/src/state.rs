@@ -133,6 +133,9 @@ pub struct Core {
     /// While a chamfered or rounded corner's element is held, the index of `pending` where its
     /// moves belong (commands from it on came after it in the program).
     pub(crate) corner_slot: Option<usize>,
+    /// The place a front end keeps for moves it can only make once a later block is read
+    /// (an approach that ends tangent to the next element): commands from it on wait.
+    pub(crate) reserved: Option<usize>,
     /// Common variables by number.
     pub common: HashMap<i64, f64>,
     // The stream.
@@ -190,6 +193,7 @@ impl Core {
             chip_break: None,
             hold_at: None,
             corner_slot: None,
+            reserved: None,
             common,
             pending: VecDeque::new(),
             line: 0,

@@ -84,6 +84,21 @@ impl Sinumerik {
 
     /// Emits the block's last element, held for the block's corner when it has one.
     pub(super) fn emit_element(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
+        if self.wab.is_some() {
+            let a = self.core.plane_point(&self.core.work_position())?;
+            let b = self.core.plane_point(end)?;
+            let (start, line) = match kind {
+                MoveKind::Arc { center, ccw, .. } => {
+                    (super::wab::arc_tangent(a, center, ccw), false)
+                }
+                _ => (super::wab::unit(a, b), true),
+            };
+            if self.wab_before_element(end, start, line)? {
+                // The line gave the approach its end point P4.
+                self.corner = None;
+                return Ok(());
+            }
+        }
         match self.corner.take() {
             Some((chamfer, feed)) if !matches!(kind, MoveKind::Rapid) => self
                 .core

@@ -134,9 +134,9 @@ impl Words {
 }
 
 /// Multi-letter addresses the control reads with `=` (§9.1.3, §9.1.6).
-const ADDRESSES: [&str; 20] = [
+const ADDRESSES: [&str; 23] = [
     "CR", "AR", "AP", "RP", "TURN", "RPL", "I1", "J1", "K1", "SF", "CHF", "CHR", "RND", "RNDM",
-    "FRC", "FRCM", "ANG", "OFFN", "SPOS", "FP",
+    "FRC", "FRCM", "ANG", "OFFN", "SPOS", "FP", "DISR", "DISCL", "FAD",
 ];
 
 /// Keywords this front end runs.
@@ -200,13 +200,7 @@ pub const NOT_BUILT: [(&str, &str); 23] = [
 
 /// G functions of the manual this controller does not run, each with the reason (the
 /// alarm 12140 says it; the code table lists them).
-pub const NOT_BUILT_G: [(u32, &str); 9] = [
-    (147, "smooth approach and retraction (WAB) is not built"),
-    (148, "smooth approach and retraction (WAB) is not built"),
-    (247, "smooth approach and retraction (WAB) is not built"),
-    (248, "smooth approach and retraction (WAB) is not built"),
-    (347, "smooth approach and retraction (WAB) is not built"),
-    (348, "smooth approach and retraction (WAB) is not built"),
+pub const NOT_BUILT_G: [(u32, &str); 3] = [
     (
         291,
         "G291 (the ISO dialect mode) is not built: run the program as fanuc-mill",
@@ -260,6 +254,7 @@ impl Sinumerik {
         // Where the block starts, for the work area check (a buffer kept from block to block).
         let mut start = std::mem::take(&mut self.block_start);
         start.clone_from(&self.core.pos);
+        self.block_entry = (self.motion, self.core.feed);
         self.modal(w)?;
         self.feed_and_speed(w)?;
         self.tool_words(w)?;
@@ -271,6 +266,8 @@ impl Sinumerik {
             self.corner = None;
         }
         self.cycles(w, nonmodal)?;
+        self.wab_after_block()?;
+        let from = from + std::mem::take(&mut self.moved_before);
         let checked = self.check_work_area(from, &start);
         self.block_start = start;
         checked?;
@@ -280,6 +277,7 @@ impl Sinumerik {
         self.m_after(w)?;
         if w.key("RET") {
             self.no_line_waits_for_ang()?;
+            self.no_approach_waits()?;
             self.return_from_program();
         }
         if let Some(name) = &w.call {
@@ -730,6 +728,8 @@ impl Sinumerik {
                 }
                 // The corners of radius compensation (§9.6.5, D103).
                 450 | 451 => self.core.outer_intersection = g == 451,
+                // How WAB comes down to the contour: in space or in the plane (§9.14).
+                340 | 341 => self.approach_in_plane = g == 341,
                 500 => self.set_work_offset(None),
                 // G54–G59 are the 1st–6th settable offsets, G507–G554 the 7th–54th (§9.2.10).
                 54..=59 => self.set_work_offset(Some((g - 54) as u8)),
@@ -900,6 +900,7 @@ impl Sinumerik {
                 0 | 1 => self.core.aux(Aux::M(m as i32)),
                 2 | 30 | 17 => {
                     self.no_line_waits_for_ang()?;
+                    self.no_approach_waits()?;
                     if self.core.depth() > 1 {
                         self.return_from_program();
                     } else if m == 17 {

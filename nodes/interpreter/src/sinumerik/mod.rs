@@ -31,6 +31,7 @@ mod thread_mill;
 mod tool;
 mod transfer;
 pub mod vars;
+mod wab;
 
 use std::sync::Arc;
 
@@ -126,6 +127,15 @@ pub struct Sinumerik {
     positioned: bool,
     /// The direction of the last G331 (+1 the way M3 turns), which G332 reverses; 0: none.
     tap_hand: f64,
+    /// G341: WAB comes down to the contour in the plane (else G340, in space).
+    approach_in_plane: bool,
+    /// A WAB approach waiting for the element after the contour's start (§9.14).
+    wab: Option<wab::Approach>,
+    /// The motion and feed in force before the block in hand (WAB moves at them).
+    block_entry: (Motion, f64),
+    /// Moves an approach put before the block in hand's own (its work area check skips
+    /// them: they were checked where they were made).
+    moved_before: usize,
 }
 
 /// The plane of G17, G18 or G19 (`001` §9.2.2).
@@ -218,6 +228,10 @@ impl Sinumerik {
             block_start: Vec::new(),
             positioned: false,
             tap_hand: 0.0,
+            approach_in_plane: false,
+            wab: None,
+            block_entry: (Motion::Line, 0.0),
+            moved_before: 0,
         };
         front.apply_length();
         front

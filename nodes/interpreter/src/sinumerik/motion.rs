@@ -232,10 +232,27 @@ impl Sinumerik {
             || w.addr.contains_key("ANG")
             || arc_words.iter().any(|k| w.addr.contains_key(*k));
         self.corner = self.block_corner(w, moves)?;
-        if !moves {
+        let wab = super::wab::code(w);
+        if wab.is_none() {
+            for k in ["DISR", "DISCL", "FAD"] {
+                if w.addr.contains_key(k) {
+                    return Err(self.fault(
+                        Fault::IllegalWord,
+                        format!("{k}= belongs to a WAB block (G147…G348)"),
+                    ));
+                }
+            }
+        }
+        if !moves && wab.is_none() {
             return Ok(());
         }
         if w.has_g(53) || w.has_g(153) {
+            if wab.is_some() {
+                return Err(self.fault(
+                    Fault::IllegalWord,
+                    "WAB (G147…G348) moves in the work's coordinates, not with G53/G153",
+                ));
+            }
             return self.machine_coordinates(w);
         }
         let here = self.core.work_position();
@@ -259,8 +276,25 @@ impl Sinumerik {
             let p = Pt::new(self.pole.z + rp * c, self.pole.r + rp * s);
             self.core.set_plane_point(&mut end, p);
         }
-        self.start_compensation()?;
-        if matches!(self.motion, Motion::Thread | Motion::TapIn | Motion::TapOut) || w.has_g(63) {
+        if let Some(code) = wab {
+            let (h, v) = self.core.plane_axes()?;
+            let normal = self.core.plane_normal();
+            let plane = polar || w.axes.iter().any(|(i, _)| *i == h || *i == v);
+            let on_normal = w.axes.iter().any(|(i, _)| Some(*i) == normal);
+            return self.wab_block(w, code, end, (plane, on_normal));
+        }
+        let threads = matches!(self.motion, Motion::Thread | Motion::TapIn | Motion::TapOut);
+        if self.wab.is_some() && (threads || w.has_g(63)) {
+            return Err(self.fault(
+                Fault::CompBlocks,
+                "WAB: the contour after an approach starts with G1, G2 or G3, not a thread",
+            ));
+        }
+        // A waiting approach starts compensation with its own first move.
+        if self.wab.is_none() {
+            self.start_compensation()?;
+        }
+        if threads || w.has_g(63) {
             return self.thread_move(w, &here, &end);
         }
         let a = self.core.plane_point(&here)?;
@@ -628,6 +662,10 @@ impl Sinumerik {
     ) -> Result<(), ProgramError> {
         let a = self.core.plane_point(here)?;
         let b = self.core.plane_point(end)?;
+        if self.wab.is_some() {
+            let start = super::wab::arc_tangent(a, c, ccw);
+            self.wab_before_element(end, start, false)?;
+        }
         let turns = match turns {
             None => 0,
             Some(t) if t.fract() == 0.0 && (0.0..=999.0).contains(&t) => t as u32,

@@ -116,15 +116,24 @@ impl Sinumerik {
     /// Starts radius compensation with the block's move, which must be a straight one
     /// (§9.6.4): the move ends perpendicular to the next element's start.
     pub(super) fn start_compensation(&mut self) -> Result<(), ProgramError> {
-        let Some(side) = self.comp_side else {
+        if self.comp_side.is_none() {
             return Ok(());
-        };
+        }
         if self.core.comp.is_some() && !std::mem::take(&mut self.comp_again) {
             return Ok(());
         }
         if !matches!(self.motion, Motion::Rapid | Motion::Line) {
             return Err(self.fault(Fault::CompStartNotLine, "G41/G42 start in a G0 or G1 block"));
         }
+        self.begin_compensation()
+    }
+
+    /// Starts compensation on the side asked for with the next move, whatever the block's
+    /// motion (a WAB approach's first move is its own, §9.14).
+    pub(super) fn begin_compensation(&mut self) -> Result<(), ProgramError> {
+        let Some(side) = self.comp_side else {
+            return Ok(());
+        };
         let offset = self.compensation_offset()?;
         // OFFN widens the offset (an allowance, half a slot's width); past the centre line
         // the path lies on the other side, which is how the manual switches G41↔G42 with a
