@@ -173,7 +173,8 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let alarm_sub = ros.subscription::<AlarmEvent>(&topics::ALARM_EVENTS)?;
     let state_pub = ros.publisher::<MachineState>(&topics::MACHINE_STATE)?;
     let alarms = AlarmReporter::new(&mut ros, run::SOURCE)?;
-    // The PLC's G image, for the block-skip switch (G44.0): the interpreter reads the blocks.
+    // The PLC's G image, for the block-skip switch (G44.0): the interpreter reads the blocks;
+    // its first arrival says the PLC has scanned (READY waits for it).
     let shm = ShmNode::new(&instance, "interpreter")?;
     let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
 
@@ -275,6 +276,8 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             core.alarm_event(&e);
         }
         if let Ok(Some(g)) = g_in.latest() {
+            // The PLC writes its G image only after a scan: the machine can be ready.
+            core.plc_scanned();
             core.block_skip_switch(g.get(g::BDT1));
         }
         carry_out(&mut core);

@@ -5,7 +5,8 @@
 //! loop, [`ProgramRun::feed`].
 //!
 //! The machine's execution state follows MTConnect's names (`MachineState`): WAIT until motion
-//! has told where the axes are, READY, ACTIVE while a run goes, FEED_HOLD, STOPPED after an
+//! has told where the axes are and the PLC has scanned once (before that its interface holds
+//! the emergency stop, and motion would refuse what a cycle start asks), READY, ACTIVE while a run goes, FEED_HOLD, STOPPED after an
 //! alarm or a cycle stop, PROGRAM_COMPLETED when motion has finished the program's last block.
 
 use std::collections::{BTreeMap, VecDeque};
@@ -237,6 +238,8 @@ pub struct RunCore {
     run_counter: u64,
     status: MotionStatus,
     position: Option<Vec<f64>>,
+    /// The PLC has scanned once since power-up.
+    plc_scanned: bool,
     /// Active error alarms by (source, number): a start is refused while any is active.
     active_alarms: Vec<(String, u32)>,
     execution: u8,
@@ -271,6 +274,7 @@ impl RunCore {
             run_counter: first_run_id,
             status: MotionStatus::default(),
             position: None,
+            plc_scanned: false,
             active_alarms: Vec::new(),
             // Cycle start needs the axes' position from motion; until then the machine waits.
             execution: MachineState::WAIT,
@@ -375,9 +379,20 @@ impl RunCore {
     pub fn axes(&mut self, commanded: &[f64]) {
         if commanded.len() == self.base.axes.len() && commanded.iter().all(|x| x.is_finite()) {
             self.position = Some(commanded.to_vec());
-            if self.execution == MachineState::WAIT {
-                self.execution = MachineState::READY;
-            }
+            self.ready_when_known();
+        }
+    }
+
+    /// The PLC has scanned once (its first state report): its interface no longer holds the
+    /// power-up emergency stop.
+    pub fn plc_scanned(&mut self) {
+        self.plc_scanned = true;
+        self.ready_when_known();
+    }
+
+    fn ready_when_known(&mut self) {
+        if self.execution == MachineState::WAIT && self.position.is_some() && self.plc_scanned {
+            self.execution = MachineState::READY;
         }
     }
 
@@ -434,6 +449,11 @@ impl RunCore {
         match c.command {
             // An MDI entry is stored as the program `MDI` and started as a program is
             // (decisions D43); cycle start runs programs in AUTO only.
+            // At power-up the PLC's interface holds the emergency stop until its first scan:
+            // a start then would be refused by motion, or wait unseen.
+            ProgramCommand::START | ProgramCommand::MDI if !self.plc_scanned => {
+                Err("the machine is not ready: the PLC has not scanned its inputs yet".into())
+            }
             ProgramCommand::START | ProgramCommand::MDI if self.mode == MachineState::MODE_HOME => {
                 self.reference_return()
             }
@@ -518,7 +538,7 @@ impl RunCore {
                             .retain(|k| k != &(source.clone(), number));
                     }
                 }
-                self.execution = if self.position.is_some() {
+                self.execution = if self.position.is_some() && self.plc_scanned {
                     MachineState::READY
                 } else {
                     MachineState::WAIT

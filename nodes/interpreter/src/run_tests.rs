@@ -57,11 +57,31 @@ fn ready() -> RunCore {
     let mut c = core();
     assert_eq!(c.execution(), MachineState::WAIT);
     assert!(command(&mut c, 1, ProgramCommand::LOAD, "part.nc", PART).accepted);
+    c.plc_scanned();
     let refused = command(&mut c, 2, ProgramCommand::START, "part.nc", "");
     assert!(!refused.accepted && refused.message.contains("no axis position"));
     c.axes(&[200.0, 100.0]);
     assert_eq!(c.execution(), MachineState::READY);
     c
+}
+
+#[test]
+fn the_machine_is_ready_only_once_the_plc_has_scanned() {
+    let mut c = core();
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "part.nc", PART).accepted);
+    c.axes(&[200.0, 100.0]);
+    // Motion knows the axes, but the PLC's interface still holds the power-up emergency
+    // stop: a start now would be refused by motion (1095) or wait unseen.
+    assert_eq!(c.execution(), MachineState::WAIT);
+    let refused = command(&mut c, 2, ProgramCommand::START, "part.nc", "");
+    assert!(!refused.accepted && refused.message.contains("PLC has not scanned"));
+    assert!(blocks(&c.take_effects()).is_empty());
+    let reset = command(&mut c, 3, ProgramCommand::RESET, "", "");
+    assert!(reset.accepted);
+    assert_eq!(c.execution(), MachineState::WAIT);
+    c.plc_scanned();
+    assert_eq!(c.execution(), MachineState::READY);
+    assert!(command(&mut c, 4, ProgramCommand::START, "part.nc", "").accepted);
 }
 
 #[test]
@@ -488,6 +508,7 @@ const COUNTED: &str =
 fn counted_core() -> RunCore {
     let mut c = core();
     assert!(command(&mut c, 1, ProgramCommand::LOAD, "count.nc", COUNTED).accepted);
+    c.plc_scanned();
     c.axes(&[200.0, 100.0]);
     c
 }
@@ -559,6 +580,7 @@ fn an_interrupted_run_restarts_at_its_block_with_the_variables_it_started_with()
         );
         let mut c = c.with_kept_position(Some(kept.clone()));
         assert!(command(&mut c, 1, ProgramCommand::LOAD, "count.nc", COUNTED).accepted);
+        c.plc_scanned();
         c.axes(&[250.0, 150.0]);
         c
     };
@@ -612,6 +634,7 @@ fn an_802d_message_shows_as_its_block_runs_until_the_next_one_or_the_end() {
     let part = "MSG(\"ROUGHING\")\nG0 X10\nG1 X20 F100\nMSG(\"FINISHING \"<<2)\nG1 X30\n\
                 MSG()\nG1 X40\nM2\n";
     assert!(command(&mut c, 1, ProgramCommand::LOAD, "PART.MPF", part).accepted);
+    c.plc_scanned();
     c.axes(&[0.0; 3]);
     assert!(command(&mut c, 2, ProgramCommand::START, "PART.MPF", "").accepted);
     // Every block goes to motion at once; the messages wait for motion.
@@ -669,6 +692,7 @@ fn an_802d_part_is_counted_in_memory_before_its_m30_goes_to_motion() {
     let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
     assert!(command(&mut c, 1, ProgramCommand::LOAD, "PART.MPF", "G0 X10\nM30\n").accepted);
+    c.plc_scanned();
     c.axes(&[0.0; 3]);
     let mut done = 0;
     for (k, run_id) in [(1.0, 1001), (2.0, 1002)] {
@@ -703,6 +727,7 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
     let main = "N10 G0 X1\nN20 EXTCALL (\"D:\\EXTERNE_UP\\BOHRUNG\")\nN30 G0 X3\nN40 M30\n";
     assert!(command(&mut c, 1, ProgramCommand::LOAD, "MAIN.MPF", main).accepted);
+    c.plc_scanned();
     c.axes(&[0.0; 3]);
     c.set_external_programs(
         [(
@@ -725,6 +750,7 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
     let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
     assert!(command(&mut c, 1, ProgramCommand::LOAD, "MAIN.MPF", main).accepted);
+    c.plc_scanned();
     c.axes(&[0.0; 3]);
     assert!(command(&mut c, 2, ProgramCommand::START, "MAIN.MPF", "").accepted);
     c.motion_status(status(1001, 0, 100, MotionStatus::STATE_RUNNING));
