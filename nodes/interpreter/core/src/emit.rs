@@ -76,6 +76,32 @@ impl Core {
         self.after_corner(end, kind)
     }
 
+    /// Coupled motion: each following axis's end moves on by its factor times its leading
+    /// axis's travel in this move (the leaders in definition order, so a follower that leads
+    /// another passes its whole travel on). A leading axis of an arc's plane would have to
+    /// be followed along the arc, which a straight following move cannot do: refused.
+    fn couple(&mut self, m: &mut [f64], kind: MoveKind) -> Result<(), ProgramError> {
+        if matches!(kind, MoveKind::Arc { .. }) {
+            let (h, v) = self.plane_axes()?;
+            if let Some(c) = self.couplings.iter().find(|c| c.lead == h || c.lead == v) {
+                return Err(self.fault(
+                    Fault::NotSupported,
+                    format!(
+                        "{} leads {} in coupled motion: a circle of its plane is not followed                          (straight moves only)",
+                        self.setup.axes[c.lead], self.setup.axes[c.follow]
+                    ),
+                ));
+            }
+        }
+        for k in 0..self.couplings.len() {
+            let c = self.couplings[k];
+            let travel = c.factor * (m[c.lead] - self.pos[c.lead]);
+            m[c.follow] += travel;
+            self.coupled[c.follow] += travel;
+        }
+        Ok(())
+    }
+
     /// Stage 2: radius compensation, when it is active.
     pub(crate) fn after_corner(&mut self, end: &[f64], kind: MoveKind) -> Result<(), ProgramError> {
         if self.comp.is_some() {
@@ -128,7 +154,10 @@ impl Core {
             self.arc_under_frame()?;
         }
         self.spindle_for(end);
-        let m = self.to_machine(end);
+        let mut m = self.to_machine(end);
+        if !self.couplings.is_empty() {
+            self.couple(&mut m, kind)?;
+        }
         // The machine position becomes `m`; the command takes `m` itself (no copy per move).
         self.pos.copy_from_slice(&m);
         let command = match kind {

@@ -39,7 +39,7 @@ pub use emit::{MoveKind, Waiting};
 pub use error::{AlarmTable, Fault, ProgramError};
 pub use flow::{CallLevel, Repeat};
 pub use setup::{Offsets, Setup, ToolOffset};
-pub use state::{CompRules, Core, CssRule, Plane, Rules, SpindleDir};
+pub use state::{CompRules, Core, Coupling, CssRule, Plane, Rules, SpindleDir};
 pub use text::{find_number, line_number, read_line, Library, Pos};
 pub use transform::{Frame, NO_WORK_OFFSET};
 pub use variables::Value;

@@ -78,6 +78,15 @@ pub struct Rules {
 /// that never moves (a macro jump loop): an alarm instead of a hang.
 pub const MAX_SILENT_BLOCKS: u32 = 1_000_000;
 
+/// A following axis coupled to a leading one: it travels `factor` times the leader's travel
+/// in machine coordinates, block by block, besides its own programmed path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coupling {
+    pub follow: usize,
+    pub lead: usize,
+    pub factor: f64,
+}
+
 /// The core's state; front ends read and change it through its fields and methods.
 pub struct Core {
     pub rules: Rules,
@@ -93,6 +102,12 @@ pub struct Core {
     pub work_system: u8,
     pub shift: Vec<f64>,
     pub local: Vec<f64>,
+    /// Coupled motion: following axes that travel a factor of their leading axes' travel,
+    /// on top of their own programmed path (see [`Coupling`]).
+    pub couplings: Vec<Coupling>,
+    /// The travel each following axis has made through its couplings: part of its program
+    /// zero, so the program goes on writing the axis's own path.
+    pub coupled: Vec<f64>,
     pub frame: Frame,
     pub tool_offset: Vec<f64>,
     pub plane: Plane,
@@ -171,6 +186,8 @@ impl Core {
             program_start: Vec::new(),
             work_system: setup.work_system.min(5),
             shift: vec![0.0; n],
+            couplings: Vec::new(),
+            coupled: vec![0.0; n],
             local: vec![0.0; n],
             frame: Frame::identity(n),
             tool_offset: vec![0.0; n],
@@ -239,7 +256,7 @@ impl Core {
         } else {
             0.0
         };
-        work + self.shift[i] + self.local[i] + self.tool_offset[i]
+        work + self.shift[i] + self.local[i] + self.tool_offset[i] + self.coupled[i]
     }
 
     /// Program zero per axis in machine coordinates (work offset, shifts, tool offset) as it

@@ -2,7 +2,7 @@
 //! coordinates (what motion moves to), per axis:
 //!
 //! ```text
-//! machine = frame(work) + work offset + shift + local system + tool offset
+//! machine = frame(work) + work offset + shift + local system + tool offset + coupled travel
 //! ```
 //!
 //! - the work offset of the active work system (off for a front end whose work offsets are
@@ -12,7 +12,9 @@
 //! - a local system inside the work system;
 //! - a programmable [`Frame`]: any composition of translations, rotations, scalings and
 //!   mirrorings (identity unless a front end sets one);
-//! - the tool offset (geometry plus wear, or a tool length along its axis).
+//! - the tool offset (geometry plus wear, or a tool length along its axis);
+//! - what a following axis of coupled motion has travelled with its leaders (`Coupling`):
+//!   the program goes on writing the axis's own path.
 //!
 //! With the identity frame each axis is a sum, computed in this order; the inverse gives the
 //! work position shown to the program.

@@ -165,14 +165,12 @@ const TANG_ON_A_MILL: &str =
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 23] = [
+pub const NOT_BUILT: [(&str, &str); 21] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
     ("TRACYL", "the cylinder transformation is not built"),
     ("TRAFOOF", "no transformation is built"),
-    ("TRAILON", "coupled motion is not built"),
-    ("TRAILOF", "coupled motion is not built"),
     (
         "MEAS",
         "probing is not built: the simulated mill has no probe",
@@ -216,7 +214,7 @@ pub fn is_address(name: &str) -> bool {
         || NOT_BUILT.iter().any(|(k, _)| *k == name)
         || [
             "DEF", "IF", "GOTOF", "GOTOB", "MSG", "SET", "REP", "AC", "IC", "DC", "ACP", "ACN",
-            "PROC", "ACC",
+            "PROC", "ACC", "TRAILON", "TRAILOF",
         ]
         .contains(&name)
 }
@@ -341,7 +339,7 @@ impl Sinumerik {
             Item::Param { number, value } => self.write_param(*number, value)?,
             Item::Proc(name, params) => self.proc(name, *params)?,
             Item::Assign { name, index, value } => {
-                let axis = self.axis_of(name);
+                let axis = self.axis_named(name);
                 if name.starts_with('H') && name[1..].bytes().all(|b| b.is_ascii_digit()) {
                     let v = self.number(value)?;
                     return self.h_function(w, &name[1..], v);
@@ -496,6 +494,12 @@ impl Sinumerik {
         if name == "RESETMON" {
             return self.resetmon(args);
         }
+        if name == "TRAILON" {
+            return self.trail_on(args);
+        }
+        if name == "TRAILOF" {
+            return self.trail_off(args);
+        }
         if NOT_BUILT.iter().any(|(k, _)| *k == name) {
             return self.not_built(name);
         }
@@ -536,7 +540,7 @@ impl Sinumerik {
     }
 
     /// The machine axis an address names: a channel axis (`X`) or a machine axis (`X1`).
-    fn axis_of(&self, name: &str) -> Option<usize> {
+    pub(super) fn axis_named(&self, name: &str) -> Option<usize> {
         let mut c = name.chars();
         let letter = c.next()?;
         let rest = c.as_str();
@@ -559,7 +563,7 @@ impl Sinumerik {
                 let [Some(arg)] = args.as_slice() else {
                     return Err(self.fault(Fault::MacroArgument, format!("{name}={f}(value)")));
                 };
-                let rotary = self.axis_of(name).is_some_and(|i| self.rotary_axis(i));
+                let rotary = self.axis_named(name).is_some_and(|i| self.rotary_axis(i));
                 if matches!(mode, Mode::Rotary(_)) && name != "SPOS" && !rotary {
                     return Err(self.fault(
                         Fault::IllegalWord,
@@ -789,7 +793,7 @@ impl Sinumerik {
         let axis = if name == "S" || name == "S1" {
             usize::from(cnc_msgs::canon::SPINDLE_AXIS)
         } else {
-            self.axis_of(name).ok_or_else(|| {
+            self.axis_named(name).ok_or_else(|| {
                 self.fault(Fault::NoSuchAxis, format!("ACC[{name}]: no such axis"))
             })?
         };

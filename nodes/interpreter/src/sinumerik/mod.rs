@@ -29,6 +29,7 @@ mod slots;
 mod spigot;
 mod thread_mill;
 mod tool;
+mod trail;
 mod transfer;
 pub mod vars;
 mod wab;
@@ -352,7 +353,16 @@ impl Sinumerik {
                     .and_then(|c| self.core.axis(c))
                     .filter(|_| axis.len() == 1)
                     .ok_or_else(|| EvalError::new(Fault::AxisAddress, format!("no axis {axis}")))?;
-                Ok(self.core.work_position()[i])
+                // What a following axis travelled coupled is part of where it is.
+                Ok(self.core.work_position()[i] + self.core.coupled[i])
+            }
+            "$AA_COUP_ACT" => {
+                let i = match idx {
+                    [Val::Str(a)] => self.axis_named(a),
+                    _ => None,
+                };
+                i.map(|i| self.coupling_state(i))
+                    .ok_or_else(|| EvalError::new(Fault::AxisAddress, "$AA_COUP_ACT[axis]"))
             }
             _ => match counter_key(name) {
                 Some(k) => Ok(self.core.common.get(&k).copied().unwrap_or(0.0)),

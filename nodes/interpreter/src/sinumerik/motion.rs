@@ -731,6 +731,9 @@ impl Sinumerik {
             std::mem::take(&mut self.core.shift),
         );
         let n = self.core.setup.axes.len();
+        // Coupled travel is no offset: G53 positions the axis itself (what this block adds
+        // through couplings is kept).
+        let coupled = std::mem::replace(&mut self.core.coupled, vec![0.0; n]);
         self.core.shift = vec![0.0; n];
         self.core.frame = cnc_interpreter_core::Frame::identity(n);
         self.core.work_system = NO_WORK_OFFSET;
@@ -752,6 +755,9 @@ impl Sinumerik {
         };
         let r = self.core.emit(&end, kind);
         (self.core.frame, self.core.work_system, self.core.shift) = saved;
+        for (c, before) in self.core.coupled.iter_mut().zip(coupled) {
+            *c += before;
+        }
         r
     }
 }
