@@ -103,6 +103,20 @@ struct Piece {
     arc: Option<(Pt, bool)>,
 }
 
+impl Piece {
+    /// The piece as a move at `feed`.
+    fn kind(&self, feed: f64) -> MoveKind {
+        match self.arc {
+            Some((c, ccw)) => MoveKind::Arc {
+                center: c,
+                ccw,
+                feed,
+            },
+            None => MoveKind::Feed(feed),
+        }
+    }
+}
+
 /// The normal on the cutter's side of direction `t`.
 fn side_normal(side: Side, t: Pt) -> Pt {
     match side {
@@ -323,18 +337,10 @@ impl Sinumerik {
         let feed = self.core.feed;
         let slow = MoveKind::Feed(a.fad.unwrap_or(feed));
         let mut steps: Vec<(Vec<f64>, MoveKind)> = Vec::new();
-        let contour_kind = |f: f64| match way.arc {
-            Some((c, ccw)) => MoveKind::Arc {
-                center: c,
-                ccw,
-                feed: f,
-            },
-            None => MoveKind::Feed(f),
-        };
         if a.discl == 0.0 && !a.in_plane {
             // G340, DISCL=0: P1, P2 and P3 are one point; two blocks (§9.14, D114).
             steps.push((at(self, way.start, d4), a.before));
-            steps.push((p4.to_vec(), contour_kind(a.fad.unwrap_or(feed))));
+            steps.push((p4.to_vec(), way.kind(a.fad.unwrap_or(feed))));
         } else {
             let (lo, hi) = (d0.min(d4), d0.max(d4));
             if d2 < lo - REVERSAL_TOLERANCE || d2 > hi + REVERSAL_TOLERANCE {
@@ -348,9 +354,9 @@ impl Sinumerik {
             steps.push((at(self, way.start, d2), a.before));
             if a.in_plane {
                 steps.push((at(self, way.start, d4), slow));
-                steps.push((p4.to_vec(), contour_kind(feed)));
+                steps.push((p4.to_vec(), way.kind(feed)));
             } else {
-                steps.push((p4.to_vec(), contour_kind(a.fad.unwrap_or(feed))));
+                steps.push((p4.to_vec(), way.kind(a.fad.unwrap_or(feed))));
             }
         }
         self.run_steps(steps)
@@ -424,14 +430,6 @@ impl Sinumerik {
         let slow = MoveKind::Feed(words.fad.unwrap_or(old_f));
         // Compensation ends on the last move (G40 in this block), not on the way off.
         let cancel = std::mem::take(&mut self.core.comp_cancel);
-        let contour_kind = |f: f64| match way.arc {
-            Some((c, ccw)) => MoveKind::Arc {
-                center: c,
-                ccw,
-                feed: f,
-            },
-            None => MoveKind::Feed(f),
-        };
         // Where the cutter's centre is at the way's end: a cancel without plane axes ends
         // there, so the tool does not move sideways as compensation goes (§9.14 说明).
         let end_dir = match way.arc {
@@ -452,15 +450,12 @@ impl Sinumerik {
             }
         }
         if self.approach_in_plane || space_direct {
-            steps.push((at(self, way.end, d4), contour_kind(old_f)));
+            steps.push((at(self, way.end, d4), way.kind(old_f)));
             if !space_direct {
                 steps.push((at(self, way.end, d2), slow));
             }
         } else {
-            steps.push((
-                at(self, way.end, d2),
-                contour_kind(words.fad.unwrap_or(old_f)),
-            ));
+            steps.push((at(self, way.end, d2), way.kind(words.fad.unwrap_or(old_f))));
         }
         let last_point = if cancel { centre_end } else { way.end };
         if plane {
