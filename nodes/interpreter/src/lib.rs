@@ -26,6 +26,7 @@ pub mod run;
 pub mod search;
 pub mod setup;
 pub mod sinumerik;
+pub mod stream;
 pub mod trace;
 
 pub use cnc_interpreter_core::{canon, geometry, rough, Aux, Canon, Command, Library};
