@@ -25,14 +25,7 @@ pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>
         }
         if core.gate() != Some(0) {
             if let Some(c) = core.pending.pop_front() {
-                for h in [
-                    core.hold_at.as_mut(),
-                    core.corner_slot.as_mut(),
-                    core.reserved.as_mut(),
-                ]
-                .into_iter()
-                .flatten()
-                {
+                for h in core.hold_points() {
                     *h -= 1;
                 }
                 core.silent_blocks = 0;

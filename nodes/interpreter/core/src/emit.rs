@@ -421,6 +421,18 @@ impl Core {
             .min()
     }
 
+    /// The queue's hold points (compensation's, the corner's, a front end's kept place), to
+    /// move on with the commands before them.
+    pub(crate) fn hold_points(&mut self) -> impl Iterator<Item = &mut usize> {
+        [
+            self.hold_at.as_mut(),
+            self.corner_slot.as_mut(),
+            self.reserved.as_mut(),
+        ]
+        .into_iter()
+        .flatten()
+    }
+
     /// Keeps the queue's present end for moves the front end can make only after a later
     /// block (an approach that must end tangent to the element after it): what later blocks
     /// queue meanwhile waits behind it. Nothing may be held (a corner or compensation's
@@ -471,14 +483,7 @@ impl Core {
         for (k, c) in moved.into_iter().enumerate() {
             self.pending.insert(at + k, c);
         }
-        for h in [
-            self.hold_at.as_mut(),
-            self.corner_slot.as_mut(),
-            self.reserved.as_mut(),
-        ]
-        .into_iter()
-        .flatten()
-        {
+        for h in self.hold_points() {
             if *h >= at {
                 *h += n;
             }

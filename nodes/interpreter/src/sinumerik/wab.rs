@@ -50,7 +50,7 @@ pub fn code(w: &Words) -> Option<(Shape, bool)> {
 }
 
 /// An approach waiting for the element after P4.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Approach {
     shape: Shape,
     in_plane: bool,
