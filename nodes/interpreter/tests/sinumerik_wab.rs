@@ -346,3 +346,16 @@ fn a_wab_that_cannot_be_made_is_an_alarm_with_its_number() {
         );
     }
 }
+
+#[test]
+fn a_retraction_whose_discl_point_lies_above_p1_turns_back_and_is_refused() {
+    // Off the contour at Z0 to Z5 (P1), but DISCL=20 puts P2 above P1.
+    let text = "T1 D1\nG0 X-20 Y0\nG41 G1 X0 Y0 F100\nG1 X10\nG148 G341 DISR=5 DISCL=20 Z5\nM30\n";
+    let r = run_r5(text);
+    assert_eq!(r.alarm(), (10741, 5));
+    // With DISCL=3 the same retraction runs: up to Z3, then to Z5.
+    let r = run_r5(&text.replace("DISCL=20", "DISCL=3")).ok();
+    let got = path(&r);
+    assert!(near(&got[got.len() - 1].1[2..], &[5.0]), "{got:#?}");
+    assert!(near(&got[got.len() - 2].1[2..], &[3.0]), "{got:#?}");
+}

@@ -188,6 +188,34 @@ impl Sinumerik {
         Ok(Words3 { disr, discl, fad })
     }
 
+    /// A position's coordinate along the plane's normal (0 on a machine without one).
+    fn depth_of(&self, p: &[f64]) -> f64 {
+        self.core.plane_normal().map_or(0.0, |i| p[i])
+    }
+
+    /// `base` with the plane point `p`, at `z` along the plane's normal.
+    fn point_at(&self, base: &[f64], p: Pt, z: f64) -> Vec<f64> {
+        let mut v = self.core.with_point(base, p);
+        if let Some(i) = self.core.plane_normal() {
+            v[i] = z;
+        }
+        v
+    }
+
+    /// The DISCL height `d2` must lie between P1's `d0` and P3's `d4` (10741): the infeed
+    /// does not turn back (§9.14, within 0.01 mm).
+    fn no_reversal(&self, d0: f64, d2: f64, d4: f64) -> Result<(), ProgramError> {
+        let (lo, hi) = (d0.min(d4), d0.max(d4));
+        if d2 < lo - REVERSAL_TOLERANCE || d2 > hi + REVERSAL_TOLERANCE {
+            return Err(self.wab_alarm(
+                10741,
+                "direction reversal on the infeed: the DISCL point does not lie between P1 \
+                 and P3",
+            ));
+        }
+        Ok(())
+    }
+
     /// The side and radius compensation runs with (None: G40).
     fn comp_now(&self) -> Option<(Side, f64)> {
         self.core.comp.as_ref().map(|c| (c.side(), c.radius()))
@@ -323,17 +351,9 @@ impl Sinumerik {
         let (side, r) = comp.unwrap_or((Side::Left, 0.0));
         let q4 = self.core.plane_point(p4)?;
         let way = piece(a.shape, true, q4, t, side, a.disr + r);
-        let d = self.core.plane_normal();
-        let depth = |p: &[f64]| d.map_or(0.0, |i| p[i]);
-        let (d0, d4) = (depth(p0), depth(p4));
+        let (d0, d4) = (self.depth_of(p0), self.depth_of(p4));
         let d2 = d4 + a.discl;
-        let at = |me: &Self, p: Pt, z: f64| {
-            let mut v = me.core.with_point(p4, p);
-            if let Some(i) = d {
-                v[i] = z;
-            }
-            v
-        };
+        let at = |me: &Self, p: Pt, z: f64| me.point_at(p4, p, z);
         let feed = self.core.feed;
         let slow = MoveKind::Feed(a.fad.unwrap_or(feed));
         let mut steps: Vec<(Vec<f64>, MoveKind)> = Vec::new();
@@ -342,14 +362,7 @@ impl Sinumerik {
             steps.push((at(self, way.start, d4), a.before));
             steps.push((p4.to_vec(), way.kind(a.fad.unwrap_or(feed))));
         } else {
-            let (lo, hi) = (d0.min(d4), d0.max(d4));
-            if d2 < lo - REVERSAL_TOLERANCE || d2 > hi + REVERSAL_TOLERANCE {
-                return Err(self.wab_alarm(
-                    10741,
-                    "direction reversal on the infeed: the DISCL point does not lie between \
-                     P1 and P3",
-                ));
-            }
+            self.no_reversal(d0, d2, d4)?;
             steps.push((at(self, way.start, d0), a.before));
             steps.push((at(self, way.start, d2), a.before));
             if a.in_plane {
@@ -409,18 +422,9 @@ impl Sinumerik {
         let p4 = self.core.work_position();
         let q4 = self.core.plane_point(&p4)?;
         let way = piece(shape, false, q4, t, side, words.disr + r);
-        let d = self.core.plane_normal();
-        let depth = |p: &[f64]| d.map_or(0.0, |i| p[i]);
-        let d4 = depth(&p4);
-        let d0 = depth(&end);
+        let (d0, d4) = (self.depth_of(&end), self.depth_of(&p4));
         let d2 = d4 + words.discl;
-        let at = |me: &Self, p: Pt, z: f64| {
-            let mut v = me.core.with_point(&p4, p);
-            if let Some(i) = d {
-                v[i] = z;
-            }
-            v
-        };
+        let at = |me: &Self, p: Pt, z: f64| me.point_at(&p4, p, z);
         let old_f = self.block_entry.1;
         let new = if self.motion == Motion::Rapid {
             MoveKind::Rapid
@@ -439,15 +443,8 @@ impl Sinumerik {
         let centre_end = along(way.end, side_normal(side, end_dir), r);
         let mut steps: Vec<(Vec<f64>, MoveKind)> = Vec::new();
         let space_direct = words.discl == 0.0 && !self.approach_in_plane;
-        if !space_direct {
-            let (lo, hi) = (d0.min(d4), d0.max(d4));
-            if (plane || normal) && (d2 < lo - REVERSAL_TOLERANCE || d2 > hi + REVERSAL_TOLERANCE) {
-                return Err(self.wab_alarm(
-                    10741,
-                    "direction reversal on the way up: the DISCL point does not lie between \
-                     P3 and P1",
-                ));
-            }
+        if !space_direct && (plane || normal) {
+            self.no_reversal(d0, d2, d4)?;
         }
         if self.approach_in_plane || space_direct {
             steps.push((at(self, way.end, d4), way.kind(old_f)));
