@@ -14,13 +14,6 @@ use cnc_interpreter::{Aux, Command, Library, Setup};
 use cnc_interpreter_core::ToolOffset;
 use support::*;
 
-fn ends(r: &Run) -> Vec<Vec<f64>> {
-    r.moves()
-        .iter()
-        .map(|c| c.end().unwrap_or_default().to_vec())
-        .collect()
-}
-
 fn arcs(r: &Run) -> Vec<(Vec<f64>, Vec<f64>, bool)> {
     r.out
         .iter()
@@ -102,7 +95,7 @@ fn f010_g70_reads_inches_until_g71() {
     // As printed: G1 without F (14800, line 7). With F100 in front and the "..." empty:
     let text = format!("F100\n{}", filled("010", &[""]));
     let r = run(&text).ok();
-    let e = ends(&r);
+    let e = r.ends();
     assert!(near(&e[0], &[254.0, 0.0, 762.0]), "{e:?}");
     assert!(near(&e[1], &[1016.0, 0.0, 1270.0]), "{e:?}");
     assert!(near(&e[2], &[19.0, 0.0, 17.3]), "{e:?}");
@@ -125,7 +118,7 @@ fn f011_g112_sets_a_pole_relative_to_the_last_one() {
     let pole2 = (pole1.0 + d.0, pole1.1 + d.1);
     let p90 = rotate((47.679, 0.0), 12.5);
     let p100 = rotate((7.344, 0.0), 26.3);
-    let e = ends(&r);
+    let e = r.ends();
     assert!(
         near(&e[1], &[pole2.0 + p90.0, pole2.1 + p90.1, 0.0]),
         "{e:?}"
@@ -208,7 +201,7 @@ fn f016_four_workpieces_under_g54_to_g57_then_g500() {
     let mut lib = Library::new();
     lib.insert_named("L47", "L47.SPF", "G1 F100 X10 Y10\nG0 X0 Y0\nRET\n");
     let r = run_with(&text, s, lib).ok();
-    let e = ends(&r);
+    let e = r.ends();
     let corners: Vec<&Vec<f64>> = e.iter().filter(|p| p[0] % 100.0 == 10.0).collect();
     assert_eq!(corners.len(), 4, "{e:?}");
     for (c, (x, y)) in
@@ -226,7 +219,7 @@ fn f016_four_workpieces_under_g54_to_g57_then_g500() {
 fn f018_rapid_by_polar_coordinates_about_the_workpiece_zero() {
     let text = filled("018", &[""]);
     let r = run(&text).ok();
-    let e = ends(&r);
+    let e = r.ends();
     assert!(near(&e[0], &[100.0, 150.0, 65.0]));
     let p = rotate((16.78, 0.0), 45.0);
     assert!(near(&e[1], &[p.0, p.1, 65.0]), "{e:?}");
@@ -363,7 +356,7 @@ fn f056_d_switches_the_length_of_the_active_tool() {
     let text = filled("056", &["N11 G0 Z10", "", "N70 G0 Z10 D1"]);
     let s = with_edges(mill(), &[(42, 30.0, 0.0), (41, 20.0, 0.0)]);
     let r = run_with(&text, s, Library::new()).ok();
-    let e = ends(&r);
+    let e = r.ends();
     // N11 with T1 D1 (50); N70 with T4 D1 (20).
     assert!(near(&e[0], &[0.0, 0.0, 60.0]), "{e:?}");
     assert!(near(&e[1], &[0.0, 0.0, 30.0]), "{e:?}");
@@ -378,7 +371,7 @@ fn f066_incremental_moves_by_r_values() {
     }
     // The mill has no X/Z lathe plane: X and Z are axes all the same.
     let r = run_with(&text, s, Library::new()).ok();
-    let e = ends(&r);
+    let e = r.ends();
     let z4 = 25.0 + 25.3f64.to_radians().sin() - 0.5;
     assert!(near(&e[0], &[10.0, 0.0, 20.0]));
     assert!(near(&e[1], &[10.0, 0.0, 25.0]));
@@ -432,7 +425,7 @@ fn f057_with_m6_the_new_tool_and_its_edge_take_effect_at_m6() {
     let mut s = with_edges(mill(), &[(12, 45.0, 0.0), (43, 20.0, 0.0)]);
     s.tool_change_with_m6 = true;
     let r = run_with(&text, s, Library::new()).ok();
-    let e = ends(&r);
+    let e = r.ends();
     // N16: T1 D1 (50); N20: T1 D2 (45); after N55 M6: T4 D3 (20).
     assert!(near(&e[0], &[0.0, 0.0, 60.0]), "{e:?}");
     assert!(near(&e[1], &[0.0, 0.0, 55.0]), "{e:?}");
@@ -541,7 +534,7 @@ fn f058_to_f060_radius_compensation_selected_held_and_cancelled() {
     );
     let s = with_edges(mill(), &[(12, 50.0, 10.0)]);
     let r = run_with(&text, s, Library::new()).ok();
-    let e = ends(&r);
+    let e = r.ends();
     // Right of a path going +X: the centre 10 below it, at P1 normal to the element.
     assert!(near(&e[1][..2], &[20.0, 0.0]), "{e:?}");
     assert!(near(&e[2][..2], &[60.0, 0.0]), "{e:?}");
@@ -551,7 +544,7 @@ fn f058_to_f060_radius_compensation_selected_held_and_cancelled() {
         filled("059", &["N20 G1 G41 X20 Y10", "N21 Z-5", "N22 X60 Y10"])
     );
     let r = run(&text).ok();
-    let e = ends(&r);
+    let e = r.ends();
     let z = e
         .iter()
         .position(|p| (p[2] - 45.0).abs() < 1e-9)
@@ -565,7 +558,7 @@ fn f058_to_f060_radius_compensation_selected_held_and_cancelled() {
         filled("060", &["X40 Y10", "N100 X60 Y10", "N110 G40 G1 X80 Y40"])
     );
     let r = run(&text).ok();
-    let e = ends(&r);
+    let e = r.ends();
     let n = e.len();
     assert!(near(&e[n - 2][..2], &[60.0, 20.0]), "{e:?}");
     assert!(
@@ -678,7 +671,7 @@ fn f071_and_f072_jumps_filled() {
     );
     let r = run(&text).ok();
     assert!(near(&r.end(), &[5.0, 7.0, 0.0]), "{:?}", r.end());
-    assert!(ends(&r).iter().all(|p| p[0] != 99.0));
+    assert!(r.ends().iter().all(|p| p[0] != 99.0));
 }
 
 #[test]

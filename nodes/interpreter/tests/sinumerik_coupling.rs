@@ -23,13 +23,8 @@ fn f046_v_follows_y_w_follows_z_reversed_and_v_adds_its_own_path() {
         &["N10 G0 X10 Y0 Z30", "N140 G1 Z5 F100", "N210 G0 Y0"],
     );
     let r = run5(&text).ok();
-    let ends: Vec<Vec<f64>> = r
-        .moves()
-        .iter()
-        .map(|c| c.end().unwrap_or_default().to_vec())
-        .collect();
     assert_eq!(
-        ends,
+        r.ends(),
         [
             vec![10.0, 0.0, 30.0, 0.0, 0.0],
             // N120 G0 Z10: Z down 20, W (factor -1) the other way, up 20.
@@ -52,11 +47,7 @@ fn trailof_ends_the_coupling_and_the_status_variable_says_which_axis_follows() {
     assert_eq!([r.front.r(1), r.front.r(2), r.front.r(3)], [8.0, 0.0, 10.0]);
     // After TRAILOF, V stands at 10 and the program reads it there.
     assert_eq!([r.front.r(4), r.front.r(5)], [0.0, 10.0]);
-    let ends: Vec<f64> = r
-        .moves()
-        .iter()
-        .map(|c| c.end().unwrap_or_default()[3])
-        .collect();
+    let ends: Vec<f64> = r.ends().iter().map(|e| e[3]).collect();
     // Y back to 0 moves V no more; V0 goes to machine 0.
     assert_eq!(ends, [10.0, 10.0, 0.0]);
 }

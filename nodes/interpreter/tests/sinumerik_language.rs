@@ -674,13 +674,8 @@ fn f077_to_f079_extcall_runs_bohrung_from_the_external_drive() {
         let name = format!("{drive}:\\EXTERNE_UP\\BOHRUNG");
         lib.insert_named(&name, &name, &bohrung);
         let r = support::run_with(&text, support::mill(), lib).ok();
-        let ends: Vec<Vec<f64>> = r
-            .moves()
-            .iter()
-            .map(|c| c.end().unwrap().to_vec())
-            .collect();
         assert_eq!(
-            ends,
+            r.ends(),
             [
                 vec![0.0, 0.0, 5.0],
                 vec![10.0, 0.0, -5.0],

@@ -138,6 +138,13 @@ impl Run {
     pub fn moves(&self) -> Vec<&Command> {
         self.out.iter().filter(|c| c.end().is_some()).collect()
     }
+    /// Every move's end point, in order.
+    pub fn ends(&self) -> Vec<Vec<f64>> {
+        self.out
+            .iter()
+            .filter_map(|c| c.end().map(<[f64]>::to_vec))
+            .collect()
+    }
     pub fn end(&self) -> Vec<f64> {
         self.moves()
             .last()
