@@ -11,7 +11,7 @@ use cnc_runtime::dds::{qos, RosNode};
 use cnc_runtime::topics;
 use ros2_client::dds::{Client, Subscription};
 use ros2_client::qos::History;
-use ros2_client::{Name, ServiceMapping, ServiceTypeName};
+use ros2_client::{Gid, MessageInfo, Name, ServiceMapping, ServiceTypeName};
 
 pub struct CellClient {
     ros: RosNode,
@@ -28,12 +28,12 @@ pub struct CellClient {
     delete: Door<DeleteProgramRequest, DeleteProgramResponse>,
     overrides: Door<SetOverridesRequest, SetOverridesResponse>,
     machine: Subscription<MachineState>,
-    spindle_sub: Subscription<SpindleState>,
-    parts: Subscription<PartCount>,
-    alarms_sub: Subscription<ActiveAlarms>,
-    axes_sub: Subscription<AxisState>,
-    stats_sub: Subscription<ServoStats>,
-    handshake_sub: Subscription<RobotHandshake>,
+    spindle_sub: Newest<SpindleState>,
+    parts: Newest<PartCount>,
+    alarms_sub: Newest<ActiveAlarms>,
+    axes_sub: Newest<AxisState>,
+    stats_sub: Newest<ServoStats>,
+    handshake_sub: Newest<RobotHandshake>,
     pub state: Option<MachineState>,
     pub spindle: Option<SpindleState>,
     pub part_count: Option<PartCount>,
@@ -45,6 +45,44 @@ pub struct CellClient {
     /// When a sample of any state topic last came (`axes` comes 25 times a second): how a
     /// supervisor knows the machine is still there.
     pub heard_at: Option<Instant>,
+}
+
+/// A state topic's reader that keeps only what is newer than what it has: a reliable reader
+/// can be handed a repaired sample after newer ones (seen under DDS Security: the axes went
+/// back to a position of the run after the final one), and a view of the machine must not go
+/// back in time. Newer is a higher sequence number from the same writer; a new writer (a
+/// restarted node) is taken as it comes.
+struct Newest<M> {
+    reader: Subscription<M>,
+    last: Option<(Gid, i64)>,
+}
+
+impl<M: 'static + serde::de::DeserializeOwned> Newest<M> {
+    fn new(reader: Subscription<M>) -> Self {
+        Newest { reader, last: None }
+    }
+
+    /// Takes every waiting sample into `into` unless it is older than the last one kept;
+    /// whether any sample came.
+    fn take_into(&mut self, into: &mut Option<M>) -> bool {
+        let mut heard = false;
+        while let Ok(Some((m, info))) = self.reader.take() {
+            heard = true;
+            if newer(self.last, &info) {
+                self.last = Some((info.publisher_gid(), info.sequence_number()));
+                *into = Some(m);
+            }
+        }
+        heard
+    }
+}
+
+/// Whether a sample described by `info` is newer than the last kept one (`last`).
+fn newer(last: Option<(Gid, i64)>, info: &MessageInfo) -> bool {
+    match last {
+        Some((gid, seq)) if gid == info.publisher_gid() => info.sequence_number() > seq,
+        _ => true,
+    }
 }
 
 /// A service client, or why this client has none: under DDS Security an identity is refused
@@ -101,12 +139,12 @@ impl CellClient {
                 &topics::MACHINE_STATE,
                 qos::state().history(History::KeepLast { depth: 64 }),
             )?,
-            spindle_sub: ros.dds_subscription(&topics::SPINDLE)?,
-            parts: ros.dds_subscription(&topics::PART_COUNT)?,
-            alarms_sub: ros.dds_subscription(&topics::ALARMS)?,
-            axes_sub: ros.dds_subscription(&topics::AXES)?,
-            stats_sub: ros.dds_subscription(&topics::SERVO_STATS)?,
-            handshake_sub: ros.dds_subscription(&topics::ROBOT_HANDSHAKE)?,
+            spindle_sub: Newest::new(ros.dds_subscription(&topics::SPINDLE)?),
+            parts: Newest::new(ros.dds_subscription(&topics::PART_COUNT)?),
+            alarms_sub: Newest::new(ros.dds_subscription(&topics::ALARMS)?),
+            axes_sub: Newest::new(ros.dds_subscription(&topics::AXES)?),
+            stats_sub: Newest::new(ros.dds_subscription(&topics::SERVO_STATS)?),
+            handshake_sub: Newest::new(ros.dds_subscription(&topics::ROBOT_HANDSHAKE)?),
             ros,
             mapping,
             namespace: ns.into(),
@@ -171,35 +209,19 @@ impl CellClient {
     /// Takes every new sample of the state topics; returns the machine states seen, in order.
     pub fn poll(&mut self) -> Vec<MachineState> {
         let mut states = Vec::new();
-        let mut heard = false;
         while let Ok(Some((m, _))) = self.machine.take() {
             states.push(m.clone());
             self.state = Some(m);
         }
-        while let Ok(Some((m, _))) = self.spindle_sub.take() {
-            self.spindle = Some(m);
-            heard = true;
-        }
-        while let Ok(Some((m, _))) = self.parts.take() {
-            self.part_count = Some(m);
-            heard = true;
-        }
-        while let Ok(Some((m, _))) = self.alarms_sub.take() {
-            self.alarms = Some(m);
-            heard = true;
-        }
-        while let Ok(Some((m, _))) = self.axes_sub.take() {
-            self.axes = Some(m);
-            heard = true;
-        }
-        while let Ok(Some((m, _))) = self.stats_sub.take() {
-            self.servo_stats = Some(m);
-            heard = true;
-        }
-        while let Ok(Some((m, _))) = self.handshake_sub.take() {
-            self.handshake = Some(m);
-            heard = true;
-        }
+        let heard = [
+            self.spindle_sub.take_into(&mut self.spindle),
+            self.parts.take_into(&mut self.part_count),
+            self.alarms_sub.take_into(&mut self.alarms),
+            self.axes_sub.take_into(&mut self.axes),
+            self.stats_sub.take_into(&mut self.servo_stats),
+            self.handshake_sub.take_into(&mut self.handshake),
+        ]
+        .contains(&true);
         if heard || !states.is_empty() {
             self.heard_at = Some(Instant::now());
         }
@@ -470,4 +492,25 @@ fn exchange_unless<
         "no reply from the cell within {} s",
         timeout.as_secs()
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn info(writer: u8, seq: i64) -> MessageInfo {
+        MessageInfo::new(None, None, seq, Gid::from([writer; 16]), None)
+    }
+
+    #[test]
+    fn a_state_view_never_goes_back_to_an_older_sample_of_its_writer() {
+        assert!(newer(None, &info(1, 7)));
+        let last = Some((Gid::from([1; 16]), 7));
+        assert!(newer(last, &info(1, 8)));
+        // A repaired sample handed over after newer ones is not taken.
+        assert!(!newer(last, &info(1, 5)));
+        assert!(!newer(last, &info(1, 7)));
+        // Another writer (a restarted node) counts from its own start.
+        assert!(newer(last, &info(2, 1)));
+    }
 }
