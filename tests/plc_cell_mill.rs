@@ -242,3 +242,66 @@ fn f063_h_functions_reach_the_ladder_with_hf_and_get_fin() {
         ]
     );
 }
+
+/// Fixture 032 (§9.3.12, D116) through the interpreter, motion and the simulated probe: the
+/// measuring line N10 from the mill's home (X0 Z150; no tool is selected on the fresh
+/// machine, so work and machine coordinates are one) meets a wall the probe finds at X200,
+/// where the line is at Z 150 − 190·⅔. The axes brake there (the rest of the line dropped), R5/R6 get the work
+/// position of the edge, and the program goes on from where they stopped. Without the wall
+/// the probe never switches and the program stops at MEASERR's M0 at the line's end.
+#[test]
+fn f032_meas_finds_the_wall_brakes_there_and_the_program_reads_the_edge() {
+    let text = fixture("032").replace("\n..\n", "\nN40 G0 X=R5-10 Z100\nM30\n");
+    let wall = cnc_runtime::config::ProbeTarget {
+        min: vec![200.0, -100.0, -100.0],
+        max: vec![400.0, 100.0, 200.0],
+    };
+    let probed = |wall: Option<cnc_runtime::config::ProbeTarget>| {
+        let mut cfg = config("sim_mill_802d");
+        cfg.sim.probe = wall.into_iter().collect();
+        let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+        let mut r = Rig::on(cfg, &text, Some(&kept));
+        r.run_until(0.1, |_| false);
+        r.started = true;
+        let mut furthest = 0.0f64;
+        r.run_until(30.0, |r| {
+            furthest = furthest.max(r.fb.position[0]);
+            r.program_done() || r.motion.state() == cnc_motion::RunState::Hold
+        });
+        (r, furthest)
+    };
+    let (r, furthest) = probed(Some(wall));
+    assert!(r.program_done(), "the program ran to its end");
+    let kept = r.stream.interpreter().memory().kept;
+    let z_at_wall = 150.0 - 190.0 * 2.0 / 3.0;
+    assert!((kept[&10_005] - 200.0).abs() < 1e-6, "R5 {}", kept[&10_005]);
+    assert!(
+        (kept[&10_006] - z_at_wall).abs() < 1e-6,
+        "R6 {}",
+        kept[&10_006]
+    );
+    // Braked within detection and the jerk-limited stop from F4000 (under 4 mm), not at the
+    // line's end at X300.
+    assert!(
+        furthest > 200.0 && furthest < 204.0,
+        "furthest X {furthest}"
+    );
+    let end = r.motion.commanded_display();
+    assert!(
+        (end[0] - 190.0).abs() < 1e-9 && (end[2] - 100.0).abs() < 1e-9,
+        "{end:?}"
+    );
+    println!(
+        "R5 {} R6 {:.4}, furthest X {furthest:.3}",
+        kept[&10_005], kept[&10_006]
+    );
+
+    let (r, furthest) = probed(None);
+    assert!(!r.program_done());
+    assert_eq!(r.motion.state(), cnc_motion::RunState::Hold, "MEASERR: M0");
+    let end = r.motion.commanded_display();
+    assert!((end[0] - 300.0).abs() < 1e-9, "the whole line: {end:?}");
+    assert!(furthest <= 300.0 + 1e-9, "{furthest}");
+    let kept = r.stream.interpreter().memory().kept;
+    assert_eq!(kept.get(&10_005), None, "R5 not written");
+}

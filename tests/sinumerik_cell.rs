@@ -21,6 +21,7 @@ mod common;
 
 const DOMAIN: u16 = 88;
 const CYCLES_DOMAIN: u16 = 89;
+const PROBE_DOMAIN: u16 = 97;
 
 fn fixture_061() -> String {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/001");
@@ -40,7 +41,16 @@ fn fixture_061() -> String {
 /// with the builder's keep relays, K1.1, D82), a supervisor node, and T1 D1's length as the
 /// launch config sets it: the tests' expectations follow from it.
 fn start(domain: u16) -> (Cell, CellClient, f64) {
-    let cfg = common::machine("sim_mill_802d", domain);
+    start_with(domain, |_| {})
+}
+
+/// As [`start`], the config changed by `change` first.
+fn start_with(
+    domain: u16,
+    change: impl FnOnce(&mut cnc_runtime::LaunchConfig),
+) -> (Cell, CellClient, f64) {
+    let mut cfg = common::machine("sim_mill_802d", domain);
+    change(&mut cfg);
     let length = cfg
         .machine
         .tools
@@ -201,6 +211,34 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
     );
     // The end of the run ends the message.
     assert_eq!(client.state.as_ref().map(|s| s.message.as_str()), Some(""));
+    let (_, errors) = cell.stop();
+    assert!(errors.is_empty(), "{errors:?}");
+}
+
+/// MEAS through the cell's nodes (D116): the io node's simulated probe finds a wall at
+/// machine X200, motion brakes there and reports the edge in its status over the machine
+/// bus, and the interpreter node, which waited for it, reads on: the program moves to
+/// X=R5−10, so the axes end at X190 only if the measured value came through.
+#[test]
+fn a_measuring_block_runs_in_the_cell_and_the_program_goes_on_with_its_value() {
+    let (cell, mut client, _) = start_with(PROBE_DOMAIN, |cfg| {
+        cfg.sim.probe = vec![cnc_runtime::config::ProbeTarget {
+            min: vec![200.0, -100.0, -100.0],
+            max: vec![400.0, 100.0, 200.0],
+        }];
+    });
+    client.wait_ready(Duration::from_secs(30)).expect("ready");
+    let job = "N10 G17 G90 G500 G0 X0 Y0 Z100\n\
+               N20 MEAS=1 G1 X300 F2000\n\
+               N30 IF $AC_MEA[1]==0 GOTOF MISSED\n\
+               N40 G0 X=$AA_MW[X]-10 Y20\n\
+               N50 M2\n\
+               N60 MISSED: M0\n\
+               N70 M2\n";
+    assert!(client.load_program("PROBE.MPF", job).unwrap().accepted);
+    let r = client.start_program("PROBE.MPF").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    completes_at(&mut client, Duration::from_secs(120), [190.0, 20.0, 100.0]);
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
 }

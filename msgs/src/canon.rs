@@ -47,6 +47,17 @@ pub enum Command {
         lead: f64,
         rpm: f64,
     },
+    /// A measuring move (touch probe, measuring input 1): a straight line at `feed` during
+    /// which the probe's rising (`rising`) or falling edge latches every axis's position. With
+    /// `stop` (delete distance to go) the axes brake at the edge and the rest of the line is
+    /// dropped; without it the line runs to its end. Motion reports the result when the block
+    /// is done (`MotionStatus::probe_*`); the program waits for it before it reads on.
+    Probe {
+        end: Vec<f64>,
+        feed: f64,
+        rising: bool,
+        stop: bool,
+    },
     Dwell {
         seconds: f64,
     },
@@ -90,7 +101,8 @@ impl Command {
             | Command::Linear { end, .. }
             | Command::Arc { end, .. }
             | Command::Thread { end, .. }
-            | Command::Tap { end, .. } => Some(end),
+            | Command::Tap { end, .. }
+            | Command::Probe { end, .. } => Some(end),
             _ => None,
         }
     }
@@ -213,6 +225,18 @@ pub fn to_motion_block(
             m.lead = *lead;
             m.aux_value = *rpm;
         }
+        Command::Probe {
+            end,
+            feed,
+            rising,
+            stop,
+        } => {
+            m.kind = MotionBlock::KIND_PROBE;
+            m.end.clone_from(end);
+            m.feed = *feed;
+            m.aux_code = if *rising { 1 } else { -1 };
+            m.flag = *stop;
+        }
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
@@ -317,6 +341,20 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
                 rpm: m.aux_value,
             }
         }
+        MotionBlock::KIND_PROBE => Command::Probe {
+            end: m.end.clone(),
+            feed: feed()?,
+            rising: match m.aux_code {
+                1 => true,
+                -1 => false,
+                other => {
+                    return Err(format!(
+                        "probe edge {other} is neither rising (1) nor falling (-1)"
+                    ))
+                }
+            },
+            stop: m.flag,
+        },
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_PROFILE => Command::Profile {
@@ -412,6 +450,12 @@ mod tests {
                 clockwise: false,
                 feed: 90.0,
                 plane: Some([2, 0]),
+            },
+            Command::Probe {
+                end: vec![5.0, -6.0],
+                feed: 300.0,
+                rising: false,
+                stop: true,
             },
             Command::Dwell { seconds: 1.5 },
             Command::Tap {
@@ -518,6 +562,23 @@ mod tests {
         for (way, degrees) in [(1, 360.0), (0, -0.5), (2, f64::NAN), (3, 1e6), (4, 10.0)] {
             (o.aux_code, o.aux_value) = (way, degrees);
             assert!(from_motion_block(&o).is_err(), "way {way} {degrees}");
+        }
+        // A measuring block names its edge and has a feed.
+        let mut p = to_motion_block(
+            1,
+            1,
+            "",
+            1,
+            &Command::Probe {
+                end: vec![0.0],
+                feed: 100.0,
+                rising: true,
+                stop: false,
+            },
+        );
+        for (edge, feed) in [(0, 100.0), (2, 100.0), (1, 0.0), (-1, f64::NAN)] {
+            (p.aux_code, p.feed) = (edge, feed);
+            assert!(from_motion_block(&p).is_err(), "edge {edge} feed {feed}");
         }
     }
 }

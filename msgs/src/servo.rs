@@ -67,6 +67,15 @@ pub struct ServoFeedback {
     /// The handwheel's (manual pulse generator's) counter: its A/B pulses counted four per
     /// detent (the encoder interface's 4× quadrature, `000` §1.3), wrapping.
     pub handwheel_count: i32,
+    /// The touch probe (measuring input 1): 1 while it is deflected.
+    pub probe: u32,
+    /// The probe's rising and falling edges, counted (wrapping) so that none is missed
+    /// between two periods, and every axis's position at the last of each: the drive latches
+    /// the count at the edge, as it does at the index mark.
+    pub probe_rising: u32,
+    pub probe_falling: u32,
+    pub probe_rising_position: [f64; MAX_AXES],
+    pub probe_falling_position: [f64; MAX_AXES],
 }
 
 impl Default for ServoFeedback {
@@ -85,6 +94,11 @@ impl Default for ServoFeedback {
             overtravel_plus: 0,
             overtravel_minus: 0,
             handwheel_count: 0,
+            probe: 0,
+            probe_rising: 0,
+            probe_falling: 0,
+            probe_rising_position: [0.0; MAX_AXES],
+            probe_falling_position: [0.0; MAX_AXES],
         }
     }
 }

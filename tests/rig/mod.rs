@@ -5,9 +5,11 @@
 #![allow(dead_code)]
 
 use cnc_interpreter::run::ProgramRun;
-use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
+use cnc_interpreter::{Canon, Dialect, Interpreter, Library, Measurement};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
+
+use cnc_motion::motion::ProbeInput;
 use cnc_motion::{Block, Motion, MotionConfig, RunState};
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{g, FImage, GImage, SignalTable, XImage, YImage};
@@ -60,8 +62,10 @@ impl Rig {
             retained,
             2,
         );
+        let mut stream = ProgramRun::new(interp);
+        stream.measure_on_machine();
         Rig {
-            stream: ProgramRun::new(interp),
+            stream,
             motion: Motion::new(mcfg, &start),
             plc,
             sim,
@@ -80,6 +84,22 @@ impl Rig {
     /// One servo period; the PLC scans when its 10 ms are due.
     pub fn tick(&mut self) {
         if self.started {
+            // A measuring block's result, once motion has it, as the interpreter node takes it.
+            if let (Some(seq), Some(r)) = (
+                self.stream.awaiting_measurement(),
+                self.motion.probe_result(),
+            ) {
+                if r.seq == seq {
+                    let m = Measurement {
+                        triggered: r.triggered,
+                        position: r.position[..self.n].to_vec(),
+                        rest: r.rest[..self.n].to_vec(),
+                    };
+                    self.stream
+                        .measured(seq, m)
+                        .unwrap_or_else(|e| panic!("alarm {}: {}", e.number, e.text));
+                }
+            }
             let done = self.motion.done_seq();
             let motion = &mut self.motion;
             self.stream
@@ -99,6 +119,7 @@ impl Rig {
         self.motion
             .spindle_feedback(self.fb.spindle_rpm, self.fb.spindle_angle_deg);
         self.motion.handwheel_input(self.fb.handwheel_count);
+        self.motion.probe_input(ProbeInput::from_feedback(&self.fb));
         let mut sp = ServoSetpoint {
             axis_count: self.n as u32,
             spindle_acceleration_percent: self.motion.spindle_acceleration_percent(),

@@ -5,7 +5,7 @@
 //! they are asked for, so the motion queue's credit decides how far ahead it reads. An error
 //! stops it for good: nothing after the bad line is produced, and nothing of the bad block.
 
-use cnc_interpreter_core::{next_command, Canon, Fault, Library, ProgramError, Setup};
+use cnc_interpreter_core::{next_command, Canon, Fault, Library, Measurement, ProgramError, Setup};
 
 use crate::dialect::{Dialect, Engine};
 use crate::setup::Memory;
@@ -39,6 +39,23 @@ impl Interpreter {
     /// The next canonical command; `Ok(None)` once the program has ended.
     pub fn next_command(&mut self) -> Result<Option<Canon>, ProgramError> {
         next_command(&mut *self.front)
+    }
+
+    /// Measuring moves wait for the machine's result (`on`), or take the probe as switching
+    /// at the line's end (a check or simulation: decisions D116).
+    pub fn measure_on_machine(&mut self, on: bool) {
+        self.front.core_mut().measure_on_machine = on;
+    }
+
+    /// A measuring move has gone out and the program waits for its result.
+    pub fn awaiting_measurement(&self) -> bool {
+        self.front.core().awaiting_measurement()
+    }
+
+    /// The machine's result of the measuring move the program waits for; an alarm (which
+    /// ends the run) when it does not fit the machine.
+    pub fn measured(&mut self, m: Measurement) -> Result<(), ProgramError> {
+        self.front.core_mut().measured(m)
     }
 
     /// A block search starts or ends (what the program counts does not count during one).

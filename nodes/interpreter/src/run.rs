@@ -570,7 +570,7 @@ impl RunCore {
         // The cell runs programs as the operator would: M99 or G27 loops go on until stop.
         setup.single_pass = false;
         let mut interp = Interpreter::with_library(self.dialect, &text, setup, self.library());
-        let (stream, message) = match &target {
+        let (mut stream, message) = match &target {
             None => (ProgramRun::new(interp), format!("{name} started")),
             Some(t) => {
                 let found = search(self.dialect, &mut interp, &text, t, &start, &self.approach)
@@ -584,6 +584,8 @@ impl RunCore {
                 (ProgramRun::restarted(interp, found), message)
             }
         };
+        // The block search read without the machine; the run measures on it.
+        stream.measure_on_machine();
         self.run_counter += 1;
         self.message.clear();
         self.run = Some(Run {
@@ -647,17 +649,25 @@ impl RunCore {
             let batch_start = self.effects.len();
             if !r.failed {
                 let (id, program) = (r.id, r.program.clone());
+                let measured = match r.stream.awaiting_measurement() {
+                    Some(seq) if self.status.run_id == id && self.status.probe_seq == seq => {
+                        r.stream.measured(seq, measurement(&self.status))
+                    }
+                    _ => Ok(()),
+                };
                 let effects = &mut self.effects;
-                let sent = r.stream.feed(
-                    done,
-                    u64::from(self.status.capacity),
-                    |seq, canon, interp| {
-                        let mut msg =
-                            to_motion_block(id, seq, &program, canon.line, &canon.command);
-                        msg.origin = interp.program_origin();
-                        effects.push(Effect::Block(msg));
-                    },
-                );
+                let sent = measured.and_then(|_| {
+                    r.stream.feed(
+                        done,
+                        u64::from(self.status.capacity),
+                        |seq, canon, interp| {
+                            let mut msg =
+                                to_motion_block(id, seq, &program, canon.line, &canon.command);
+                            msg.origin = interp.program_origin();
+                            effects.push(Effect::Block(msg));
+                        },
+                    )
+                });
                 if let Some(m) = r.stream.message_due(done) {
                     self.message = m;
                 }
@@ -824,6 +834,15 @@ impl RunCore {
             self.memory = now;
             self.effects.push(Effect::StoreMemory);
         }
+    }
+}
+
+/// Motion's result of the last measuring block (`MotionStatus::probe_*`).
+fn measurement(status: &MotionStatus) -> cnc_interpreter_core::Measurement {
+    cnc_interpreter_core::Measurement {
+        triggered: status.probe_triggered,
+        position: status.probe_position.clone(),
+        rest: status.probe_rest.clone(),
     }
 }
 

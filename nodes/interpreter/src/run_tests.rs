@@ -39,6 +39,7 @@ fn status(run_id: u64, done_seq: u64, capacity: u32, state: u8) -> MotionStatus 
         capacity,
         line: 0,
         state,
+        ..MotionStatus::default()
     }
 }
 
@@ -764,4 +765,83 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
         })
         .collect();
     assert_eq!(raised, [14011]);
+}
+
+/// A measuring block (MEAS, D116): the run sends it and nothing after it until motion's
+/// status carries its result; the program then reads on from where the axes came to rest.
+#[test]
+fn a_measuring_block_holds_the_program_until_motion_reports_its_result() {
+    let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0, 0.0, 100.0]);
+    let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 10);
+    let program = "G90 G0 X0 Y0 Z10\nMEAS=1 G1 Z-20 F300\nR5=$AA_MW[Z]\n\
+                   IF $AC_MEA[1]==0 GOTOF MISSED\nG1 X10 F500\nM30\nMISSED: M0\nM30\n";
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PROBE.MPF", program).accepted);
+    c.plc_scanned();
+    c.axes(&[0.0, 0.0, 100.0]);
+    assert!(command(&mut c, 2, ProgramCommand::START, "PROBE.MPF", "").accepted);
+    c.motion_status(status(0, 0, 64, MotionStatus::STATE_IDLE));
+    c.step();
+    let sent = c.take_effects();
+    let kinds: Vec<u8> = blocks(&sent).iter().map(|b| b.kind).collect();
+    assert_eq!(kinds.last(), Some(&MotionBlock::KIND_PROBE), "{kinds:?}");
+    let probe_seq = blocks(&sent).last().map_or(0, |b| b.seq);
+    // Credit is plenty, but the program waits for the measurement.
+    let waiting = status(11, probe_seq - 1, 64, MotionStatus::STATE_RUNNING);
+    c.motion_status(waiting.clone());
+    c.step();
+    assert!(blocks(&c.take_effects()).is_empty());
+    // Done without its result (another block's): still waiting.
+    c.motion_status(MotionStatus {
+        probe_seq: probe_seq - 1,
+        ..status(11, probe_seq, 64, MotionStatus::STATE_IDLE)
+    });
+    c.step();
+    assert!(blocks(&c.take_effects()).is_empty());
+    // The probe switched at Z2.5 and the axes came to rest at Z2.3.
+    c.motion_status(MotionStatus {
+        probe_seq,
+        probe_triggered: true,
+        probe_position: vec![0.0, 0.0, 2.5],
+        probe_rest: vec![0.0, 0.0, 2.3],
+        ..status(11, probe_seq, 64, MotionStatus::STATE_IDLE)
+    });
+    c.step();
+    let after = c.take_effects();
+    let next = blocks(&after);
+    let line = next.first().expect("the program reads on");
+    // The line after the switch (G1 X10) starts from the rest: it keeps Z2.3.
+    assert_eq!(line.kind, MotionBlock::KIND_LINEAR);
+    assert_eq!(line.end, vec![10.0, 0.0, 2.3]);
+    // R5 (kept as 10 005) holds the Z where the probe switched.
+    assert_eq!(c.memory().kept.get(&10_005), Some(&2.5));
+}
+
+/// A result that does not fit the machine ends the run with an alarm.
+#[test]
+fn a_measurement_that_does_not_fit_the_machine_is_an_alarm() {
+    let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0, 0.0, 100.0]);
+    let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 10);
+    let program = "MEAS=-1 G1 Z-20 F300\nG1 X10\nM30\n";
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PROBE.MPF", program).accepted);
+    c.plc_scanned();
+    c.axes(&[0.0, 0.0, 100.0]);
+    assert!(command(&mut c, 2, ProgramCommand::START, "PROBE.MPF", "").accepted);
+    c.motion_status(status(0, 0, 64, MotionStatus::STATE_IDLE));
+    c.step();
+    let seq = blocks(&c.take_effects()).last().map_or(0, |b| b.seq);
+    c.motion_status(MotionStatus {
+        probe_seq: seq,
+        probe_triggered: true,
+        probe_position: vec![0.0, 2.5],
+        probe_rest: vec![0.0, 0.0, f64::NAN],
+        ..status(11, seq, 64, MotionStatus::STATE_IDLE)
+    });
+    c.step();
+    let effects = c.take_effects();
+    assert!(blocks(&effects).is_empty());
+    assert!(effects
+        .iter()
+        .any(|e| matches!(e, Effect::Raise { line: 1, text, .. }
+            if text.contains("measurement names 2 and 3 axis values"))));
+    assert_eq!(c.execution(), MachineState::STOPPED);
 }

@@ -5,6 +5,8 @@
 
 use std::collections::VecDeque;
 
+use cnc_interpreter_core::Measurement;
+
 use crate::{Canon, Command, Interpreter, ProgramError};
 
 /// One program run's block stream: commands go to motion while fewer than the queue's
@@ -23,6 +25,8 @@ pub struct ProgramRun {
     end: Option<u64>,
     /// Operator messages read, each with the sequence number after which it shows.
     messages: VecDeque<(u64, String)>,
+    /// Sequence number of the last measuring block sent.
+    measuring: Option<u64>,
 }
 
 impl ProgramRun {
@@ -35,6 +39,7 @@ impl ProgramRun {
             sent: 0,
             end: None,
             messages: VecDeque::new(),
+            measuring: None,
         }
     }
 
@@ -52,6 +57,7 @@ impl ProgramRun {
             sent: 0,
             end: None,
             messages: VecDeque::new(),
+            measuring: None,
         }
     }
 
@@ -107,6 +113,9 @@ impl ProgramRun {
                 Some(canon) => {
                     self.sent += 1;
                     count += 1;
+                    if matches!(canon.command, Command::Probe { .. }) {
+                        self.measuring = Some(self.sent);
+                    }
                     if canon.command == Command::ProgramEnd {
                         self.end = Some(self.sent);
                     }
@@ -117,6 +126,28 @@ impl ProgramRun {
         }
         self.file_messages();
         Ok(count)
+    }
+
+    /// Measuring blocks wait for motion's result before the program reads on (the stream of
+    /// a machine; a simulation takes the probe as switching at the line's end: D116).
+    pub fn measure_on_machine(&mut self) {
+        self.interp.measure_on_machine(true);
+    }
+
+    /// The measuring block whose result the program waits for.
+    pub fn awaiting_measurement(&self) -> Option<u64> {
+        self.measuring
+            .filter(|_| self.interp.awaiting_measurement())
+    }
+
+    /// Motion's result of measuring block `seq`; one of another block is not this program's
+    /// to take.
+    pub fn measured(&mut self, seq: u64, m: Measurement) -> Result<(), ProgramError> {
+        if self.awaiting_measurement() != Some(seq) {
+            return Ok(());
+        }
+        self.measuring = None;
+        self.interp.measured(m)
     }
 
     /// Every command of the program has been sent.

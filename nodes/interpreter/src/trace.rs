@@ -6,6 +6,7 @@
 //! N<line> LINEAR X50.0000 Z-30.0000 F200.0000
 //! N<line> ARC_CW X26.0000 Z-31.0000 CX34.0000 CZ-31.0000 F900.0000
 //! N<line> THREAD X48.8571 Z-72.0000 LEAD2.0000 Q0.000
+//! N<line> PROBE X300.0000 Z-40.0000 F4000.0000 RISING STOP
 //! N<line> DWELL 2.000
 //! N<line> M3 | S600.0 | T1 | FEED_PER_REV | FEED_PER_MIN | EXACT_STOP | BLENDING | END
 //! N<line> PROFILE_JERK_LIMITED | PROFILE_TRAPEZOIDAL
@@ -67,6 +68,18 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             s.push_str("TAP");
             axes(&mut s, letters, end, "");
             let _ = write!(s, " LEAD{lead:.4} S{rpm:.1}");
+        }
+        Command::Probe {
+            end,
+            feed,
+            rising,
+            stop,
+        } => {
+            s.push_str("PROBE");
+            axes(&mut s, letters, end, "");
+            let edge = if *rising { "RISING" } else { "FALLING" };
+            let rest = if *stop { "STOP" } else { "TO_END" };
+            let _ = write!(s, " F{feed:.4} {edge} {rest}");
         }
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
@@ -305,6 +318,11 @@ impl LinuxCnc {
                     write_num(out, self.value(end, k));
                 }
                 out.push_str(")\n");
+            }
+            // LinuxCNC's G38.2: a straight probe at the feed.
+            Command::Probe { end, feed, .. } => {
+                self.set_feed(out, *feed);
+                self.six(out, "STRAIGHT_PROBE(", end);
             }
             Command::Dwell { seconds } => {
                 self.call(out, "DWELL(");

@@ -453,7 +453,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
         Some((17020, 6)),
         "this test's mill has no fixed points: f031_… runs it on sim_mill_802d",
     ),
-    ("032", Some((12140, 7)), "probing"),
+    ("032", Some((12080, 11)), "template"),
     (
         "033",
         Some((12140, 7)),

@@ -53,6 +53,25 @@ pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
                 [lo.min(hi), lo.max(hi)]
             })
             .collect(),
+        // Displayed coordinates to slide travel (a lathe's X in diameter to radius).
+        probe: cfg
+            .sim
+            .probe
+            .iter()
+            .map(|t| {
+                let scaled = |v: &[f64]| -> Vec<f64> {
+                    v.iter()
+                        .zip(&cfg.machine.axes)
+                        .map(|(v, a)| v * a.scale())
+                        .collect()
+                };
+                let (lo, hi) = (scaled(&t.min), scaled(&t.max));
+                crate::sim::probe::Target {
+                    min: lo.iter().zip(&hi).map(|(a, b)| a.min(*b)).collect(),
+                    max: lo.iter().zip(&hi).map(|(a, b)| a.max(*b)).collect(),
+                }
+            })
+            .collect(),
     }
 }
 

@@ -40,3 +40,7 @@ pub const OVERTRAVEL_PLUS: u32 = 40;
 /// An axis on its − overtravel switch (`000` alarm 66, "limit alarm": its tables have no
 /// number of their own for the − switch; decisions D70).
 pub const OVERTRAVEL_MINUS: u32 = 66;
+/// A measuring block asks for the probe's rising edge while the probe is already deflected
+/// (the SINUMERIK family's 21700 "probe already deflected, edge cannot be detected"; the
+/// other manuals have none: decisions D116).
+pub const PROBE_DEFLECTED: u32 = 21700;

@@ -21,7 +21,7 @@ use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::motion::alarm;
-use crate::motion::ReferenceInputs;
+use crate::motion::{ProbeInput, ProbeResult, ReferenceInputs};
 use crate::servo::{LateWatch, Lateness, ServoStatistics};
 use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 
@@ -38,7 +38,9 @@ enum Input {
 }
 
 enum Report {
-    Status(MotionStatus),
+    /// The status, and the last measuring block's result with the machine's axis count (its
+    /// vectors are filled here, off the servo thread).
+    Status(MotionStatus, Option<(ProbeResult, usize)>),
     /// A tick later than the warning limit (its interval, µs), or the warning cleared.
     Late(Option<f64>),
     /// Commanded and actual slide positions.
@@ -179,7 +181,15 @@ fn dds_loop(
         }
         loop {
             match from_servo.try_recv() {
-                Ok(Report::Status(s)) => publish(&status_pub, s),
+                Ok(Report::Status(mut s, probe)) => {
+                    if let Some((p, n)) = probe {
+                        s.probe_seq = p.seq;
+                        s.probe_triggered = p.triggered;
+                        s.probe_position = p.position[..n].to_vec();
+                        s.probe_rest = p.rest[..n].to_vec();
+                    }
+                    publish(&status_pub, s)
+                }
                 Ok(Report::Late(Some(us))) => alarms.raise(alarms.alarm(
                     alarm::SERVO_LATE,
                     Alarm::SEVERITY_WARNING,
@@ -343,6 +353,8 @@ fn servo_loop(
     let mut overtravel = (first.overtravel_plus, first.overtravel_minus);
     // The handwheel's counter of the latest feedback.
     let mut handwheel = first.handwheel_count;
+    // The touch probe's input and latches of the latest feedback.
+    let mut probe = ProbeInput::from_feedback(&first);
     let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
     // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
     let mut g = GImage::default();
@@ -472,6 +484,7 @@ fn servo_loop(
         reference.marker = 0;
         motion.overtravel_inputs(overtravel.0, overtravel.1);
         motion.handwheel_input(handwheel);
+        motion.probe_input(probe);
         // What the drives get; under machine lock it is not the commanded position.
         let mut setpoint = [0.0; MAX_AXES];
         setpoint[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
@@ -500,6 +513,7 @@ fn servo_loop(
             reference.dog = fb.reference_dog;
             overtravel = (fb.overtravel_plus, fb.overtravel_minus);
             handwheel = fb.handwheel_count;
+            probe = ProbeInput::from_feedback(&fb);
             if fb.marker != 0 {
                 reference.marker |= fb.marker;
                 for i in 0..n {
@@ -532,6 +546,7 @@ fn servo_loop(
             motion.done_seq(),
             motion.state(),
             motion.line(),
+            motion.probe_result().copied(),
         );
         if last_status != Some(status) || seq.is_multiple_of(25) {
             last_status = Some(status);
@@ -549,8 +564,9 @@ fn servo_loop(
                 capacity,
                 line: status.4,
                 state,
+                ..MotionStatus::default()
             };
-            let _ = reports.send(Report::Status(msg));
+            let _ = reports.send(Report::Status(msg, status.5.map(|p| (p, n))));
         }
         if seq.is_multiple_of(10) {
             let mut commanded = [0.0; MAX_AXES];

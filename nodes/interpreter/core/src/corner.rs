@@ -170,7 +170,13 @@ impl Core {
         let b = self.plane_point(next_end)?;
         let base = corner.end.clone();
         match (corner.chamfer, next_kind) {
-            (_, MoveKind::Rapid | MoveKind::Thread { .. } | MoveKind::Tap { .. }) => plain(self),
+            (
+                _,
+                MoveKind::Rapid
+                | MoveKind::Thread { .. }
+                | MoveKind::Tap { .. }
+                | MoveKind::Probe { .. },
+            ) => plain(self),
             (chamfer, MoveKind::Feed(_)) => {
                 let Some(t2) = unit(b.z - p.z, b.r - p.r) else {
                     return plain(self);

@@ -16,7 +16,8 @@ pub trait FrontEnd {
     fn read_block(&mut self) -> Result<(), ProgramError>;
 }
 
-/// The next canonical command of `front`'s program; `Ok(None)` once the program has ended.
+/// The next canonical command of `front`'s program; `Ok(None)` once the program has ended,
+/// or while it waits for a measuring move's result ([`Core::awaiting_measurement`]).
 pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>, ProgramError> {
     loop {
         let core = front.core_mut();
@@ -33,7 +34,8 @@ pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>
                 return Ok(Some(c));
             }
         }
-        if core.done {
+        // A measuring move's result decides where the program goes on from (`measure.rs`).
+        if core.done || core.awaiting_measurement {
             return Ok(None);
         }
         core.silent_blocks += 1;

@@ -62,6 +62,13 @@ pub enum MoveKind {
         lead: f64,
         rpm: f64,
     },
+    /// A measuring line at the feed: the probe's edge latches the axes, `stop` brakes there
+    /// ([`crate::measure`]).
+    Probe {
+        feed: f64,
+        rising: bool,
+        stop: bool,
+    },
 }
 
 /// Largest feed per revolution, mm/rev.
@@ -123,7 +130,9 @@ impl Core {
         }
         // Feed and lead are checked before anything changes: a bad block moves nothing.
         let feed = match kind {
-            MoveKind::Feed(feed) | MoveKind::Arc { feed, .. } => self.check_feed(feed)?,
+            MoveKind::Feed(feed) | MoveKind::Arc { feed, .. } | MoveKind::Probe { feed, .. } => {
+                self.check_feed(feed)?
+            }
             MoveKind::Rapid => 0.0,
             MoveKind::Thread { lead, .. } => {
                 if !(lead > 0.0 && lead.is_finite()) {
@@ -187,6 +196,12 @@ impl Core {
                 start_angle: angle,
             },
             MoveKind::Tap { lead, rpm } => Command::Tap { end: m, lead, rpm },
+            MoveKind::Probe { rising, stop, .. } => Command::Probe {
+                end: m,
+                feed,
+                rising,
+                stop,
+            },
         };
         self.push(command);
         Ok(())
@@ -362,6 +377,13 @@ impl Core {
                 return Err(self.fault(
                     Fault::CompInCycle,
                     "thread cutting or tapping while tool-nose compensation is active",
+                ))
+            }
+            // `Core::measure` refuses it before it comes here.
+            MoveKind::Probe { .. } => {
+                return Err(self.fault(
+                    Fault::NotSupported,
+                    "a measuring move under radius compensation is not built",
                 ))
             }
         };

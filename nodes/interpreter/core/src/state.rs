@@ -172,6 +172,16 @@ pub struct Core {
     /// A block search runs the program without motion: what the machine's work counts
     /// (pieces on a tool) does not count again.
     pub searching: bool,
+    /// Measuring moves wait for the machine's result (a running cell); otherwise the probe is
+    /// taken as switching at the line's end (a check, a simulation, a block search: D116).
+    pub measure_on_machine: bool,
+    /// A measuring move has gone out and its result has not come: nothing is read on.
+    pub(crate) awaiting_measurement: bool,
+    /// The last measuring move's result.
+    pub measurement: Option<crate::measure::Measurement>,
+    /// Where the probe last switched (machine coordinates): a job in which it did not
+    /// switch leaves it.
+    pub measured_at: Option<Vec<f64>>,
 }
 
 impl Core {
@@ -222,6 +232,10 @@ impl Core {
             emitted: 0,
             operator_messages: Vec::new(),
             searching: false,
+            measure_on_machine: false,
+            awaiting_measurement: false,
+            measurement: None,
+            measured_at: None,
             rules,
             setup,
             library,
@@ -268,8 +282,14 @@ impl Core {
     /// Current position in work coordinates (X as diameter).
     /// One allocation per call: asked for at every move.
     pub fn work_position(&self) -> Vec<f64> {
+        self.work_of(&self.pos)
+    }
+
+    /// The work coordinates of the machine position `machine` under the transform chain as
+    /// it stands.
+    pub fn work_of(&self, machine: &[f64]) -> Vec<f64> {
         let mut p: Vec<f64> = (0..self.pos.len())
-            .map(|i| self.pos[i] - self.origin(i))
+            .map(|i| machine.get(i).copied().unwrap_or(0.0) - self.origin(i))
             .collect();
         if !self.frame.is_identity() {
             self.frame.invert_in_place(&mut p);

@@ -356,6 +356,39 @@ impl Sinumerik {
                 // What a following axis travelled coupled is part of where it is.
                 Ok(self.core.work_position()[i] + self.core.coupled[i])
             }
+            // §9.3.12: the status of the last measuring job, 1 when the probe switched; the
+            // table writes it $AC_MEAS (D116).
+            "$AC_MEA" | "$AC_MEAS" => match idx {
+                [Val::Num(k)] if *k == 1.0 => Ok(self
+                    .core
+                    .measurement
+                    .as_ref()
+                    .map_or(0.0, |m| f64::from(u8::from(m.triggered)))),
+                _ => Err(EvalError::new(
+                    Fault::OutOfRange,
+                    format!("{name}[1]: the 802D has measuring input 1"),
+                )),
+            },
+            // The measured position of an axis: machine (MM) or work (MW) coordinates, as
+            // the frames stand when it is read.
+            "$AA_MM" | "$AA_MW" => {
+                let i = match idx {
+                    [Val::Str(a)] => self.axis_named(a),
+                    _ => None,
+                }
+                .ok_or_else(|| EvalError::new(Fault::AxisAddress, format!("{name}[axis]")))?;
+                let at = self.core.measured_at.as_ref().ok_or_else(|| {
+                    EvalError::new(
+                        Fault::MacroVariable,
+                        format!("{name}: no measurement has been made in this program"),
+                    )
+                })?;
+                Ok(if name == "$AA_MM" {
+                    at[i]
+                } else {
+                    self.core.work_of(at)[i]
+                })
+            }
             "$AA_COUP_ACT" => {
                 let i = match idx {
                     [Val::Str(a)] => self.axis_named(a),

@@ -243,6 +243,13 @@ impl Sinumerik {
                 }
             }
         }
+        let probe = self.measuring_words(w)?;
+        if probe.is_some() && !moves {
+            return Err(self.fault(
+                Fault::MissingWord,
+                "MEAS/MEAW measure during the block's move: program the axes to move",
+            ));
+        }
         if !moves && wab.is_none() {
             return Ok(());
         }
@@ -275,6 +282,9 @@ impl Sinumerik {
             let (s, c) = ap.to_radians().sin_cos();
             let p = Pt::new(self.pole.z + rp * c, self.pole.r + rp * s);
             self.core.set_plane_point(&mut end, p);
+        }
+        if let Some((rising, stop)) = probe {
+            return self.measuring_move(w, &here, &end, rising, stop);
         }
         if let Some(code) = wab {
             let (h, v) = self.core.plane_axes()?;
@@ -342,6 +352,66 @@ impl Sinumerik {
                 self.arc_to(&here, &end, c, ccw, w.get("TURN"), feed)?;
             }
         }
+        Ok(())
+    }
+
+    /// `MEAS=±1` / `MEAW=±1` (§9.3.12): the probe's rising (1) or falling (−1) edge of
+    /// measuring input 1, with (MEAS) or without (MEAW) delete distance to go.
+    fn measuring_words(&self, w: &Words) -> Result<Option<(bool, bool)>, ProgramError> {
+        let (value, stop) = match (w.get("MEAS"), w.get("MEAW")) {
+            (None, None) => return Ok(None),
+            (Some(_), Some(_)) => {
+                return Err(self.fault(
+                    Fault::IllegalWord,
+                    "MEAS and MEAW in one block: one measuring job per block",
+                ))
+            }
+            (Some(v), None) => (v, true),
+            (None, Some(v)) => (v, false),
+        };
+        match value {
+            1.0 => Ok(Some((true, stop))),
+            -1.0 => Ok(Some((false, stop))),
+            v => Err(self.fault(
+                Fault::OutOfRange,
+                format!(
+                    "{}={}: 1 measures at the probe's rising edge, -1 at its falling edge \
+                     (measuring input 1)",
+                    if stop { "MEAS" } else { "MEAW" },
+                    cnc_interpreter_core::show(v)
+                ),
+            )),
+        }
+    }
+
+    /// A measuring block (§9.3.12): a straight G1 line to `end` while the probe's edge
+    /// latches the axes; the program reads on once the machine has measured (D116).
+    fn measuring_move(
+        &mut self,
+        w: &Words,
+        here: &[f64],
+        end: &[f64],
+        rising: bool,
+        stop: bool,
+    ) -> Result<(), ProgramError> {
+        let circle_words = ["I", "J", "K", "CR", "AR", "I1", "J1", "K1", "TURN", "ANG"];
+        let other = circle_words.iter().find(|k| w.addr.contains_key(**k));
+        if self.motion != Motion::Line || other.is_some() || self.ang.is_some() {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "MEAS/MEAW measure along a straight G1 line here (not G0, circles, ANG or threads)",
+            ));
+        }
+        if self.corner.is_some() || self.wab.is_some() || w.has_g(63) {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "a measuring block takes no chamfer, rounding, approach or tapping",
+            ));
+        }
+        let feed = self.rotary_feed(self.core.feed, here, end);
+        self.core.measure(end, feed, rising, stop)?;
+        // Where the line ends is the machine's to say: no tangent carries over.
+        self.tangent = None;
         Ok(())
     }
 

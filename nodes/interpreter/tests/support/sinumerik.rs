@@ -58,10 +58,12 @@ pub fn with_edge(entry: u32, radius: f64) -> Setup {
     s
 }
 
-/// A line the manual prints as a placeholder (`...`, `…`, `X... Y...`, a lone `.`).
+/// A line the manual prints as a placeholder (`...`, `…`, `X... Y...`, a line of dots).
 pub fn placeholder(line: &str) -> bool {
     let code = line.split(';').next().unwrap_or("").trim();
-    code.contains("...") || code.contains('…') || code == "."
+    code.contains("...")
+        || code.contains('…')
+        || (!code.is_empty() && code.bytes().all(|b| b == b'.'))
 }
 
 /// The fixture with its placeholder lines replaced by `fills`, one each, in order (an

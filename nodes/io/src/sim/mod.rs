@@ -8,6 +8,7 @@
 //! Pure: [`SimLathe::step`] advances the machine by `dt` seconds.
 
 pub mod devices;
+pub mod probe;
 pub mod spindle_position;
 
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
@@ -32,6 +33,9 @@ pub struct SimConfig {
     /// Per axis: where the − and + overtravel switches are pressed (slide travel, machine
     /// coordinates); none given: no switches.
     pub overtravel: Vec<[f64; 2]>,
+    /// Where the touch probe's stylus is deflected (slide travel, machine coordinates); none:
+    /// it never switches.
+    pub probe: Vec<probe::Target>,
 }
 
 /// An incremental encoder and its reference dog, in slide travel (mm): the encoder counts
@@ -100,6 +104,7 @@ pub struct SimLathe {
     overtravel: (u32, u32),
     /// The handwheel's counter, four counts a detent (the encoder interface's 4× quadrature).
     handwheel_count: i32,
+    probe: probe::Probe,
 }
 
 impl SimLathe {
@@ -116,6 +121,7 @@ impl SimLathe {
             }
         }
         SimLathe {
+            probe: probe::Probe::new(cfg.probe.clone()),
             devices: Devices::new(cfg.devices.clone()),
             cfg,
             encoder_offset,
@@ -265,6 +271,12 @@ impl SimLathe {
             }
         }
         self.overtravel = (fb.overtravel_minus, fb.overtravel_plus);
+        self.probe.step(
+            &before[..n],
+            &self.position[..n],
+            &self.encoder_offset[..n],
+            &mut fb,
+        );
         fb
     }
 
@@ -332,6 +344,7 @@ mod tests {
                 devices: DeviceConfig::default(),
                 encoders: vec![None, None],
                 overtravel: Vec::new(),
+                probe: Vec::new(),
             },
             &[10.0, 20.0],
         )
@@ -553,6 +566,7 @@ mod tests {
                 devices: DeviceConfig::default(),
                 encoders: vec![Some(e)],
                 overtravel: Vec::new(),
+                probe: Vec::new(),
             },
             &[60.0],
         );

@@ -70,6 +70,15 @@ impl Motion {
                     .push(seg, feed, block.seq, block.line, !self.exact_stop, 0.0);
                 Ok(Active::Path)
             }
+            Command::Probe { .. } => {
+                // Cut on its own: nothing blends into or out of a measuring line.
+                let (seg, feed) = self.segment_for(block, &start)?;
+                self.start_probing(block)?;
+                self.planner.reset(start);
+                self.planner
+                    .push(seg, feed, block.seq, block.line, false, 0.0);
+                Ok(Active::Path)
+            }
             Command::Thread { start_angle, .. } => {
                 let piece = self.thread_piece(block, &start)?;
                 self.thread.clear();
@@ -129,7 +138,7 @@ impl Motion {
     ) -> Result<(Segment, f64), (u32, String)> {
         self.check_block(&block.kind)?;
         match &block.kind {
-            Command::Linear { end, feed } => {
+            Command::Linear { end, feed } | Command::Probe { end, feed, .. } => {
                 let feed = self.feed_mm_per_min(*feed)?;
                 self.check_limits(end)?;
                 let end = self.to_slide(end);

@@ -30,10 +30,12 @@ pub mod handwheel;
 pub mod jog;
 mod overtravel;
 mod panel;
+mod probe;
 mod reference;
 mod tapping;
 mod window;
 
+pub use probe::{ProbeInput, ProbeResult};
 pub use reference::ReferenceInputs;
 
 /// Something the shell must publish.
@@ -187,6 +189,12 @@ pub struct Motion {
     /// Per axis, its place in the PLC's per-axis signals (X, Y, Z, A, B, C: 0–5), found once
     /// from its letter so that the tick does not search for it.
     signal_axis: Vec<Option<usize>>,
+    /// The touch probe's input of the latest feedback.
+    probe_input: ProbeInput,
+    /// The measuring block under way.
+    probing: Option<probe::Probing>,
+    /// The last measuring block's result in this run.
+    probe_result: Option<ProbeResult>,
 }
 
 impl Motion {
@@ -209,6 +217,9 @@ impl Motion {
             .map(|a| "XYZABC".find(a.name.as_str()).filter(|_| a.name.len() == 1))
             .collect();
         Motion {
+            probe_input: ProbeInput::default(),
+            probing: None,
+            probe_result: None,
             referenced,
             shift: vec![0.0; n],
             encoder_setpoint: commanded.clone(),
@@ -321,6 +332,8 @@ impl Motion {
             self.cycle_stop = false;
             self.block_stop = false;
             self.last_line = None;
+            self.probing = None;
+            self.probe_result = None;
             self.clear_strobe();
         }
         // Blocks of a run started during an emergency stop (before the PLC's first scan at
@@ -390,6 +403,7 @@ impl Motion {
         self.cycle_stop = false;
         self.block_stop = false;
         self.last_line = None;
+        self.probing = None;
         self.clear_strobe();
         self.reference = None;
         self.jog = None;
@@ -579,6 +593,7 @@ impl Motion {
             return;
         }
         self.take_machine_lock();
+        self.watch_probe();
         let mut budget = 8; // blocks that can finish within one tick (zero-length moves, aux)
         while budget > 0 && !self.alarm {
             budget -= 1;
@@ -654,6 +669,7 @@ impl Motion {
             }
             break;
         }
+        self.finish_probing();
         // Cycle stop: once the axes stand on the path, the rest of the run is dropped.
         if self.cycle_stop && self.stopped_on_path() {
             self.drop_run();
@@ -711,6 +727,7 @@ impl Motion {
     fn drop_run(&mut self) {
         self.queue.clear();
         self.active = None;
+        self.probing = None;
         let here = self.commanded_point();
         self.planner.reset(here);
         self.clear_strobe();
@@ -729,6 +746,7 @@ impl Motion {
     fn raise(&mut self, number: u32, text: String, line: u32) {
         self.alarm = true;
         self.active = None;
+        self.probing = None;
         self.reference = None;
         self.jog = None;
         self.handwheel.stop();
@@ -848,8 +866,9 @@ impl Motion {
             Active::Path => {
                 let mut out = [0.0; MAX_AXES];
                 self.finished.clear();
+                let braking = self.probe_braking();
                 let end = self.planner.step(
-                    hold,
+                    hold || braking,
                     self.panel.feed_override,
                     self.trial.speed_cap(),
                     &mut self.finished,
@@ -861,6 +880,13 @@ impl Motion {
                 }
                 if let Some(line) = self.planner.line() {
                     self.line = line;
+                }
+                // A measuring block that braked at its edge ends at rest: the rest of its
+                // line is dropped (delete distance to go).
+                if braking && self.planner.velocity() == 0.0 {
+                    let here = self.commanded_point();
+                    self.planner.reset(here);
+                    return true;
                 }
                 end
             }

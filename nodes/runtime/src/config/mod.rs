@@ -162,6 +162,30 @@ mod tests {
         }
     }
 
+    /// The simulated probe's boxes (D116): as many finite bounds below as above, in order.
+    #[test]
+    fn probe_boxes_need_ordered_finite_bounds() {
+        let with = |boxes: &str| {
+            let text = include_str!("../../../../launch_configs/sim_mill_802d.yaml").replacen(
+                "sim:\n",
+                &format!("sim:\n  probe: {boxes}\n"),
+                1,
+            );
+            LaunchConfig::from_yaml(&text)
+        };
+        let cfg = with("[{min: [0, 0, -10], max: [100, 80, 60]}]").expect("a box");
+        assert_eq!(cfg.sim.probe[0].max, vec![100.0, 80.0, 60.0]);
+        for bad in [
+            "[{min: [0, 0], max: [1, 1, 1]}]",
+            "[{min: [5, 0, 0], max: [1, 1, 1]}]",
+            "[{min: [.nan, 0, 0], max: [1, 1, 1]}]",
+            "[{min: [], max: []}]",
+        ] {
+            let e = with(bad).unwrap_err();
+            assert!(e.contains("sim.probe[0]"), "{bad}: {e}");
+        }
+    }
+
     /// EXTCALL's drives (D110): one letter each, a folder taken from the config's folder.
     #[test]
     fn external_drives_are_letters_with_folders_from_the_configs_folder() {

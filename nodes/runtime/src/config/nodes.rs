@@ -355,6 +355,20 @@ pub struct SimConfig {
     /// topic: set false, and the bridge does not even subscribe to it.
     #[serde(default = "default_true")]
     pub client_inputs: bool,
+    /// The touch probe in the spindle (measuring input 1, MEAS/MEAW): boxes in the machine's
+    /// coordinates as displayed, per axis in the machine's order, inside which its stylus is
+    /// deflected: the work as the probe finds it, its length included. None: the probe never
+    /// switches.
+    #[serde(default)]
+    pub probe: Vec<ProbeTarget>,
+}
+
+/// A box of the simulated probe's work: per axis its lower and upper bound.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProbeTarget {
+    pub min: Vec<f64>,
+    pub max: Vec<f64>,
 }
 
 fn default_true() -> bool {
@@ -384,6 +398,7 @@ impl Default for SimConfig {
             turret_stations: default_turret_stations(),
             tool_magazine: false,
             client_inputs: true,
+            probe: Vec::new(),
         }
     }
 }
@@ -586,6 +601,17 @@ impl SimConfig {
                 "sim.turret_stations {}: 4, 6 or 8",
                 self.turret_stations
             ));
+        }
+        for (k, t) in self.probe.iter().enumerate() {
+            let finite = t.min.iter().chain(&t.max).all(|v| v.is_finite());
+            let ordered = t.min.iter().zip(&t.max).all(|(lo, hi)| lo <= hi);
+            if t.min.len() != t.max.len() || t.min.is_empty() || !finite || !ordered {
+                return Err(format!(
+                    "sim.probe[{k}]: min and max need as many finite bounds (one per axis, in \
+                     the machine's order), min ≤ max (min {:?}, max {:?})",
+                    t.min, t.max
+                ));
+            }
         }
         Ok(())
     }
