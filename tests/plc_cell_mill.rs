@@ -305,3 +305,67 @@ fn f032_meas_finds_the_wall_brakes_there_and_the_program_reads_the_edge() {
     let kept = r.stream.interpreter().memory().kept;
     assert_eq!(kept.get(&10_005), None, "R5 not written");
 }
+
+/// Fixture 091 (§9.15, D117) through motion and the simulated drives on the 802D mill with
+/// its optional fourth axis as C and T1 D1 the fixture's cutter (radius 10.123): the program
+/// runs as printed to its M2, back at X25 Z50 C120 (T1's length along Z), and while the
+/// cutter is at the groove's base the developed position of its centre (C·r and the Y
+/// slide's offset from C's centre) stays within OFFN − R of the groove's centre line, the
+/// Y slide reaching that offset on both walls of the axial section.
+#[test]
+fn f091_tracyl_cuts_the_hook_slot_on_the_four_axis_mill() {
+    let path = format!(
+        "{}/launch_configs/sim_mill_802d.yaml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(path).unwrap().replace(
+        "    # - { name: A, min: -99999.0, max: 99999.0, home: 0.0, max_velocity: 10800.0, max_acceleration: 3600.0 }",
+        "    - { name: C, min: -99999.0, max: 99999.0, home: 0.0, max_velocity: 10800.0, max_acceleration: 3600.0 }",
+    );
+    let mut cfg = cnc_runtime::LaunchConfig::from_yaml(&text).unwrap();
+    assert_eq!(
+        cfg.machine.axes.len(),
+        4,
+        "the C axis line is in sim_mill_802d.yaml"
+    );
+    let length = {
+        let t1 = cfg.machine.tools.get_mut(&11).unwrap();
+        t1.radius = 10.123;
+        t1.z
+    };
+    let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+    let mut r = Rig::on(cfg, &fixture("091"), Some(&kept));
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let inside = 12.4 - 10.123;
+    let base = 17.5 + length;
+    let (mut worst, mut wall_minus, mut wall_plus) = (0.0f64, 0.0f64, 0.0f64);
+    let ok = r.run_until(600.0, |r| {
+        let p = &r.fb.position;
+        if (p[0] - base).abs() < 1e-3 && p[2] <= 1.0 {
+            let y = p[3].to_radians() * 17.5 + (p[1] - 60.0);
+            let z = p[2];
+            let seg = |q: f64, lo: f64, hi: f64, across: f64| {
+                ((lo - q).max(0.0).max(q - hi)).hypot(across)
+            };
+            let d = seg(z, -30.0, 1.0, y - 70.0).min(seg(y, 20.0, 70.0, z + 30.0));
+            worst = worst.max(d);
+            if z > -25.0 {
+                wall_minus = wall_minus.min(p[1] - 60.0);
+                wall_plus = wall_plus.max(p[1] - 60.0);
+            }
+        }
+        r.program_done()
+    });
+    assert!(ok, "the program did not finish; events {:?}", r.events);
+    println!("furthest from the centre line {worst:.4} (OFFN − R {inside:.4}); Y slide {wall_minus:.4} … {wall_plus:.4}");
+    // The drives lag and corners blend within the path tolerance: 0.02 mm.
+    assert!(worst <= inside + 0.02, "{worst}");
+    assert!((wall_minus + inside).abs() < 1e-3 && (wall_plus - inside).abs() < 1e-3);
+    let end = r.motion.commanded_display();
+    let want = [25.0, 60.0, 50.0 + length, 120.0];
+    assert!(
+        end.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6),
+        "{end:?}"
+    );
+}

@@ -541,7 +541,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     (
         "091",
         Some((12550, 10)),
-        "the 3-axis mill has no C (TRACYL)",
+        "the 3-axis mill has no C: sinumerik_tracyl.rs runs it on X Y Z C",
     ),
 ];
 

@@ -90,6 +90,11 @@ pub struct Out {
     pub depth: f64,
     pub kind: Kind,
     pub line: u32,
+    /// The controlled point less the programmed contour's point at the element's end (the
+    /// offset and the tip); `None` where it is what it was at the element's start. A
+    /// transformation that offsets groove walls with a slide of its own needs it
+    /// ([`crate::cylinder`]).
+    pub offset: Option<Pt>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -372,12 +377,25 @@ impl RadiusComp {
     }
 
     fn out(&self, path: Elem, depth: f64, kind: Kind, line: u32) -> Out {
+        self.out_along(path, path.end_tangent(), depth, kind, line)
+    }
+
+    /// An offset element (or a corner arc) whose end runs along `tangent`: the contour's
+    /// point there is the offset to the tangent's side away.
+    fn out_along(&self, path: Elem, tangent: Pt, depth: f64, kind: Kind, line: u32) -> Out {
         Out {
             path: path.translated(self.tip),
             depth,
             kind,
             line,
+            offset: self.offset_along(tangent),
         }
+    }
+
+    /// The controlled point less the contour's point on an element running along
+    /// `tangent` (`None` for no direction).
+    fn offset_along(&self, tangent: Pt) -> Option<Pt> {
+        (len(tangent) > EPS).then(|| add(scale(left(unit(tangent)), self.offset), self.tip))
     }
 
     /// The held element as it is cut: from the uncompensated point if it is the start-up
@@ -392,7 +410,9 @@ impl RadiusComp {
             Some(from) => h.path.with_start(from),
             None => h.path,
         };
-        out.push(self.out(path, h.depth, h.kind, h.line));
+        // A line's own course: trimmed, its offset path may be reversed or empty.
+        let tangent = h.course.unwrap_or_else(|| h.path.end_tangent());
+        out.push(self.out_along(path, tangent, h.depth, h.kind, h.line));
         self.release_stills(add(path.end(), self.tip), out);
         Ok(())
     }
@@ -405,6 +425,7 @@ impl RadiusComp {
                 depth: s.depth,
                 kind: s.kind,
                 line: s.line,
+                offset: None,
             });
         }
     }
@@ -478,6 +499,7 @@ impl RadiusComp {
                         depth,
                         kind,
                         line,
+                        offset: self.offset_along(off.start_tangent()),
                     });
                     self.held = Some(hold(off, None));
                 }
@@ -501,6 +523,7 @@ impl RadiusComp {
                 depth: s_depth,
                 kind: s_kind,
                 line: s_line,
+                offset: self.offset_along(off.start_tangent()),
             });
             self.release_stills(add(off.start(), self.tip), &mut out);
             self.held = Some(hold(off, None));
@@ -527,6 +550,7 @@ impl RadiusComp {
             depth,
             kind,
             line,
+            offset: None,
         }]
     }
 
@@ -654,6 +678,7 @@ impl RadiusComp {
             depth,
             kind,
             line,
+            offset: Some(Pt::new(0.0, 0.0)),
         });
         out
     }
@@ -707,6 +732,7 @@ impl RadiusComp {
                 depth,
                 kind,
                 line,
+                offset: self.offset_along(off.end_tangent()),
             });
             self.release_stills(add(off.end(), self.tip), &mut out);
         }

@@ -167,6 +167,12 @@ impl Core {
         if !self.couplings.is_empty() {
             self.couple(&mut m, kind)?;
         }
+        // Under the cylinder transformation the position is the basic system's and the
+        // command is mapped onto the machine from where the controlled point stands (under
+        // compensation `pos` is the programmed point, not the cutter's).
+        let from = self
+            .cylinder
+            .map(|_| std::mem::replace(&mut self.controlled, m.clone()));
         // The machine position becomes `m`; the command takes `m` itself (no copy per move).
         self.pos.copy_from_slice(&m);
         let command = match kind {
@@ -203,7 +209,10 @@ impl Core {
                 stop,
             },
         };
-        self.push(command);
+        match (self.cylinder, from) {
+            (Some(c), Some(from)) => self.push_on_cylinder(c, &from, command)?,
+            _ => self.push(command),
+        }
         Ok(())
     }
 
@@ -570,6 +579,9 @@ impl Core {
                 (_, comp::Kind::Feed(f)) => MoveKind::Feed(f),
                 (_, comp::Kind::Rapid) => MoveKind::Rapid,
             };
+            if self.cylinder.is_some() {
+                self.out_offset = Some(o.offset.unwrap_or(self.wall));
+            }
             self.machine(&end, kind)?;
         }
         Ok(())

@@ -20,6 +20,7 @@ pub mod chip_break;
 pub mod comp;
 pub mod corner;
 pub mod cycles;
+pub mod cylinder;
 pub mod driver;
 pub mod emit;
 pub mod error;

@@ -182,6 +182,15 @@ pub struct Core {
     /// Where the probe last switched (machine coordinates): a job in which it did not
     /// switch leaves it.
     pub measured_at: Option<Vec<f64>>,
+    /// The cylinder surface transformation in force ([`crate::cylinder`]): `pos` is then
+    /// the basic system's position.
+    pub cylinder: Option<crate::cylinder::Cylinder>,
+    /// Under it, the compensation's offset at the end of the last move, and the one the move
+    /// being queued ends with.
+    pub(crate) wall: Pt,
+    pub(crate) out_offset: Option<Pt>,
+    /// Under it, where the controlled point stands in the basic system.
+    pub(crate) controlled: Vec<f64>,
 }
 
 impl Core {
@@ -236,6 +245,10 @@ impl Core {
             awaiting_measurement: false,
             measurement: None,
             measured_at: None,
+            cylinder: None,
+            wall: Pt::new(0.0, 0.0),
+            out_offset: None,
+            controlled: Vec::new(),
             rules,
             setup,
             library,

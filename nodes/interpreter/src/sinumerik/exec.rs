@@ -92,6 +92,8 @@ pub struct Words {
     pub call: Option<String>,
     /// The cycle the block calls (or makes modal with MCALL).
     pub cycle: Option<CycleCall>,
+    /// TRACYL or TRAFOOF (§9.15).
+    pub cylinder: Option<super::tracyl::CylinderWord>,
 }
 
 impl Words {
@@ -110,6 +112,7 @@ impl Words {
         self.keys.clear();
         self.call = None;
         self.cycle = None;
+        self.cylinder = None;
     }
 
     fn push_g(&mut self, n: u32) {
@@ -165,12 +168,10 @@ const TANG_ON_A_MILL: &str =
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 19] = [
+pub const NOT_BUILT: [(&str, &str); 17] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
-    ("TRACYL", "the cylinder transformation is not built"),
-    ("TRAFOOF", "no transformation is built"),
     ("FXS", "travel to fixed stop is not built"),
     // §9.3.13: "该功能不适用于铣削工艺" (D112).
     ("TANG", TANG_ON_A_MILL),
@@ -206,7 +207,7 @@ pub fn is_address(name: &str) -> bool {
         || NOT_BUILT.iter().any(|(k, _)| *k == name)
         || [
             "DEF", "IF", "GOTOF", "GOTOB", "MSG", "SET", "REP", "AC", "IC", "DC", "ACP", "ACN",
-            "PROC", "ACC", "TRAILON", "TRAILOF",
+            "PROC", "ACC", "TRAILON", "TRAILOF", "TRACYL", "TRAFOOF", "TRAFOFF",
         ]
         .contains(&name)
 }
@@ -240,6 +241,8 @@ impl Sinumerik {
             }
             self.item(item, w)?;
         }
+        self.cylinder_block(w)?;
+        self.check_cylinder_axes(w)?;
         let from = self.core.queued();
         // Where the block starts, for the work area check (a buffer kept from block to block).
         let mut start = std::mem::take(&mut self.block_start);
@@ -366,7 +369,9 @@ impl Sinumerik {
                 value,
             } => self.word(w, *letter, digits, *value)?,
             Item::Name(n) => {
-                if let Some(k) = KEYWORDS.iter().find(|k| **k == n.as_ref()) {
+                if ["TRAFOOF", "TRAFOFF"].contains(&n.as_ref()) {
+                    self.set_cylinder_word(w, super::tracyl::CylinderWord::Off)?;
+                } else if let Some(k) = KEYWORDS.iter().find(|k| **k == n.as_ref()) {
                     w.keys.push(k);
                 } else if NOT_BUILT.iter().any(|(k, _)| k == n) {
                     self.not_built(n)?;
@@ -488,6 +493,9 @@ impl Sinumerik {
         }
         if name == "TRAILON" {
             return self.trail_on(args);
+        }
+        if name == "TRACYL" {
+            return self.tracyl(w, args);
         }
         if name == "TRAILOF" {
             return self.trail_off(args);

@@ -29,6 +29,7 @@ mod slots;
 mod spigot;
 mod thread_mill;
 mod tool;
+mod tracyl;
 mod trail;
 mod transfer;
 pub mod vars;

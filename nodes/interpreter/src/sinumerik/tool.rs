@@ -175,7 +175,14 @@ impl Sinumerik {
                 ))
             }
         };
-        Ok((entry.radius + self.contour_offset) / factor)
+        // Under TRACYL compensation refers to the groove wall, OFFN from the centre line, and
+        // the cutter runs inside it (§9.15, D117).
+        let offset = if self.core.cylinder.is_some() {
+            self.contour_offset - entry.radius
+        } else {
+            entry.radius + self.contour_offset
+        };
+        Ok(offset / factor)
     }
 
     /// A new edge or OFFN while compensation runs (§9.6.7 "补偿号的更换"): the new radius

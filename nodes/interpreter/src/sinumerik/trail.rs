@@ -46,6 +46,13 @@ impl Sinumerik {
                 ))
             }
         };
+        if self.core.cylinder.is_some() {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "TRAILON under TRACYL: coupled motion and the cylinder transformation together \
+                 are not built",
+            ));
+        }
         let follow = self.axis_argument("TRAILON", f)?;
         let lead = self.axis_argument("TRAILON", l)?;
         let factor = match factor {
