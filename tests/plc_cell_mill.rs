@@ -369,3 +369,71 @@ fn f091_tracyl_cuts_the_hook_slot_on_the_four_axis_mill() {
         "{end:?}"
     );
 }
+
+/// Fixture 044 (§9.3.23, D118) through the interpreter, motion and the simulated drives:
+/// the mill's Z meets a mechanical stop at 120 on its way from 150 to Z100; the move ends
+/// there (X short of 250, the rest dropped), Z presses against the stop with the clamping
+/// torque the block gives (12.3 %), `$AA_FXS[Z1]` reads 1, and the deselection's move takes
+/// Z off the stop with its torque limit lifted. Without the stop the move ends at Z100
+/// without meeting one: alarm 20091.
+#[test]
+fn f044_z_travels_to_its_fixed_stop_and_clamps_with_the_programmed_torque() {
+    let text = fixture("044").replace("N10 G1 G94 ...", "N10 G1 G94 F100")
+        + "N110 R1=$AA_FXS[Z1]\nN120 G1 Z140 FXS[Z1]=0\nN130 X0\nM30\n";
+    let with_stop = |stop: Option<f64>| {
+        let mut cfg = config("sim_mill_802d");
+        cfg.sim.fixed_stops = stop
+            .map(|at| cnc_runtime::config::FixedStopConfig {
+                axis: "Z".into(),
+                at,
+            })
+            .into_iter()
+            .collect();
+        let kept = Retained::first_power_up(&cfg.plc.keep_relays).unwrap();
+        let mut r = Rig::on(cfg, &text, Some(&kept));
+        r.run_until(0.1, |_| false);
+        r.started = true;
+        r
+    };
+    let mut r = with_stop(Some(120.0));
+    let mut clamped_torque = None;
+    let mut lowest = f64::MAX;
+    // F100 over some 150 mm each way: minutes of simulated time.
+    let ok = r.run_until(600.0, |r| {
+        lowest = lowest.min(r.fb.position[2]);
+        if r.motion.fixed_stop_active(2) && r.motion.state() == cnc_motion::RunState::Idle {
+            clamped_torque = Some(r.fb.torque_percent[2]);
+        }
+        r.program_done() || r.motion.state() == cnc_motion::RunState::Alarm
+    });
+    assert!(
+        ok && r.program_done(),
+        "motion {:?} {:?} at {:?}, PLC {:?}",
+        r.motion.state(),
+        r.motion.take_events(),
+        r.fb.position,
+        r.events
+    );
+    assert_eq!(lowest, 120.0, "Z never passed its stop");
+    let kept = r.stream.interpreter().memory().kept;
+    assert_eq!(kept.get(&10_001), Some(&1.0), "$AA_FXS[Z1] at the stop");
+    println!("clamping torque {clamped_torque:?}");
+    assert_eq!(clamped_torque, Some(12.3));
+    assert_eq!(r.fb.torque_percent[2], 0.0, "off the stop");
+    let end = r.motion.commanded_display();
+    assert!(
+        end[0].abs() < 1e-9 && (end[2] - 140.0).abs() < 1e-9,
+        "{end:?}"
+    );
+
+    let mut r = with_stop(None);
+    let alarmed = r.run_until(600.0, |r| r.motion.state() == cnc_motion::RunState::Alarm);
+    assert!(alarmed, "a move that met no stop");
+    let events = r.motion.take_events();
+    assert!(
+        events
+            .iter()
+            .any(|e| matches!(e, cnc_motion::MotionEvent::Alarm { number: 20091, .. })),
+        "{events:?}"
+    );
+}

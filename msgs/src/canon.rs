@@ -58,6 +58,18 @@ pub enum Command {
         rising: bool,
         stop: bool,
     },
+    /// Travel to a fixed stop on `axis` (its index in the machine's order): on, its drive's
+    /// torque is limited to `torque` percent for the move that follows, which ends where the
+    /// axis meets the stop (the rest of it dropped); the axis then presses against it and
+    /// must stay within `window` (mm or degrees). Off, the limit is lifted for the move that
+    /// follows, which leaves the stop. Motion reports the move's end as it does a measuring
+    /// block's; the program waits for it.
+    FixedStop {
+        axis: u8,
+        on: bool,
+        torque: f64,
+        window: f64,
+    },
     Dwell {
         seconds: f64,
     },
@@ -237,6 +249,18 @@ pub fn to_motion_block(
             m.aux_code = if *rising { 1 } else { -1 };
             m.flag = *stop;
         }
+        Command::FixedStop {
+            axis,
+            on,
+            torque,
+            window,
+        } => {
+            m.kind = MotionBlock::KIND_FIXED_STOP;
+            m.aux_code = i32::from(*axis);
+            m.flag = *on;
+            m.aux_value = *torque;
+            m.lead = *window;
+        }
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
@@ -355,6 +379,24 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
             },
             stop: m.flag,
         },
+        MotionBlock::KIND_FIXED_STOP => {
+            let limits_ok = (m.aux_value > 0.0 && m.aux_value <= 100.0) && m.lead > 0.0;
+            match u8::try_from(m.aux_code) {
+                Ok(axis) if !m.flag || (limits_ok && m.lead.is_finite()) => Command::FixedStop {
+                    axis,
+                    on: m.flag,
+                    torque: m.aux_value,
+                    window: m.lead,
+                },
+                _ => {
+                    return Err(format!(
+                        "fixed stop on axis {} with torque {} % and window {} is not valid \
+                         (0 < torque ≤ 100, window > 0)",
+                        m.aux_code, m.aux_value, m.lead
+                    ))
+                }
+            }
+        }
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_PROFILE => Command::Profile {
@@ -456,6 +498,12 @@ mod tests {
                 feed: 300.0,
                 rising: false,
                 stop: true,
+            },
+            Command::FixedStop {
+                axis: 2,
+                on: true,
+                torque: 12.3,
+                window: 2.0,
             },
             Command::Dwell { seconds: 1.5 },
             Command::Tap {

@@ -231,6 +231,7 @@ ros_message! {
             KIND_FEEDFORWARD: u8 = 12,
             KIND_ACCELERATION: u8 = 13,
             KIND_PROBE: u8 = 14,
+            KIND_FIXED_STOP: u8 = 15,
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,
@@ -267,10 +268,10 @@ ros_message! {
         capacity: u32,
         line: u32,
         state: u8,
-        probe_seq: u64,
-        probe_triggered: bool,
-        probe_position: Vec<f64>,
-        probe_rest: Vec<f64>,
+        result_seq: u64,
+        result_triggered: bool,
+        result_position: Vec<f64>,
+        result_rest: Vec<f64>,
     }
 }
 

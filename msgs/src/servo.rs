@@ -22,6 +22,9 @@ pub struct ServoSetpoint {
     /// The spindle drive's acceleration, percent of its rated (`ACC[S]`, 1–200; 100 when no
     /// program set it). The spindle is a drive on the same bus as the axes.
     pub spindle_acceleration_percent: f64,
+    /// Per axis, the drive's torque limit in percent of its maximum (100: none; lower while
+    /// the axis travels to a fixed stop or presses against it).
+    pub torque_limit_percent: [f64; MAX_AXES],
 }
 
 impl Default for ServoSetpoint {
@@ -33,6 +36,7 @@ impl Default for ServoSetpoint {
             axis_count: 0,
             enable: 0,
             spindle_acceleration_percent: 100.0,
+            torque_limit_percent: [100.0; MAX_AXES],
         }
     }
 }
@@ -76,6 +80,8 @@ pub struct ServoFeedback {
     pub probe_falling: u32,
     pub probe_rising_position: [f64; MAX_AXES],
     pub probe_falling_position: [f64; MAX_AXES],
+    /// Per axis, the torque the drive gives, percent of its maximum.
+    pub torque_percent: [f64; MAX_AXES],
 }
 
 impl Default for ServoFeedback {
@@ -99,6 +105,7 @@ impl Default for ServoFeedback {
             probe_falling: 0,
             probe_rising_position: [0.0; MAX_AXES],
             probe_falling_position: [0.0; MAX_AXES],
+            torque_percent: [0.0; MAX_AXES],
         }
     }
 }

@@ -63,7 +63,7 @@ impl Rig {
             2,
         );
         let mut stream = ProgramRun::new(interp);
-        stream.measure_on_machine();
+        stream.on_machine();
         Rig {
             stream,
             motion: Motion::new(mcfg, &start),
@@ -85,10 +85,9 @@ impl Rig {
     pub fn tick(&mut self) {
         if self.started {
             // A measuring block's result, once motion has it, as the interpreter node takes it.
-            if let (Some(seq), Some(r)) = (
-                self.stream.awaiting_measurement(),
-                self.motion.probe_result(),
-            ) {
+            if let (Some(seq), Some(r)) =
+                (self.stream.awaiting_machine(), self.motion.block_result())
+            {
                 if r.seq == seq {
                     let m = Measurement {
                         triggered: r.triggered,
@@ -96,7 +95,7 @@ impl Rig {
                         rest: r.rest[..self.n].to_vec(),
                     };
                     self.stream
-                        .measured(seq, m)
+                        .machine_result(seq, m)
                         .unwrap_or_else(|e| panic!("alarm {}: {}", e.number, e.text));
                 }
             }
@@ -122,11 +121,10 @@ impl Rig {
         self.motion.probe_input(ProbeInput::from_feedback(&self.fb));
         let mut sp = ServoSetpoint {
             axis_count: self.n as u32,
-            spindle_acceleration_percent: self.motion.spindle_acceleration_percent(),
             ..Default::default()
         };
         sp.position[..self.n].copy_from_slice(self.motion.tick(Some(&actual[..self.n]), &self.gi));
-        sp.enable = u32::from(self.motion.servo_enabled());
+        self.motion.fill_setpoint(&mut sp);
         self.fb = self.sim.step(&sp, &self.yi, DT);
         self.t += DT;
         if self.t + 1e-9 >= self.next_scan {

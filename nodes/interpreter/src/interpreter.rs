@@ -43,19 +43,19 @@ impl Interpreter {
 
     /// Measuring moves wait for the machine's result (`on`), or take the probe as switching
     /// at the line's end (a check or simulation: decisions D116).
-    pub fn measure_on_machine(&mut self, on: bool) {
-        self.front.core_mut().measure_on_machine = on;
+    pub fn on_machine(&mut self, on: bool) {
+        self.front.core_mut().on_machine = on;
     }
 
     /// A measuring move has gone out and the program waits for its result.
-    pub fn awaiting_measurement(&self) -> bool {
-        self.front.core().awaiting_measurement()
+    pub fn awaiting_machine(&self) -> bool {
+        self.front.core().awaiting_machine()
     }
 
     /// The machine's result of the measuring move the program waits for; an alarm (which
     /// ends the run) when it does not fit the machine.
-    pub fn measured(&mut self, m: Measurement) -> Result<(), ProgramError> {
-        self.front.core_mut().measured(m)
+    pub fn machine_result(&mut self, m: Measurement) -> Result<(), ProgramError> {
+        self.front.core_mut().machine_result(m)
     }
 
     /// A block search starts or ends (what the program counts does not count during one).

@@ -585,7 +585,7 @@ impl RunCore {
             }
         };
         // The block search read without the machine; the run measures on it.
-        stream.measure_on_machine();
+        stream.on_machine();
         self.run_counter += 1;
         self.message.clear();
         self.run = Some(Run {
@@ -649,9 +649,9 @@ impl RunCore {
             let batch_start = self.effects.len();
             if !r.failed {
                 let (id, program) = (r.id, r.program.clone());
-                let measured = match r.stream.awaiting_measurement() {
-                    Some(seq) if self.status.run_id == id && self.status.probe_seq == seq => {
-                        r.stream.measured(seq, measurement(&self.status))
+                let measured = match r.stream.awaiting_machine() {
+                    Some(seq) if self.status.run_id == id && self.status.result_seq == seq => {
+                        r.stream.machine_result(seq, measurement(&self.status))
                     }
                     _ => Ok(()),
                 };
@@ -840,9 +840,9 @@ impl RunCore {
 /// Motion's result of the last measuring block (`MotionStatus::probe_*`).
 fn measurement(status: &MotionStatus) -> cnc_interpreter_core::Measurement {
     cnc_interpreter_core::Measurement {
-        triggered: status.probe_triggered,
-        position: status.probe_position.clone(),
-        rest: status.probe_rest.clone(),
+        triggered: status.result_triggered,
+        position: status.result_position.clone(),
+        rest: status.result_rest.clone(),
     }
 }
 

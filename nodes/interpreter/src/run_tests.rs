@@ -784,26 +784,26 @@ fn a_measuring_block_holds_the_program_until_motion_reports_its_result() {
     let sent = c.take_effects();
     let kinds: Vec<u8> = blocks(&sent).iter().map(|b| b.kind).collect();
     assert_eq!(kinds.last(), Some(&MotionBlock::KIND_PROBE), "{kinds:?}");
-    let probe_seq = blocks(&sent).last().map_or(0, |b| b.seq);
+    let result_seq = blocks(&sent).last().map_or(0, |b| b.seq);
     // Credit is plenty, but the program waits for the measurement.
-    let waiting = status(11, probe_seq - 1, 64, MotionStatus::STATE_RUNNING);
+    let waiting = status(11, result_seq - 1, 64, MotionStatus::STATE_RUNNING);
     c.motion_status(waiting.clone());
     c.step();
     assert!(blocks(&c.take_effects()).is_empty());
     // Done without its result (another block's): still waiting.
     c.motion_status(MotionStatus {
-        probe_seq: probe_seq - 1,
-        ..status(11, probe_seq, 64, MotionStatus::STATE_IDLE)
+        result_seq: result_seq - 1,
+        ..status(11, result_seq, 64, MotionStatus::STATE_IDLE)
     });
     c.step();
     assert!(blocks(&c.take_effects()).is_empty());
     // The probe switched at Z2.5 and the axes came to rest at Z2.3.
     c.motion_status(MotionStatus {
-        probe_seq,
-        probe_triggered: true,
-        probe_position: vec![0.0, 0.0, 2.5],
-        probe_rest: vec![0.0, 0.0, 2.3],
-        ..status(11, probe_seq, 64, MotionStatus::STATE_IDLE)
+        result_seq,
+        result_triggered: true,
+        result_position: vec![0.0, 0.0, 2.5],
+        result_rest: vec![0.0, 0.0, 2.3],
+        ..status(11, result_seq, 64, MotionStatus::STATE_IDLE)
     });
     c.step();
     let after = c.take_effects();
@@ -830,10 +830,10 @@ fn a_measurement_that_does_not_fit_the_machine_is_an_alarm() {
     c.step();
     let seq = blocks(&c.take_effects()).last().map_or(0, |b| b.seq);
     c.motion_status(MotionStatus {
-        probe_seq: seq,
-        probe_triggered: true,
-        probe_position: vec![0.0, 2.5],
-        probe_rest: vec![0.0, 0.0, f64::NAN],
+        result_seq: seq,
+        result_triggered: true,
+        result_position: vec![0.0, 2.5],
+        result_rest: vec![0.0, 0.0, f64::NAN],
         ..status(11, seq, 64, MotionStatus::STATE_IDLE)
     });
     c.step();
@@ -842,6 +842,6 @@ fn a_measurement_that_does_not_fit_the_machine_is_an_alarm() {
     assert!(effects
         .iter()
         .any(|e| matches!(e, Effect::Raise { line: 1, text, .. }
-            if text.contains("measurement names 2 and 3 axis values"))));
+            if text.contains("machine's result names 2 and 3 axis values"))));
     assert_eq!(c.execution(), MachineState::STOPPED);
 }

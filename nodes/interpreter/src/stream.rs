@@ -25,8 +25,11 @@ pub struct ProgramRun {
     end: Option<u64>,
     /// Operator messages read, each with the sequence number after which it shows.
     messages: VecDeque<(u64, String)>,
-    /// Sequence number of the last measuring block sent.
+    /// Sequence number of the last block sent whose end the machine decides (a measuring
+    /// block, the move after a fixed stop's selection).
     measuring: Option<u64>,
+    /// A fixed stop's selection went out: the next move is its travel.
+    to_fixed_stop: bool,
 }
 
 impl ProgramRun {
@@ -40,6 +43,7 @@ impl ProgramRun {
             end: None,
             messages: VecDeque::new(),
             measuring: None,
+            to_fixed_stop: false,
         }
     }
 
@@ -58,6 +62,7 @@ impl ProgramRun {
             end: None,
             messages: VecDeque::new(),
             measuring: None,
+            to_fixed_stop: false,
         }
     }
 
@@ -113,8 +118,15 @@ impl ProgramRun {
                 Some(canon) => {
                     self.sent += 1;
                     count += 1;
-                    if matches!(canon.command, Command::Probe { .. }) {
+                    let moves = canon.command.end().is_some();
+                    if matches!(canon.command, Command::Probe { .. })
+                        || (self.to_fixed_stop && moves)
+                    {
                         self.measuring = Some(self.sent);
+                        self.to_fixed_stop = false;
+                    }
+                    if matches!(canon.command, Command::FixedStop { on: true, .. }) {
+                        self.to_fixed_stop = true;
                     }
                     if canon.command == Command::ProgramEnd {
                         self.end = Some(self.sent);
@@ -128,26 +140,25 @@ impl ProgramRun {
         Ok(count)
     }
 
-    /// Measuring blocks wait for motion's result before the program reads on (the stream of
-    /// a machine; a simulation takes the probe as switching at the line's end: D116).
-    pub fn measure_on_machine(&mut self) {
-        self.interp.measure_on_machine(true);
+    /// Blocks whose end the machine decides wait for motion's result before the program
+    /// reads on (the stream of a machine; a simulation takes the event as coming at the
+    /// move's end: D116, D118).
+    pub fn on_machine(&mut self) {
+        self.interp.on_machine(true);
     }
 
-    /// The measuring block whose result the program waits for.
-    pub fn awaiting_measurement(&self) -> Option<u64> {
-        self.measuring
-            .filter(|_| self.interp.awaiting_measurement())
+    /// The block whose result the program waits for.
+    pub fn awaiting_machine(&self) -> Option<u64> {
+        self.measuring.filter(|_| self.interp.awaiting_machine())
     }
 
-    /// Motion's result of measuring block `seq`; one of another block is not this program's
-    /// to take.
-    pub fn measured(&mut self, seq: u64, m: Measurement) -> Result<(), ProgramError> {
-        if self.awaiting_measurement() != Some(seq) {
+    /// Motion's result of block `seq`; one of another block is not this program's to take.
+    pub fn machine_result(&mut self, seq: u64, m: Measurement) -> Result<(), ProgramError> {
+        if self.awaiting_machine() != Some(seq) {
             return Ok(());
         }
         self.measuring = None;
-        self.interp.measured(m)
+        self.interp.machine_result(m)
     }
 
     /// Every command of the program has been sent.

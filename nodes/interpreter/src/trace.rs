@@ -81,6 +81,19 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             let rest = if *stop { "STOP" } else { "TO_END" };
             let _ = write!(s, " F{feed:.4} {edge} {rest}");
         }
+        Command::FixedStop {
+            axis,
+            on,
+            torque,
+            window,
+        } => {
+            let letter = letters.get(usize::from(*axis)).copied().unwrap_or('?');
+            if *on {
+                let _ = write!(s, "FIXED_STOP {letter} TORQUE{torque}% WINDOW{window}");
+            } else {
+                let _ = write!(s, "FIXED_STOP_OFF {letter}");
+            }
+        }
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
         }
@@ -384,10 +397,11 @@ impl LinuxCnc {
             }
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
             // rs274 has no call for the acceleration profile (its planner's is fixed), the
-            // drives' feedforward or an acceleration override.
+            // drives' feedforward, an acceleration override or a fixed stop.
             Command::Profile { .. }
             | Command::Feedforward { .. }
-            | Command::Acceleration { .. } => {}
+            | Command::Acceleration { .. }
+            | Command::FixedStop { .. } => {}
         }
     }
 }

@@ -28,7 +28,7 @@ struct OnMachine {
 impl OnMachine {
     fn new(text: &str) -> Self {
         let mut front = Sinumerik::new(text, mill_g54(), Library::new());
-        front.core.measure_on_machine = true;
+        front.core.on_machine = true;
         OnMachine { front }
     }
 
@@ -44,10 +44,10 @@ impl OnMachine {
         }
     }
 
-    fn measured(&mut self, triggered: bool, position: [f64; 3], rest: [f64; 3]) {
+    fn machine_result(&mut self, triggered: bool, position: [f64; 3], rest: [f64; 3]) {
         self.front
             .core
-            .measured(Measurement {
+            .machine_result(Measurement {
                 triggered,
                 position: position.to_vec(),
                 rest: rest.to_vec(),
@@ -83,11 +83,11 @@ fn f032_measures_along_its_line_and_waits_for_the_machine() {
     let (end, feed, rising, stop) = probe_of(out.last().expect("a command"));
     assert_eq!(end, vec![400.0, 0.0, -60.0]);
     assert_eq!((feed, rising, stop), (4000.0, true, true));
-    assert!(m.front.core.awaiting_measurement());
+    assert!(m.front.core.awaiting_machine());
     assert!(m.commands().expect("still waiting").is_empty());
     // The probe switched at machine X250 Z−20 (work X150 Z0) and the axes rested a little
     // further on.
-    m.measured(true, [250.0, 0.0, -20.0], [250.4, 0.0, -20.1]);
+    m.machine_result(true, [250.0, 0.0, -20.0], [250.4, 0.0, -20.1]);
     let rest = m.commands().expect("no alarm");
     assert_eq!(m.front.r(5), 150.0);
     assert_eq!(m.front.r(6), 0.0);
@@ -102,7 +102,7 @@ fn f032_measures_along_its_line_and_waits_for_the_machine() {
 fn f032_jumps_to_its_error_label_when_the_probe_does_not_switch() {
     let mut m = OnMachine::new(&f032());
     m.commands().expect("no alarm");
-    m.measured(false, [300.0, 0.0, -40.0], [300.0, 0.0, -40.0]);
+    m.machine_result(false, [300.0, 0.0, -40.0], [300.0, 0.0, -40.0]);
     let rest = m.commands().expect("no alarm");
     assert_eq!(
         rest.first(),
@@ -137,7 +137,7 @@ fn meaw_and_the_falling_edge_and_the_two_coordinate_systems_under_a_frame() {
     // Work X20 Y0 under the frame: machine X 100 + 10, Y 50 + 20 (Z stays at 100).
     assert!(near(&end, &[110.0, 70.0, 100.0]), "{end:?}");
     assert_eq!((rising, stop), (false, false));
-    m.measured(true, [110.0, 62.5, 100.0], [110.0, 70.0, 100.0]);
+    m.machine_result(true, [110.0, 62.5, 100.0], [110.0, 70.0, 100.0]);
     m.commands().expect("no alarm");
     assert_eq!((m.front.r(1), m.front.r(2)), (110.0, 62.5));
     // Back through the frame: 12.5 along the rotated X, nothing across it.
@@ -154,9 +154,9 @@ fn a_probe_that_did_not_switch_leaves_the_last_measured_values() {
     let text = "MEAS=1 G1 Z50 F100\nR1=$AA_MM[Z]\nMEAS=1 G1 Z0\nR2=$AA_MM[Z] R3=$AC_MEA[1]\nM30\n";
     let mut m = OnMachine::new(text);
     m.commands().expect("no alarm");
-    m.measured(true, [0.0, 0.0, 60.0], [0.0, 0.0, 59.8]);
+    m.machine_result(true, [0.0, 0.0, 60.0], [0.0, 0.0, 59.8]);
     m.commands().expect("no alarm");
-    m.measured(false, [0.0, 0.0, -20.0], [0.0, 0.0, -20.0]);
+    m.machine_result(false, [0.0, 0.0, -20.0], [0.0, 0.0, -20.0]);
     m.commands().expect("no alarm");
     assert_eq!(
         (m.front.r(1), m.front.r(2), m.front.r(3)),

@@ -72,6 +72,18 @@ pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
                 }
             })
             .collect(),
+        fixed_stops: cfg
+            .machine
+            .axes
+            .iter()
+            .map(|a| {
+                cfg.sim
+                    .fixed_stops
+                    .iter()
+                    .find(|s| s.axis == a.name)
+                    .map(|s| s.at * a.scale())
+            })
+            .collect(),
     }
 }
 

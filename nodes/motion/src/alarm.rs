@@ -44,3 +44,9 @@ pub const OVERTRAVEL_MINUS: u32 = 66;
 /// (the SINUMERIK family's 21700 "probe already deflected, edge cannot be detected"; the
 /// other manuals have none: decisions D116).
 pub const PROBE_DEFLECTED: u32 = 21700;
+/// A travel to a fixed stop whose move ended without meeting it (`001` §9.3.23, "未到达固定
+/// 挡块", D118).
+pub const FIXED_STOP_NOT_REACHED: u32 = 20091;
+/// An axis clamped at its fixed stop left the monitoring window (`001` §9.3.23, "固定挡块
+/// 损坏", D118).
+pub const FIXED_STOP_ABORTED: u32 = 20094;

@@ -21,7 +21,7 @@ use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::motion::alarm;
-use crate::motion::{ProbeInput, ProbeResult, ReferenceInputs};
+use crate::motion::{BlockResult, ProbeInput, ReferenceInputs};
 use crate::servo::{LateWatch, Lateness, ServoStatistics};
 use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 
@@ -40,7 +40,7 @@ enum Input {
 enum Report {
     /// The status, and the last measuring block's result with the machine's axis count (its
     /// vectors are filled here, off the servo thread).
-    Status(MotionStatus, Option<(ProbeResult, usize)>),
+    Status(MotionStatus, Option<(BlockResult, usize)>),
     /// A tick later than the warning limit (its interval, µs), or the warning cleared.
     Late(Option<f64>),
     /// Commanded and actual slide positions.
@@ -183,10 +183,10 @@ fn dds_loop(
             match from_servo.try_recv() {
                 Ok(Report::Status(mut s, probe)) => {
                     if let Some((p, n)) = probe {
-                        s.probe_seq = p.seq;
-                        s.probe_triggered = p.triggered;
-                        s.probe_position = p.position[..n].to_vec();
-                        s.probe_rest = p.rest[..n].to_vec();
+                        s.result_seq = p.seq;
+                        s.result_triggered = p.triggered;
+                        s.result_position = p.position[..n].to_vec();
+                        s.result_rest = p.rest[..n].to_vec();
                     }
                     publish(&status_pub, s)
                 }
@@ -493,14 +493,15 @@ fn servo_loop(
         f_out.send(fi)?;
         seq += 1;
         let computed = monotonic_ns();
-        setpoints.send(ServoSetpoint {
+        let mut out = ServoSetpoint {
             seq,
             sent_ns: monotonic_ns(),
             position: setpoint,
             axis_count: n as u32,
-            enable: u32::from(motion.servo_enabled()),
-            spindle_acceleration_percent: motion.spindle_acceleration_percent(),
-        })?;
+            ..ServoSetpoint::default()
+        };
+        motion.fill_setpoint(&mut out);
+        setpoints.send(out)?;
         // The answer to this setpoint, within half a period; a late answer to an earlier one
         // still updates the position but is not a round trip of this tick.
         have_feedback = false;
@@ -546,7 +547,7 @@ fn servo_loop(
             motion.done_seq(),
             motion.state(),
             motion.line(),
-            motion.probe_result().copied(),
+            motion.block_result().copied(),
         );
         if last_status != Some(status) || seq.is_multiple_of(25) {
             last_status = Some(status);

@@ -101,7 +101,7 @@ fn meas_latches_the_face_brakes_and_drops_the_rest_of_the_line() {
     ));
     let trace = run_over(&mut m, &mut face, 20_000);
     assert_eq!(m.state(), RunState::Idle);
-    let r = *m.probe_result().expect("a result");
+    let r = *m.block_result().expect("a result");
     assert_eq!(r.seq, 1);
     assert!(r.triggered);
     // Latched at the face exactly, not where a period ended.
@@ -124,7 +124,7 @@ fn meaw_latches_the_face_and_runs_the_line_to_its_end() {
     let mut face = Face::new(FACE, &start);
     m.push(probe(1, [4.0, 0.0, -10.0], true, false));
     let trace = run_over(&mut m, &mut face, 20_000);
-    let r = *m.probe_result().expect("a result");
+    let r = *m.block_result().expect("a result");
     assert!(r.triggered);
     assert!((r.position[2] - FACE).abs() < 1e-9);
     // On the line from (0, 10) to (4, −10), Z 2.5 is at X 1.5.
@@ -140,7 +140,7 @@ fn a_probe_that_does_not_switch_reports_so_and_the_line_ends_as_programmed() {
     let mut face = Face::new(-50.0, &start);
     m.push(probe(1, [0.0, 0.0, 0.0], true, true));
     run_over(&mut m, &mut face, 20_000);
-    let r = *m.probe_result().expect("a result");
+    let r = *m.block_result().expect("a result");
     assert!(!r.triggered);
     assert_eq!(r.rest[..3], [0.0, 0.0, 0.0]);
     assert_eq!(r.position, r.rest);
@@ -154,7 +154,7 @@ fn a_falling_edge_is_where_the_stylus_comes_free() {
     let mut face = Face::new(FACE, &start);
     m.push(probe(1, [0.0, 0.0, 8.0], false, true));
     run_over(&mut m, &mut face, 20_000);
-    let r = *m.probe_result().expect("a result");
+    let r = *m.block_result().expect("a result");
     assert!(r.triggered);
     assert!((r.position[2] - FACE).abs() < 1e-9);
     assert!(
@@ -178,7 +178,7 @@ fn a_rising_edge_asked_of_a_deflected_probe_is_an_alarm_and_nothing_moves() {
         matches!(&events[..], [MotionEvent::Alarm { number, line: 10, .. }] if *number == alarm::PROBE_DEFLECTED),
         "{events:?}"
     );
-    assert!(m.probe_result().is_none());
+    assert!(m.block_result().is_none());
 }
 
 #[test]
@@ -199,7 +199,7 @@ fn a_measuring_line_is_cut_on_its_own_and_a_reset_forgets_it() {
     let trace = run_over(&mut m, &mut face, 20_000);
     // At the corner (X5 Z10) the axes stood: some tick's position is the corner itself.
     assert!(trace.iter().any(|p| p[..3] == [5.0, 0.0, 10.0]));
-    assert!(m.probe_result().is_some_and(|r| r.triggered && r.seq == 2));
+    assert!(m.block_result().is_some_and(|r| r.triggered && r.seq == 2));
     // A reset during a measuring block drops it without a result.
     m.push(Block {
         run_id: 2,
@@ -210,9 +210,9 @@ fn a_measuring_line_is_cut_on_its_own_and_a_reset_forgets_it() {
         let actual = m.commanded().to_vec();
         m.tick(Some(&actual), &g);
     }
-    assert!(m.probe_result().is_none());
+    assert!(m.block_result().is_none());
     m.reset();
     ticks(&mut m, &g, 10);
-    assert!(m.probe_result().is_none());
+    assert!(m.block_result().is_none());
     assert_eq!(m.state(), RunState::Idle);
 }

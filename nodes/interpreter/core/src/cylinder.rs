@@ -157,7 +157,7 @@ impl Core {
             }
             Command::Linear { end, feed } => {
                 let to = c.machine(&end, self.wall_along(&c, w1));
-                let feed = on_machine(feed, dist(from, &end), &start, &to);
+                let feed = machine_feed(feed, dist(from, &end), &start, &to);
                 self.push(Command::Linear { end: to, feed });
             }
             Command::Arc {
@@ -224,7 +224,7 @@ impl Core {
                     // The offset turns with the circle (around a corner, or off an arc).
                     let w = if k < n { rotate(w0, t * sweep) } else { w1 };
                     let q = c.machine(&p, self.wall_along(&c, w));
-                    let f = on_machine(feed, dist(&prev_bcs, &p), &prev, &q);
+                    let f = machine_feed(feed, dist(&prev_bcs, &p), &prev, &q);
                     self.push(Command::Linear {
                         end: q.clone(),
                         feed: f,
@@ -247,7 +247,7 @@ impl Core {
 
 /// The feed of a machine line from `a` to `b` that takes as long as `length` of developed
 /// path at `feed`.
-fn on_machine(feed: f64, length: f64, a: &[f64], b: &[f64]) -> f64 {
+fn machine_feed(feed: f64, length: f64, a: &[f64], b: &[f64]) -> f64 {
     let machine = dist(a, b);
     if length > 1e-12 && machine > 1e-12 {
         feed * machine / length

@@ -17,7 +17,7 @@ pub trait FrontEnd {
 }
 
 /// The next canonical command of `front`'s program; `Ok(None)` once the program has ended,
-/// or while it waits for a measuring move's result ([`Core::awaiting_measurement`]).
+/// or while it waits for the machine's result of a block ([`Core::awaiting_machine`]).
 pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>, ProgramError> {
     loop {
         let core = front.core_mut();
@@ -34,8 +34,8 @@ pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>
                 return Ok(Some(c));
             }
         }
-        // A measuring move's result decides where the program goes on from (`measure.rs`).
-        if core.done || core.awaiting_measurement {
+        // The machine's result of a block decides where the program goes on from (`measure.rs`).
+        if core.done || core.awaiting.is_some() {
             return Ok(None);
         }
         core.silent_blocks += 1;

@@ -1,24 +1,35 @@
-//! Measuring moves: a straight line during which the touch probe's edge latches every axis
-//! (MEAS/MEAW, a skip move). Where the axes end is the machine's to say: with delete
-//! distance to go they stop short of the line's end. So after a measuring move the program
-//! reads on only once the result has come ([`Core::measured`]); until then
-//! [`crate::next_command`] has nothing to give. Without a machine (a check, a simulation, a
-//! block search) the probe is taken as switching at the line's end, so the rest of the
-//! program is read as on a part that is where the program expects it (decisions D116).
+//! Blocks whose end the machine decides: a measuring move (a straight line during which the
+//! touch probe's edge latches every axis: MEAS/MEAW, a skip move) and a travel to a fixed
+//! stop (the move ends where the axis meets the stop). With delete distance to go the axes
+//! stop short of the programmed end, so the program reads on only once the machine's result
+//! has come ([`Core::machine_result`]); until then [`crate::next_command`] has nothing to
+//! give. Without a machine (a check, a simulation, a block search) the event is taken as
+//! coming at the move's end, so the rest of the program is read as on a part that is where
+//! the program expects it (decisions D116, D118).
 
+use crate::canon::Command;
 use crate::emit::MoveKind;
 use crate::error::{Fault, ProgramError};
 use crate::state::Core;
 
-/// A measuring move's result, in machine coordinates (X as diameter on a diameter axis).
+/// A block's result from the machine, in machine coordinates (X as diameter on a diameter
+/// axis).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measurement {
-    /// The probe switched during the move.
+    /// The event came: the probe switched, the fixed stop was reached.
     pub triggered: bool,
-    /// Every axis where the probe switched (where the axes came to rest if it did not).
+    /// Every axis at the event (where the axes came to rest if none came).
     pub position: Vec<f64>,
     /// Where the axes came to rest.
     pub rest: Vec<f64>,
+}
+
+/// What the program waits for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Awaited {
+    Measurement,
+    /// The travel of this axis to its fixed stop.
+    FixedStop(usize),
 }
 
 impl Core {
@@ -39,34 +50,85 @@ impl Core {
         }
         self.measurement = None;
         self.emit(end, MoveKind::Probe { feed, rising, stop })?;
-        if self.measure_on_machine {
-            self.awaiting_measurement = true;
-        } else {
-            self.measured_at = Some(self.pos.clone());
-            self.measurement = Some(Measurement {
-                triggered: true,
-                position: self.pos.clone(),
-                rest: self.pos.clone(),
-            });
+        self.await_machine(Awaited::Measurement)
+    }
+
+    /// A line to work position `end` at `feed` with `axis` travelling to its fixed stop,
+    /// its drive's torque limited to `torque` percent, then watched within `window`.
+    pub fn to_fixed_stop(
+        &mut self,
+        end: &[f64],
+        feed: f64,
+        axis: usize,
+        torque: f64,
+        window: f64,
+    ) -> Result<(), ProgramError> {
+        let axis_code = u8::try_from(axis)
+            .map_err(|_| self.fault(Fault::AxisAddress, "no such axis for a fixed stop"))?;
+        if self.comp.is_some() {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "travel to a fixed stop under radius compensation is not built: cancel it first",
+            ));
         }
+        self.push(Command::FixedStop {
+            axis: axis_code,
+            on: true,
+            torque,
+            window,
+        });
+        self.fixed_stops[axis] = 3;
+        self.emit(end, MoveKind::Feed(feed))?;
+        self.await_machine(Awaited::FixedStop(axis))
+    }
+
+    /// Lifts `axis`'s fixed stop before the move the caller emits next (which must leave it).
+    pub fn leave_fixed_stop(&mut self, axis: usize) -> Result<(), ProgramError> {
+        let axis_code = u8::try_from(axis)
+            .map_err(|_| self.fault(Fault::AxisAddress, "no such axis for a fixed stop"))?;
+        self.push(Command::FixedStop {
+            axis: axis_code,
+            on: false,
+            torque: 100.0,
+            window: 1.0,
+        });
+        self.fixed_stops[axis] = 0;
         Ok(())
     }
 
-    /// Whether a measuring move waits for its result.
-    pub fn awaiting_measurement(&self) -> bool {
-        self.awaiting_measurement
+    /// After a block whose end the machine decides: wait for its result, or without a
+    /// machine take the event as coming at the move's end.
+    fn await_machine(&mut self, what: Awaited) -> Result<(), ProgramError> {
+        if self.on_machine {
+            self.awaiting = Some(what);
+            Ok(())
+        } else {
+            let at = self.pos.clone();
+            self.awaiting = Some(what);
+            self.machine_result(Measurement {
+                triggered: true,
+                position: at.clone(),
+                rest: at,
+            })
+        }
     }
 
-    /// The machine's result of the measuring move: the program goes on from where the axes
-    /// came to rest. A result that does not name every axis with a number is an alarm.
-    pub fn measured(&mut self, m: Measurement) -> Result<(), ProgramError> {
+    /// Whether the program waits for the machine's result of a block.
+    pub fn awaiting_machine(&self) -> bool {
+        self.awaiting.is_some()
+    }
+
+    /// The machine's result of the block the program waits for: the program goes on from
+    /// where the axes came to rest. A result that does not name every axis with a number is
+    /// an alarm.
+    pub fn machine_result(&mut self, m: Measurement) -> Result<(), ProgramError> {
         let n = self.pos.len();
         let whole = |v: &[f64]| v.len() == n && v.iter().all(|x| x.is_finite());
         if !whole(&m.rest) || !whole(&m.position) {
             let e = self.fault(
                 Fault::OutOfRange,
                 format!(
-                    "the measurement names {} and {} axis values, the machine has {n}",
+                    "the machine's result names {} and {} axis values, the machine has {n}",
                     m.position.len(),
                     m.rest.len()
                 ),
@@ -77,11 +139,20 @@ impl Core {
             return Err(e);
         }
         self.pos.clone_from(&m.rest);
-        if m.triggered {
-            self.measured_at = Some(m.position.clone());
+        match self.awaiting.take() {
+            Some(Awaited::Measurement) => {
+                if m.triggered {
+                    self.measured_at = Some(m.position.clone());
+                }
+                self.measurement = Some(m);
+            }
+            Some(Awaited::FixedStop(axis)) => {
+                if let Some(s) = self.fixed_stops.get_mut(axis) {
+                    *s = if m.triggered { 1 } else { 2 };
+                }
+            }
+            None => {}
         }
-        self.measurement = Some(m);
-        self.awaiting_measurement = false;
         Ok(())
     }
 }

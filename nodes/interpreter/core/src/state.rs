@@ -172,13 +172,17 @@ pub struct Core {
     /// A block search runs the program without motion: what the machine's work counts
     /// (pieces on a tool) does not count again.
     pub searching: bool,
-    /// Measuring moves wait for the machine's result (a running cell); otherwise the probe is
-    /// taken as switching at the line's end (a check, a simulation, a block search: D116).
-    pub measure_on_machine: bool,
-    /// A measuring move has gone out and its result has not come: nothing is read on.
-    pub(crate) awaiting_measurement: bool,
+    /// Blocks whose end the machine decides (a measuring move, a travel to a fixed stop) wait
+    /// for its result (a running cell); otherwise their event is taken as coming at the
+    /// move's end (a check, a simulation, a block search: D116).
+    pub on_machine: bool,
+    /// Such a block has gone out and its result has not come: nothing is read on.
+    pub(crate) awaiting: Option<crate::measure::Awaited>,
     /// The last measuring move's result.
     pub measurement: Option<crate::measure::Measurement>,
+    /// Per axis, its travel to a fixed stop as the program sees it (0 none, 1 at the stop, 2
+    /// not reached, 3 selected: the manual's `$AA_FXS` values).
+    pub fixed_stops: Vec<u8>,
     /// Where the probe last switched (machine coordinates): a job in which it did not
     /// switch leaves it.
     pub measured_at: Option<Vec<f64>>,
@@ -241,8 +245,9 @@ impl Core {
             emitted: 0,
             operator_messages: Vec::new(),
             searching: false,
-            measure_on_machine: false,
-            awaiting_measurement: false,
+            on_machine: false,
+            awaiting: None,
+            fixed_stops: vec![0; n],
             measurement: None,
             measured_at: None,
             cylinder: None,

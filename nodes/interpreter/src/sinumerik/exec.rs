@@ -94,6 +94,8 @@ pub struct Words {
     pub cycle: Option<CycleCall>,
     /// TRACYL or TRAFOOF (§9.15).
     pub cylinder: Option<super::tracyl::CylinderWord>,
+    /// FXS[axis]=1 or =0: the axis and whether it is selected (§9.3.23).
+    pub fxs: Option<(usize, bool)>,
 }
 
 impl Words {
@@ -113,6 +115,7 @@ impl Words {
         self.call = None;
         self.cycle = None;
         self.cylinder = None;
+        self.fxs = None;
     }
 
     fn push_g(&mut self, n: u32) {
@@ -168,11 +171,10 @@ const TANG_ON_A_MILL: &str =
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 17] = [
+pub const NOT_BUILT: [(&str, &str); 16] = [
     ("COMPCAD", "the compressor is not built"),
     ("STOPFIFO", "fast-block buffering is not built"),
     ("STARTFIFO", "fast-block buffering is not built"),
-    ("FXS", "travel to fixed stop is not built"),
     // §9.3.13: "该功能不适用于铣削工艺" (D112).
     ("TANG", TANG_ON_A_MILL),
     ("TANGON", TANG_ON_A_MILL),
@@ -207,7 +209,8 @@ pub fn is_address(name: &str) -> bool {
         || NOT_BUILT.iter().any(|(k, _)| *k == name)
         || [
             "DEF", "IF", "GOTOF", "GOTOB", "MSG", "SET", "REP", "AC", "IC", "DC", "ACP", "ACN",
-            "PROC", "ACC", "TRAILON", "TRAILOF", "TRACYL", "TRAFOOF", "TRAFOFF",
+            "PROC", "ACC", "TRAILON", "TRAILOF", "TRACYL", "TRAFOOF", "TRAFOFF", "FXS", "FXST",
+            "FXSW",
         ]
         .contains(&name)
 }
@@ -341,6 +344,9 @@ impl Sinumerik {
                 }
                 if name == "ACC" {
                     return self.acceleration_override(index, value);
+                }
+                if ["FXS", "FXST", "FXSW"].contains(&name.as_ref()) {
+                    return self.fixed_stop_word(w, name, index, value);
                 }
                 if ["$MA_", "$MN_", "$MC_"].iter().any(|p| name.starts_with(p)) {
                     return Err(self.fault(

@@ -18,6 +18,7 @@ mod face;
 pub use exec::{g_group, NOT_BUILT, NOT_BUILT_G};
 pub mod expr;
 mod frames;
+mod fxs;
 pub mod lex;
 mod limits;
 mod milling_calls;
@@ -127,6 +128,10 @@ pub struct Sinumerik {
     block_start: Vec<f64>,
     /// The spindle is in position control (SPOS, M19, a tap) until M3/M4/M5 or the end.
     positioned: bool,
+    /// Per axis, the setting data of travel to a fixed stop: clamping torque (percent) and
+    /// monitoring window (FXST, FXSW; §9.3.23).
+    fxs_torque: Vec<f64>,
+    fxs_window: Vec<f64>,
     /// The direction of the last G331 (+1 the way M3 turns), which G332 reverses; 0: none.
     tap_hand: f64,
     /// G341: WAB comes down to the contour in the plane (else G340, in space).
@@ -196,6 +201,7 @@ impl Sinumerik {
         core.feed_on_contour = true;
         // The tool the machine holds stays active, with its first edge (§9.6.2).
         let tool = core.setup.active_tool;
+        let n = core.setup.axes.len();
         let mut front = Sinumerik {
             core,
             motion: Motion::Line,
@@ -234,6 +240,8 @@ impl Sinumerik {
             wab: None,
             block_entry: (Motion::Line, 0.0),
             moved_before: 0,
+            fxs_torque: vec![fxs::DEFAULT_TORQUE; n],
+            fxs_window: vec![fxs::DEFAULT_WINDOW; n],
         };
         front.apply_length();
         front
@@ -389,6 +397,15 @@ impl Sinumerik {
                 } else {
                     self.core.work_of(at)[i]
                 })
+            }
+            // §9.3.23: 0 not at a stop, 1 at it, 2 not reached, 3 selected.
+            "$AA_FXS" => {
+                let i = match idx {
+                    [Val::Str(a)] => self.axis_named(a),
+                    _ => None,
+                };
+                i.map(|i| f64::from(self.core.fixed_stops[i]))
+                    .ok_or_else(|| EvalError::new(Fault::AxisAddress, "$AA_FXS[axis]"))
             }
             "$AA_COUP_ACT" => {
                 let i = match idx {

@@ -250,6 +250,19 @@ impl Sinumerik {
                 "MEAS/MEAW measure during the block's move: program the axes to move",
             ));
         }
+        if probe.is_some() && w.fxs.is_some() {
+            return Err(self.fault(
+                Fault::IllegalWord,
+                "MEAS and FXS are not programmed in one block (§9.3.23)",
+            ));
+        }
+        if w.fxs.is_some() && !moves {
+            return Err(self.fault(
+                Fault::MissingWord,
+                "FXS is selected and deselected in the block of a move (§9.3.23)",
+            ));
+        }
+        self.check_clamped_axes(w)?;
         if !moves && wab.is_none() {
             return Ok(());
         }
@@ -285,6 +298,9 @@ impl Sinumerik {
         }
         if let Some((rising, stop)) = probe {
             return self.measuring_move(w, &here, &end, rising, stop);
+        }
+        if self.fixed_stop_move(w, moves, &end)? {
+            return Ok(());
         }
         if let Some(code) = wab {
             let (h, v) = self.core.plane_axes()?;

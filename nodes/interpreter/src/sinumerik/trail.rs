@@ -14,7 +14,11 @@ const MAX_LEADERS: usize = 2;
 
 impl Sinumerik {
     /// An axis named as an argument (`V`, `Y`): its index.
-    fn axis_argument(&self, what: &str, e: &Option<Expr>) -> Result<usize, ProgramError> {
+    pub(super) fn axis_argument(
+        &self,
+        what: &str,
+        e: &Option<Expr>,
+    ) -> Result<usize, ProgramError> {
         let name = match e {
             Some(Expr::Var(n, idx)) if idx.is_empty() => n.as_ref(),
             Some(Expr::Axis(n)) => n.as_ref(),

@@ -36,6 +36,8 @@ pub struct SimConfig {
     /// Where the touch probe's stylus is deflected (slide travel, machine coordinates); none:
     /// it never switches.
     pub probe: Vec<probe::Target>,
+    /// Per axis, a mechanical stop its slide cannot pass (slide travel, machine coordinates).
+    pub fixed_stops: Vec<Option<f64>>,
 }
 
 /// An incremental encoder and its reference dog, in slide travel (mm): the encoder counts
@@ -105,6 +107,8 @@ pub struct SimLathe {
     /// The handwheel's counter, four counts a detent (the encoder interface's 4× quadrature).
     handwheel_count: i32,
     probe: probe::Probe,
+    /// Per axis, the side of its fixed stop the slide is on (+1 above, −1 below).
+    stop_side: [f64; MAX_AXES],
 }
 
 impl SimLathe {
@@ -120,7 +124,14 @@ impl SimLathe {
                 encoder_offset[i] = position[i];
             }
         }
+        let mut stop_side = [1.0; MAX_AXES];
+        for (i, at) in cfg.fixed_stops.iter().enumerate().take(MAX_AXES) {
+            if let Some(at) = at {
+                stop_side[i] = if position[i] < *at { -1.0 } else { 1.0 };
+            }
+        }
         SimLathe {
+            stop_side,
             probe: probe::Probe::new(cfg.probe.clone()),
             devices: Devices::new(cfg.devices.clone()),
             cfg,
@@ -183,6 +194,7 @@ impl SimLathe {
                 };
             }
         }
+        let torque = self.fixed_stops(setpoint, &before, n);
         // A disabled drive starts interpolating from where its slide stands.
         let enabled = setpoint.enable != 0 && !self.emergency_stop;
         for i in 0..n {
@@ -246,6 +258,7 @@ impl SimLathe {
             spindle_rpm: self.spindle_rpm,
             spindle_angle_deg: self.spindle_angle(),
             handwheel_count: self.handwheel_count,
+            torque_percent: torque,
             ..ServoFeedback::default()
         };
         for (i, was) in before.iter().enumerate().take(n) {
@@ -312,6 +325,39 @@ impl SimLathe {
 }
 
 impl SimLathe {
+    /// The fixed stops: a slide that would pass its stop stands at it, and its drive, set
+    /// beyond, gives its torque limit against it; elsewhere the simulated drives carry no
+    /// load (torque 0). Returns each axis's torque, percent.
+    fn fixed_stops(
+        &mut self,
+        setpoint: &ServoSetpoint,
+        before: &[f64; MAX_AXES],
+        n: usize,
+    ) -> [f64; MAX_AXES] {
+        let mut torque = [0.0; MAX_AXES];
+        for (i, stop) in self.cfg.fixed_stops.iter().enumerate().take(n) {
+            let Some(at) = *stop else { continue };
+            let side = self.stop_side[i];
+            if (self.position[i] - at) * side < 0.0 || (before[i] - at) * side < 0.0 {
+                self.position[i] = at;
+            }
+            if self.position[i] != at {
+                self.stop_side[i] = (self.position[i] - at).signum();
+            }
+            let target = setpoint.position[i] + self.encoder_offset[i];
+            let pressing = self.position[i] == at && (target - at) * side < 0.0;
+            if pressing && setpoint.enable != 0 && !self.emergency_stop {
+                let limit = setpoint.torque_limit_percent[i];
+                torque[i] = if limit.is_finite() {
+                    limit.clamp(0.0, 100.0)
+                } else {
+                    100.0
+                };
+            }
+        }
+        torque
+    }
+
     /// The drive orients: asked to, with no direction commanded and no emergency stop.
     fn orienting(&self, yi: &YImage) -> bool {
         yi.get(y::SPINDLE_ORIENT)
@@ -345,6 +391,7 @@ mod tests {
                 encoders: vec![None, None],
                 overtravel: Vec::new(),
                 probe: Vec::new(),
+                fixed_stops: Vec::new(),
             },
             &[10.0, 20.0],
         )
@@ -567,6 +614,7 @@ mod tests {
                 encoders: vec![Some(e)],
                 overtravel: Vec::new(),
                 probe: Vec::new(),
+                fixed_stops: Vec::new(),
             },
             &[60.0],
         );
@@ -602,5 +650,53 @@ mod tests {
         sp.position[0] = 45.0;
         let fb = m.step(&sp, &YImage::default(), 0.004);
         assert_eq!((fb.marker, fb.marker_position[0] + 60.0), (1, 105.0));
+    }
+
+    /// A fixed stop (D118): the slide stands at it however far beyond the setpoint goes, its
+    /// drive gives the torque limit while set beyond it, and it leaves the stop the other way.
+    #[test]
+    fn a_slide_stands_at_its_fixed_stop_and_presses_with_the_torque_limit() {
+        let mut m = SimLathe::new(
+            SimConfig {
+                drive_lag: vec![0.008, 0.008],
+                spindle_acceleration: 2000.0,
+                at_speed_tolerance: 0.02,
+                devices: DeviceConfig::default(),
+                encoders: vec![None, None],
+                overtravel: Vec::new(),
+                probe: Vec::new(),
+                fixed_stops: vec![None, Some(15.0)],
+            },
+            &[10.0, 20.0],
+        );
+        let mut sp = ServoSetpoint {
+            enable: 1,
+            axis_count: 2,
+            ..Default::default()
+        };
+        sp.position[0] = 10.0;
+        sp.torque_limit_percent[1] = 12.3;
+        let mut fb = ServoFeedback::default();
+        for k in 1..=100 {
+            sp.position[1] = 20.0 - 0.1 * k as f64;
+            fb = m.step(&sp, &YImage::default(), 0.004);
+        }
+        assert_eq!(fb.position[1], 15.0, "stands at the stop");
+        assert_eq!(fb.torque_percent[1], 12.3);
+        assert_eq!(fb.torque_percent[0], 0.0);
+        // Set back above the stop: it leaves, and no torque is given.
+        sp.position[1] = 18.0;
+        for _ in 0..100 {
+            fb = m.step(&sp, &YImage::default(), 0.004);
+        }
+        assert!((fb.position[1] - 18.0).abs() < 1e-6);
+        assert_eq!(fb.torque_percent[1], 0.0);
+        // Without a torque limit (no FXS) the drive pushes with all it has.
+        sp.torque_limit_percent[1] = 100.0;
+        sp.position[1] = 10.0;
+        for _ in 0..100 {
+            fb = m.step(&sp, &YImage::default(), 0.004);
+        }
+        assert_eq!((fb.position[1], fb.torque_percent[1]), (15.0, 100.0));
     }
 }

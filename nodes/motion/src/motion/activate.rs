@@ -65,6 +65,7 @@ impl Motion {
             }
             Command::Linear { .. } | Command::Arc { .. } => {
                 let (seg, feed) = self.segment_for(block, &start)?;
+                self.approach_fixed_stops(block.seq);
                 self.planner.reset(start);
                 self.planner
                     .push(seg, feed, block.seq, block.line, !self.exact_stop, 0.0);
@@ -91,6 +92,10 @@ impl Motion {
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),
+            Command::FixedStop { .. } => {
+                self.fixed_stop_block(block)?;
+                Ok(Active::Dwell { remaining: 0.0 })
+            }
             // Feed mode, path mode, profile and feedforward were taken over when the block
             // was popped.
             Command::FeedMode { .. }

@@ -33,7 +33,7 @@ impl Motion {
             } else {
                 0.0
             };
-            self.encoder_setpoint[i] = self.drive[i] + lead - self.shift[i];
+            self.encoder_setpoint[i] = self.drive[i] + lead + self.press(i) - self.shift[i];
             self.last_drive[i] = self.drive[i];
         }
     }
@@ -54,6 +54,14 @@ impl Motion {
 
     /// The spindle drive's acceleration, percent of its rated (`ACC[S]`): sent to the drives
     /// with every setpoint.
+    /// What the drives get with this tick's positions: enable, the spindle's acceleration
+    /// share and the axes' torque limits (the node and the test rig send the same).
+    pub fn fill_setpoint(&self, sp: &mut cnc_msgs::servo::ServoSetpoint) {
+        sp.enable = u32::from(self.servo_enabled());
+        sp.spindle_acceleration_percent = self.spindle_acceleration_percent();
+        sp.torque_limit_percent = self.torque_limits();
+    }
+
     pub fn spindle_acceleration_percent(&self) -> f64 {
         self.spindle_acceleration * 100.0
     }

@@ -26,6 +26,7 @@ pub use panel::Panel;
 
 mod activate;
 mod feedforward;
+mod fixed_stop;
 pub mod handwheel;
 pub mod jog;
 mod overtravel;
@@ -35,7 +36,7 @@ mod reference;
 mod tapping;
 mod window;
 
-pub use probe::{ProbeInput, ProbeResult};
+pub use probe::ProbeInput;
 pub use reference::ReferenceInputs;
 
 /// Something the shell must publish.
@@ -46,6 +47,19 @@ pub enum MotionEvent {
         text: String,
         line: u32,
     },
+}
+
+/// A finished block whose end the machine decided (a measuring block, a travel to a fixed
+/// stop), in display units (X in diameter on a lathe): the interpreter reads on from `rest`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BlockResult {
+    pub seq: u64,
+    /// Its event came: the probe switched, the fixed stop was reached.
+    pub triggered: bool,
+    /// Every axis's machine position at the event (`rest` when none came).
+    pub position: Point,
+    /// Where the axes came to rest.
+    pub rest: Point,
 }
 
 /// Run state reported to the interpreter.
@@ -193,8 +207,10 @@ pub struct Motion {
     probe_input: ProbeInput,
     /// The measuring block under way.
     probing: Option<probe::Probing>,
-    /// The last measuring block's result in this run.
-    probe_result: Option<ProbeResult>,
+    /// The last block whose end the machine decided, in this run.
+    block_result: Option<BlockResult>,
+    /// Per axis, its travel to a fixed stop (FXS).
+    fixed_stops: Vec<Option<fixed_stop::FixedStop>>,
 }
 
 impl Motion {
@@ -217,9 +233,10 @@ impl Motion {
             .map(|a| "XYZABC".find(a.name.as_str()).filter(|_| a.name.len() == 1))
             .collect();
         Motion {
+            fixed_stops: vec![None; n],
             probe_input: ProbeInput::default(),
             probing: None,
-            probe_result: None,
+            block_result: None,
             referenced,
             shift: vec![0.0; n],
             encoder_setpoint: commanded.clone(),
@@ -333,7 +350,8 @@ impl Motion {
             self.block_stop = false;
             self.last_line = None;
             self.probing = None;
-            self.probe_result = None;
+            self.block_result = None;
+            self.release_fixed_stops();
             self.clear_strobe();
         }
         // Blocks of a run started during an emergency stop (before the PLC's first scan at
@@ -407,6 +425,7 @@ impl Motion {
         self.clear_strobe();
         self.reference = None;
         self.jog = None;
+        self.release_fixed_stops();
         self.handwheel.stop();
         self.commanded.clone_from(&self.actual);
         let here = self.commanded_point();
@@ -487,6 +506,11 @@ impl Motion {
             .map(|(_, a)| matches!(a, Active::Path | Active::Thread { .. }))
     }
 
+    /// The last block of this run whose end the machine decided, once it is done.
+    pub fn block_result(&self) -> Option<&BlockResult> {
+        self.block_result.as_ref()
+    }
+
     pub fn take_events(&mut self) -> Vec<MotionEvent> {
         std::mem::take(&mut self.events)
     }
@@ -555,6 +579,7 @@ impl Motion {
                 self.emergency_stop = true;
                 self.dead_run = self.run_id;
                 self.drop_run();
+                self.release_fixed_stops();
                 self.feed_hold = false;
                 self.cycle_stop = false;
                 self.block_stop = false;
@@ -594,6 +619,7 @@ impl Motion {
         }
         self.take_machine_lock();
         self.watch_probe();
+        self.watch_fixed_stops();
         let mut budget = 8; // blocks that can finish within one tick (zero-length moves, aux)
         while budget > 0 && !self.alarm {
             budget -= 1;
@@ -670,6 +696,7 @@ impl Motion {
             break;
         }
         self.finish_probing();
+        self.finish_fixed_stops();
         // Cycle stop: once the axes stand on the path, the rest of the run is dropped.
         if self.cycle_stop && self.stopped_on_path() {
             self.drop_run();
@@ -691,6 +718,10 @@ impl Motion {
             return;
         }
         let lagging = self.cfg.axes.iter().enumerate().find_map(|(i, a)| {
+            // At (or on its way to) a fixed stop the lag is the stop's doing.
+            if self.lag_allowed(i) {
+                return None;
+            }
             let lag = (self.drive[i] - self.actual[i]).abs();
             let limit = a.following_error_limit();
             (lag > limit).then(|| {
@@ -747,6 +778,7 @@ impl Motion {
         self.alarm = true;
         self.active = None;
         self.probing = None;
+        self.drop_fixed_stop_approaches();
         self.reference = None;
         self.jog = None;
         self.handwheel.stop();
@@ -866,7 +898,7 @@ impl Motion {
             Active::Path => {
                 let mut out = [0.0; MAX_AXES];
                 self.finished.clear();
-                let braking = self.probe_braking();
+                let braking = self.probe_braking() || self.fixed_stop_braking();
                 let end = self.planner.step(
                     hold || braking,
                     self.panel.feed_override,

@@ -49,26 +49,10 @@ pub(super) struct Probing {
     pub(super) braking: bool,
 }
 
-/// A finished measuring block's result, in display units (X in diameter on a lathe).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ProbeResult {
-    pub seq: u64,
-    pub triggered: bool,
-    /// Every axis's machine position at the edge (the rest position when none came).
-    pub position: Point,
-    /// Where the axes came to rest: the line's end, or short of it after a braked edge.
-    pub rest: Point,
-}
-
 impl Motion {
     /// The probe's input of this period's feedback.
     pub fn probe_input(&mut self, input: ProbeInput) {
         self.probe_input = input;
-    }
-
-    /// The result of the last measuring block of this run, once it is done.
-    pub fn probe_result(&self) -> Option<&ProbeResult> {
-        self.probe_result.as_ref()
     }
 
     /// Starts watching the probe for a measuring block; a rising edge cannot come while the
@@ -83,7 +67,7 @@ impl Motion {
                 "probe already deflected: its rising edge cannot be detected".into(),
             ));
         }
-        self.probe_result = None;
+        self.block_result = None;
         self.probing = Some(Probing {
             seq: block.seq,
             rising,
@@ -147,7 +131,7 @@ impl Motion {
             rest[i] = self.commanded[i] / a.scale();
             position[i] = p.latched.map_or(rest[i], |l| l[i] / a.scale());
         }
-        self.probe_result = Some(ProbeResult {
+        self.block_result = Some(BlockResult {
             seq: p.seq,
             triggered: p.latched.is_some(),
             position,

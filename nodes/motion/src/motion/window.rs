@@ -24,8 +24,11 @@ impl Motion {
     /// Path blocks waiting in the queue join the planner's window while it has room, so
     /// corners between them are blended and the speed carries over.
     pub(super) fn extend_chain(&mut self) -> Result<(), (u32, String, u32)> {
-        // A measuring line is cut on its own.
-        if !matches!(self.active, Some((_, Active::Path))) || self.probing.is_some() {
+        // A measuring line, and a move into a fixed stop, are cut on their own.
+        if !matches!(self.active, Some((_, Active::Path)))
+            || self.probing.is_some()
+            || self.fixed_stop_moving()
+        {
             return Ok(());
         }
         while self.planner.has_room() {

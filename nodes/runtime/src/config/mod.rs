@@ -186,6 +186,25 @@ mod tests {
         }
     }
 
+    /// The simulated machine's mechanical stops (D118): on a machine axis, within its travel.
+    #[test]
+    fn fixed_stops_are_on_an_axis_within_its_travel() {
+        let with = |stops: &str| {
+            let text = include_str!("../../../../launch_configs/sim_mill_802d.yaml").replacen(
+                "sim:\n",
+                &format!("sim:\n  fixed_stops: {stops}\n"),
+                1,
+            );
+            LaunchConfig::from_yaml(&text)
+        };
+        let cfg = with("[{axis: Z, at: 95.0}]").expect("a stop");
+        assert_eq!(cfg.sim.fixed_stops[0].at, 95.0);
+        for bad in ["[{axis: Q, at: 1.0}]", "[{axis: Z, at: 900.0}]"] {
+            let e = with(bad).unwrap_err();
+            assert!(e.contains("sim.fixed_stops[0]"), "{bad}: {e}");
+        }
+    }
+
     /// EXTCALL's drives (D110): one letter each, a folder taken from the config's folder.
     #[test]
     fn external_drives_are_letters_with_folders_from_the_configs_folder() {

@@ -361,6 +361,19 @@ pub struct SimConfig {
     /// switches.
     #[serde(default)]
     pub probe: Vec<ProbeTarget>,
+    /// Mechanical stops a slide cannot pass (a quill's workpiece, a clamp; FXS travels to
+    /// them): the axis by name and where its slide meets the stop, machine coordinates as
+    /// displayed. None: nothing stops a slide inside its travel.
+    #[serde(default)]
+    pub fixed_stops: Vec<FixedStopConfig>,
+}
+
+/// A mechanical stop of the simulated machine.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FixedStopConfig {
+    pub axis: String,
+    pub at: f64,
 }
 
 /// A box of the simulated probe's work: per axis its lower and upper bound.
@@ -399,6 +412,7 @@ impl Default for SimConfig {
             tool_magazine: false,
             client_inputs: true,
             probe: Vec::new(),
+            fixed_stops: Vec::new(),
         }
     }
 }
@@ -667,6 +681,18 @@ pub(super) fn validate(cfg: &super::LaunchConfig) -> Result<(), String> {
     cfg.network.validate()?;
     cfg.servo.validate()?;
     cfg.sim.validate()?;
+    for (k, stop) in cfg.sim.fixed_stops.iter().enumerate() {
+        let axis = cfg.machine.axes.iter().find(|a| a.name == stop.axis);
+        match axis {
+            Some(a) if stop.at.is_finite() && (a.min..=a.max).contains(&stop.at) => {}
+            _ => {
+                return Err(format!(
+                    "sim.fixed_stops[{k}]: {} at {} is no place within a machine axis's travel",
+                    stop.axis, stop.at
+                ))
+            }
+        }
+    }
     cfg.plc.validate()?;
     cfg.recorder.validate()?;
     cfg.realtime.validate()
