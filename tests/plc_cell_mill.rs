@@ -437,3 +437,54 @@ fn f044_z_travels_to_its_fixed_stop_and_clamps_with_the_programmed_torque() {
         "{events:?}"
     );
 }
+
+/// Fixture 041 (§9.3.20, D119) through motion: under COMPCAD the CAD points N60–N67 (its
+/// template line made one more point of the curve) are cut within the compressor's tolerance
+/// of every one of them, the STOPFIFO section starting once it is whole (the program's end
+/// queued), and the program ends at its G0 Z50.
+#[test]
+fn f041_compcad_cuts_the_cad_points_within_the_tolerance() {
+    // At F600 (the fixture's F10000 moves 0.67 mm a servo period) the path's samples lie
+    // close enough to measure it between them.
+    let text = fixture("041")
+        .replace("\n...\n", "\nN67 X44.326 Z32.196\n")
+        .replace("N20 G1 F10000", "N20 G1 F600");
+    let mut r = mill(&text);
+    let mut last: Option<Vec<f64>> = None;
+    let points = [
+        (30.0, 32.499),
+        (41.365, 32.5),
+        (43.115, 32.497),
+        (43.365, 32.477),
+        (43.556, 32.449),
+        (43.818, 32.387),
+        (44.076, 32.3),
+        (44.326, 32.196),
+    ];
+    let mut nearest = [f64::MAX; 8];
+    let ok = r.run_until(60.0, |r| {
+        let c = r.motion.commanded_display();
+        let a = last.replace(c.clone()).unwrap_or_else(|| c.clone());
+        // Each point's distance from this period's piece of path (X–Z).
+        let (dx, dz) = (c[0] - a[0], c[2] - a[2]);
+        let len2 = dx * dx + dz * dz;
+        for (k, (x, z)) in points.iter().enumerate() {
+            let t = if len2 > 0.0 {
+                (((x - a[0]) * dx + (z - a[2]) * dz) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let d = (a[0] + t * dx - x).hypot(a[2] + t * dz - z);
+            nearest[k] = nearest[k].min(d);
+        }
+        r.program_done()
+    });
+    assert!(ok, "events {:?}", r.events);
+    println!("nearest approach to each point: {nearest:?}");
+    assert!(nearest.iter().all(|d| *d <= 0.01), "{nearest:?}");
+    let end = r.motion.commanded_display();
+    assert!(
+        (end[0] - 44.326).abs() < 1e-9 && (end[2] - 50.0).abs() < 1e-9,
+        "{end:?}"
+    );
+}

@@ -70,6 +70,18 @@ pub enum Command {
         torque: f64,
         window: f64,
     },
+    /// The compressor on or off for the lines that follow: a run of short lines whose end
+    /// points lie on one circle is cut as its arc, within the compressor's tolerance. A run
+    /// starts with it off.
+    Compressor {
+        on: bool,
+    },
+    /// The look-ahead's buffer: `fill` (STOPFIFO) holds the blocks after it until the queue
+    /// is full, the buffer's end (`fill` false, STARTFIFO) or the program end is queued, so
+    /// the section runs without waiting for the interpreter.
+    Fifo {
+        fill: bool,
+    },
     Dwell {
         seconds: f64,
     },
@@ -261,6 +273,14 @@ pub fn to_motion_block(
             m.aux_value = *torque;
             m.lead = *window;
         }
+        Command::Compressor { on } => {
+            m.kind = MotionBlock::KIND_COMPRESSOR;
+            m.flag = *on;
+        }
+        Command::Fifo { fill } => {
+            m.kind = MotionBlock::KIND_FIFO;
+            m.flag = *fill;
+        }
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
@@ -397,6 +417,8 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
                 }
             }
         }
+        MotionBlock::KIND_COMPRESSOR => Command::Compressor { on: m.flag },
+        MotionBlock::KIND_FIFO => Command::Fifo { fill: m.flag },
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_PROFILE => Command::Profile {
@@ -505,6 +527,8 @@ mod tests {
                 torque: 12.3,
                 window: 2.0,
             },
+            Command::Compressor { on: true },
+            Command::Fifo { fill: true },
             Command::Dwell { seconds: 1.5 },
             Command::Tap {
                 end: vec![10.0, 10.0, -25.0],

@@ -232,6 +232,8 @@ ros_message! {
             KIND_ACCELERATION: u8 = 13,
             KIND_PROBE: u8 = 14,
             KIND_FIXED_STOP: u8 = 15,
+            KIND_COMPRESSOR: u8 = 16,
+            KIND_FIFO: u8 = 17,
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,

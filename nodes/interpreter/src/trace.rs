@@ -94,6 +94,12 @@ pub fn line(letters: &[char], c: &Canon) -> String {
                 let _ = write!(s, "FIXED_STOP_OFF {letter}");
             }
         }
+        Command::Compressor { on } => s.push_str(if *on {
+            "COMPRESSOR_ON"
+        } else {
+            "COMPRESSOR_OFF"
+        }),
+        Command::Fifo { fill } => s.push_str(if *fill { "FIFO_FILL" } else { "FIFO_RUN" }),
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
         }
@@ -397,11 +403,14 @@ impl LinuxCnc {
             }
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
             // rs274 has no call for the acceleration profile (its planner's is fixed), the
-            // drives' feedforward, an acceleration override or a fixed stop.
+            // drives' feedforward, an acceleration override, a fixed stop, the compressor or
+            // the look-ahead buffer.
             Command::Profile { .. }
             | Command::Feedforward { .. }
             | Command::Acceleration { .. }
-            | Command::FixedStop { .. } => {}
+            | Command::FixedStop { .. }
+            | Command::Compressor { .. }
+            | Command::Fifo { .. } => {}
         }
     }
 }

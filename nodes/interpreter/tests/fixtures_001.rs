@@ -466,7 +466,7 @@ const AS_PRINTED: [AsPrinted; 88] = [
     ("038", Some((12080, 8)), "template"),
     ("039", Some((12080, 9)), "template"),
     ("040", Some((12080, 8)), "template"),
-    ("041", Some((12140, 10)), "the compressor"),
+    ("041", Some((12080, 19)), "template"),
     ("042", Some((12550, 7)), "the 3-axis mill has no A"),
     ("043", Some((12080, 11)), "template"),
     ("044", Some((12080, 7)), "template"),

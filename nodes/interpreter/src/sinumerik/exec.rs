@@ -146,10 +146,33 @@ const ADDRESSES: [&str; 25] = [
 ];
 
 /// Keywords this front end runs.
-const KEYWORDS: [&str; 23] = [
-    "CIP", "CT", "TRANS", "ATRANS", "ROT", "AROT", "SCALE", "ASCALE", "MIRROR", "AMIRROR",
-    "STOPRE", "RET", "CFTCP", "CFC", "BRISK", "SOFT", "FFWOF", "COMPOF", "WALIMOF", "FENDNORM",
-    "MCALL", "WALIMON", "FFWON",
+const KEYWORDS: [&str; 26] = [
+    "CIP",
+    "CT",
+    "TRANS",
+    "ATRANS",
+    "ROT",
+    "AROT",
+    "SCALE",
+    "ASCALE",
+    "MIRROR",
+    "AMIRROR",
+    "STOPRE",
+    "RET",
+    "CFTCP",
+    "CFC",
+    "BRISK",
+    "SOFT",
+    "FFWOF",
+    "COMPOF",
+    "WALIMOF",
+    "FENDNORM",
+    "MCALL",
+    "WALIMON",
+    "FFWON",
+    "COMPCAD",
+    "STOPFIFO",
+    "STARTFIFO",
 ];
 
 const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
@@ -171,10 +194,7 @@ const TANG_ON_A_MILL: &str =
 
 /// Keywords of the manual this controller does not run, each with the reason (the alarm says
 /// it; the coverage table lists them).
-pub const NOT_BUILT: [(&str, &str); 16] = [
-    ("COMPCAD", "the compressor is not built"),
-    ("STOPFIFO", "fast-block buffering is not built"),
-    ("STARTFIFO", "fast-block buffering is not built"),
+pub const NOT_BUILT: [(&str, &str); 13] = [
     // §9.3.13: "该功能不适用于铣削工艺" (D112).
     ("TANG", TANG_ON_A_MILL),
     ("TANGON", TANG_ON_A_MILL),
@@ -762,6 +782,14 @@ impl Sinumerik {
                 }),
                 // The drives' feedforward (D106).
                 "FFWON" | "FFWOF" => self.core.push(Command::Feedforward { on: *k == "FFWON" }),
+                // The compressor, and the look-ahead buffer's fast section (D119).
+                "COMPCAD" | "COMPOF" => self.core.push(Command::Compressor {
+                    on: *k == "COMPCAD",
+                }),
+                "STOPFIFO" | "STARTFIFO" => {
+                    self.fifo = *k == "STOPFIFO";
+                    self.core.push(Command::Fifo { fill: self.fifo });
+                }
                 _ => {}
             }
         }

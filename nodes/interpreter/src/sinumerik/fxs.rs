@@ -143,6 +143,7 @@ impl Sinumerik {
                 "travel to a fixed stop is a G1 line here (not G0, circles or under TRACYL)",
             ));
         }
+        self.no_wait_in_fifo("FXS")?;
         let (torque, window) = (self.fxs_torque[axis], self.fxs_window[axis]);
         let feed = self.core.feed;
         self.core.to_fixed_stop(end, feed, axis, torque, window)?;

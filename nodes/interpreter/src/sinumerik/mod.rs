@@ -132,6 +132,9 @@ pub struct Sinumerik {
     /// monitoring window (FXST, FXSW; §9.3.23).
     fxs_torque: Vec<f64>,
     fxs_window: Vec<f64>,
+    /// Inside a STOPFIFO section: the machine runs it from its buffer, so no block in it may
+    /// wait for the machine (D119).
+    fifo: bool,
     /// The direction of the last G331 (+1 the way M3 turns), which G332 reverses; 0: none.
     tap_hand: f64,
     /// G341: WAB comes down to the contour in the plane (else G340, in space).
@@ -242,6 +245,7 @@ impl Sinumerik {
             moved_before: 0,
             fxs_torque: vec![fxs::DEFAULT_TORQUE; n],
             fxs_window: vec![fxs::DEFAULT_WINDOW; n],
+            fifo: false,
         };
         front.apply_length();
         front

@@ -424,10 +424,25 @@ impl Sinumerik {
                 "a measuring block takes no chamfer, rounding, approach or tapping",
             ));
         }
+        self.no_wait_in_fifo("MEAS/MEAW")?;
         let feed = self.rotary_feed(self.core.feed, here, end);
         self.core.measure(end, feed, rising, stop)?;
         // Where the line ends is the machine's to say: no tangent carries over.
         self.tangent = None;
+        Ok(())
+    }
+
+    /// A block whose end the machine decides waits for it: not inside a STOPFIFO section,
+    /// which the machine runs from its buffer without the interpreter (D119).
+    pub(super) fn no_wait_in_fifo(&self, what: &str) -> Result<(), ProgramError> {
+        if self.fifo {
+            return Err(self.fault(
+                Fault::NotSupported,
+                format!(
+                    "{what} waits for the machine: not inside a STOPFIFO section (STARTFIFO first)"
+                ),
+            ));
+        }
         Ok(())
     }
 

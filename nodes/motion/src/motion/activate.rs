@@ -66,6 +66,20 @@ impl Motion {
             Command::Linear { .. } | Command::Arc { .. } => {
                 let (seg, feed) = self.segment_for(block, &start)?;
                 self.approach_fixed_stops(block.seq);
+                // COMPCAD: this line and the ones queued after it, as one arc if they fit.
+                let fitted = match self.compressor && self.fixed_stops.iter().all(Option::is_none) {
+                    true => self.compress(&start, Some(block)),
+                    false => None,
+                };
+                if let Some((arc, feed, last, k)) = fitted {
+                    self.planner.reset(start);
+                    self.planner
+                        .push(arc, feed, last, block.line, !self.exact_stop, 0.0);
+                    for _ in 1..k {
+                        self.queue.pop_front();
+                    }
+                    return Ok(Active::Path);
+                }
                 self.planner.reset(start);
                 self.planner
                     .push(seg, feed, block.seq, block.line, !self.exact_stop, 0.0);
@@ -102,6 +116,8 @@ impl Motion {
             | Command::PathMode { .. }
             | Command::Profile { .. }
             | Command::Feedforward { .. }
+            | Command::Compressor { .. }
+            | Command::Fifo { .. }
             | Command::Acceleration { .. } => Ok(Active::Dwell { remaining: 0.0 }),
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
@@ -258,7 +274,7 @@ impl Motion {
     }
 
     /// A programmed feed in mm/min, from mm/rev under G99; the dry-run feed under dry run.
-    fn feed_mm_per_min(&self, feed: f64) -> Result<f64, (u32, String)> {
+    pub(super) fn feed_mm_per_min(&self, feed: f64) -> Result<f64, (u32, String)> {
         if self.panel.dry_run {
             Ok(self.cfg.dry_run_feed)
         } else if self.feed_per_rev {

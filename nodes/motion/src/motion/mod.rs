@@ -25,6 +25,7 @@ pub use crate::alarm;
 pub use panel::Panel;
 
 mod activate;
+mod compressor;
 mod feedforward;
 mod fixed_stop;
 pub mod handwheel;
@@ -211,6 +212,11 @@ pub struct Motion {
     block_result: Option<BlockResult>,
     /// Per axis, its travel to a fixed stop (FXS).
     fixed_stops: Vec<Option<fixed_stop::FixedStop>>,
+    /// COMPCAD: runs of lines on a circle are cut as its arc (D119).
+    compressor: bool,
+    /// STOPFIFO: the blocks after it wait until the queue is full or the section's end is
+    /// queued (D119).
+    fifo_fill: bool,
 }
 
 impl Motion {
@@ -233,6 +239,8 @@ impl Motion {
             .map(|a| "XYZABC".find(a.name.as_str()).filter(|_| a.name.len() == 1))
             .collect();
         Motion {
+            compressor: false,
+            fifo_fill: false,
             fixed_stops: vec![None; n],
             probe_input: ProbeInput::default(),
             probing: None,
@@ -352,6 +360,8 @@ impl Motion {
             self.probing = None;
             self.block_result = None;
             self.release_fixed_stops();
+            self.compressor = false;
+            self.fifo_fill = false;
             self.clear_strobe();
         }
         // Blocks of a run started during an emergency stop (before the PLC's first scan at
@@ -426,6 +436,8 @@ impl Motion {
         self.reference = None;
         self.jog = None;
         self.release_fixed_stops();
+        self.compressor = false;
+        self.fifo_fill = false;
         self.handwheel.stop();
         self.commanded.clone_from(&self.actual);
         let here = self.commanded_point();
@@ -628,6 +640,10 @@ impl Motion {
                 if self.cycle_stop || self.block_stop {
                     break;
                 }
+                // STOPFIFO: the section waits in the queue until it is whole or the queue full.
+                if self.fifo_fill && !self.fifo_ready() {
+                    break;
+                }
                 let Some(next_line) = self.queue.front().map(|b| b.line) else {
                     break;
                 };
@@ -648,6 +664,8 @@ impl Motion {
                         self.planner.set_shape(profile_shape(jerk_limited));
                     }
                     Command::Feedforward { on } => self.feedforward = on,
+                    Command::Compressor { on } => self.compressor = on,
+                    Command::Fifo { fill } => self.fifo_fill = fill,
                     Command::Acceleration { axis, percent } => {
                         self.set_acceleration_override(usize::from(axis), percent / 100.0);
                     }
@@ -705,6 +723,16 @@ impl Motion {
         }
         self.update_f();
         self.drive_setpoint();
+    }
+
+    /// Whether a STOPFIFO section may run: the queue is full, or the section's end or the
+    /// program's is in it.
+    fn fifo_ready(&self) -> bool {
+        self.queue.len() + 1 >= self.cfg.queue_capacity
+            || self
+                .queue
+                .iter()
+                .any(|b| matches!(b.kind, Command::Fifo { fill: false } | Command::ProgramEnd))
     }
 
     /// Whether the drives may be enabled: false after a drive fault until reset.

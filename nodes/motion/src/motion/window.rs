@@ -39,6 +39,23 @@ impl Motion {
             if self.panel.single_block && line != self.line {
                 break;
             }
+            // COMPCAD: lines on a circle join as its arc (D119).
+            let fitted = match (self.compressor, &next.kind) {
+                (true, Command::Linear { .. }) => self.compress(&self.planner.end(), None),
+                _ => None,
+            };
+            if let Some((arc, feed, last, k)) = fitted {
+                let last_line = self.queue.get(k - 1).map_or(line, |b| b.line);
+                self.planner
+                    .push(arc, feed, last, last_line, !self.exact_stop, 0.0);
+                for _ in 0..k {
+                    self.queue.pop_front();
+                }
+                continue;
+            }
+            let Some(next) = self.queue.front() else {
+                break;
+            };
             match &next.kind {
                 Command::Linear { .. } if !self.exact_stop => {
                     let start = self.planner.end();
@@ -76,6 +93,10 @@ impl Motion {
                 }
                 Command::Profile { jerk_limited } => {
                     self.planner.set_shape(super::profile_shape(*jerk_limited));
+                    self.planner.push_marker(seq, line);
+                }
+                Command::Compressor { on } => {
+                    self.compressor = *on;
                     self.planner.push_marker(seq, line);
                 }
                 _ => break,
