@@ -15,7 +15,8 @@ mod cycle_call;
 mod drilling;
 mod exec;
 mod face;
-pub use exec::{g_group, NOT_BUILT, NOT_BUILT_G};
+pub use exec::g_group;
+pub use names::{NOT_BUILT, NOT_BUILT_G};
 pub mod expr;
 mod frames;
 mod fxs;
@@ -24,6 +25,7 @@ mod limits;
 mod milling_calls;
 pub mod monitor;
 mod motion;
+mod names;
 mod pocket;
 mod rect_pocket;
 mod slots;
@@ -569,7 +571,7 @@ impl Sinumerik {
             ));
         }
         for v in &d.vars {
-            if !name_ok(&v.name) || exec::is_address(&v.name) || self.core.axis_named(&v.name) {
+            if !name_ok(&v.name) || names::is_address(&v.name) || self.core.axis_named(&v.name) {
                 return Err(self.fault(
                     Fault::Macro,
                     format!("{} cannot name a variable: 2–32 letters, digits or _, the first two letters, and no address or keyword", v.name),

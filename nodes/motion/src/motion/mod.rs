@@ -26,6 +26,7 @@ pub use panel::Panel;
 
 mod activate;
 mod compressor;
+mod drive_fault;
 mod feedforward;
 mod fixed_stop;
 pub mod handwheel;
@@ -34,6 +35,7 @@ mod overtravel;
 mod panel;
 mod probe;
 mod reference;
+mod signals;
 mod tapping;
 mod window;
 
@@ -740,48 +742,6 @@ impl Motion {
         !self.servo_off
     }
 
-    /// Compares each slide with the setpoint it was given (the one sent last tick).
-    fn check_following_error(&mut self) {
-        if self.servo_off {
-            return;
-        }
-        let lagging = self.cfg.axes.iter().enumerate().find_map(|(i, a)| {
-            // At (or on its way to) a fixed stop the lag is the stop's doing.
-            if self.lag_allowed(i) {
-                return None;
-            }
-            let lag = (self.drive[i] - self.actual[i]).abs();
-            let limit = a.following_error_limit();
-            (lag > limit).then(|| {
-                format!(
-                    "following error: {} lags its setpoint by {lag:.3} mm (limit {limit:.3})",
-                    a.name
-                )
-            })
-        });
-        if let Some(text) = lagging {
-            self.drive_fault(alarm::FOLLOWING_ERROR, text);
-        }
-    }
-
-    /// A drive fault: servo off, the run dropped, the setpoints held where the slides are
-    /// (`000` §11.2: servo alarms switch the servo off).
-    /// The servo loop cannot keep its period: the servo alarm, the axes stop where they are
-    /// and the servo is switched off, as for a drive fault (D57).
-    pub fn servo_overrun(&mut self, text: String) {
-        self.drive_fault(alarm::SERVO_OVERRUN, text);
-    }
-
-    fn drive_fault(&mut self, number: u32, text: String) {
-        let line = self.line;
-        self.raise(number, text, line);
-        self.queue.clear();
-        self.servo_off = true;
-        self.commanded.clone_from(&self.actual);
-        let here = self.commanded_point();
-        self.planner.reset(here);
-    }
-
     /// Forgets the queue and whatever is moving; the axes keep their commanded position.
     fn drop_run(&mut self) {
         self.queue.clear();
@@ -814,67 +774,6 @@ impl Motion {
         self.planner.reset(here);
         self.clear_strobe();
         self.events.push(MotionEvent::Alarm { number, text, line });
-    }
-
-    fn clear_strobe(&mut self) {
-        for b in [
-            f::MF,
-            f::SF,
-            f::TF,
-            f::HF,
-            f::DM00,
-            f::DM01,
-            f::DM02,
-            f::DM30,
-        ] {
-            self.f.set(b, false);
-        }
-    }
-
-    /// The NC's state signals (`000` App.2, inventory §9.4).
-    fn update_f(&mut self) {
-        let running = self.active.is_some() || !self.queue.is_empty();
-        let distributing = matches!(
-            self.active,
-            Some((
-                _,
-                Active::Path | Active::Thread { .. } | Active::Rapid { .. }
-            ))
-        );
-        let hold = self.state() == RunState::Hold;
-        for (k, r) in self.signal_axis.iter().zip(&self.referenced) {
-            if let Some(k) = *k {
-                self.f.set(f::zp(k), *r);
-            }
-        }
-        self.f.set(f::MREF, self.reference.is_some());
-        let all_locked = self.machine_locked();
-        let fi = &mut self.f;
-        fi.set(f::OP, running);
-        fi.set(f::STL, running && !hold);
-        fi.set(f::SPL, hold);
-        fi.set(f::SA, !self.servo_off);
-        fi.set(f::MA, !self.alarm && !self.servo_off);
-        fi.set(f::AL, self.alarm);
-        fi.set(f::DEN, !distributing);
-        fi.set(
-            f::CUT,
-            matches!(self.active, Some((_, Active::Path | Active::Thread { .. }))),
-        );
-        fi.set(
-            f::THRD,
-            matches!(self.active, Some((_, Active::Thread { .. }))),
-        );
-        fi.set(f::MCYC, true);
-        fi.set(f::MJ, self.mode == MachineState::MODE_JOG);
-        fi.set(f::MH, self.mode == MachineState::MODE_HANDWHEEL);
-        fi.set(f::MSBK, self.panel.single_block);
-        fi.set(f::DRUR, self.panel.dry_run);
-        fi.set(f::MMLK, all_locked);
-        fi.set(f::MAFL, self.panel.aux_lock);
-        fi.set(f::MBDT, self.panel.block_skip);
-        fi.set(f::RST, self.reset_ticks > 0);
-        self.reset_ticks = self.reset_ticks.saturating_sub(1);
     }
 
     /// The commanded slide position as a planner point.
