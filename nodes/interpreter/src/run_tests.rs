@@ -767,19 +767,26 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
     assert_eq!(raised, [14011]);
 }
 
-/// A measuring block (MEAS, D116): the run sends it and nothing after it until motion's
-/// status carries its result; the program then reads on from where the axes came to rest.
-#[test]
-fn a_measuring_block_holds_the_program_until_motion_reports_its_result() {
+/// An 802D mill at X0 Y0 Z100 running `program`, its run numbered 11.
+fn mill_running(program: &str) -> RunCore {
     let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0, 0.0, 100.0]);
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 10);
-    let program = "G90 G0 X0 Y0 Z10\nMEAS=1 G1 Z-20 F300\nR5=$AA_MW[Z]\n\
-                   IF $AC_MEA[1]==0 GOTOF MISSED\nG1 X10 F500\nM30\nMISSED: M0\nM30\n";
     assert!(command(&mut c, 1, ProgramCommand::LOAD, "PROBE.MPF", program).accepted);
     c.plc_scanned();
     c.axes(&[0.0, 0.0, 100.0]);
     assert!(command(&mut c, 2, ProgramCommand::START, "PROBE.MPF", "").accepted);
     c.motion_status(status(0, 0, 64, MotionStatus::STATE_IDLE));
+    c
+}
+
+/// A measuring block (MEAS, D116): the run sends it and nothing after it until motion's
+/// status carries its result; the program then reads on from where the axes came to rest.
+#[test]
+fn a_measuring_block_holds_the_program_until_motion_reports_its_result() {
+    let mut c = mill_running(
+        "G90 G0 X0 Y0 Z10\nMEAS=1 G1 Z-20 F300\nR5=$AA_MW[Z]\n\
+         IF $AC_MEA[1]==0 GOTOF MISSED\nG1 X10 F500\nM30\nMISSED: M0\nM30\n",
+    );
     c.step();
     let sent = c.take_effects();
     let kinds: Vec<u8> = blocks(&sent).iter().map(|b| b.kind).collect();
@@ -819,14 +826,7 @@ fn a_measuring_block_holds_the_program_until_motion_reports_its_result() {
 /// A result that does not fit the machine ends the run with an alarm.
 #[test]
 fn a_measurement_that_does_not_fit_the_machine_is_an_alarm() {
-    let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0, 0.0, 100.0]);
-    let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 10);
-    let program = "MEAS=-1 G1 Z-20 F300\nG1 X10\nM30\n";
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PROBE.MPF", program).accepted);
-    c.plc_scanned();
-    c.axes(&[0.0, 0.0, 100.0]);
-    assert!(command(&mut c, 2, ProgramCommand::START, "PROBE.MPF", "").accepted);
-    c.motion_status(status(0, 0, 64, MotionStatus::STATE_IDLE));
+    let mut c = mill_running("MEAS=-1 G1 Z-20 F300\nG1 X10\nM30\n");
     c.step();
     let seq = blocks(&c.take_effects()).last().map_or(0, |b| b.seq);
     c.motion_status(MotionStatus {

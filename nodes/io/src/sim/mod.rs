@@ -381,20 +381,22 @@ fn spindle_command(yi: &YImage) -> f64 {
 mod tests {
     use super::*;
 
+    /// Two axes with an 8 ms lag and absolute encoders, nothing else.
+    fn config() -> SimConfig {
+        SimConfig {
+            drive_lag: vec![0.008, 0.008],
+            spindle_acceleration: 2000.0,
+            at_speed_tolerance: 0.02,
+            devices: DeviceConfig::default(),
+            encoders: vec![None, None],
+            overtravel: Vec::new(),
+            probe: Vec::new(),
+            fixed_stops: Vec::new(),
+        }
+    }
+
     fn sim() -> SimLathe {
-        SimLathe::new(
-            SimConfig {
-                drive_lag: vec![0.008, 0.008],
-                spindle_acceleration: 2000.0,
-                at_speed_tolerance: 0.02,
-                devices: DeviceConfig::default(),
-                encoders: vec![None, None],
-                overtravel: Vec::new(),
-                probe: Vec::new(),
-                fixed_stops: Vec::new(),
-            },
-            &[10.0, 20.0],
-        )
+        SimLathe::new(config(), &[10.0, 20.0])
     }
 
     #[test]
@@ -658,14 +660,8 @@ mod tests {
     fn a_slide_stands_at_its_fixed_stop_and_presses_with_the_torque_limit() {
         let mut m = SimLathe::new(
             SimConfig {
-                drive_lag: vec![0.008, 0.008],
-                spindle_acceleration: 2000.0,
-                at_speed_tolerance: 0.02,
-                devices: DeviceConfig::default(),
-                encoders: vec![None, None],
-                overtravel: Vec::new(),
-                probe: Vec::new(),
                 fixed_stops: vec![None, Some(15.0)],
+                ..config()
             },
             &[10.0, 20.0],
         );
