@@ -395,6 +395,9 @@ enum Copies {
 /// timeout shorter than this does not cut the match short.
 const DISCOVERY_WAIT: Duration = Duration::from_secs(30);
 
+/// How often a wait for a server reads the match state again (see [`wait_for_server`]).
+const RECHECK: Duration = Duration::from_millis(250);
+
 /// Waits until this node has matched the service's server (its request reader and its reply
 /// writer), at most `timeout` (and at least [`DISCOVERY_WAIT`]). A request written before that
 /// match would be lost.
@@ -404,16 +407,26 @@ fn wait_for_server<Req: ros2_client::Message + 'static, Resp: ros2_client::Messa
     timeout: Duration,
 ) -> Result<(), String> {
     let timeout = timeout.max(DISCOVERY_WAIT);
-    let matched = smol::block_on(smol::future::or(
-        async {
-            client.wait_for_service(node).await;
-            true
-        },
-        async {
-            smol::Timer::after(timeout).await;
-            false
-        },
-    ));
+    let deadline = Instant::now() + timeout;
+    // ros2-client's wait hears of a match through a channel of 8 events that drops what does
+    // not fit, so in a burst of discovery (a cell starting, a busy host) the event of this
+    // match can be lost and the wait would run its whole time although the server matched
+    // (CI: "no server of the service found within 30 s"). A fresh wait reads the match state
+    // as it stands when made: the wait is made again every RECHECK.
+    let mut matched = false;
+    while !matched && Instant::now() < deadline {
+        let slice = RECHECK.min(deadline.saturating_duration_since(Instant::now()));
+        matched = smol::block_on(smol::future::or(
+            async {
+                client.wait_for_service(node).await;
+                true
+            },
+            async {
+                smol::Timer::after(slice).await;
+                false
+            },
+        ));
+    }
     if matched {
         Ok(())
     } else {
