@@ -131,9 +131,11 @@ impl Words {
             .get(n as usize / 64)
             .is_some_and(|w| w >> (n % 64) & 1 == 1)
     }
+    #[inline]
     pub fn key(&self, k: &str) -> bool {
         self.keys.contains(&k)
     }
+    #[inline]
     pub fn get(&self, a: &str) -> Option<f64> {
         self.addr.get(a).map(|v| v.0)
     }

@@ -83,6 +83,9 @@ impl Sinumerik {
 
     /// The block's axes may move: one at its stop moves only with its deselection.
     pub(super) fn check_clamped_axes(&self, w: &Words) -> Result<(), ProgramError> {
+        if !self.core.fixed_stops.contains(&1) {
+            return Ok(());
+        }
         for (&i, _) in w.axes.iter() {
             let leaving = w.fxs == Some((i, false));
             if self.core.fixed_stops.get(i) == Some(&1) && !leaving {

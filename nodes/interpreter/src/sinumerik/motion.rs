@@ -374,6 +374,9 @@ impl Sinumerik {
     /// `MEAS=±1` / `MEAW=±1` (§9.3.12): the probe's rising (1) or falling (−1) edge of
     /// measuring input 1, with (MEAS) or without (MEAW) delete distance to go.
     fn measuring_words(&self, w: &Words) -> Result<Option<(bool, bool)>, ProgramError> {
+        if w.addr.is_empty() {
+            return Ok(None);
+        }
         let (value, stop) = match (w.get("MEAS"), w.get("MEAW")) {
             (None, None) => return Ok(None),
             (Some(_), Some(_)) => {

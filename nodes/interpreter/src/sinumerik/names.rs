@@ -41,6 +41,7 @@ pub(super) const KEYWORDS: [&str; 26] = [
 const LETTERS: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ";
 
 /// An address's name as a constant: one letter or one of [`ADDRESSES`].
+#[inline]
 pub(super) fn address_name(name: &str) -> Option<&'static str> {
     match name.as_bytes() {
         [c] if c.is_ascii_uppercase() => {
