@@ -129,6 +129,9 @@ fn what_cannot_travel_to_a_stop_is_an_alarm_with_its_number() {
         // At the stop the axis moves only with its deselection; no second selection.
         ("G1 F100 Z10 FXS[Z1]=1\nG1 Z20\n", 12080, 2),
         ("G1 F100 Z10 FXS[Z1]=1\nG1 Z5 FXS[Z1]=1\n", 12080, 2),
+        // Nothing may hold the move back: no chamfer or rounding at either end.
+        ("G1 F100 Z10 FXS[Z1]=1 RND=2\nX5\n", 12140, 1),
+        ("G1 F100 X10 RND=2\nZ10 FXS[Z1]=1\n", 12140, 2),
     ] {
         let r = run(&format!("{text}M30\n"));
         assert_eq!(r.alarm(), (alarm, line), "{text}: {:?}", r.error);

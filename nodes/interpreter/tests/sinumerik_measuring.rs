@@ -178,8 +178,9 @@ fn what_cannot_be_measured_is_an_alarm_with_its_number() {
         ("MEAS=1 G0 X10\n", 12140, 1),
         // Not under radius compensation.
         ("T1 D1\nG1 G41 X10 Y10 F100\nMEAS=1 X20\n", 12140, 3),
-        // No chamfer into the unknown.
+        // No chamfer into the unknown, nor one waiting for it.
         ("MEAS=1 G1 X10 F100 CHF=1\nX20\n", 12140, 1),
+        ("G1 X10 F100 CHF=1\nMEAS=1 Y20\n", 12140, 2),
         // Nothing measured yet.
         ("R1=$AA_MW[X]\n", 12550, 1),
         ("R1=$AC_MEA[2]\n", 17020, 1),

@@ -140,6 +140,14 @@ impl Sinumerik {
                 ),
             ));
         }
+        // The move goes out at once and the program waits for it: nothing may hold it back
+        // (a chamfer or rounding at its end waits for the next block, which is not read).
+        if self.corner.is_some() || self.core.holding() {
+            return Err(self.fault(
+                Fault::NotSupported,
+                "a travel to a fixed stop takes no chamfer or rounding, before or after it",
+            ));
+        }
         if self.motion != Motion::Line || self.core.cylinder.is_some() {
             return Err(self.fault(
                 Fault::NotSupported,

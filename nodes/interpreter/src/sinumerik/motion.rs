@@ -421,7 +421,7 @@ impl Sinumerik {
                 "MEAS/MEAW measure along a straight G1 line here (not G0, circles, ANG or threads)",
             ));
         }
-        if self.corner.is_some() || self.wab.is_some() || w.has_g(63) {
+        if self.corner.is_some() || self.wab.is_some() || w.has_g(63) || self.core.holding() {
             return Err(self.fault(
                 Fault::NotSupported,
                 "a measuring block takes no chamfer, rounding, approach or tapping",
