@@ -218,20 +218,25 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
 /// MEAS through the cell's nodes (D116): the io node's simulated probe finds a wall at
 /// machine X200, motion brakes there and reports the edge in its status over the machine
 /// bus, and the interpreter node, which waited for it, reads on: the program moves to
-/// X=R5−10, so the axes end at X190 only if the measured value came through.
+/// X=R5−10, so the axes end at X190 only if the measured value came through; and the
+/// interpreter node writes the MSG service's text with it to the machine's file (D120).
 #[test]
 fn a_measuring_block_runs_in_the_cell_and_the_program_goes_on_with_its_value() {
+    let dir = common::fresh_dir("sinumerik_cell_msg");
+    let msg_file = dir.join("msg.txt");
     let (cell, mut client, _) = start_with(PROBE_DOMAIN, |cfg| {
         cfg.sim.probe = vec![cnc_runtime::config::ProbeTarget {
             min: vec![200.0, -100.0, -100.0],
             max: vec![400.0, 100.0, 200.0],
         }];
+        cfg.machine.msg_file = Some(msg_file.clone());
     });
     client.wait_ready(Duration::from_secs(30)).expect("ready");
     let job = "N10 G17 G90 G500 G0 X0 Y0 Z100\n\
                N20 MEAS=1 G1 X300 F2000\n\
                N30 IF $AC_MEA[1]==0 GOTOF MISSED\n\
                N40 G0 X=$AA_MW[X]-10 Y20\n\
+               N45 MSG(\"File: wall at X\"<<$AA_MW[X])\n\
                N50 M2\n\
                N60 MISSED: M0\n\
                N70 M2\n";
@@ -241,4 +246,8 @@ fn a_measuring_block_runs_in_the_cell_and_the_program_goes_on_with_its_value() {
     completes_at(&mut client, Duration::from_secs(120), [190.0, 20.0, 100.0]);
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
+    // The MSG service's file output (§8.4.4, D120) has the measured value.
+    let written = std::fs::read_to_string(&msg_file).expect("the MSG service's file");
+    assert_eq!(written, "wall at X200\n");
+    let _ = std::fs::remove_dir_all(&dir);
 }

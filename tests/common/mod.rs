@@ -75,6 +75,7 @@ pub fn machine(name: &str, domain: u16) -> LaunchConfig {
     cfg.network.domain_id = Some(domain);
     cfg.plc.memory_file = None;
     cfg.machine.memory_file = None;
+    cfg.machine.msg_file = None;
     cfg.machine.position_file = None;
     cfg.machine.parameter_file = None;
     cfg.machine.program_directory = None;

@@ -5,7 +5,9 @@
 //! they are asked for, so the motion queue's credit decides how far ahead it reads. An error
 //! stops it for good: nothing after the bad line is produced, and nothing of the bad block.
 
-use cnc_interpreter_core::{next_command, Canon, Fault, Library, Measurement, ProgramError, Setup};
+use cnc_interpreter_core::{
+    next_command, Canon, Fault, Library, Measurement, ProgramError, ServiceOutput, Setup,
+};
 
 use crate::dialect::{Dialect, Engine};
 use crate::setup::Memory;
@@ -67,6 +69,12 @@ impl Interpreter {
     /// before it ([`cnc_interpreter_core::Core::operator_message`]).
     pub fn take_messages(&mut self) -> Vec<(u64, String)> {
         std::mem::take(&mut self.front.core_mut().operator_messages)
+    }
+
+    /// The message service's texts read since the last call, each with the number of
+    /// commands before it ([`cnc_interpreter_core::Core::service_message`]).
+    pub fn take_service_messages(&mut self) -> Vec<(u64, ServiceOutput, String)> {
+        std::mem::take(&mut self.front.core_mut().service_messages)
     }
 
     /// The kept variables and the offset page as the program has left them, for the shell to

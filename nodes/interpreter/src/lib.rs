@@ -19,6 +19,7 @@ pub mod interpreter;
 pub mod iso;
 pub mod library;
 pub mod mill;
+pub mod msg_service;
 pub mod node;
 pub mod offset_page;
 pub mod position;

@@ -33,6 +33,10 @@ pub use crate::run::{valid_program_name, MAX_MDI_BYTES, MAX_PROGRAMS, MAX_PROGRA
 
 /// The interpreter's view of the machine from the launch config: axes, reference point, tool
 /// post, the offset page and the work offsets; the program starts at `start`.
+/// A program's text for an output of the message service that is off (a warning: nothing
+/// else changes; our number, the manual has a prompt line, not an alarm).
+pub const MSG_SERVICE_OFF: u32 = 1096;
+
 pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     let letters = cfg.axis_letters();
     let mut setup = Setup::new(&letters, &cfg.diameter_axes(), start);
@@ -216,6 +220,8 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         position: keeper,
         tracker: PositionTracker::default(),
     };
+    let msg_file = cfg.machine.msg_file.clone();
+    let msg_file_kib = cfg.machine.msg_file_kib;
     let carry_out = |core: &mut RunCore| {
         for effect in core.take_effects() {
             match effect {
@@ -236,6 +242,31 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                     alarms.raise(alarms.alarm(number, Alarm::SEVERITY_ERROR, &text, &program, line))
                 }
                 Effect::Clear(number) => alarms.clear(number),
+                Effect::MessageService(output, text) => match (output, &msg_file) {
+                    (cnc_interpreter_core::ServiceOutput::File, Some(path)) => {
+                        if let Err(e) = crate::msg_service::append(path, &text, msg_file_kib) {
+                            log::error!("interpreter: MSG service file: {e}");
+                        }
+                    }
+                    // An interface that is off: nothing goes out, and the operator is told
+                    // ("发生 MSG 指令处理故障", `001` §8.4.4).
+                    (output, _) => alarms.raise(alarms.alarm(
+                        MSG_SERVICE_OFF,
+                        Alarm::SEVERITY_WARNING,
+                        &format!(
+                            "MSG instruction processing fault: the {} output is off on this \
+                             machine ({text:?} not sent)",
+                            match output {
+                                cnc_interpreter_core::ServiceOutput::File => {
+                                    "File (machine.msg_file)"
+                                }
+                                cnc_interpreter_core::ServiceOutput::Serial => "V24 (RS232)",
+                            }
+                        ),
+                        "",
+                        0,
+                    )),
+                },
                 Effect::StoreMemory => {
                     // Durable before the blocks that follow are published (write ahead).
                     if let Some(p) = memory_path.as_deref() {

@@ -53,6 +53,8 @@ pub enum Effect {
     /// The machine memory changed: store [`RunCore::memory`], durably, before carrying out
     /// the effects after it.
     StoreMemory,
+    /// Send a text through the message service's output (`001` §8.4.4), as its block runs.
+    MessageService(cnc_interpreter_core::ServiceOutput, String),
 }
 
 /// What `/machine_state` says, without its time stamp.
@@ -670,6 +672,9 @@ impl RunCore {
                 });
                 if let Some(m) = r.stream.message_due(done) {
                     self.message = m;
+                }
+                for (output, text) in r.stream.service_due(done) {
+                    self.effects.push(Effect::MessageService(output, text));
                 }
                 match sent {
                     Ok(n) => busy = n > 0,

@@ -845,3 +845,31 @@ fn a_measurement_that_does_not_fit_the_machine_is_an_alarm() {
             if text.contains("machine's result names 2 and 3 axis values"))));
     assert_eq!(c.execution(), MachineState::STOPPED);
 }
+
+/// The MSG service's text goes out as its block runs: once motion has finished the commands
+/// before it (D120).
+#[test]
+fn a_msg_service_text_goes_out_when_its_block_runs() {
+    let mut c = mill_running("G0 X10\nMSG(\"File: at X10\")\nG0 X20\nM30\n");
+    c.step();
+    let sent = c.take_effects();
+    let first = blocks(&sent)
+        .iter()
+        .find(|b| b.kind == MotionBlock::KIND_RAPID)
+        .map_or(0, |b| b.seq);
+    let service = |effects: &[Effect]| {
+        effects
+            .iter()
+            .filter(|e| matches!(e, Effect::MessageService(..)))
+            .count()
+    };
+    assert_eq!(service(&sent), 0, "not before X10 is reached");
+    c.motion_status(status(11, first - 1, 64, MotionStatus::STATE_RUNNING));
+    c.step();
+    assert_eq!(service(&c.take_effects()), 0);
+    c.motion_status(status(11, first, 64, MotionStatus::STATE_RUNNING));
+    c.step();
+    let effects = c.take_effects();
+    assert!(effects.iter().any(|e| matches!(e,
+        Effect::MessageService(cnc_interpreter_core::ServiceOutput::File, t) if t == "at X10")));
+}

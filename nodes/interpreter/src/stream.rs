@@ -5,7 +5,7 @@
 
 use std::collections::VecDeque;
 
-use cnc_interpreter_core::Measurement;
+use cnc_interpreter_core::{Measurement, ServiceOutput};
 
 use crate::{Canon, Command, Interpreter, ProgramError};
 
@@ -25,6 +25,8 @@ pub struct ProgramRun {
     end: Option<u64>,
     /// Operator messages read, each with the sequence number after which it shows.
     messages: VecDeque<(u64, String)>,
+    /// The message service's texts, each with the sequence number after which it goes out.
+    service: VecDeque<(u64, ServiceOutput, String)>,
     /// Sequence number of the last block sent whose end the machine decides (a measuring
     /// block, the move after a fixed stop's selection).
     measuring: Option<u64>,
@@ -42,6 +44,7 @@ impl ProgramRun {
             sent: 0,
             end: None,
             messages: VecDeque::new(),
+            service: VecDeque::new(),
             measuring: None,
             to_fixed_stop: false,
         }
@@ -61,6 +64,7 @@ impl ProgramRun {
             sent: 0,
             end: None,
             messages: VecDeque::new(),
+            service: VecDeque::new(),
             measuring: None,
             to_fixed_stop: false,
         }
@@ -85,6 +89,22 @@ impl ProgramRun {
             let seq = (before as i64 + shift).max(0) as u64;
             self.messages.push_back((seq, text));
         }
+        for (before, output, text) in self.interp.take_service_messages() {
+            let seq = (before as i64 + shift).max(0) as u64;
+            self.service.push_back((seq, output, text));
+        }
+    }
+
+    /// The message service's texts due once motion has finished block `done`, every one in
+    /// order (each goes out, where the display shows only the newest message).
+    pub fn service_due(&mut self, done: u64) -> Vec<(ServiceOutput, String)> {
+        let mut due = Vec::new();
+        while self.service.front().is_some_and(|(seq, _, _)| *seq <= done) {
+            if let Some((_, output, text)) = self.service.pop_front() {
+                due.push((output, text));
+            }
+        }
+        due
     }
 
     /// The program's own block number (from 1, as in an uninterrupted run) of this run's

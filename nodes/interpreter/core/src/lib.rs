@@ -42,7 +42,7 @@ pub use error::{AlarmTable, Fault, ProgramError};
 pub use flow::{CallLevel, Repeat};
 pub use measure::Measurement;
 pub use setup::{Offsets, Setup, ToolOffset};
-pub use state::{CompRules, Core, Coupling, CssRule, Plane, Rules, SpindleDir};
+pub use state::{CompRules, Core, Coupling, CssRule, Plane, Rules, ServiceOutput, SpindleDir};
 pub use text::{find_number, line_number, read_line, Library, Pos};
 pub use transform::{Frame, NO_WORK_OFFSET};
 pub use variables::Value;

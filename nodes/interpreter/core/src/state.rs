@@ -45,6 +45,15 @@ pub enum SpindleDir {
     Ccw,
 }
 
+/// Where the control's message service sends a program's text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ServiceOutput {
+    /// The serial line (RS232).
+    Serial,
+    /// A file of the machine's.
+    File,
+}
+
 /// What radius compensation allows and how its alarms name it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompRules {
@@ -169,6 +178,9 @@ pub struct Core {
     /// Messages a program shows the operator, each with the number of commands that
     /// come before it: it shows once the machine has finished those.
     pub operator_messages: Vec<(u64, String)>,
+    /// Texts a program sends out through the control's message service (a serial line, a
+    /// file), each with the number of commands before it, as `operator_messages`.
+    pub service_messages: Vec<(u64, ServiceOutput, String)>,
     /// A block search runs the program without motion: what the machine's work counts
     /// (pieces on a tool) does not count again.
     pub searching: bool,
@@ -244,6 +256,7 @@ impl Core {
             saw_end: false,
             emitted: 0,
             operator_messages: Vec::new(),
+            service_messages: Vec::new(),
             searching: false,
             on_machine: false,
             awaiting: None,
@@ -396,6 +409,12 @@ impl Core {
     pub fn operator_message(&mut self, text: String) {
         let before = self.emitted + self.pending.len() as u64;
         self.operator_messages.push((before, text));
+    }
+
+    /// A text for the message service's `output`, sent when the commands before it are done.
+    pub fn service_message(&mut self, output: ServiceOutput, text: String) {
+        let before = self.emitted + self.pending.len() as u64;
+        self.service_messages.push((before, output, text));
     }
 
     pub fn push(&mut self, command: Command) {

@@ -7,7 +7,7 @@
 use std::borrow::Borrow;
 use std::sync::Arc;
 
-use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, SpindleDir, Turn};
+use cnc_interpreter_core::{Aux, Command, Fault, ProgramError, ServiceOutput, SpindleDir, Turn};
 
 use super::block::{Block, Item};
 use super::cycle_call::{is_cycle, CycleCall};
@@ -407,6 +407,10 @@ impl Sinumerik {
                 [Some(e)] => self.value(e)?.text(),
                 _ => return Err(self.fault(Fault::MacroArgument, "MSG takes one text")),
             };
+            if let Some((output, text)) = service_output(&text) {
+                self.service_message(output, text);
+                return Ok(());
+            }
             // The display shows 65 characters (§9.1.6).
             let shown: String = text.chars().take(65).collect();
             self.messages.push((self.core.line, shown.clone()));
@@ -917,4 +921,31 @@ pub fn g_group(g: u32) -> Option<u8> {
         62 | 621 => 57,
         _ => return None,
     })
+}
+
+/// `MSG("V24: …")` and `MSG("File: …")` (`001` §8.4.4, tables 8-2, 8-5, 8-6; the table writes
+/// `FILE:` too): the message service's output and the text after the interface's name.
+fn service_output(text: &str) -> Option<(ServiceOutput, &str)> {
+    let (head, rest) = text.split_once(':')?;
+    let output = match head.trim().to_ascii_uppercase().as_str() {
+        "V24" => ServiceOutput::Serial,
+        "FILE" => ServiceOutput::File,
+        _ => return None,
+    };
+    Some((output, rest.trim_start()))
+}
+
+impl Sinumerik {
+    /// A text for the message service: sent unless it is the text this output sent last, which
+    /// goes out again only after an empty text for it (§8.4.4's note: "如果在零件程序中相同的信
+    /// 息文本重复出现，则在每次输出后必须输入空文本指令"). An empty text sends nothing.
+    fn service_message(&mut self, output: ServiceOutput, text: &str) {
+        let last = &mut self.service_last[output as usize];
+        if text.is_empty() {
+            *last = None;
+        } else if last.as_deref() != Some(text) {
+            *last = Some(text.to_string());
+            self.core.service_message(output, text.to_string());
+        }
+    }
 }

@@ -137,6 +137,8 @@ pub struct Sinumerik {
     /// Inside a STOPFIFO section: the machine runs it from its buffer, so no block in it may
     /// wait for the machine (D119).
     fifo: bool,
+    /// The text each output of the message service sent last (serial, file), §8.4.4.
+    service_last: [Option<String>; 2],
     /// The direction of the last G331 (+1 the way M3 turns), which G332 reverses; 0: none.
     tap_hand: f64,
     /// G341: WAB comes down to the contour in the plane (else G340, in space).
@@ -248,6 +250,7 @@ impl Sinumerik {
             fxs_torque: vec![fxs::DEFAULT_TORQUE; n],
             fxs_window: vec![fxs::DEFAULT_WINDOW; n],
             fifo: false,
+            service_last: [None, None],
         };
         front.apply_length();
         front

@@ -58,6 +58,7 @@ impl LaunchConfig {
             &mut m.tool_table,
             &mut m.memory_file,
             &mut m.position_file,
+            &mut m.msg_file,
             &mut m.program_directory,
             &mut m.parameter_file,
             &mut self.plc.program,
@@ -96,6 +97,9 @@ impl LaunchConfig {
         }
         if let Some(f) = &m.program_directory {
             out.push(("program memory", f.as_path()));
+        }
+        if let Some(f) = &m.msg_file {
+            out.push(("MSG service file", f.as_path()));
         }
         if let Some(f) = &m.parameter_file {
             out.push(("parameters", f.as_path()));

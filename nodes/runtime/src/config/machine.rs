@@ -38,6 +38,14 @@ pub struct MachineConfig {
     /// absent: not kept.
     #[serde(default)]
     pub position_file: Option<std::path::PathBuf>,
+    /// The message service's file (`001` §8.4.4, `MSG("File: …")`): a line per text, kept to
+    /// `msg_file_kib` by dropping its oldest lines (relative to the config file's folder);
+    /// absent: the file output is off.
+    #[serde(default)]
+    pub msg_file: Option<std::path::PathBuf>,
+    /// Its largest size: 10, 100 or 1024 KiB (the manual's choices).
+    #[serde(default = "default_msg_file_kib")]
+    pub msg_file_kib: u32,
     /// Program memory: a folder of plain program files, relative to the config file's
     /// folder ([`crate::program_store`]); absent: programs are kept for this run only.
     #[serde(default)]
@@ -340,6 +348,10 @@ impl AxisEntry {
 /// Time to ramp up to full acceleration when an axis names no jerk limit, s.
 pub const DEFAULT_JERK_TIME: f64 = 0.05;
 
+fn default_msg_file_kib() -> u32 {
+    10
+}
+
 fn default_in_position() -> f64 {
     0.0005
 }
@@ -350,6 +362,12 @@ fn default_drive_lag() -> f64 {
 impl MachineConfig {
     /// The machine section's own rules; an error names the setting and what it may be.
     pub(crate) fn validate(&self) -> Result<(), String> {
+        if ![10, 100, 1024].contains(&self.msg_file_kib) {
+            return Err(format!(
+                "machine.msg_file_kib {}: 10, 100 or 1024 (the MSG service's sizes)",
+                self.msg_file_kib
+            ));
+        }
         let ns = &self.namespace;
         if !DIALECTS.contains(&self.dialect.as_str()) {
             return Err(format!(

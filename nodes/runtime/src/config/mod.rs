@@ -205,6 +205,28 @@ mod tests {
         }
     }
 
+    /// The MSG service's file (D120): taken from the config's folder, one of the manual's
+    /// three sizes.
+    #[test]
+    fn the_msg_service_file_is_found_from_the_config_and_has_one_of_three_sizes() {
+        let text = include_str!("../../../../launch_configs/sim_mill.yaml");
+        let with = |kib: u32| {
+            let t = text.replacen(
+                "machine:\n",
+                &format!("machine:\n  msg_file: msg.txt\n  msg_file_kib: {kib}\n"),
+                1,
+            );
+            LaunchConfig::from_yaml_in(&t, std::path::Path::new("/cfg"), None)
+        };
+        let cfg = with(100).expect("a msg file");
+        assert_eq!(
+            cfg.machine.msg_file.as_deref(),
+            Some(std::path::Path::new("/cfg/msg.txt"))
+        );
+        let e = with(50).unwrap_err();
+        assert!(e.contains("msg_file_kib"), "{e}");
+    }
+
     /// EXTCALL's drives (D110): one letter each, a folder taken from the config's folder.
     #[test]
     fn external_drives_are_letters_with_folders_from_the_configs_folder() {
