@@ -49,9 +49,10 @@ impl Interpreter {
         self.front.core_mut().on_machine = on;
     }
 
-    /// A measuring move has gone out and the program waits for its result.
-    pub fn awaiting_machine(&self) -> bool {
-        self.front.core().awaiting_machine()
+    /// The number (from 1, among the program's commands) of the move whose result from the
+    /// machine the program waits for.
+    pub fn awaited_command(&self) -> Option<u64> {
+        self.front.core().awaited_command()
     }
 
     /// The machine's result of the measuring move the program waits for; an alarm (which

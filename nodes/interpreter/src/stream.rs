@@ -27,11 +27,6 @@ pub struct ProgramRun {
     messages: VecDeque<(u64, String)>,
     /// The message service's texts, each with the sequence number after which it goes out.
     service: VecDeque<(u64, ServiceOutput, String)>,
-    /// Sequence number of the last block sent whose end the machine decides (a measuring
-    /// block, the move after a fixed stop's selection).
-    measuring: Option<u64>,
-    /// A fixed stop's selection went out: the next move is its travel.
-    to_fixed_stop: bool,
 }
 
 impl ProgramRun {
@@ -45,8 +40,6 @@ impl ProgramRun {
             end: None,
             messages: VecDeque::new(),
             service: VecDeque::new(),
-            measuring: None,
-            to_fixed_stop: false,
         }
     }
 
@@ -65,8 +58,6 @@ impl ProgramRun {
             end: None,
             messages: VecDeque::new(),
             service: VecDeque::new(),
-            measuring: None,
-            to_fixed_stop: false,
         }
     }
 
@@ -84,15 +75,20 @@ impl ProgramRun {
     /// command is this run's `n + preamble − skipped`th (a restart's search ran the skipped
     /// ones without motion and the preamble came first).
     fn file_messages(&mut self) {
-        let shift = self.preamble as i64 - self.skipped as i64;
         for (before, text) in self.interp.take_messages() {
-            let seq = (before as i64 + shift).max(0) as u64;
+            let seq = self.run_seq(before);
             self.messages.push_back((seq, text));
         }
         for (before, output, text) in self.interp.take_service_messages() {
-            let seq = (before as i64 + shift).max(0) as u64;
+            let seq = self.run_seq(before);
             self.service.push_back((seq, output, text));
         }
+    }
+
+    /// This run's sequence number of the interpreter's `n`th command: shifted by the
+    /// preamble, less what a restart's search skipped.
+    fn run_seq(&self, n: u64) -> u64 {
+        (n as i64 + self.preamble as i64 - self.skipped as i64).max(0) as u64
     }
 
     /// The message service's texts due once motion has finished block `done`, every one in
@@ -138,16 +134,6 @@ impl ProgramRun {
                 Some(canon) => {
                     self.sent += 1;
                     count += 1;
-                    let moves = canon.command.end().is_some();
-                    if matches!(canon.command, Command::Probe { .. })
-                        || (self.to_fixed_stop && moves)
-                    {
-                        self.measuring = Some(self.sent);
-                        self.to_fixed_stop = false;
-                    }
-                    if matches!(canon.command, Command::FixedStop { on: true, .. }) {
-                        self.to_fixed_stop = true;
-                    }
                     if canon.command == Command::ProgramEnd {
                         self.end = Some(self.sent);
                     }
@@ -167,9 +153,9 @@ impl ProgramRun {
         self.interp.on_machine(true);
     }
 
-    /// The block whose result the program waits for.
+    /// The block whose result from the machine the program waits for.
     pub fn awaiting_machine(&self) -> Option<u64> {
-        self.measuring.filter(|_| self.interp.awaiting_machine())
+        self.interp.awaited_command().map(|n| self.run_seq(n))
     }
 
     /// Motion's result of block `seq`; one of another block is not this program's to take.
@@ -177,7 +163,6 @@ impl ProgramRun {
         if self.awaiting_machine() != Some(seq) {
             return Ok(());
         }
-        self.measuring = None;
         self.interp.machine_result(m)
     }
 

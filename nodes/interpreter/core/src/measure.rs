@@ -96,15 +96,16 @@ impl Core {
         Ok(())
     }
 
-    /// After a block whose end the machine decides: wait for its result, or without a
-    /// machine take the event as coming at the move's end.
+    /// After a block whose end the machine decides, its move the last command queued: wait
+    /// for its result, or without a machine take the event as coming at the move's end.
     fn await_machine(&mut self, what: Awaited) -> Result<(), ProgramError> {
+        // The move's number among the program's commands, from 1.
+        let number = self.emitted + self.pending.len() as u64;
+        self.awaiting = Some((what, number));
         if self.on_machine {
-            self.awaiting = Some(what);
             Ok(())
         } else {
             let at = self.pos.clone();
-            self.awaiting = Some(what);
             self.machine_result(Measurement {
                 triggered: true,
                 position: at.clone(),
@@ -116,6 +117,12 @@ impl Core {
     /// Whether the program waits for the machine's result of a block.
     pub fn awaiting_machine(&self) -> bool {
         self.awaiting.is_some()
+    }
+
+    /// The number (from 1, among the program's commands) of the move whose result the
+    /// program waits for.
+    pub fn awaited_command(&self) -> Option<u64> {
+        self.awaiting.map(|(_, number)| number)
     }
 
     /// The machine's result of the block the program waits for: the program goes on from
@@ -139,7 +146,7 @@ impl Core {
             return Err(e);
         }
         self.pos.clone_from(&m.rest);
-        match self.awaiting.take() {
+        match self.awaiting.take().map(|(what, _)| what) {
             Some(Awaited::Measurement) => {
                 if m.triggered {
                     self.measured_at = Some(m.position.clone());

@@ -188,8 +188,9 @@ pub struct Core {
     /// for its result (a running cell); otherwise their event is taken as coming at the
     /// move's end (a check, a simulation, a block search: D116).
     pub on_machine: bool,
-    /// Such a block has gone out and its result has not come: nothing is read on.
-    pub(crate) awaiting: Option<crate::measure::Awaited>,
+    /// Such a block has gone out and its result has not come: nothing is read on. With the
+    /// move's number among the program's commands.
+    pub(crate) awaiting: Option<(crate::measure::Awaited, u64)>,
     /// The last measuring move's result.
     pub measurement: Option<crate::measure::Measurement>,
     /// Per axis, its travel to a fixed stop as the program sees it (0 none, 1 at the stop, 2
