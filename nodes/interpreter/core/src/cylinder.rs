@@ -21,7 +21,7 @@
 
 use crate::canon::Command;
 use crate::error::{Fault, ProgramError};
-use crate::geometry::Pt;
+use crate::geometry::{arc_sweep, Pt};
 use crate::show;
 use crate::state::Core;
 
@@ -171,25 +171,11 @@ impl Core {
                     Some([h, v]) => (usize::from(h), usize::from(v)),
                     None => self.plane_axes()?,
                 };
-                let a0 = (from[v] - center[v]).atan2(from[h] - center[h]);
-                let a1 = (end[v] - center[v]).atan2(end[h] - center[h]);
-                let rho = (from[h] - center[h]).hypot(from[v] - center[v]);
-                let mut sweep = a1 - a0;
-                if clockwise {
-                    while sweep >= -1e-12 {
-                        sweep -= std::f64::consts::TAU;
-                    }
-                } else {
-                    while sweep <= 1e-12 {
-                        sweep += std::f64::consts::TAU;
-                    }
-                }
-                // A part circle whose ends meet within rounding is none: only a full circle
-                // turns all the way round.
-                let whole = dist(from, &end) < 1e-9;
-                if !whole && sweep.abs() > std::f64::consts::TAU - 1e-9 {
-                    sweep = 0.0;
-                }
+                let on_plane = |p: &[f64]| Pt::new(p[h], p[v]);
+                let (a, mid) = (on_plane(from), on_plane(&center));
+                let a0 = (a.r - mid.r).atan2(a.z - mid.z);
+                let rho = a.dist(mid);
+                let sweep = arc_sweep(a, on_plane(&end), mid, !clockwise);
                 let step = if rho > CHORD_TOLERANCE {
                     2.0 * (1.0 - CHORD_TOLERANCE / rho).acos()
                 } else {
