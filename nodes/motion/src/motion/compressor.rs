@@ -34,7 +34,9 @@ impl Motion {
         };
         let head = first.or_else(|| self.queue.front())?;
         let feed = feed_of(head)?;
-        let mut points: Vec<(Point, u64)> = Vec::with_capacity(window::MAX_MERGE);
+        // On the stack: the servo thread allocates nothing per block.
+        let mut points = [([0.0; MAX_AXES], 0u64); window::MAX_MERGE];
+        let mut count = 0;
         let blocks = first.into_iter().chain(self.queue.iter());
         for b in blocks.take(window::MAX_MERGE) {
             if feed_of(b) != Some(feed) || self.check_block(&b.kind).is_err() {
@@ -46,11 +48,12 @@ impl Motion {
             if self.panel.single_block && b.line != head.line {
                 break;
             }
-            points.push((self.to_slide(end), b.seq));
+            points[count] = (self.to_slide(end), b.seq);
+            count += 1;
         }
-        let tolerance = self.cfg.tolerance * 0.5;
+        let tolerance = self.cfg.tolerance * window::MERGE_SHARE;
         let mut best = None;
-        for k in MIN_LINES..=points.len() {
+        for k in MIN_LINES..=count {
             match fit(start, &points[..k], n, tolerance) {
                 Some(seg) => best = Some((seg, k)),
                 None => break,
@@ -68,10 +71,8 @@ impl Motion {
 fn fit(start: &Point, points: &[(Point, u64)], n: usize, tolerance: f64) -> Option<Segment> {
     let end = points.last()?.0;
     // The plane: the two axes that move; every other stays put.
-    let moving: Vec<usize> = (0..n)
-        .filter(|&i| points.iter().any(|(p, _)| (p[i] - start[i]).abs() > 1e-9))
-        .collect();
-    let [h, v] = moving[..] else {
+    let mut moving = (0..n).filter(|&i| points.iter().any(|(p, _)| (p[i] - start[i]).abs() > 1e-9));
+    let (Some(h), Some(v), None) = (moving.next(), moving.next(), moving.next()) else {
         return None;
     };
     let mid = points[points.len() / 2].0;

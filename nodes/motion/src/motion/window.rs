@@ -6,7 +6,7 @@ use super::*;
 /// Most lines merged into one chord.
 pub(super) const MAX_MERGE: usize = 32;
 /// Share of the path tolerance merging may use; blends at the chord's ends use the rest.
-const MERGE_SHARE: f64 = 0.5;
+pub(super) const MERGE_SHARE: f64 = 0.5;
 /// Blocks the planner must hold before a merge waits for more lines from the interpreter.
 const MERGE_WAIT_BLOCKS: usize = 8;
 
