@@ -38,9 +38,9 @@ enum Input {
 }
 
 enum Report {
-    /// The status, and the last measuring block's result with the machine's axis count (its
+    /// The status, and the result of the last block whose end the machine decided (its
     /// vectors are filled here, off the servo thread).
-    Status(MotionStatus, Option<(BlockResult, usize)>),
+    Status(MotionStatus, Option<BlockResult>),
     /// A tick later than the warning limit (its interval, µs), or the warning cleared.
     Late(Option<f64>),
     /// Commanded and actual slide positions.
@@ -181,8 +181,9 @@ fn dds_loop(
         }
         loop {
             match from_servo.try_recv() {
-                Ok(Report::Status(mut s, probe)) => {
-                    if let Some((p, n)) = probe {
+                Ok(Report::Status(mut s, result)) => {
+                    if let Some(p) = result {
+                        let n = axes.len();
                         s.result_seq = p.seq;
                         s.result_triggered = p.triggered;
                         s.result_position = p.position[..n].to_vec();
@@ -567,7 +568,7 @@ fn servo_loop(
                 state,
                 ..MotionStatus::default()
             };
-            let _ = reports.send(Report::Status(msg, status.5.map(|p| (p, n))));
+            let _ = reports.send(Report::Status(msg, status.5));
         }
         if seq.is_multiple_of(10) {
             let mut commanded = [0.0; MAX_AXES];
