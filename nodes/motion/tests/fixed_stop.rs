@@ -2,7 +2,7 @@
 //! cannot go below `STOP`; otherwise the drive follows its setpoint exactly.
 
 use cnc_motion::motion::alarm;
-use cnc_motion::{Block, Command, Motion, MotionEvent, RunState};
+use cnc_motion::{Block, Command, Motion, RunState};
 use cnc_msgs::signals::GImage;
 
 mod support;
@@ -96,11 +96,7 @@ fn a_move_that_never_meets_the_stop_is_alarm_20091() {
     m.push(line(2, [0.0, 0.0, 100.0]));
     run_against_stop(&mut m, 50_000);
     assert_eq!(m.state(), RunState::Alarm);
-    let events = m.take_events();
-    assert!(
-        matches!(&events[..], [MotionEvent::Alarm { number, line: 20, .. }] if *number == alarm::FIXED_STOP_NOT_REACHED),
-        "{events:?}"
-    );
+    assert_eq!(alarms(&mut m), [(alarm::FIXED_STOP_NOT_REACHED, 20)]);
     assert_eq!(m.torque_limits()[2], 100.0);
 }
 
@@ -119,18 +115,10 @@ fn a_clamped_axis_pushed_out_of_its_window_is_alarm_20094() {
         m.tick(Some(&slides), &g);
     }
     assert_eq!(m.state(), RunState::Alarm);
-    let events = m.take_events();
-    assert!(
-        matches!(&events[..], [MotionEvent::Alarm { number, .. }] if *number == alarm::FIXED_STOP_ABORTED),
-        "{events:?}"
-    );
+    assert_eq!(alarms(&mut m), [(alarm::FIXED_STOP_ABORTED, 20)]);
     // Without FXS the same stop is a crash: the following error trips the drive.
     let mut m = Motion::new(mill(), &[0.0, 0.0, 120.0]);
     m.push(line(1, [0.0, 0.0, 80.0]));
     run_against_stop(&mut m, 50_000);
-    let events = m.take_events();
-    assert!(
-        matches!(&events[..], [MotionEvent::Alarm { number, .. }] if *number == alarm::FOLLOWING_ERROR),
-        "{events:?}"
-    );
+    assert_eq!(alarms(&mut m), [(alarm::FOLLOWING_ERROR, 10)]);
 }

@@ -3,7 +3,7 @@
 //! path crossed it (as the drive latches it).
 
 use cnc_motion::motion::{alarm, ProbeInput};
-use cnc_motion::{Block, Command, Motion, MotionEvent, RunState};
+use cnc_motion::{Block, Command, Motion, RunState};
 use cnc_msgs::servo::MAX_AXES;
 use cnc_msgs::signals::GImage;
 
@@ -173,16 +173,12 @@ fn a_rising_edge_asked_of_a_deflected_probe_is_an_alarm_and_nothing_moves() {
     let trace = run_over(&mut m, &mut face, 1_000);
     assert_eq!(m.state(), RunState::Alarm);
     assert!(trace.iter().all(|p| p[..3] == [0.0, 0.0, 0.0]));
-    let events = m.take_events();
-    assert!(
-        matches!(&events[..], [MotionEvent::Alarm { number, line: 10, .. }] if *number == alarm::PROBE_DEFLECTED),
-        "{events:?}"
-    );
+    assert_eq!(alarms(&mut m), [(alarm::PROBE_DEFLECTED, 10)]);
     assert!(m.block_result().is_none());
 }
 
 #[test]
-fn a_measuring_line_is_cut_on_its_own_and_a_reset_forgets_it() {
+fn a_measuring_line_is_cut_on_its_own_and_a_new_run_starts_without_a_result() {
     // Lines before it end at rest: the probe block never blends with them.
     let start = [0.0, 0.0, 10.0];
     let mut m = Motion::new(mill(), &start);
@@ -200,19 +196,12 @@ fn a_measuring_line_is_cut_on_its_own_and_a_reset_forgets_it() {
     // At the corner (X5 Z10) the axes stood: some tick's position is the corner itself.
     assert!(trace.iter().any(|p| p[..3] == [5.0, 0.0, 10.0]));
     assert!(m.block_result().is_some_and(|r| r.triggered && r.seq == 2));
-    // A reset during a measuring block drops it without a result.
+    // A new run does not carry the last run's result: none until its own block is done.
     m.push(Block {
         run_id: 2,
         ..probe(1, [5.0, 0.0, 20.0], false, true)
     });
-    let g = GImage::released();
-    for _ in 0..10 {
-        let actual = m.commanded().to_vec();
-        m.tick(Some(&actual), &g);
-    }
+    ticks(&mut m, &GImage::released(), 10);
+    assert_eq!(m.state(), RunState::Running);
     assert!(m.block_result().is_none());
-    m.reset();
-    ticks(&mut m, &g, 10);
-    assert!(m.block_result().is_none());
-    assert_eq!(m.state(), RunState::Idle);
 }

@@ -112,14 +112,12 @@ impl Motion {
                     if (self.actual[i] - at).abs() > window =>
                 {
                     self.fixed_stops[i] = None;
-                    let name = self.cfg.axes[i].name.clone();
-                    let line = self.line;
-                    self.raise(
+                    self.fixed_stop_alarm(
+                        i,
                         alarm::FIXED_STOP_ABORTED,
-                        format!(
-                            "fixed stop aborted: {name} left its window of {window} at the stop"
+                        &format!(
+                            "fixed stop aborted: {{}} left its window of {window} at the stop"
                         ),
-                        line,
                     );
                 }
                 _ => {}
@@ -132,6 +130,15 @@ impl Motion {
         self.fixed_stops
             .iter()
             .any(|s| matches!(s, Some(FixedStop::Met { .. })))
+    }
+
+    /// Alarm `number` for axis `i`, its name put in `text` where `{}` stands, on the line
+    /// being run.
+    fn fixed_stop_alarm(&mut self, i: usize, number: u32, text: &str) {
+        let name = self.cfg.axes.get(i).map_or("?", |a| a.name.as_str());
+        let text = text.replacen("{}", name, 1);
+        let line = self.line;
+        self.raise(number, text, line);
     }
 
     /// Whether a move into a fixed stop is under way (nothing joins it).
@@ -178,12 +185,10 @@ impl Motion {
                 }
                 Some(FixedStop::Approaching { seq, .. }) if self.done_seq >= seq => {
                     self.fixed_stops[i] = None;
-                    let name = self.cfg.axes[i].name.clone();
-                    let line = self.line;
-                    self.raise(
+                    self.fixed_stop_alarm(
+                        i,
                         alarm::FIXED_STOP_NOT_REACHED,
-                        format!("fixed stop not reached: {name} ended its move without meeting it"),
-                        line,
+                        "fixed stop not reached: {} ended its move without meeting it",
                     );
                     return;
                 }

@@ -3,7 +3,7 @@
 
 #![allow(dead_code)] // each test file uses its own part
 
-use cnc_motion::{AxisConfig, Block, Command, Motion, MotionConfig, RunState};
+use cnc_motion::{AxisConfig, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
 use cnc_msgs::signals::{f, g, GImage, SignalTable};
 
 /// A two-axis lathe (X on diameter, Z) with the S-curve profile, a 4 ms period.
@@ -129,4 +129,14 @@ pub fn drive(m: &mut Motion, max_ticks: usize) -> Driven {
         }
     }
     d
+}
+
+/// The alarms motion has raised since last asked, as (number, line).
+pub fn alarms(m: &mut Motion) -> Vec<(u32, u32)> {
+    m.take_events()
+        .into_iter()
+        .map(|e| match e {
+            MotionEvent::Alarm { number, line, .. } => (number, line),
+        })
+        .collect()
 }
