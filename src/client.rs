@@ -27,7 +27,7 @@ pub struct CellClient {
     list: Door<ListProgramsRequest, ListProgramsResponse>,
     delete: Door<DeleteProgramRequest, DeleteProgramResponse>,
     overrides: Door<SetOverridesRequest, SetOverridesResponse>,
-    machine: Subscription<MachineState>,
+    machine: Newest<MachineState>,
     spindle_sub: Newest<SpindleState>,
     parts: Newest<PartCount>,
     alarms_sub: Newest<ActiveAlarms>,
@@ -62,18 +62,23 @@ impl<M: 'static + serde::de::DeserializeOwned> Newest<M> {
         Newest { reader, last: None }
     }
 
-    /// Takes every waiting sample into `into` unless it is older than the last one kept;
-    /// whether any sample came.
-    fn take_into(&mut self, into: &mut Option<M>) -> bool {
+    /// Hands every waiting sample to `keep`, in order, unless it is older than the last one
+    /// kept; whether any sample came.
+    fn take_newer(&mut self, mut keep: impl FnMut(M)) -> bool {
         let mut heard = false;
         while let Ok(Some((m, info))) = self.reader.take() {
             heard = true;
             if newer(self.last, &info) {
                 self.last = Some((info.publisher_gid(), info.sequence_number()));
-                *into = Some(m);
+                keep(m);
             }
         }
         heard
+    }
+
+    /// The newest waiting sample into `into` ([`Newest::take_newer`]).
+    fn take_into(&mut self, into: &mut Option<M>) -> bool {
+        self.take_newer(|m| *into = Some(m))
     }
 }
 
@@ -135,10 +140,10 @@ impl CellClient {
             overrides: client::<SetOverrides>(&mut ros, mapping, ns, "set_overrides"),
             // Every transition, in order: a start that fails at once goes ACTIVE then STOPPED
             // within a millisecond, and a depth-1 reader would see only STOPPED.
-            machine: ros.dds_subscription_with_qos(
+            machine: Newest::new(ros.dds_subscription_with_qos(
                 &topics::MACHINE_STATE,
                 qos::state().history(History::KeepLast { depth: 64 }),
-            )?,
+            )?),
             spindle_sub: Newest::new(ros.dds_subscription(&topics::SPINDLE)?),
             parts: Newest::new(ros.dds_subscription(&topics::PART_COUNT)?),
             alarms_sub: Newest::new(ros.dds_subscription(&topics::ALARMS)?),
@@ -209,9 +214,9 @@ impl CellClient {
     /// Takes every new sample of the state topics; returns the machine states seen, in order.
     pub fn poll(&mut self) -> Vec<MachineState> {
         let mut states = Vec::new();
-        while let Ok(Some((m, _))) = self.machine.take() {
-            states.push(m.clone());
-            self.state = Some(m);
+        self.machine.take_newer(|m| states.push(m));
+        if let Some(last) = states.last() {
+            self.state = Some(last.clone());
         }
         let heard = [
             self.spindle_sub.take_into(&mut self.spindle),
