@@ -80,7 +80,10 @@ fn the_program_reads_on_from_where_the_axis_met_its_stop() {
     assert!(front.core.awaiting_machine());
     assert_eq!(selections(&out), vec![(2, true, 20.0, 1.0)]);
     // Before the result $AA_FXS would read 3 (selected).
-    assert_eq!(front.core.fixed_stops[2], 3);
+    assert_eq!(
+        front.core.fixed_stops[2],
+        cnc_interpreter_core::measure::FixedStop::Selected
+    );
     front
         .core
         .machine_result(Measurement {

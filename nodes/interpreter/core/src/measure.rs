@@ -24,6 +24,17 @@ pub struct Measurement {
     pub rest: Vec<f64>,
 }
 
+/// An axis's travel to a fixed stop as the program sees it; the values are the ones a
+/// control's status variable reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FixedStop {
+    #[default]
+    Off = 0,
+    AtStop = 1,
+    NotReached = 2,
+    Selected = 3,
+}
+
 /// What the program waits for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Awaited {
@@ -77,7 +88,7 @@ impl Core {
             torque,
             window,
         });
-        self.fixed_stops[axis] = 3;
+        self.fixed_stops[axis] = FixedStop::Selected;
         self.emit(end, MoveKind::Feed(feed))?;
         self.await_machine(Awaited::FixedStop(axis))
     }
@@ -92,7 +103,7 @@ impl Core {
             torque: 100.0,
             window: 1.0,
         });
-        self.fixed_stops[axis] = 0;
+        self.fixed_stops[axis] = FixedStop::Off;
         Ok(())
     }
 
@@ -155,7 +166,11 @@ impl Core {
             }
             Some(Awaited::FixedStop(axis)) => {
                 if let Some(s) = self.fixed_stops.get_mut(axis) {
-                    *s = if m.triggered { 1 } else { 2 };
+                    *s = if m.triggered {
+                        FixedStop::AtStop
+                    } else {
+                        FixedStop::NotReached
+                    };
                 }
             }
             None => {}

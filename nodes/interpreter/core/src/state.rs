@@ -193,9 +193,8 @@ pub struct Core {
     pub(crate) awaiting: Option<(crate::measure::Awaited, u64)>,
     /// The last measuring move's result.
     pub measurement: Option<crate::measure::Measurement>,
-    /// Per axis, its travel to a fixed stop as the program sees it (0 none, 1 at the stop, 2
-    /// not reached, 3 selected: the manual's `$AA_FXS` values).
-    pub fixed_stops: Vec<u8>,
+    /// Per axis, its travel to a fixed stop as the program sees it.
+    pub fixed_stops: Vec<crate::measure::FixedStop>,
     /// Where the probe last switched (machine coordinates): a job in which it did not
     /// switch leaves it.
     pub measured_at: Option<Vec<f64>>,
@@ -261,7 +260,7 @@ impl Core {
             searching: false,
             on_machine: false,
             awaiting: None,
-            fixed_stops: vec![0; n],
+            fixed_stops: vec![crate::measure::FixedStop::Off; n],
             measurement: None,
             measured_at: None,
             cylinder: None,

@@ -6,11 +6,11 @@
 //! this program's run; unprogrammed, the machine data's defaults hold. The deselection block
 //! carries the move away from the stop.
 
+use cnc_interpreter_core::measure::FixedStop;
 use cnc_interpreter_core::{Fault, ProgramError};
 
 use super::exec::Words;
 use super::expr::Expr;
-
 use super::{Motion, Sinumerik};
 
 /// The clamping torque without FXST, percent of the drive's maximum (the machine data's
@@ -83,12 +83,12 @@ impl Sinumerik {
 
     /// The block's axes may move: one at its stop moves only with its deselection.
     pub(super) fn check_clamped_axes(&self, w: &Words) -> Result<(), ProgramError> {
-        if !self.core.fixed_stops.contains(&1) {
+        if !self.core.fixed_stops.contains(&FixedStop::AtStop) {
             return Ok(());
         }
         for (&i, _) in w.axes.iter() {
             let leaving = w.fxs == Some((i, false));
-            if self.core.fixed_stops.get(i) == Some(&1) && !leaving {
+            if self.core.fixed_stops.get(i) == Some(&FixedStop::AtStop) && !leaving {
                 return Err(self.fault(
                     Fault::IllegalWord,
                     format!(
@@ -103,21 +103,10 @@ impl Sinumerik {
 
     /// The block's FXS around its move to `end`: a selection makes the move (true: the move
     /// is done); a deselection lifts the stop before the move that follows.
-    pub(super) fn fixed_stop_move(
-        &mut self,
-        w: &Words,
-        moves: bool,
-        end: &[f64],
-    ) -> Result<bool, ProgramError> {
+    pub(super) fn fixed_stop_move(&mut self, w: &Words, end: &[f64]) -> Result<bool, ProgramError> {
         let Some((axis, on)) = w.fxs else {
             return Ok(false);
         };
-        if !moves {
-            return Err(self.fault(
-                Fault::MissingWord,
-                "FXS is selected and deselected in the block of a move (§9.3.23)",
-            ));
-        }
         if !on {
             self.core.leave_fixed_stop(axis)?;
             return Ok(false);
@@ -131,7 +120,7 @@ impl Sinumerik {
                 ),
             ));
         }
-        if self.core.fixed_stops[axis] == 1 {
+        if self.core.fixed_stops[axis] == FixedStop::AtStop {
             return Err(self.fault(
                 Fault::IllegalWord,
                 format!(

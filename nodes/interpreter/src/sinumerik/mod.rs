@@ -413,7 +413,7 @@ impl Sinumerik {
                     [Val::Str(a)] => self.axis_named(a),
                     _ => None,
                 };
-                i.map(|i| f64::from(self.core.fixed_stops[i]))
+                i.map(|i| f64::from(self.core.fixed_stops[i] as u8))
                     .ok_or_else(|| EvalError::new(Fault::AxisAddress, "$AA_FXS[axis]"))
             }
             "$AA_COUP_ACT" => {

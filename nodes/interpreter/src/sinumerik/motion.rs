@@ -299,7 +299,7 @@ impl Sinumerik {
         if let Some((rising, stop)) = probe {
             return self.measuring_move(w, &here, &end, rising, stop);
         }
-        if self.fixed_stop_move(w, moves, &end)? {
+        if self.fixed_stop_move(w, &end)? {
             return Ok(());
         }
         if let Some(code) = wab {
