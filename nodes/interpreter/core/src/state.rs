@@ -316,16 +316,28 @@ impl Core {
         self.work_of(&self.pos)
     }
 
+    /// [`Core::work_position`] into `out`, whose room a caller keeps from block to block.
+    pub fn work_position_into(&self, out: &mut Vec<f64>) {
+        self.work_of_into(&self.pos, out);
+    }
+
     /// The work coordinates of the machine position `machine` under the transform chain as
     /// it stands.
     pub fn work_of(&self, machine: &[f64]) -> Vec<f64> {
-        let mut p: Vec<f64> = (0..self.pos.len())
-            .map(|i| machine.get(i).copied().unwrap_or(0.0) - self.origin(i))
-            .collect();
-        if !self.frame.is_identity() {
-            self.frame.invert_in_place(&mut p);
-        }
+        let mut p = Vec::with_capacity(self.pos.len());
+        self.work_of_into(machine, &mut p);
         p
+    }
+
+    /// [`Core::work_of`] into `out` (emptied first).
+    fn work_of_into(&self, machine: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(
+            (0..self.pos.len()).map(|i| machine.get(i).copied().unwrap_or(0.0) - self.origin(i)),
+        );
+        if !self.frame.is_identity() {
+            self.frame.invert_in_place(out);
+        }
     }
 
     pub fn to_machine(&self, work: &[f64]) -> Vec<f64> {

@@ -6,7 +6,7 @@
 use std::borrow::Cow;
 
 use super::expr::{Expr, Parser};
-use super::lex::{strip_comment, tokens, Tok};
+use super::lex::{strip_comment, tokens_into, Tok};
 
 /// An item of a block; names and digits borrow from the line.
 #[derive(Debug, Clone, PartialEq)]
@@ -78,10 +78,49 @@ const TYPES: [&str; 5] = ["BOOL", "CHAR", "INT", "REAL", "STRING"];
 
 /// Parses one line; an error is the syntax alarm's text.
 pub fn parse(line: &str) -> Result<Block<'_>, String> {
-    let toks = tokens(strip_comment(line))?;
-    let mut p = Parser::new(&toks);
+    Buffers::default().parse(line)
+}
+
+/// The room of the last block's token and item lists, kept for the next: a program reads a
+/// block per command, and these two lists were the front end's most frequent allocations.
+#[derive(Debug, Default)]
+pub struct Buffers {
+    toks: Vec<Tok<'static>>,
+    items: Vec<Item<'static>>,
+}
+
+impl Buffers {
+    /// Parses one line into the kept lists.
+    pub fn parse<'s>(&mut self, line: &'s str) -> Result<Block<'s>, String> {
+        let mut toks = relabel(std::mem::take(&mut self.toks));
+        let items = relabel(std::mem::take(&mut self.items));
+        let block = tokens_into(strip_comment(line), &mut toks).and_then(|()| {
+            let mut p = Parser::new(&toks);
+            parse_tokens(&mut p, items)
+        });
+        self.toks = relabel(toks);
+        block
+    }
+
+    /// Takes back a block's item list once the block has run.
+    pub fn recycle(&mut self, block: Block<'_>) {
+        self.items = relabel(block.items);
+    }
+}
+
+/// An emptied list as a list of another lifetime with its room kept: the standard library
+/// collects a vector's own iterator in place when the element's layout stays the same (the
+/// unit test below watches that it still does).
+fn relabel<T, U>(mut v: Vec<T>) -> Vec<U> {
+    v.clear();
+    v.into_iter().filter_map(|_| None).collect()
+}
+
+/// The block the parser's tokens make, its items in `items` (empty, its room reused).
+fn parse_tokens<'s>(p: &mut Parser<'_, 's>, items: Vec<Item<'s>>) -> Result<Block<'s>, String> {
     let mut b = Block {
         skip: p.eat_op("/"),
+        items,
         ..Block::default()
     };
     match p.peek() {
@@ -105,7 +144,7 @@ pub fn parse(line: &str) -> Result<Block<'_>, String> {
         p.at += 2;
     }
     while p.peek().is_some() {
-        let item = item(&mut p)?;
+        let item = item(p)?;
         b.items.push(item);
     }
     Ok(b)
@@ -303,6 +342,31 @@ fn def<'s>(p: &mut Parser<'_, 's>) -> Result<Def<'s>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn kept_lists_keep_their_room_and_a_block_reads_the_same_through_them() {
+        let mut room = Buffers::default();
+        let text = String::from("N10 G1 X=R2*SIN(R1)+R6 Y20 F100");
+        let first = room.parse(&text).unwrap();
+        assert_eq!(first, parse(&text).unwrap());
+        let items = first.items.capacity();
+        room.recycle(first);
+        let toks = room.toks.capacity();
+        assert!(
+            items >= 4 && toks >= 10,
+            "room {items} items, {toks} tokens"
+        );
+        // The next line, of another lifetime, reads into the same room.
+        let next = String::from("R1=R1+1");
+        let b = room.parse(&next).unwrap();
+        assert_eq!(b, parse(&next).unwrap());
+        assert_eq!(b.items.capacity(), items);
+        room.recycle(b);
+        assert_eq!(room.toks.capacity(), toks);
+        // A line in error leaves the room usable.
+        assert!(room.parse("X10 ?").is_err());
+        assert_eq!(room.parse("G0 X1").unwrap(), parse("G0 X1").unwrap());
+    }
 
     #[test]
     fn numbers_labels_and_items() {

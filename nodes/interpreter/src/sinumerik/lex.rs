@@ -69,8 +69,14 @@ pub fn upper(name: &str) -> Cow<'_, str> {
 /// Everything outside strings is ASCII, so the line is read byte by byte and every token
 /// boundary is a character boundary.
 pub fn tokens(line: &str) -> Result<Vec<Tok<'_>>, String> {
-    let b = line.as_bytes();
     let mut out = Vec::with_capacity(16);
+    tokens_into(line, &mut out).map(|()| out)
+}
+
+/// [`tokens`] into `out` (emptied first), whose room a caller keeps from line to line.
+pub fn tokens_into<'s>(line: &'s str, out: &mut Vec<Tok<'s>>) -> Result<(), String> {
+    out.clear();
+    let b = line.as_bytes();
     let mut i = 0;
     while i < b.len() {
         let c = b[i];
@@ -118,7 +124,7 @@ pub fn tokens(line: &str) -> Result<Vec<Tok<'_>>, String> {
             i += op.len();
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 fn next_is_digit(b: &[u8], i: usize) -> bool {

@@ -109,6 +109,11 @@ pub struct Sinumerik {
     jump: Option<(bool, String)>,
     /// The lists a block's words are sorted into, kept for the next block.
     words: exec::Words,
+    /// The token and item lists of the last block, their room kept for the next.
+    parse_room: block::Buffers,
+    /// A move's start and end in the work's coordinates, their room kept for the next move.
+    here_room: Vec<f64>,
+    end_room: Vec<f64>,
     /// The drilling cycle MCALL made modal.
     modal_cycle: Option<cycle_call::CycleCall>,
     /// G25/G26 working area and spindle limits, WALIMON.
@@ -231,6 +236,9 @@ impl Sinumerik {
             messages: Vec::new(),
             jump: None,
             words: exec::Words::default(),
+            parse_room: block::Buffers::default(),
+            here_room: Vec::new(),
+            end_room: Vec::new(),
             modal_cycle: None,
             limits: limits::Limits::default(),
             rndm: None,
@@ -682,11 +690,17 @@ impl FrontEnd for Sinumerik {
         if trimmed.starts_with('%') || lex::strip_comment(trimmed).trim().is_empty() {
             return Ok(());
         }
-        let block = block::parse(line).map_err(|e| self.fault(Fault::DataFormat, e))?;
-        if block.skip && self.core.setup.block_skip {
-            return Ok(());
-        }
-        self.run_block(&block, &text)
+        let block = match self.parse_room.parse(line) {
+            Ok(b) => b,
+            Err(e) => return Err(self.fault(Fault::DataFormat, e)),
+        };
+        let done = if block.skip && self.core.setup.block_skip {
+            Ok(())
+        } else {
+            self.run_block(&block, &text)
+        };
+        self.parse_room.recycle(block);
+        done
     }
 }
 

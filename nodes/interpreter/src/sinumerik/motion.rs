@@ -16,6 +16,9 @@ use super::contour::AngStep;
 use super::exec::{Mode, Words};
 use super::{Motion, Sinumerik};
 
+/// The words that belong to a circle (a block with one of them moves).
+const ARC_WORDS: [&str; 9] = ["I", "J", "K", "CR", "AR", "I1", "J1", "K1", "TURN"];
+
 /// The interpolation parameter of an axis: I for X, J for Y, K for Z.
 fn centre_letter(axis: char) -> Option<char> {
     match axis {
@@ -225,12 +228,11 @@ impl Sinumerik {
 
     /// The block's move, if it has one.
     pub(super) fn motion_block(&mut self, w: &Words) -> Result<(), ProgramError> {
-        let arc_words = ["I", "J", "K", "CR", "AR", "I1", "J1", "K1", "TURN"];
         let polar = w.addr.contains_key("AP") || w.addr.contains_key("RP");
         let moves = !w.axes.is_empty()
             || polar
             || w.addr.contains_key("ANG")
-            || arc_words.iter().any(|k| w.addr.contains_key(*k));
+            || ARC_WORDS.iter().any(|k| w.addr.contains_key(*k));
         self.corner = self.block_corner(w, moves)?;
         let wab = super::wab::code(w);
         if wab.is_none() {
@@ -275,8 +277,29 @@ impl Sinumerik {
             }
             return self.machine_coordinates(w);
         }
-        let here = self.core.work_position();
-        let mut end = here.clone();
+        // Where the block starts and ends in the work's coordinates, in lists kept from block
+        // to block (a move a block is the front end's most frequent work).
+        let mut here = std::mem::take(&mut self.here_room);
+        self.core.work_position_into(&mut here);
+        let mut end = std::mem::take(&mut self.end_room);
+        end.clone_from(&here);
+        let done = self.move_to(w, &here, &mut end, polar, probe, wab);
+        self.here_room = here;
+        self.end_room = end;
+        done
+    }
+
+    /// The block's move from `here` to `end` (the work's coordinates; `end` as the position
+    /// stands, the block's axis words still to apply).
+    fn move_to(
+        &mut self,
+        w: &Words,
+        here: &[f64],
+        end: &mut [f64],
+        polar: bool,
+        probe: Option<(bool, bool)>,
+        wab: Option<(super::wab::Shape, bool)>,
+    ) -> Result<(), ProgramError> {
         let unit = self.unit();
         for (&i, &(v, mode)) in w.axes.iter() {
             let linear = !self.rotary_axis(i);
@@ -294,12 +317,12 @@ impl Sinumerik {
             let (ap, rp) = self.polar_words(w)?;
             let (s, c) = ap.to_radians().sin_cos();
             let p = Pt::new(self.pole.z + rp * c, self.pole.r + rp * s);
-            self.core.set_plane_point(&mut end, p);
+            self.core.set_plane_point(end, p);
         }
         if let Some((rising, stop)) = probe {
-            return self.measuring_move(w, &here, &end, rising, stop);
+            return self.measuring_move(w, here, end, rising, stop);
         }
-        if self.fixed_stop_move(w, &end)? {
+        if self.fixed_stop_move(w, end)? {
             return Ok(());
         }
         if let Some(code) = wab {
@@ -307,7 +330,7 @@ impl Sinumerik {
             let normal = self.core.plane_normal();
             let plane = polar || w.axes.iter().any(|(i, _)| *i == h || *i == v);
             let on_normal = w.axes.iter().any(|(i, _)| Some(*i) == normal);
-            return self.wab_block(w, code, end, (plane, on_normal));
+            return self.wab_block(w, code, end.to_vec(), (plane, on_normal));
         }
         let threads = matches!(self.motion, Motion::Thread | Motion::TapIn | Motion::TapOut);
         if self.wab.is_some() && (threads || w.has_g(63)) {
@@ -321,14 +344,14 @@ impl Sinumerik {
             self.start_compensation()?;
         }
         if threads || w.has_g(63) {
-            return self.thread_move(w, &here, &end);
+            return self.thread_move(w, here, end);
         }
-        let a = self.core.plane_point(&here)?;
-        let b = self.core.plane_point(&end)?;
+        let a = self.core.plane_point(here)?;
+        let b = self.core.plane_point(end)?;
         let feed = self.core.feed;
         match self.motion {
             Motion::Rapid | Motion::Line => {
-                if let Some(k) = arc_words.iter().find(|k| w.addr.contains_key(**k)) {
+                if let Some(k) = ARC_WORDS.iter().find(|k| w.addr.contains_key(**k)) {
                     return Err(self.fault(
                         Fault::IllegalWord,
                         format!("{k} belongs to a circle (G2/G3/CIP)"),
@@ -337,15 +360,15 @@ impl Sinumerik {
                 let kind = if self.motion == Motion::Rapid {
                     MoveKind::Rapid
                 } else {
-                    MoveKind::Feed(self.rotary_feed(feed, &here, &end))
+                    MoveKind::Feed(self.rotary_feed(feed, here, end))
                 };
-                let a = match self.ang_end(w, &here, &mut end, kind)? {
+                let a = match self.ang_end(w, here, end, kind)? {
                     AngStep::Wait => return Ok(()),
                     AngStep::Via(corner) => self.core.plane_point(&corner)?,
                     AngStep::Plain => a,
                 };
-                let b = self.core.plane_point(&end)?;
-                self.emit_element(&end, kind)?;
+                let b = self.core.plane_point(end)?;
+                self.emit_element(end, kind)?;
                 if a.dist(b) > 1e-9 {
                     let l = a.dist(b);
                     self.tangent = Some(Pt::new((b.z - a.z) / l, (b.r - a.r) / l));
@@ -358,14 +381,14 @@ impl Sinumerik {
                         "ANG defines straight lines (G0/G1), not circles",
                     ));
                 }
-                let (c, ccw, end) = if circle {
+                let (c, ccw) = if circle {
                     self.circle(w, a, end, polar)?
                 } else if self.motion == Motion::Cip {
-                    self.through_point(w, a, end, &here)?
+                    self.through_point(w, a, end, here)?
                 } else {
-                    self.tangential(a, b, end)?
+                    self.tangential(a, b)?
                 };
-                self.arc_to(&here, &end, c, ccw, w.get("TURN"), feed)?;
+                self.arc_to(here, end, c, ccw, w.get("TURN"), feed)?;
             }
         }
         Ok(())
@@ -580,9 +603,9 @@ impl Sinumerik {
         &self,
         w: &Words,
         a: Pt,
-        mut end: Vec<f64>,
+        end: &mut [f64],
         polar: bool,
-    ) -> Result<(Pt, bool, Vec<f64>), ProgramError> {
+    ) -> Result<(Pt, bool), ProgramError> {
         let ccw = self.motion == Motion::Ccw;
         let (h, v) = self.core.plane_axes()?;
         let letters = (
@@ -622,16 +645,16 @@ impl Sinumerik {
                 ));
             }
             // The start must lie on the circle the pole and RP make.
-            let b = self.core.plane_point(&end)?;
+            let b = self.core.plane_point(end)?;
             let c = check_center(a, b, self.pole).map_err(|e| {
                 arc_err(
                     e,
                     "the start is not on the circle of radius RP around the pole",
                 )
             })?;
-            return Ok((c, ccw, end));
+            return Ok((c, ccw));
         }
-        let b = self.core.plane_point(&end)?;
+        let b = self.core.plane_point(end)?;
         let end_given = w.axes.contains_key(&h) || w.axes.contains_key(&v);
         match (has_centre, radius, angle) {
             (true, None, None) => {
@@ -640,14 +663,14 @@ impl Sinumerik {
                     centre_word(letters.1, a.r).unwrap_or(a.r),
                 );
                 let c = check_center(a, b, c).map_err(|e| arc_err(e, "start and end are not on one circle around the centre"))?;
-                Ok((c, ccw, end))
+                Ok((c, ccw))
             }
             (false, Some(r), None) => {
                 if r.abs() < 0.01 {
                     return Err(self.fault(Fault::ArcRadius, "CR= is 0.010…99999.999"));
                 }
                 let c = center_from_radius(a, b, r, ccw).map_err(|e| arc_err(e, "the radius does not reach the end, or the end is the start (a full circle needs its centre)"))?;
-                Ok((c, ccw, end))
+                Ok((c, ccw))
             }
             (true, None, Some(ar)) => {
                 // Centre and opening angle: the end follows (§9.3.3).
@@ -661,8 +684,8 @@ impl Sinumerik {
                 }
                 let turn = if ccw { ar } else { -ar }.to_radians();
                 let p = rotate(a, c, turn);
-                self.core.set_plane_point(&mut end, p);
-                Ok((c, ccw, end))
+                self.core.set_plane_point(end, p);
+                Ok((c, ccw))
             }
             (false, None, Some(ar)) if end_given => {
                 self.check_angle(ar)?;
@@ -671,7 +694,7 @@ impl Sinumerik {
                 // More than a semicircle: the centre on the other side.
                 let r = if ar > 180.0 { -r } else { r };
                 let c = center_from_radius(a, b, r, ccw).map_err(|e| arc_err(e, "AR with this end"))?;
-                Ok((c, ccw, end))
+                Ok((c, ccw))
             }
             _ => Err(self.fault(
                 Fault::ArcRAndIk,
@@ -693,9 +716,9 @@ impl Sinumerik {
         &self,
         w: &Words,
         a: Pt,
-        end: Vec<f64>,
+        end: &[f64],
         here: &[f64],
-    ) -> Result<(Pt, bool, Vec<f64>), ProgramError> {
+    ) -> Result<(Pt, bool), ProgramError> {
         let (h, v) = self.core.plane_axes()?;
         let unit = self.unit();
         let coord = |i: usize| -> Result<f64, ProgramError> {
@@ -720,23 +743,18 @@ impl Sinumerik {
             })
         };
         let m = Pt::new(coord(h)?, coord(v)?);
-        let b = self.core.plane_point(&end)?;
+        let b = self.core.plane_point(end)?;
         let (c, ccw) = three_point(a, m, b).map_err(|_| {
             self.fault(
                 Fault::ThreePointArc,
                 "intermediate point of the circle incorrect: the three points are on a line",
             )
         })?;
-        Ok((c, ccw, end))
+        Ok((c, ccw))
     }
 
     /// CT: the circle tangent to the path before it (§9.3.5).
-    fn tangential(
-        &self,
-        a: Pt,
-        b: Pt,
-        end: Vec<f64>,
-    ) -> Result<(Pt, bool, Vec<f64>), ProgramError> {
+    fn tangential(&self, a: Pt, b: Pt) -> Result<(Pt, bool), ProgramError> {
         let t = self.tangent.ok_or_else(|| {
             self.fault(
                 Fault::ArcEnd,
@@ -750,7 +768,7 @@ impl Sinumerik {
             return Err(self.fault(Fault::ArcEnd, "CT: the end lies on the tangent, no circle"));
         }
         let rho = (dz * dz + dr * dr) / (2.0 * nd);
-        Ok((Pt::new(a.z + rho * n.z, a.r + rho * n.r), nd > 0.0, end))
+        Ok((Pt::new(a.z + rho * n.z, a.r + rho * n.r), nd > 0.0))
     }
 
     /// The arc (with TURN= full turns before it, a helix along the other axes) and the
