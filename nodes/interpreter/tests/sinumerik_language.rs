@@ -692,3 +692,47 @@ fn f077_to_f079_extcall_runs_bohrung_from_the_external_drive() {
         assert_eq!((e.number, e.line), (14011, 1), "{bad}: {e}");
     }
 }
+
+/// G54–G59 are the 1st–6th settable offsets and G507–G554 the 7th–54th (§9.2.10), each
+/// shifting by its own values from the offset page; G500 takes none; G53 suppresses the active
+/// one for its block only (non-modal), and the next block is in the offset again.
+#[test]
+fn settable_offsets_shift_by_their_own_values_and_g53_suppresses_them_for_one_block() {
+    let mut s = mill();
+    // Offset k (0 = G54) shifts X by 10·(k+1), Y by −(k+1), Z by 100·(k+1).
+    for k in 0..54u8 {
+        let f = f64::from(k + 1);
+        s.offsets.work.insert(
+            k,
+            [('X', 10.0 * f), ('Y', -f), ('Z', 100.0 * f)]
+                .into_iter()
+                .collect(),
+        );
+    }
+    let codes: Vec<u32> = (54..=59).chain(507..=554).collect();
+    let mut text = String::new();
+    for g in &codes {
+        text.push_str(&format!("G{g} G0 X1 Y2 Z3\n"));
+    }
+    text.push_str("G53 X1 Y2 Z3\nX1 Y2 Z3\nG500 X1 Y2 Z3\nM30\n");
+    let mut front = Sinumerik::new(&text, s, Library::new());
+    let mut e = Vec::new();
+    while let Some(c) = next_command(&mut front).unwrap() {
+        e.extend(c.command.end().map(<[f64]>::to_vec));
+    }
+    assert_eq!(e.len(), codes.len() + 3, "{e:?}");
+    for (k, g) in codes.iter().enumerate() {
+        let f = (k + 1) as f64;
+        assert_eq!(e[k], [1.0 + 10.0 * f, 2.0 - f, 3.0 + 100.0 * f], "G{g}");
+    }
+    // G53: machine coordinates for its block; the next block in G554 again; G500: none.
+    let f = codes.len() as f64;
+    let n = codes.len();
+    assert_eq!(e[n], [1.0, 2.0, 3.0], "G53");
+    assert_eq!(
+        e[n + 1],
+        [1.0 + 10.0 * f, 2.0 - f, 3.0 + 100.0 * f],
+        "after G53"
+    );
+    assert_eq!(e[n + 2], [1.0, 2.0, 3.0], "G500");
+}
