@@ -306,6 +306,45 @@ fn f032_meas_finds_the_wall_brakes_there_and_the_program_reads_the_edge() {
     assert_eq!(kept.get(&10_005), None, "R5 not written");
 }
 
+/// Fixture 080 (§9.12.1, D121) through the interpreter and motion on the simulated mill: a
+/// cut of 100 mm at F600, then the fixture's check of the cutting time against R10. The block
+/// that reads `$AC_CUTTING_TIME` waits until the cut has run, then reads what motion counted:
+/// the cut's 10 s and its ramps, not the rapid before it. Over a limit of 5 s the program
+/// jumps to WZZEIT and holds at its M0; under a limit of 20 s it runs on to its end.
+#[test]
+fn f080_reads_the_cutting_time_the_machine_counted_and_jumps_on_it() {
+    let run = |limit: f64| {
+        let text = format!(
+            "R10={limit}\nG0 X0 Y0 Z100\nG1 X100 F600\nR1=$AC_CUTTING_TIME R2=$AC_CYCLE_TIME\n{}",
+            fixture("080").replace("\n...\n", "\nG0 X1\nM30\n")
+        );
+        let mut r = mill(&text);
+        r.run_until(40.0, |r| {
+            r.program_done() || r.motion.state() == cnc_motion::RunState::Hold
+        });
+        r
+    };
+    let r = run(5.0);
+    assert_eq!(r.motion.state(), cnc_motion::RunState::Hold, "WZZEIT: M0");
+    let kept = r.stream.interpreter().memory().kept;
+    let (cutting, cycle) = (kept[&10_001], kept[&10_002]);
+    assert!((10.0..10.3).contains(&cutting), "cutting {cutting}");
+    // The rapid of 50 mm at 12 m/min takes 0.25 s at the least.
+    assert!(
+        cycle > cutting + 0.25,
+        "the rapid counts in the cycle: {cycle}"
+    );
+    assert!((r.motion.commanded_display()[0] - 100.0).abs() < 1e-9);
+    println!("$AC_CUTTING_TIME {cutting:.3} s, $AC_CYCLE_TIME {cycle:.3} s");
+
+    let r = run(20.0);
+    assert!(
+        r.program_done(),
+        "under the limit the program runs to its end"
+    );
+    assert!((r.motion.commanded_display()[0] - 1.0).abs() < 1e-9);
+}
+
 /// Fixture 091 (§9.15, D117) through motion and the simulated drives on the 802D mill with
 /// its optional fourth axis as C and T1 D1 the fixture's cutter (radius 10.123): the program
 /// runs as printed to its M2, back at X25 Z50 C120 (T1's length along Z), and while the

@@ -219,7 +219,8 @@ fn the_cycles_run_in_the_cell_hold_at_the_m0_of_cycle87_and_go_on_at_cycle_start
 /// machine X200, motion brakes there and reports the edge in its status over the machine
 /// bus, and the interpreter node, which waited for it, reads on: the program moves to
 /// X=R5−10, so the axes end at X190 only if the measured value came through; and the
-/// interpreter node writes the MSG service's text with it to the machine's file (D120).
+/// interpreter node writes the MSG service's text with it to the machine's file (D120), and
+/// with the cutting time motion's status carried to it (D121).
 #[test]
 fn a_measuring_block_runs_in_the_cell_and_the_program_goes_on_with_its_value() {
     let dir = common::fresh_dir("sinumerik_cell_msg");
@@ -237,6 +238,7 @@ fn a_measuring_block_runs_in_the_cell_and_the_program_goes_on_with_its_value() {
                N30 IF $AC_MEA[1]==0 GOTOF MISSED\n\
                N40 G0 X=$AA_MW[X]-10 Y20\n\
                N45 MSG(\"File: wall at X\"<<$AA_MW[X])\n\
+               N46 MSG(\"File: cut \"<<TRUNC($AC_CUTTING_TIME))\n\
                N50 M2\n\
                N60 MISSED: M0\n\
                N70 M2\n";
@@ -246,8 +248,10 @@ fn a_measuring_block_runs_in_the_cell_and_the_program_goes_on_with_its_value() {
     completes_at(&mut client, Duration::from_secs(120), [190.0, 20.0, 100.0]);
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
-    // The MSG service's file output (§8.4.4, D120) has the measured value.
+    // The MSG service's file output (§8.4.4, D120) has the measured value, and the cutting
+    // time motion counted and reported in its status (D121): the measuring line's 200 mm at
+    // F2000 to the wall, 6 s and its ramps.
     let written = std::fs::read_to_string(&msg_file).expect("the MSG service's file");
-    assert_eq!(written, "wall at X200\n");
+    assert_eq!(written, "wall at X200\ncut 6\n");
     let _ = std::fs::remove_dir_all(&dir);
 }

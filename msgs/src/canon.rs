@@ -82,6 +82,10 @@ pub enum Command {
     Fifo {
         fill: bool,
     },
+    /// A preprocessing stop that reads the machine: motion reports it done, with its run-time
+    /// timers, once every block before it has finished; the program waits for it (a block
+    /// that reads a timer, `$AC_CUTTING_TIME`).
+    Sync,
     Dwell {
         seconds: f64,
     },
@@ -281,6 +285,7 @@ pub fn to_motion_block(
             m.kind = MotionBlock::KIND_FIFO;
             m.flag = *fill;
         }
+        Command::Sync => m.kind = MotionBlock::KIND_SYNC,
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
@@ -419,6 +424,7 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
         }
         MotionBlock::KIND_COMPRESSOR => Command::Compressor { on: m.flag },
         MotionBlock::KIND_FIFO => Command::Fifo { fill: m.flag },
+        MotionBlock::KIND_SYNC => Command::Sync,
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_PROFILE => Command::Profile {
@@ -529,6 +535,7 @@ mod tests {
             },
             Command::Compressor { on: true },
             Command::Fifo { fill: true },
+            Command::Sync,
             Command::Dwell { seconds: 1.5 },
             Command::Tap {
                 end: vec![10.0, 10.0, -25.0],

@@ -234,6 +234,7 @@ ros_message! {
             KIND_FIXED_STOP: u8 = 15,
             KIND_COMPRESSOR: u8 = 16,
             KIND_FIFO: u8 = 17,
+            KIND_SYNC: u8 = 18,
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,
@@ -274,6 +275,10 @@ ros_message! {
         result_triggered: bool,
         result_position: Vec<f64>,
         result_rest: Vec<f64>,
+        cutting_time: f64,
+        cycle_time: f64,
+        operating_time: f64,
+        power_on_time: f64,
     }
 }
 

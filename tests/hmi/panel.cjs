@@ -91,6 +91,9 @@ async function waitFor(what, check, seconds) {
     return [...lines];
   };
   const first = await cycle(1);
+  // The program's run time, as motion counted it (D121), shown once it has run.
+  const runTime = await text("cycle_time");
+  if (!/^\d+:\d\d\.\d$/.test(runTime) || runTime === "0:00.0") fail(`run time shown ${runTime}`);
   const second = await cycle(2);
   // Block search from the panel: the third part starts at line 5 (`Z-15`); no line before it
   // runs, and the field is cleared for the next cycle start.

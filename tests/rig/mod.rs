@@ -5,7 +5,7 @@
 #![allow(dead_code)]
 
 use cnc_interpreter::run::ProgramRun;
-use cnc_interpreter::{Canon, Dialect, Interpreter, Library, Measurement};
+use cnc_interpreter::{Canon, Dialect, Interpreter, Library, MachineTimers, Measurement};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
 
@@ -84,15 +84,23 @@ impl Rig {
     /// One servo period; the PLC scans when its 10 ms are due.
     pub fn tick(&mut self) {
         if self.started {
-            // A measuring block's result, once motion has it, as the interpreter node takes it.
+            // A block's result (a measuring block, a preprocessing stop), once motion has it,
+            // with the timers, as the interpreter node takes it from motion's status.
             if let (Some(seq), Some(r)) =
                 (self.stream.awaiting_machine(), self.motion.block_result())
             {
                 if r.seq == seq {
+                    let t = self.motion.timers();
                     let m = Measurement {
                         triggered: r.triggered,
                         position: r.position[..self.n].to_vec(),
                         rest: r.rest[..self.n].to_vec(),
+                        timers: Some(MachineTimers {
+                            cutting: t.cutting,
+                            cycle: t.cycle,
+                            operating: t.operating,
+                            power_on: t.power_on,
+                        }),
                     };
                     self.stream
                         .machine_result(seq, m)

@@ -50,6 +50,11 @@ function connect() {
 }
 
 const fmt = (v) => (typeof v === "number" ? v.toFixed(3) : "-");
+// Seconds as minutes:seconds with tenths (the program's run time).
+const clock = (s) => {
+  const t = Math.round(s * 10) / 10;
+  return `${Math.floor(t / 60)}:${(t % 60).toFixed(1).padStart(4, "0")}`;
+};
 
 const handlers = {
   welcome(m) {
@@ -95,6 +100,7 @@ const handlers = {
       $("ov_rapid").textContent = m.overrides.rapid;
     }
     $("parts").textContent = m.parts ? m.parts.count : 0;
+    if (m.timers) $("cycle_time").textContent = clock(m.timers.cycle);
     $("alarms").innerHTML = (m.alarms || [])
       .map((a) => `<li class="${a.acknowledged ? "seen" : "unseen"}">${a.number} ${escape(a.text)}${a.line ? ` (line ${a.line})` : ""} [${a.source}]${a.acknowledged ? " (seen)" : ""}</li>`)
       .join("");

@@ -30,7 +30,9 @@ pub mod sinumerik;
 pub mod stream;
 pub mod trace;
 
-pub use cnc_interpreter_core::{canon, geometry, rough, Aux, Canon, Command, Library, Measurement};
+pub use cnc_interpreter_core::{
+    canon, geometry, rough, Aux, Canon, Command, Library, MachineTimers, Measurement,
+};
 pub use dialect::Dialect;
 pub use error::ProgramError;
 pub use fanuc::syntax;

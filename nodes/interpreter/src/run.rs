@@ -842,12 +842,19 @@ impl RunCore {
     }
 }
 
-/// Motion's result of the last measuring block (`MotionStatus::probe_*`).
+/// Motion's result of the last block whose end it decided (`MotionStatus::result_*`), with
+/// the timers the same report carries.
 fn measurement(status: &MotionStatus) -> cnc_interpreter_core::Measurement {
     cnc_interpreter_core::Measurement {
         triggered: status.result_triggered,
         position: status.result_position.clone(),
         rest: status.result_rest.clone(),
+        timers: Some(cnc_interpreter_core::MachineTimers {
+            cutting: status.cutting_time,
+            cycle: status.cycle_time,
+            operating: status.operating_time,
+            power_on: status.power_on_time,
+        }),
     }
 }
 

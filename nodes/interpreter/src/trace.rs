@@ -100,6 +100,7 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             "COMPRESSOR_OFF"
         }),
         Command::Fifo { fill } => s.push_str(if *fill { "FIFO_FILL" } else { "FIFO_RUN" }),
+        Command::Sync => s.push_str("SYNC"),
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
         }
@@ -404,8 +405,9 @@ impl LinuxCnc {
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
             // rs274 has no call for the acceleration profile (its planner's is fixed), the
             // drives' feedforward, an acceleration override, a fixed stop, the compressor or
-            // the look-ahead buffer.
+            // the look-ahead buffer, or a preprocessing stop that reads the machine.
             Command::Profile { .. }
+            | Command::Sync
             | Command::Feedforward { .. }
             | Command::Acceleration { .. }
             | Command::FixedStop { .. }

@@ -90,6 +90,7 @@ fn the_program_reads_on_from_where_the_axis_met_its_stop() {
             triggered: true,
             position: vec![0.0, 0.0, 95.0],
             rest: vec![0.0, 0.0, 95.0],
+            timers: None,
         })
         .expect("the machine's axes");
     let mut rest = Vec::new();

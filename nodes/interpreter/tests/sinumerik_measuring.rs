@@ -51,6 +51,7 @@ impl OnMachine {
                 triggered,
                 position: position.to_vec(),
                 rest: rest.to_vec(),
+                timers: None,
             })
             .expect("a result of the machine's axes");
     }

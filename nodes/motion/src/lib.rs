@@ -21,4 +21,4 @@ pub mod thread;
 
 pub use block::{Aux, Block, Command};
 pub use config::{AxisConfig, MotionConfig};
-pub use motion::{Motion, MotionEvent, Panel, RunState};
+pub use motion::{Motion, MotionEvent, Panel, RunState, RunTimers};

@@ -559,6 +559,9 @@ fn servo_loop(
                 RunState::Alarm => MotionStatus::STATE_ALARM,
             };
             let capacity = motion.capacity() as u32;
+            // The timers as of this period: the status that reports a preprocessing stop
+            // reached carries them as they stood when the program stopped to read them.
+            let timers = motion.timers();
             let msg = MotionStatus {
                 run_id: status.0,
                 accepted_seq: status.1,
@@ -566,6 +569,10 @@ fn servo_loop(
                 capacity,
                 line: status.4,
                 state,
+                cutting_time: timers.cutting,
+                cycle_time: timers.cycle,
+                operating_time: timers.operating,
+                power_on_time: timers.power_on,
                 ..MotionStatus::default()
             };
             let _ = reports.send(Report::Status(msg, status.5));

@@ -277,6 +277,13 @@ impl View {
                 "feed": o.feed_percent, "spindle": o.spindle_percent, "rapid": o.rapid_percent,
             })),
             "parts": self.parts.as_ref().map(|p| json!({"count": p.count, "target": p.target})),
+            // The run-time timers motion counts, seconds (D121): AUTO shows the program's.
+            "timers": {
+                "cycle": self.status.cycle_time,
+                "cutting": self.status.cutting_time,
+                "operating": self.status.operating_time,
+                "power_on": self.status.power_on_time,
+            },
             "alarms": self.active.iter().map(|a| json!({
                 "number": a.number, "severity": a.severity, "text": a.text,
                 "source": a.source, "program": a.program, "line": a.line,
@@ -365,7 +372,16 @@ mod tests {
             ..MotionBlock::default()
         });
         v.on_axes(axes(50.0, -20.0));
+        v.on_motion_status(MotionStatus {
+            run_id: 7,
+            done_seq: 1,
+            cycle_time: 12.5,
+            cutting_time: 8.25,
+            ..MotionStatus::default()
+        });
         let f = v.frame();
+        assert_eq!(f["timers"]["cycle"], 12.5);
+        assert_eq!(f["timers"]["cutting"], 8.25);
         assert_eq!(f["axes"][0]["work"], 150.0);
         assert_eq!(f["axes"][1]["work"], 180.0);
         assert_eq!(f["axes"][0]["to_go"], -10.0);

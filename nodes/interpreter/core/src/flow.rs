@@ -123,6 +123,13 @@ impl Core {
         Some((text, range))
     }
 
+    /// The line being run is read again next: a block that must wait for the machine before
+    /// it runs (a preprocessing stop) runs once the machine has answered.
+    pub fn read_line_again(&mut self) {
+        let start = self.block_start;
+        self.level().pos = start;
+    }
+
     /// Any block has been read (a `%` opening a tape is only recognised before one).
     pub fn saw_any_block(&self) -> bool {
         self.line > 1 || self.levels.len() > 1

@@ -40,7 +40,7 @@ pub use driver::{next_command, FrontEnd};
 pub use emit::{MoveKind, Waiting};
 pub use error::{AlarmTable, Fault, ProgramError};
 pub use flow::{CallLevel, Repeat};
-pub use measure::Measurement;
+pub use measure::{MachineTimers, Measurement};
 pub use setup::{Offsets, Setup, ToolOffset};
 pub use state::{CompRules, Core, Coupling, CssRule, Plane, Rules, ServiceOutput, SpindleDir};
 pub use text::{find_number, line_number, read_line, Library, Pos};

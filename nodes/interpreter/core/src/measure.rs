@@ -22,6 +22,22 @@ pub struct Measurement {
     pub position: Vec<f64>,
     /// Where the axes came to rest.
     pub rest: Vec<f64>,
+    /// The machine's run-time timers when it reported the block (`None` without a machine).
+    pub timers: Option<MachineTimers>,
+}
+
+/// The machine's run-time timers, seconds (decisions D121): what a preprocessing stop that
+/// reads the machine ([`Core::sync_with_machine`]) found.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MachineTimers {
+    /// Tool-engaged feed time of every program since power-on.
+    pub cutting: f64,
+    /// Run time of the program started last.
+    pub cycle: f64,
+    /// Run time of every program since power-on.
+    pub operating: f64,
+    /// Time since power-on.
+    pub power_on: f64,
 }
 
 /// An axis's travel to a fixed stop as the program sees it; the values are the ones a
@@ -41,6 +57,8 @@ pub enum Awaited {
     Measurement,
     /// The travel of this axis to its fixed stop.
     FixedStop(usize),
+    /// A preprocessing stop that reads the machine (its timers).
+    Sync,
 }
 
 impl Core {
@@ -107,6 +125,20 @@ impl Core {
         Ok(())
     }
 
+    /// A preprocessing stop that reads the machine: every command before it runs to its end,
+    /// then the machine reports its timers ([`Core::machine_timers`]); the program reads on
+    /// after that. The block that asked is read again then ([`Core::read_line_again`]).
+    /// Without a machine the timers stay as they were.
+    pub fn sync_with_machine(&mut self) -> Result<(), ProgramError> {
+        self.push(Command::Sync);
+        self.await_machine(Awaited::Sync)
+    }
+
+    /// The timers the last preprocessing stop read, taken once.
+    pub fn machine_timers(&mut self) -> Option<MachineTimers> {
+        self.timers_read.take()
+    }
+
     /// After a block whose end the machine decides, its move the last command queued: wait
     /// for its result, or without a machine take the event as coming at the move's end.
     fn await_machine(&mut self, what: Awaited) -> Result<(), ProgramError> {
@@ -121,6 +153,7 @@ impl Core {
                 triggered: true,
                 position: at.clone(),
                 rest: at,
+                timers: None,
             })
         }
     }
@@ -156,8 +189,15 @@ impl Core {
             self.pending.clear();
             return Err(e);
         }
+        let what = self.awaiting.take().map(|(what, _)| what);
+        if what == Some(Awaited::Sync) {
+            // Nothing moved: the position stays the program's (under TRACYL it is not the
+            // machine's).
+            self.timers_read = m.timers;
+            return Ok(());
+        }
         self.pos.clone_from(&m.rest);
-        match self.awaiting.take().map(|(what, _)| what) {
+        match what {
             Some(Awaited::Measurement) => {
                 if m.triggered {
                     self.measured_at = Some(m.position.clone());
@@ -173,7 +213,7 @@ impl Core {
                     };
                 }
             }
-            None => {}
+            Some(Awaited::Sync) | None => {}
         }
         Ok(())
     }

@@ -193,6 +193,8 @@ pub struct Core {
     pub(crate) awaiting: Option<(crate::measure::Awaited, u64)>,
     /// The last measuring move's result.
     pub measurement: Option<crate::measure::Measurement>,
+    /// The timers the last preprocessing stop read from the machine, until taken.
+    pub(crate) timers_read: Option<crate::measure::MachineTimers>,
     /// Per axis, its travel to a fixed stop as the program sees it.
     pub fixed_stops: Vec<crate::measure::FixedStop>,
     /// Where the probe last switched (machine coordinates): a job in which it did not
@@ -262,6 +264,7 @@ impl Core {
             awaiting: None,
             fixed_stops: vec![crate::measure::FixedStop::Off; n],
             measurement: None,
+            timers_read: None,
             measured_at: None,
             cylinder: None,
             wall: Pt::new(0.0, 0.0),

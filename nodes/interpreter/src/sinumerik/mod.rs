@@ -31,6 +31,7 @@ mod rect_pocket;
 mod slots;
 mod spigot;
 mod thread_mill;
+mod timers;
 mod tool;
 mod tracyl;
 mod trail;
@@ -109,6 +110,10 @@ pub struct Sinumerik {
     jump: Option<(bool, String)>,
     /// The lists a block's words are sorted into, kept for the next block.
     words: exec::Words,
+    /// The run-time timers as the last preprocessing stop read them (D121).
+    timers: cnc_interpreter_core::MachineTimers,
+    /// The block being read again after its preprocessing stop: it runs now.
+    synced: bool,
     /// The token and item lists of the last block, their room kept for the next.
     parse_room: block::Buffers,
     /// A move's start and end in the work's coordinates, their room kept for the next move.
@@ -236,6 +241,8 @@ impl Sinumerik {
             messages: Vec::new(),
             jump: None,
             words: exec::Words::default(),
+            timers: cnc_interpreter_core::MachineTimers::default(),
+            synced: false,
             parse_room: block::Buffers::default(),
             here_room: Vec::new(),
             end_room: Vec::new(),
@@ -434,7 +441,7 @@ impl Sinumerik {
             }
             _ => match counter_key(name) {
                 Some(k) => Ok(self.core.common.get(&k).copied().unwrap_or(0.0)),
-                None => Err(unknown()),
+                None => timers::timer(&self.timers, name).unwrap_or_else(|| Err(unknown())),
             },
         }
     }
@@ -628,18 +635,13 @@ impl Sinumerik {
     }
 }
 
-/// Where the part counters and timers of §9.12 live in the core's common store.
+/// Where the part counters of §9.12 live in the core's common store.
 fn counter_key(name: &str) -> Option<i64> {
     let names = [
         "$AC_TOTAL_PARTS",
         "$AC_REQUIRED_PARTS",
         "$AC_ACTUAL_PARTS",
         "$AC_SPECIAL_PARTS",
-        "$AC_CUTTING_TIME",
-        "$AC_CYCLE_TIME",
-        "$AC_OPERATING_TIME",
-        "$AN_SETUP_TIME",
-        "$AN_POWERON_TIME",
     ];
     names
         .iter()
@@ -694,11 +696,22 @@ impl FrontEnd for Sinumerik {
             Ok(b) => b,
             Err(e) => return Err(self.fault(Fault::DataFormat, e)),
         };
-        let done = if block.skip && self.core.setup.block_skip {
-            Ok(())
-        } else {
-            self.run_block(&block, &text)
-        };
+        if block.skip && self.core.setup.block_skip {
+            self.parse_room.recycle(block);
+            return Ok(());
+        }
+        // A block that reads a run-time timer runs after a preprocessing stop has read them.
+        if let Some(t) = self.core.machine_timers() {
+            self.timers = t;
+        }
+        if !std::mem::take(&mut self.synced) && timers::reads_timer(line) {
+            self.parse_room.recycle(block);
+            self.synced = true;
+            self.core.sync_with_machine()?;
+            self.core.read_line_again();
+            return Ok(());
+        }
+        let done = self.run_block(&block, &text);
         self.parse_room.recycle(block);
         done
     }

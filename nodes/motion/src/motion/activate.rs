@@ -119,6 +119,11 @@ impl Motion {
             | Command::Compressor { .. }
             | Command::Fifo { .. }
             | Command::Acceleration { .. } => Ok(Active::Dwell { remaining: 0.0 }),
+            // Every block before it has finished: the program may read the machine.
+            Command::Sync => {
+                self.sync_reached(block.seq);
+                Ok(Active::Dwell { remaining: 0.0 })
+            }
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
                 raised: false,

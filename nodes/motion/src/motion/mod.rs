@@ -37,10 +37,12 @@ mod probe;
 mod reference;
 mod signals;
 mod tapping;
+mod timers;
 mod window;
 
 pub use probe::ProbeInput;
 pub use reference::ReferenceInputs;
+pub use timers::RunTimers;
 
 /// Something the shell must publish.
 #[derive(Debug, Clone, PartialEq)]
@@ -219,6 +221,10 @@ pub struct Motion {
     /// STOPFIFO: the blocks after it wait until the queue is full or the section's end is
     /// queued (D119).
     fifo_fill: bool,
+    /// The run-time timers (D121).
+    timers: RunTimers,
+    /// A program runs: from its first block to its end, a reset or a dropped run.
+    program_running: bool,
 }
 
 impl Motion {
@@ -243,6 +249,8 @@ impl Motion {
         Motion {
             compressor: false,
             fifo_fill: false,
+            timers: RunTimers::default(),
+            program_running: false,
             fixed_stops: vec![None; n],
             probe_input: ProbeInput::default(),
             probing: None,
@@ -365,6 +373,7 @@ impl Motion {
             self.compressor = false;
             self.fifo_fill = false;
             self.clear_strobe();
+            self.start_program_time();
         }
         // Blocks of a run started during an emergency stop (before the PLC's first scan at
         // power-on) wait in the queue.
@@ -423,6 +432,7 @@ impl Motion {
     /// is dropped: its blocks still on their way are let go.
     pub fn reset(&mut self) {
         self.dead_run = self.run_id;
+        self.program_running = false;
         self.reset_ticks = RESET_SIGNAL_TICKS;
         self.alarm = false;
         self.servo_off = false;
@@ -560,6 +570,7 @@ impl Motion {
         // dropped with this period.
         let detents = self.take_detents();
         self.trial_run(plc, detents, self.cfg.period);
+        self.count_power_on(self.cfg.period);
         if let Some(a) = actual {
             for ((dst, src), s) in self.actual.iter_mut().zip(a).zip(&self.shift) {
                 *dst = *src + *s;
@@ -632,6 +643,7 @@ impl Motion {
             return;
         }
         self.take_machine_lock();
+        self.count_run_time(dt);
         self.watch_probe();
         self.watch_fixed_stops();
         let mut budget = 8; // blocks that can finish within one tick (zero-length moves, aux)
@@ -699,6 +711,9 @@ impl Motion {
                 );
                 if let Some((block, _)) = self.active.take() {
                     self.done_seq = self.done_seq.max(block.seq);
+                    if block.kind == Command::ProgramEnd {
+                        self.program_running = false;
+                    }
                     self.last_line = Some(self.line);
                     // M00, and M01 with the optional-stop switch on, stop after their FIN.
                     self.block_stop = match block.kind {
@@ -744,6 +759,7 @@ impl Motion {
 
     /// Forgets the queue and whatever is moving; the axes keep their commanded position.
     fn drop_run(&mut self) {
+        self.program_running = false;
         self.queue.clear();
         self.active = None;
         self.probing = None;
