@@ -345,6 +345,32 @@ fn f080_reads_the_cutting_time_the_machine_counted_and_jumps_on_it() {
     assert!((r.motion.commanded_display()[0] - 1.0).abs() < 1e-9);
 }
 
+/// Tool life through the interpreter and motion on the simulated mill (§9.13.2, D122): T1 D1
+/// has 0.1 min (6 s) of life; a cut of 100 mm at F600 takes 10 s, so reading `$TC_MOP2` after
+/// it (a preprocessing stop) finds the life used up by the cutting time motion counted, the
+/// tool disabled (`$TC_TP8` bit 2), and the program's end accounts nothing more.
+#[test]
+fn tool_life_wears_by_the_cutting_time_motion_counted() {
+    let text = "$TC_TP9[1]=1 $TC_MOP11[1,1]=0.1 $TC_MOP2[1,1]=0.1\nT1 D1\nG0 X0 Y0 Z100\n\
+                G1 X100 F600\nR1=$TC_MOP2[1,1]\nG0 Z120\nM30\n";
+    let mut r = mill(text);
+    r.run_until(40.0, |r| r.program_done());
+    assert!(r.program_done(), "the program runs to its end");
+    let kept = r.stream.interpreter().memory().kept;
+    let key =
+        |name: &str, d: u32| cnc_interpreter::sinumerik::monitor::kept_key(name, 1, d).unwrap();
+    let seen = kept[&10_001];
+    let cut = (0.1 - seen) * 60.0;
+    assert!((10.0..10.3).contains(&cut), "R1 {seen}: {cut} s cut");
+    assert_eq!(
+        kept[&key("$TC_MOP2", 1)],
+        seen,
+        "M30 accounts no more cutting"
+    );
+    assert_eq!(kept[&key("$TC_TP8", 0)] as i64 & 4, 4, "T1 disabled");
+    println!("$TC_MOP2[1,1] {seen:.5} min after {cut:.3} s of cutting");
+}
+
 /// Fixture 091 (§9.15, D117) through motion and the simulated drives on the 802D mill with
 /// its optional fourth axis as C and T1 D1 the fixture's cutter (radius 10.123): the program
 /// runs as printed to its M2, back at X25 Z50 C120 (T1's length along Z), and while the

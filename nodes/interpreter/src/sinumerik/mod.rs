@@ -114,6 +114,12 @@ pub struct Sinumerik {
     timers: cnc_interpreter_core::MachineTimers,
     /// The block being read again after its preprocessing stop: it runs now.
     synced: bool,
+    /// A tool on the offset page is monitored by its life (`$TC_TP9` bit 1, D122): edge
+    /// changes and the program's end are preprocessing stops that account its cutting time.
+    life_used: bool,
+    /// The machine's cutting time when the active edge's life was last accounted (`None`
+    /// before the run's first preprocessing stop).
+    life_start: Option<f64>,
     /// The token and item lists of the last block, their room kept for the next.
     parse_room: block::Buffers,
     /// A move's start and end in the work's coordinates, their room kept for the next move.
@@ -243,6 +249,8 @@ impl Sinumerik {
             words: exec::Words::default(),
             timers: cnc_interpreter_core::MachineTimers::default(),
             synced: false,
+            life_used: false,
+            life_start: None,
             parse_room: block::Buffers::default(),
             here_room: Vec::new(),
             end_room: Vec::new(),
@@ -268,6 +276,7 @@ impl Sinumerik {
             service_last: [None, None],
         };
         front.apply_length();
+        front.life_used = front.life_in_use();
         front
     }
 
@@ -683,6 +692,12 @@ impl FrontEnd for Sinumerik {
                 self.sync_scopes();
                 return Ok(());
             }
+            // The last edge's life is accounted before the program ends (D122).
+            if self.life_used && !std::mem::take(&mut self.synced) {
+                self.synced = true;
+                return self.core.sync_with_machine();
+            }
+            self.machine_read();
             return self.core.end_of_main();
         };
         self.sync_scopes();
@@ -700,11 +715,11 @@ impl FrontEnd for Sinumerik {
             self.parse_room.recycle(block);
             return Ok(());
         }
-        // A block that reads a run-time timer runs after a preprocessing stop has read them.
-        if let Some(t) = self.core.machine_timers() {
-            self.timers = t;
-        }
-        if !std::mem::take(&mut self.synced) && timers::reads_timer(line) {
+        // A block that reads the machine (a run-time timer, D121) or changes a life-monitored
+        // tool's edge (D122) runs after a preprocessing stop has read the timers.
+        if std::mem::take(&mut self.synced) {
+            self.machine_read();
+        } else if timers::reads_timer(line) || self.life_stop(&block, line) {
             self.parse_room.recycle(block);
             self.synced = true;
             self.core.sync_with_machine()?;

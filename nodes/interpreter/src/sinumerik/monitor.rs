@@ -6,12 +6,16 @@
 //! again until RESETMON.
 //!
 //! The data live in the core's kept store (keys [`BASE`]…), so they survive power-off as the
-//! offset page's do; only edges on the offset page have them. Tool life (type 1, counted in
-//! G1/G2/G3 time) is not built: it needs the path time motion measures, so `$TC_TP9` refuses
-//! it rather than monitor nothing.
+//! offset page's do; only edges on the offset page have them.
+//!
+//! Tool life (type 1, D122): the remaining life `$TC_MOP2` of the active edge goes down by the
+//! cutting time the machine counted while it was active (motion's `$AC_CUTTING_TIME`, D121),
+//! accounted at preprocessing stops: the run's first block, every block that changes the edge
+//! (T, D, M6), the main program's end, and a block that reads `$TC_MOP2`.
 
 use cnc_interpreter_core::{Fault, ProgramError};
 
+use super::block::{Block, Item};
 use super::expr::{EvalError, Expr, Val};
 use super::Sinumerik;
 
@@ -36,6 +40,7 @@ pub const KEYS: std::ops::RangeInclusive<i64> = BASE..=BASE + DATA.len() as i64 
 /// Positions in [`DATA`].
 const TP8: usize = 0;
 const TP9: usize = 1;
+const MOP1: usize = 2;
 const MOP2: usize = 3;
 const MOP3: usize = 4;
 const MOP4: usize = 5;
@@ -167,23 +172,95 @@ impl Sinumerik {
         if matches!(k, TP8 | TP9 | MOP3 | MOP4 | MOP13) {
             x = x.round();
         }
-        if k == TP9 {
-            if !(0.0..=3.0).contains(&x) {
-                return Err(EvalError::new(
-                    Fault::OutOfRange,
-                    "$TC_TP9: 0 none, 1 life, 2 count",
-                ));
-            }
-            if x as i64 & LIFE != 0 {
-                return Err(EvalError::new(
-                    Fault::NotSupported,
-                    "$TC_TP9: tool life monitoring is not built (the life counts in G1/G2/G3 \
-                     time, which motion would have to measure): count monitoring is 2",
-                ));
-            }
+        if k == TP9 && !(0.0..=3.0).contains(&x) {
+            return Err(EvalError::new(
+                Fault::OutOfRange,
+                "$TC_TP9: 0 none, 1 life, 2 count, 3 both",
+            ));
         }
         self.set_datum(k, t, d, x);
+        if k == TP9 {
+            self.life_used = self.life_in_use();
+        }
         Ok(())
+    }
+
+    /// Whether a tool of the offset page is monitored by its life.
+    pub(super) fn life_in_use(&self) -> bool {
+        let tools = self.core.setup.offsets.tools.keys().map(|e| e / 10);
+        tools
+            .filter(|t| *t > 0)
+            .any(|t| self.datum(TP9, t, 0) as i64 & LIFE != 0)
+    }
+
+    /// Whether `block` must wait for a preprocessing stop that accounts the active edge's
+    /// life: with life monitoring in use, the run's first block, a block that changes the
+    /// edge (T, D, M6), ends the main program (M2, M30) or reads `$TC_MOP2`.
+    pub(super) fn life_stop(&self, block: &Block, line: &str) -> bool {
+        if !self.life_used {
+            return false;
+        }
+        let main = self.core.depth() == 1;
+        let changes = block.items.iter().any(|item| match item {
+            Item::Word { letter, value, .. } => {
+                matches!(letter, 'T' | 'D')
+                    || (*letter == 'M'
+                        && (*value == 6.0 || (main && matches!(*value as u32, 2 | 30))))
+            }
+            Item::Assign { name, .. } => matches!(name.as_ref(), "T" | "D"),
+            _ => false,
+        });
+        self.life_start.is_none()
+            || changes
+            || super::lex::strip_comment(line)
+                .to_ascii_uppercase()
+                .contains("$TC_MOP2")
+    }
+
+    /// After a preprocessing stop: the timers as the machine reported them (none without a
+    /// machine), and the active edge's life down by the cutting time since its last stop.
+    pub(super) fn machine_read(&mut self) {
+        if let Some(t) = self.core.machine_timers() {
+            self.timers = t;
+        }
+        let now = self.timers.cutting;
+        let Some(start) = self.life_start.replace(now) else {
+            return;
+        };
+        let (t, d) = (self.tool, self.edge);
+        if t == 0 || d == 0 || self.core.searching || self.datum(TP9, t, 0) as i64 & LIFE == 0 {
+            return;
+        }
+        if !self.core.setup.offsets.tools.contains_key(&(t * 10 + d)) {
+            return;
+        }
+        let left = self.datum(MOP2, t, d) - (now - start).max(0.0) / 60.0;
+        self.set_datum(MOP2, t, d, left);
+        let warn = self.datum(MOP1, t, d);
+        self.reach_limits(t, d, left, warn);
+    }
+
+    /// A remaining count or life `left` at or below its prewarning limit `warn` (if one is
+    /// set) is message 6411, at or below 0 message 6413 and the tool disabled; each once.
+    fn reach_limits(&mut self, t: u32, d: u32, left: f64, warn: f64) {
+        let state = self.datum(TP8, t, 0) as i64;
+        let (flag, number, text) = if left <= 0.0 {
+            (DISABLED, LIMIT_REACHED, "has reached its monitoring limit")
+        } else if warn > 0.0 && left <= warn {
+            (
+                PREWARNING,
+                PREWARNING_REACHED,
+                "has reached its prewarning limit",
+            )
+        } else {
+            return;
+        };
+        if state & flag == 0 {
+            self.set_datum(TP8, t, 0, (state | flag) as f64);
+            let shown = format!("{number} tool {t} {text} with D = {d}");
+            self.messages.push((self.core.line, shown.clone()));
+            self.core.operator_message(shown);
+        }
     }
 
     /// A cutting edge became active: SETPIECE will count it (§9.13.3, "SETPIECE memory").
@@ -253,25 +330,8 @@ impl Sinumerik {
             }
             let left = self.datum(MOP4, t, d) - n;
             self.set_datum(MOP4, t, d, left);
-            let state = self.datum(TP8, t, 0) as i64;
             let warn = self.datum(MOP3, t, d);
-            let (flag, number, text) = if left <= 0.0 {
-                (DISABLED, LIMIT_REACHED, "has reached its monitoring limit")
-            } else if warn > 0.0 && left <= warn {
-                (
-                    PREWARNING,
-                    PREWARNING_REACHED,
-                    "has reached its prewarning limit",
-                )
-            } else {
-                continue;
-            };
-            if state & flag == 0 {
-                self.set_datum(TP8, t, 0, (state | flag) as f64);
-                let shown = format!("{number} tool {t} {text} with D = {d}");
-                self.messages.push((self.core.line, shown.clone()));
-                self.core.operator_message(shown);
-            }
+            self.reach_limits(t, d, left, warn);
         }
         Ok(())
     }
