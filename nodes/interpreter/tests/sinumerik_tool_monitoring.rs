@@ -170,3 +170,50 @@ fn a_check_wears_no_tool_and_resetmon_restores_the_life() {
     let r = run(text).ok();
     assert_eq!((r.front.r(1), r.front.r(2)), (2.0, 5.0));
 }
+
+/// `$A_MONIFACT` (§9.13.2): the life clock's factor. T1 D1 cuts 30 s at the factor 1, then the
+/// program sets 5 (a preprocessing stop: the 30 s are accounted at 1) and cuts 6 s more, which
+/// take 30 s of life. It reads back, starts each program at 1.0, and 0 is refused.
+#[test]
+fn the_life_clock_factor_scales_what_is_cut_after_it_is_set() {
+    use cnc_interpreter::sinumerik::Sinumerik;
+    use cnc_interpreter::{MachineTimers, Measurement};
+    use cnc_interpreter_core::next_command;
+    let text = "$TC_TP9[1]=1 $TC_MOP11[1,1]=10 $TC_MOP2[1,1]=10\nT1 D1\nR1=$A_MONIFACT\n\
+                G1 X100 F200\n$A_MONIFACT=5\nG1 X120\nR2=$TC_MOP2[1,1] R3=$A_MONIFACT\nM30\n";
+    let mut front = Sinumerik::new(text, mill(), Library::new());
+    front.core.on_machine = true;
+    // The stops: T1 D1 (the first block after life monitoring came on), $A_MONIFACT=5 after
+    // 30 s, the read of $TC_MOP2 after 6 s more, M30.
+    let mut reports = [0.0, 30.0, 36.0, 36.0].into_iter();
+    loop {
+        match next_command(&mut front) {
+            Ok(Some(_)) => {}
+            Ok(None) if front.core.awaiting_machine() => {
+                let cutting = reports.next().expect("four stops");
+                let at = front.core.pos.clone();
+                front
+                    .core
+                    .machine_result(Measurement {
+                        triggered: true,
+                        position: at.clone(),
+                        rest: at,
+                        timers: Some(MachineTimers {
+                            cutting,
+                            ..MachineTimers::default()
+                        }),
+                    })
+                    .unwrap();
+            }
+            Ok(None) => break,
+            Err(e) => panic!("alarm {e}"),
+        }
+    }
+    assert_eq!(reports.next(), None, "every stop taken");
+    assert_eq!(front.r(1), 1.0);
+    // 10 min − 0.5 min (30 s at 1) − 0.5 min (6 s at 5).
+    assert!((front.r(2) - 9.0).abs() < 1e-9, "{}", front.r(2));
+    assert_eq!(front.r(3), 5.0);
+    assert_eq!(run("$A_MONIFACT=0\n").alarm(), (17020, 1));
+    assert_eq!(run("R1=$A_MONIFACT\nM30\n").ok().front.r(1), 1.0);
+}

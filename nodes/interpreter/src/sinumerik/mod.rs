@@ -120,6 +120,8 @@ pub struct Sinumerik {
     /// The machine's cutting time when the active edge's life was last accounted (`None`
     /// before the run's first preprocessing stop).
     life_start: Option<f64>,
+    /// `$A_MONIFACT`: minutes of life a minute of cutting takes (1.0 at the start).
+    monifact: f64,
     /// The token and item lists of the last block, their room kept for the next.
     parse_room: block::Buffers,
     /// A move's start and end in the work's coordinates, their room kept for the next move.
@@ -251,6 +253,7 @@ impl Sinumerik {
             synced: false,
             life_used: false,
             life_start: None,
+            monifact: 1.0,
             parse_room: block::Buffers::default(),
             here_room: Vec::new(),
             end_room: Vec::new(),

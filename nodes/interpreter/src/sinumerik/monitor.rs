@@ -11,7 +11,8 @@
 //! Tool life (type 1, D122): the remaining life `$TC_MOP2` of the active edge goes down by the
 //! cutting time the machine counted while it was active (motion's `$AC_CUTTING_TIME`, D121),
 //! accounted at preprocessing stops: the run's first block, every block that changes the edge
-//! (T, D, M6), the main program's end, and a block that reads `$TC_MOP2`.
+//! (T, D, M6), the main program's end, and a block that reads `$TC_MOP2` or sets the life
+//! clock's factor `$A_MONIFACT`.
 
 use cnc_interpreter_core::{Fault, ProgramError};
 
@@ -54,6 +55,8 @@ const PREWARNING: i64 = 16;
 /// `$TC_TP9` bits: life, count.
 const LIFE: i64 = 1;
 const COUNT: i64 = 2;
+/// The life clock's factor (§9.13.2): 1.0 at each program's start.
+const MONIFACT: &str = "$A_MONIFACT";
 /// Message numbers of the SINUMERIK alarm list (the manual names none, D111).
 pub const PREWARNING_REACHED: u32 = 6411;
 pub const LIMIT_REACHED: u32 = 6413;
@@ -138,8 +141,11 @@ impl Sinumerik {
         Ok((t, d))
     }
 
-    /// Reads `$TC_TP8/9[t]` or `$TC_MOPk[t,d]`; None if `name` is no monitoring datum.
+    /// Reads `$TC_TP8/9[t]`, `$TC_MOPk[t,d]` or `$A_MONIFACT`; None if `name` is none of them.
     pub(super) fn monitor_read(&self, name: &str, idx: &[Val]) -> Option<Result<f64, EvalError>> {
+        if name == MONIFACT {
+            return Some(Ok(self.monifact));
+        }
         let k = index_of(name)?;
         Some(self.monitored_edge(name, idx).map(|(t, d)| {
             let v = self.datum(k, t, d);
@@ -159,8 +165,29 @@ impl Sinumerik {
         idx: &[Val],
         v: &Val,
     ) -> Option<Result<(), EvalError>> {
+        if name == MONIFACT {
+            return Some(self.set_monifact(v));
+        }
         let k = index_of(name)?;
         Some(self.write_datum(k, name, idx, v))
+    }
+
+    /// `$A_MONIFACT=f` (§9.13.2): from here on a minute of cutting takes `f` minutes of life;
+    /// above 0. The block that writes it is a preprocessing stop (see [`Self::life_stop`]), so
+    /// the time cut before it is accounted with the factor it had.
+    fn set_monifact(&mut self, v: &Val) -> Result<(), EvalError> {
+        let f = v.num()?;
+        if !(f > 0.0 && f <= 1.0e6) {
+            return Err(EvalError::new(
+                Fault::OutOfRange,
+                format!(
+                    "{MONIFACT} is above 0, not {}",
+                    cnc_interpreter_core::show(f)
+                ),
+            ));
+        }
+        self.monifact = f;
+        Ok(())
     }
 
     fn write_datum(&mut self, k: usize, name: &str, idx: &[Val], v: &Val) -> Result<(), EvalError> {
@@ -195,7 +222,8 @@ impl Sinumerik {
 
     /// Whether `block` must wait for a preprocessing stop that accounts the active edge's
     /// life: with life monitoring in use, the run's first block, a block that changes the
-    /// edge (T, D, M6), ends the main program (M2, M30) or reads `$TC_MOP2`.
+    /// edge (T, D, M6), ends the main program (M2, M30), reads `$TC_MOP2` or sets
+    /// `$A_MONIFACT`.
     pub(super) fn life_stop(&self, block: &Block, line: &str) -> bool {
         if !self.life_used {
             return false;
@@ -207,7 +235,7 @@ impl Sinumerik {
                     || (*letter == 'M'
                         && (*value == 6.0 || (main && matches!(*value as u32, 2 | 30))))
             }
-            Item::Assign { name, .. } => matches!(name.as_ref(), "T" | "D"),
+            Item::Assign { name, .. } => matches!(name.as_ref(), "T" | "D" | MONIFACT),
             _ => false,
         });
         self.life_start.is_none()
@@ -234,7 +262,7 @@ impl Sinumerik {
         if !self.core.setup.offsets.tools.contains_key(&(t * 10 + d)) {
             return;
         }
-        let left = self.datum(MOP2, t, d) - (now - start).max(0.0) / 60.0;
+        let left = self.datum(MOP2, t, d) - (now - start).max(0.0) / 60.0 * self.monifact;
         self.set_datum(MOP2, t, d, left);
         let warn = self.datum(MOP1, t, d);
         self.reach_limits(t, d, left, warn);
