@@ -258,6 +258,7 @@ ros_message! {
         aux_code: i32,
         aux_value: f64,
         origin: Vec<f64>,
+        work_frame: Vec<f64>,
     }
 }
 

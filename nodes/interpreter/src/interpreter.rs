@@ -99,6 +99,11 @@ impl Interpreter {
     pub fn program_origin(&self) -> Vec<f64> {
         self.front.core().program_origin()
     }
+
+    /// See [`cnc_interpreter_core::Core::work_frame`].
+    pub fn work_frame(&self) -> Vec<f64> {
+        self.front.core().work_frame()
+    }
 }
 
 /// Interprets a whole program without running it: every command, or the first error.

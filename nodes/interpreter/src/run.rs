@@ -666,6 +666,7 @@ impl RunCore {
                             let mut msg =
                                 to_motion_block(id, seq, &program, canon.line, &canon.command);
                             msg.origin = interp.program_origin();
+                            msg.work_frame = interp.work_frame();
                             effects.push(Effect::Block(msg));
                         },
                     )

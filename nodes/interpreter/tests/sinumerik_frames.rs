@@ -518,3 +518,39 @@ fn unequal_plane_scale_factors_refuse_a_circle_and_scale_lines() {
     assert_eq!((e.number, e.line), (14040, 5), "{e}");
     assert!(e.text.contains("same scale factor"), "{e}");
 }
+
+/// The map the interpreter sends with each block for the operator's work position
+/// (`Core::work_frame`): under G54, TRANS, AROT, ASCALE and AMIRROR, a machine point less the
+/// origin taken through it is the work point the program wrote; without a frame it is empty.
+#[test]
+fn the_work_frame_sent_for_the_display_takes_machine_points_back_to_the_programs() {
+    let mut s = Setup::new(&LETTERS, &[false; 3], &[0.0; 3]);
+    let g54 = s.offsets.work.entry(0).or_default();
+    g54.insert('X', 100.0);
+    g54.insert('Y', -40.0);
+    let text = "G54 G17 G0 X1 Y2 Z3\nTRANS X5 Y7\nAROT RPL=30\nASCALE X2 Y2\nAMIRROR X0\n\
+                G1 X10 Y-4 Z6 F100\nM30\n";
+    let mut front = Sinumerik::new(text, s, Library::new());
+    assert!(front.core.work_frame().is_empty(), "no frame yet");
+    let mut ends = Vec::new();
+    let mut maps = Vec::new();
+    while let Some(c) = next_command(&mut front).unwrap() {
+        if let Some(end) = c.command.end() {
+            ends.push(end.to_vec());
+            maps.push((front.core.program_origin(), front.core.work_frame()));
+        }
+    }
+    let (end, (origin, frame)) = (&ends[1], &maps[1]);
+    assert_eq!(frame.len(), 12, "3 rows of 3 and a constant");
+    let work: Vec<f64> = (0..3)
+        .map(|i| {
+            let row = &frame[i * 4..i * 4 + 4];
+            (0..3).map(|j| row[j] * (end[j] - origin[j])).sum::<f64>() + row[3]
+        })
+        .collect();
+    for (w, p) in work.iter().zip([10.0, -4.0, 6.0]) {
+        assert!((w - p).abs() < TOL, "{work:?} from the machine's {end:?}");
+    }
+    // The frame really turns: the machine point is not the work point shifted.
+    assert!((end[0] - origin[0] - 10.0).abs() > 1.0, "{end:?}");
+}

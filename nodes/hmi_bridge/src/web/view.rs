@@ -205,7 +205,8 @@ impl View {
     }
 
     /// Per axis: machine position, work position (machine minus the program origin of the
-    /// executing block) and distance to go (end of that block minus the commanded position).
+    /// executing block, under a rotating frame through the block's `work_frame`) and distance
+    /// to go (end of that block minus the commanded position).
     fn positions(&self) -> Vec<Value> {
         let Some(a) = &self.axes else {
             return Vec::new();
@@ -216,15 +217,35 @@ impl View {
             .range((self.status.run_id, 0)..=(self.status.run_id, self.status.done_seq))
             .next_back()
             .map(|(_, b)| b);
+        let shown = block.or(last);
+        let origin = |i: usize| shown.and_then(|b| b.origin.get(i)).copied().unwrap_or(0.0);
+        let n = a.axes.len();
+        let relative: Vec<f64> = (0..n)
+            .map(|i| a.axes[i].actual_position - origin(i))
+            .collect();
+        let work = shown
+            .map(|b| b.work_frame.as_slice())
+            .filter(|f| f.len() == n * (n + 1))
+            .map_or_else(
+                || relative.clone(),
+                |f| {
+                    (0..n)
+                        .map(|i| {
+                            let row = &f[i * (n + 1)..(i + 1) * (n + 1)];
+                            row[..n]
+                                .iter()
+                                .zip(&relative)
+                                .map(|(c, x)| c * x)
+                                .sum::<f64>()
+                                + row[n]
+                        })
+                        .collect()
+                },
+            );
         a.axes
             .iter()
             .enumerate()
             .map(|(i, axis)| {
-                let origin = block
-                    .or(last)
-                    .and_then(|b| b.origin.get(i))
-                    .copied()
-                    .unwrap_or(0.0);
                 let moving = block.is_some_and(|b| {
                     b.kind <= MotionBlock::KIND_ARC_CCW || b.kind == MotionBlock::KIND_THREAD
                 });
@@ -235,7 +256,7 @@ impl View {
                 json!({
                     "name": axis.name,
                     "machine": axis.actual_position,
-                    "work": axis.actual_position - origin,
+                    "work": work[i],
                     "to_go": to_go,
                     "following_error": axis.following_error,
                     "homed": axis.homed,
@@ -390,6 +411,41 @@ mod tests {
         // A lathe's path: Z across, X as radius up.
         assert_eq!(f["path"][0], json!([-20.0, 25.0]));
         assert_eq!(f["plot"], json!(["Z", "X"]));
+    }
+
+    /// Under a rotating frame the work position is the block's `work_frame` map of the machine
+    /// position less the origin; a map of the wrong size is not used.
+    #[test]
+    fn the_work_position_under_a_rotation_comes_through_the_blocks_map() {
+        for (frame, want) in [
+            // ROT 90° in the plane: work X is machine Y, work Y is −machine X (less origin).
+            (vec![0.0, 1.0, 0.0, -1.0, 0.0, 0.0], (5.0, -5.0)),
+            // A constant in the map (a shift inside the frame).
+            (vec![1.0, 0.0, 2.0, 0.0, 1.0, -3.0], (7.0, 2.0)),
+            (vec![1.0, 2.0], (5.0, 5.0)),
+        ] {
+            let mut v = View::new(vec!["X".into(), "Z".into()], vec![false, false]);
+            v.on_motion_status(MotionStatus {
+                run_id: 3,
+                ..MotionStatus::default()
+            });
+            v.on_block(MotionBlock {
+                run_id: 3,
+                seq: 1,
+                kind: MotionBlock::KIND_LINEAR,
+                end: vec![0.0, 0.0],
+                origin: vec![10.0, 20.0],
+                work_frame: frame.clone(),
+                ..MotionBlock::default()
+            });
+            v.on_axes(axes(15.0, 25.0));
+            let f = v.frame();
+            assert_eq!(
+                (f["axes"][0]["work"].clone(), f["axes"][1]["work"].clone()),
+                (json!(want.0), json!(want.1)),
+                "{frame:?}"
+            );
+        }
     }
 
     #[test]

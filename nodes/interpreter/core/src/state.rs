@@ -313,6 +313,35 @@ impl Core {
         (0..self.pos.len()).map(|i| self.origin(i)).collect()
     }
 
+    /// The frame's map from a machine position less [`Core::program_origin`] to the work
+    /// position, as `n` rows of `n` coefficients and a constant (row-major, `n × (n + 1)`),
+    /// so that a display turns the slides' position into the work's under a rotating,
+    /// scaling or mirroring frame; empty when the frame only shifts (the work position is
+    /// then the machine's less the origin) or under the cylinder transformation, which is
+    /// no linear map.
+    pub fn work_frame(&self) -> Vec<f64> {
+        if self.frame.is_identity() || self.cylinder.is_some() {
+            return Vec::new();
+        }
+        let n = self.pos.len();
+        let origin = self.program_origin();
+        let constant = self.work_of(&origin);
+        let mut rows = vec![0.0; n * (n + 1)];
+        let mut m = origin.clone();
+        for j in 0..n {
+            m[j] += 1.0;
+            let w = self.work_of(&m);
+            m[j] = origin[j];
+            for i in 0..n {
+                rows[i * (n + 1) + j] = w[i] - constant[i];
+            }
+        }
+        for i in 0..n {
+            rows[i * (n + 1) + n] = constant[i];
+        }
+        rows
+    }
+
     /// Current position in work coordinates (X as diameter).
     /// One allocation per call: asked for at every move.
     pub fn work_position(&self) -> Vec<f64> {
