@@ -21,9 +21,9 @@ const TIMERS: [&str; 4] = [
 /// Whether a line reads a run-time timer (outside its comment), so that it must wait for the
 /// machine before it runs.
 pub fn reads_timer(line: &str) -> bool {
-    let text = strip_comment(line);
-    text.contains('$') && {
-        let upper = text.to_ascii_uppercase();
+    // Most blocks name no system variable: one scan for `$` decides them.
+    line.contains('$') && {
+        let upper = strip_comment(line).to_ascii_uppercase();
         TIMERS.iter().any(|t| upper.contains(t))
     }
 }
