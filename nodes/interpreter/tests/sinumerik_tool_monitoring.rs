@@ -73,46 +73,24 @@ fn setpiece_counts_only_monitored_tools() {
     assert_eq!(r.front.tool_datum("$TC_MOP4", 1, 1), 5.0);
 }
 
-/// Tool life on the machine (D122): T1 D1 has 1 minute left, its prewarning at 0.5. The run's
-/// first block, the change to T2 and the program's end are preprocessing stops; at each the
-/// machine reports its cutting time, and T1 D1's life goes down by what was cut while it was
-/// the active edge (40 s, then 30 s more: 6411, then 6413 and the tool disabled), while T2
-/// D1, not monitored, keeps its own.
-#[test]
-fn the_active_edge_wears_by_the_cutting_time_the_machine_reports_at_each_stop() {
-    use cnc_interpreter::sinumerik::Sinumerik;
-    use cnc_interpreter::{Command, MachineTimers, Measurement};
-    use cnc_interpreter_core::next_command;
-    let mut s = mill();
-    s.offsets
-        .tools
-        .insert(21, cnc_interpreter_core::ToolOffset::default());
-    for (key, v) in [
-        ("$TC_TP9", 1.0),
-        ("$TC_MOP11", 1.0),
-        ("$TC_MOP2", 1.0),
-        ("$TC_MOP1", 0.5),
-    ] {
-        let d = u32::from(key != "$TC_TP9");
-        s.kept.insert(
-            cnc_interpreter::sinumerik::monitor::kept_key(key, 1, d).unwrap(),
-            v,
-        );
-    }
-    let text = "T1 D1\nG1 X100 F150\nT2 D1\nG1 X0\nT1 D1\nG1 X50\nM30\n";
-    let mut front = Sinumerik::new(text, s, Library::new());
+/// Runs `front` on a machine that answers its preprocessing stops, in turn, with the cutting
+/// times `reports` (seconds); `at_stop` sees the program at each stop before the answer. The
+/// commands it sent; every report must be taken.
+fn on_machine(
+    front: &mut cnc_interpreter::sinumerik::Sinumerik,
+    reports: &[f64],
+    mut at_stop: impl FnMut(&cnc_interpreter::sinumerik::Sinumerik),
+) -> Vec<cnc_interpreter::Command> {
+    use cnc_interpreter::{MachineTimers, Measurement};
     front.core.on_machine = true;
-    // The machine's cutting time at each stop: the run's start (T1 D1), the change to T2
-    // after 40 s of cutting, the change back after 50 s more, M30 after 30 s more.
-    let mut reports = [100.0, 140.0, 190.0, 220.0].into_iter();
-    let (mut out, mut stops, mut life) = (Vec::new(), 0, Vec::new());
+    let mut reports = reports.iter();
+    let mut out = Vec::new();
     loop {
-        match next_command(&mut front) {
+        match cnc_interpreter_core::next_command(front) {
             Ok(Some(c)) => out.push(c.command),
             Ok(None) if front.core.awaiting_machine() => {
-                stops += 1;
-                life.push(front.tool_datum("$TC_MOP2", 1, 1));
-                let cutting = reports
+                at_stop(front);
+                let cutting = *reports
                     .next()
                     .expect("no more stops than the test's reports");
                 let at = front.core.pos.clone();
@@ -133,6 +111,44 @@ fn the_active_edge_wears_by_the_cutting_time_the_machine_reports_at_each_stop() 
             Err(e) => panic!("alarm {e}"),
         }
     }
+    assert_eq!(reports.next(), None, "every report taken");
+    out
+}
+
+/// Tool life on the machine (D122): T1 D1 has 1 minute left, its prewarning at 0.5. The run's
+/// first block, the change to T2 and the program's end are preprocessing stops; at each the
+/// machine reports its cutting time, and T1 D1's life goes down by what was cut while it was
+/// the active edge (40 s, then 30 s more: 6411, then 6413 and the tool disabled), while T2
+/// D1, not monitored, keeps its own.
+#[test]
+fn the_active_edge_wears_by_the_cutting_time_the_machine_reports_at_each_stop() {
+    use cnc_interpreter::sinumerik::Sinumerik;
+    use cnc_interpreter::Command;
+    let mut s = mill();
+    s.offsets
+        .tools
+        .insert(21, cnc_interpreter_core::ToolOffset::default());
+    for (key, v) in [
+        ("$TC_TP9", 1.0),
+        ("$TC_MOP11", 1.0),
+        ("$TC_MOP2", 1.0),
+        ("$TC_MOP1", 0.5),
+    ] {
+        let d = u32::from(key != "$TC_TP9");
+        s.kept.insert(
+            cnc_interpreter::sinumerik::monitor::kept_key(key, 1, d).unwrap(),
+            v,
+        );
+    }
+    let text = "T1 D1\nG1 X100 F150\nT2 D1\nG1 X0\nT1 D1\nG1 X50\nM30\n";
+    let mut front = Sinumerik::new(text, s, Library::new());
+    // The machine's cutting time at each stop: the run's start (T1 D1), the change to T2
+    // after 40 s of cutting, the change back after 50 s more, M30 after 30 s more.
+    let mut life = Vec::new();
+    let out = on_machine(&mut front, &[100.0, 140.0, 190.0, 220.0], |f| {
+        life.push(f.tool_datum("$TC_MOP2", 1, 1))
+    });
+    let stops = life.len();
     assert_eq!(stops, 4);
     // Before each stop's accounting: full, full, a third (40 s gone), a third (T2's 50 s are
     // not T1's).
@@ -177,39 +193,12 @@ fn a_check_wears_no_tool_and_resetmon_restores_the_life() {
 #[test]
 fn the_life_clock_factor_scales_what_is_cut_after_it_is_set() {
     use cnc_interpreter::sinumerik::Sinumerik;
-    use cnc_interpreter::{MachineTimers, Measurement};
-    use cnc_interpreter_core::next_command;
     let text = "$TC_TP9[1]=1 $TC_MOP11[1,1]=10 $TC_MOP2[1,1]=10\nT1 D1\nR1=$A_MONIFACT\n\
                 G1 X100 F200\n$A_MONIFACT=5\nG1 X120\nR2=$TC_MOP2[1,1] R3=$A_MONIFACT\nM30\n";
     let mut front = Sinumerik::new(text, mill(), Library::new());
-    front.core.on_machine = true;
     // The stops: T1 D1 (the first block after life monitoring came on), $A_MONIFACT=5 after
     // 30 s, the read of $TC_MOP2 after 6 s more, M30.
-    let mut reports = [0.0, 30.0, 36.0, 36.0].into_iter();
-    loop {
-        match next_command(&mut front) {
-            Ok(Some(_)) => {}
-            Ok(None) if front.core.awaiting_machine() => {
-                let cutting = reports.next().expect("four stops");
-                let at = front.core.pos.clone();
-                front
-                    .core
-                    .machine_result(Measurement {
-                        triggered: true,
-                        position: at.clone(),
-                        rest: at,
-                        timers: Some(MachineTimers {
-                            cutting,
-                            ..MachineTimers::default()
-                        }),
-                    })
-                    .unwrap();
-            }
-            Ok(None) => break,
-            Err(e) => panic!("alarm {e}"),
-        }
-    }
-    assert_eq!(reports.next(), None, "every stop taken");
+    on_machine(&mut front, &[0.0, 30.0, 36.0, 36.0], |_| {});
     assert_eq!(front.r(1), 1.0);
     // 10 min − 0.5 min (30 s at 1) − 0.5 min (6 s at 5).
     assert!((front.r(2) - 9.0).abs() < 1e-9, "{}", front.r(2));
