@@ -5,7 +5,8 @@
 //! has come ([`Core::machine_result`]); until then [`crate::next_command`] has nothing to
 //! give. Without a machine (a check, a simulation, a block search) the event is taken as
 //! coming at the move's end, so the rest of the program is read as on a part that is where
-//! the program expects it (decisions D116, D118).
+//! the program expects it (decisions D116, D118). A preprocessing stop that reads the
+//! machine's run-time timers (`Sync`, D121) waits the same way; nothing moves in it.
 
 use crate::canon::Command;
 use crate::emit::MoveKind;
