@@ -63,7 +63,7 @@ def main():
     def block(run_id, seq, kind, end, feed=0.0):
         return block_t(run_id=run_id, seq=seq, program="O0666", line=seq, kind=kind, end=end, center=[],
                        plane=[], feed=feed, dwell_seconds=0.0, lead=0.0, start_angle=0.0, flag=False,
-                       aux_kind=0, aux_code=0, aux_value=0.0, origin=[])
+                       aux_kind=0, aux_code=0, aux_value=0.0, origin=[], work_frame=[])
 
     fake = alarm_t(number=9999, severity=2, text="fake", source="interpreter", program="", line=0,
                    stamp=time_t(sec=0, nanosec=0), acknowledged=False)
