@@ -206,7 +206,7 @@ impl View {
 
     /// Per axis: machine position, work position (machine minus the program origin of the
     /// executing block, under a rotating frame through the block's `work_frame`) and distance
-    /// to go (end of that block minus the commanded position).
+    /// to go (end of that block minus the commanded position, turned by the same frame).
     fn positions(&self) -> Vec<Value> {
         let Some(a) = &self.axes else {
             return Vec::new();
@@ -218,46 +218,34 @@ impl View {
             .next_back()
             .map(|(_, b)| b);
         let shown = block.or(last);
-        let origin = |i: usize| shown.and_then(|b| b.origin.get(i)).copied().unwrap_or(0.0);
         let n = a.axes.len();
+        let frame = shown
+            .map(|b| b.work_frame.as_slice())
+            .filter(|f| f.len() == n * (n + 1));
+        let origin = |i: usize| shown.and_then(|b| b.origin.get(i)).copied().unwrap_or(0.0);
         let relative: Vec<f64> = (0..n)
             .map(|i| a.axes[i].actual_position - origin(i))
             .collect();
-        let work = shown
-            .map(|b| b.work_frame.as_slice())
-            .filter(|f| f.len() == n * (n + 1))
-            .map_or_else(
-                || relative.clone(),
-                |f| {
-                    (0..n)
-                        .map(|i| {
-                            let row = &f[i * (n + 1)..(i + 1) * (n + 1)];
-                            row[..n]
-                                .iter()
-                                .zip(&relative)
-                                .map(|(c, x)| c * x)
-                                .sum::<f64>()
-                                + row[n]
-                        })
-                        .collect()
-                },
-            );
+        let work = through(frame, &relative, true);
+        let moving = block.is_some_and(|b| {
+            b.kind <= MotionBlock::KIND_ARC_CCW || b.kind == MotionBlock::KIND_THREAD
+        });
+        let to_go: Vec<f64> = (0..n)
+            .map(|i| match block.and_then(|b| b.end.get(i)) {
+                Some(end) if moving => end - a.axes[i].commanded_position,
+                _ => 0.0,
+            })
+            .collect();
+        let to_go = through(frame, &to_go, false);
         a.axes
             .iter()
             .enumerate()
             .map(|(i, axis)| {
-                let moving = block.is_some_and(|b| {
-                    b.kind <= MotionBlock::KIND_ARC_CCW || b.kind == MotionBlock::KIND_THREAD
-                });
-                let to_go = match block.and_then(|b| b.end.get(i)) {
-                    Some(end) if moving => end - axis.commanded_position,
-                    _ => 0.0,
-                };
                 json!({
                     "name": axis.name,
                     "machine": axis.actual_position,
                     "work": work[i],
-                    "to_go": to_go,
+                    "to_go": to_go[i],
                     "following_error": axis.following_error,
                     "homed": axis.homed,
                 })
@@ -354,6 +342,27 @@ impl View {
     }
 }
 
+/// `v` through a block's work frame (`n` rows of `n` coefficients and a constant): a
+/// position with the constant, a difference of positions (a distance to go) without; `v`
+/// itself without a frame.
+fn through(frame: Option<&[f64]>, v: &[f64], position: bool) -> Vec<f64> {
+    let Some(f) = frame else {
+        return v.to_vec();
+    };
+    let n = v.len();
+    (0..n)
+        .map(|i| {
+            let row = &f[i * (n + 1)..(i + 1) * (n + 1)];
+            let linear: f64 = row[..n].iter().zip(v).map(|(c, x)| c * x).sum();
+            if position {
+                linear + row[n]
+            } else {
+                linear
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -443,6 +452,18 @@ mod tests {
             assert_eq!(
                 (f["axes"][0]["work"].clone(), f["axes"][1]["work"].clone()),
                 (json!(want.0), json!(want.1)),
+                "{frame:?}"
+            );
+            // The distance to go (end 0, 0 less 15, 25) turns with the frame, without its
+            // constant.
+            let to_go = (f["axes"][0]["to_go"].clone(), f["axes"][1]["to_go"].clone());
+            let want_to_go = match frame.len() {
+                6 if frame[1] == 1.0 => (-25.0, 15.0),
+                _ => (-15.0, -25.0),
+            };
+            assert_eq!(
+                to_go,
+                (json!(want_to_go.0), json!(want_to_go.1)),
                 "{frame:?}"
             );
         }
