@@ -696,11 +696,13 @@ impl FrontEnd for Sinumerik {
                 return Ok(());
             }
             // The last edge's life is accounted before the program ends (D122).
-            if self.life_used && !std::mem::take(&mut self.synced) {
-                self.synced = true;
-                return self.core.sync_with_machine();
+            if self.life_used {
+                if !std::mem::take(&mut self.synced) {
+                    self.synced = true;
+                    return self.core.sync_with_machine();
+                }
+                self.machine_read();
             }
-            self.machine_read();
             return self.core.end_of_main();
         };
         self.sync_scopes();

@@ -10,12 +10,16 @@ use cnc_interpreter_core::{Fault, MachineTimers};
 use super::expr::EvalError;
 use super::lex::strip_comment;
 
-/// The timers a program can read (`$AN_SETUP_TIME` is refused: see [`timer`]).
-const TIMERS: [&str; 4] = [
-    "$AC_CUTTING_TIME",
-    "$AC_CYCLE_TIME",
-    "$AC_OPERATING_TIME",
-    "$AN_POWERON_TIME",
+/// A timer's value from the machine's report.
+type Reading = fn(&MachineTimers) -> f64;
+
+/// The timers a program can read, each with its value from the machine's report
+/// (`$AN_SETUP_TIME` is refused: see [`timer`]).
+const TIMERS: [(&str, Reading); 4] = [
+    ("$AC_CUTTING_TIME", |t| t.cutting),
+    ("$AC_CYCLE_TIME", |t| t.cycle),
+    ("$AC_OPERATING_TIME", |t| t.operating),
+    ("$AN_POWERON_TIME", |t| t.power_on / 60.0),
 ];
 
 /// Whether a line reads a run-time timer (outside its comment), so that it must wait for the
@@ -24,28 +28,25 @@ pub fn reads_timer(line: &str) -> bool {
     // Most blocks name no system variable: one scan for `$` decides them.
     line.contains('$') && {
         let upper = strip_comment(line).to_ascii_uppercase();
-        TIMERS.iter().any(|t| upper.contains(t))
+        TIMERS.iter().any(|(name, _)| upper.contains(name))
     }
 }
 
 /// The value of timer `name` in `t`; `None` if `name` is no timer.
 pub fn timer(t: &MachineTimers, name: &str) -> Option<Result<f64, EvalError>> {
-    Some(Ok(match name {
-        "$AC_CUTTING_TIME" => t.cutting,
-        "$AC_CYCLE_TIME" => t.cycle,
-        "$AC_OPERATING_TIME" => t.operating,
-        "$AN_POWERON_TIME" => t.power_on / 60.0,
-        // Minutes since the control last started with its default values: a time kept across
-        // power-off, which this controller does not keep.
-        "$AN_SETUP_TIME" => {
-            return Some(Err(EvalError::new(
-                Fault::NotSupported,
-                "$AN_SETUP_TIME (the time since the last start with default values) is not \
-                 kept by this controller",
-            )))
-        }
-        _ => return None,
-    }))
+    // Minutes since the control last started with its default values: a time kept across
+    // power-off, which this controller does not keep.
+    if name == "$AN_SETUP_TIME" {
+        return Some(Err(EvalError::new(
+            Fault::NotSupported,
+            "$AN_SETUP_TIME (the time since the last start with default values) is not kept \
+             by this controller",
+        )));
+    }
+    TIMERS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, value)| Ok(value(t)))
 }
 
 #[cfg(test)]

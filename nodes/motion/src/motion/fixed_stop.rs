@@ -198,10 +198,7 @@ impl Motion {
         if let Some((seq, triggered)) = result {
             let here = self.commanded_point();
             self.planner.reset(here);
-            let mut rest = [0.0; MAX_AXES];
-            for (i, a) in self.cfg.axes.iter().enumerate().take(MAX_AXES) {
-                rest[i] = self.commanded[i] / a.scale();
-            }
+            let rest = self.display_point(&self.commanded);
             self.block_result = Some(BlockResult {
                 seq,
                 triggered,

@@ -540,6 +540,16 @@ impl Motion {
     }
 
     /// Commanded position in display units.
+    /// A slide point in display units (X as diameter), as a block's result reports it; no
+    /// allocation (it is made on the servo thread).
+    fn display_point(&self, slide: &[f64]) -> Point {
+        let mut p = [0.0; MAX_AXES];
+        for ((d, s), a) in p.iter_mut().zip(slide).zip(&self.cfg.axes) {
+            *d = s / a.scale();
+        }
+        p
+    }
+
     pub fn commanded_display(&self) -> Vec<f64> {
         self.commanded
             .iter()

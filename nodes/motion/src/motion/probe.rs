@@ -125,12 +125,8 @@ impl Motion {
             return;
         }
         self.probing = None;
-        let mut rest = [0.0; MAX_AXES];
-        let mut position = [0.0; MAX_AXES];
-        for (i, a) in self.cfg.axes.iter().enumerate().take(MAX_AXES) {
-            rest[i] = self.commanded[i] / a.scale();
-            position[i] = p.latched.map_or(rest[i], |l| l[i] / a.scale());
-        }
+        let rest = self.display_point(&self.commanded);
+        let position = p.latched.map_or(rest, |l| self.display_point(&l));
         self.block_result = Some(BlockResult {
             seq: p.seq,
             triggered: p.latched.is_some(),

@@ -4,7 +4,7 @@
 //! ([`Command::Sync`](crate::block::Command::Sync)): motion reports that block done once
 //! every block before it has finished, and its status carries the timers.
 
-use super::{Active, BlockResult, Motion, MAX_AXES};
+use super::{Active, BlockResult, Motion};
 
 /// The timers, seconds.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -61,10 +61,7 @@ impl Motion {
     /// The preprocessing stop `seq` is reached (every block before it done): its result is
     /// where the axes stand; the status that reports it carries the timers.
     pub(super) fn sync_reached(&mut self, seq: u64) {
-        let mut at = [0.0; MAX_AXES];
-        for (i, a) in self.cfg.axes.iter().enumerate().take(MAX_AXES) {
-            at[i] = self.commanded[i] / a.scale();
-        }
+        let at = self.display_point(&self.commanded);
         self.block_result = Some(BlockResult {
             seq,
             triggered: true,
