@@ -112,12 +112,55 @@ pub fn grants(role: &Role) -> (Vec<String>, Vec<String>) {
     (publish, subscribe)
 }
 
+/// How the cell's traffic is protected on the wire (D113). Both kinds authenticate every RTPS
+/// message with the sender's key and a MAC per receiver (origin authentication), so a host
+/// without credentials can neither forge nor alter a message, and an authenticated participant
+/// cannot send in another's name; they differ in whether the samples, the endpoints' submessages
+/// and discovery are also encrypted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Protection {
+    /// Everything signed, nothing encrypted: a capture reads the programs and the state.
+    Sign,
+    /// Signed, and discovery, liveliness, submessages and samples encrypted (the default).
+    #[default]
+    Encrypt,
+}
+
+impl Protection {
+    pub fn parse(s: &str) -> Result<Protection, String> {
+        match s {
+            "sign" => Ok(Protection::Sign),
+            "encrypt" => Ok(Protection::Encrypt),
+            other => Err(format!("protection {other:?}: sign or encrypt")),
+        }
+    }
+
+    /// The governance's protection kinds: (discovery and liveliness, RTPS, metadata, data).
+    fn kinds(self) -> [&'static str; 4] {
+        match self {
+            Protection::Sign => [
+                "SIGN",
+                "SIGN_WITH_ORIGIN_AUTHENTICATION",
+                "SIGN_WITH_ORIGIN_AUTHENTICATION",
+                "SIGN",
+            ],
+            Protection::Encrypt => [
+                "ENCRYPT",
+                "SIGN_WITH_ORIGIN_AUTHENTICATION",
+                "ENCRYPT_WITH_ORIGIN_AUTHENTICATION",
+                "ENCRYPT",
+            ],
+        }
+    }
+}
+
 /// The governance document: only participants with a certificate of the cell's authority
-/// join, and every topic is under read and write access control, so a participant's
-/// permissions decide what it may write and read. Nothing is encrypted or signed (all
-/// protection kinds NONE, unlike SROS2's default): rustdds 0.15.1's cryptographic plugin
-/// delivered no sample between two participants on this machine (D113 in docs/decisions.md).
-pub fn governance_xml() -> String {
+/// join, every topic is under read and write access control (a participant's permissions
+/// decide what it may write and read), and every message is protected as `protection` says.
+/// The RTPS level is signed, not encrypted, in both: under `Encrypt` what it would hide is
+/// encrypted a level below already (D113).
+pub fn governance_xml(protection: Protection) -> String {
+    let [discovery, rtps, metadata, data] = protection.kinds();
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-Security/20170801/omg_shared_ca_governance.xsd">
@@ -126,18 +169,18 @@ pub fn governance_xml() -> String {
 {domains}
       <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
       <enable_join_access_control>true</enable_join_access_control>
-      <discovery_protection_kind>NONE</discovery_protection_kind>
-      <liveliness_protection_kind>NONE</liveliness_protection_kind>
-      <rtps_protection_kind>NONE</rtps_protection_kind>
+      <discovery_protection_kind>{discovery}</discovery_protection_kind>
+      <liveliness_protection_kind>{discovery}</liveliness_protection_kind>
+      <rtps_protection_kind>{rtps}</rtps_protection_kind>
       <topic_access_rules>
         <topic_rule>
           <topic_expression>*</topic_expression>
-          <enable_discovery_protection>false</enable_discovery_protection>
-          <enable_liveliness_protection>false</enable_liveliness_protection>
+          <enable_discovery_protection>true</enable_discovery_protection>
+          <enable_liveliness_protection>true</enable_liveliness_protection>
           <enable_read_access_control>true</enable_read_access_control>
           <enable_write_access_control>true</enable_write_access_control>
-          <metadata_protection_kind>NONE</metadata_protection_kind>
-          <data_protection_kind>NONE</data_protection_kind>
+          <metadata_protection_kind>{metadata}</metadata_protection_kind>
+          <data_protection_kind>{data}</data_protection_kind>
         </topic_rule>
       </topic_access_rules>
     </domain_rule>
@@ -218,8 +261,13 @@ fn e(what: &'static str) -> impl Fn(openssl::error::ErrorStack) -> String {
 }
 
 /// Creates the keystore at `dir` (which must not exist, so a cell's authority is never
-/// replaced by accident) with the authority and every enclave. Returns the enclave folders.
-pub fn init(dir: &Path, enclaves: &[Enclave]) -> Result<Vec<PathBuf>, String> {
+/// replaced by accident) with the authority, every enclave and the governance of `protection`.
+/// Returns the enclave folders.
+pub fn init(
+    dir: &Path,
+    enclaves: &[Enclave],
+    protection: Protection,
+) -> Result<Vec<PathBuf>, String> {
     if dir.exists() {
         return Err(format!(
             "{}: exists; a keystore is made once (remove it to start a new authority)",
@@ -248,10 +296,11 @@ pub fn init(dir: &Path, enclaves: &[Enclave]) -> Result<Vec<PathBuf>, String> {
     ] {
         write(&dir.join("private").join(name), &ca_key_pem, true)?;
     }
-    let governance = sign(&ca, &ca_key, governance_xml().as_bytes()).map_err(e("governance"))?;
+    let governance_text = governance_xml(protection);
+    let governance = sign(&ca, &ca_key, governance_text.as_bytes()).map_err(e("governance"))?;
     write(
         &dir.join("enclaves/governance.xml"),
-        governance_xml().as_bytes(),
+        governance_text.as_bytes(),
         false,
     )?;
     write(&dir.join("enclaves/governance.p7s"), &governance, false)?;
@@ -453,11 +502,30 @@ mod tests {
     }
 
     #[test]
+    fn every_message_is_authenticated_whichever_the_protection() {
+        for protection in [Protection::Sign, Protection::Encrypt] {
+            let g = governance_xml(protection);
+            assert!(!g.contains(">NONE<"), "{protection:?}: {g}");
+            assert!(
+                g.contains("<rtps_protection_kind>SIGN_WITH_ORIGIN_AUTHENTICATION<"),
+                "{g}"
+            );
+            let encrypted = g.matches(">ENCRYPT").count();
+            assert_eq!(
+                encrypted,
+                if protection == Protection::Sign { 0 } else { 4 }
+            );
+        }
+        assert_eq!(Protection::parse("sign"), Ok(Protection::Sign));
+        assert!(Protection::parse("none").is_err());
+    }
+
+    #[test]
     fn a_keystore_is_made_once_with_signed_documents() {
         let dir = std::env::temp_dir().join(format!("cnc_keystore_{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let enclaves = cell_enclaves(&["lathe1".into()]).unwrap();
-        let folders = init(&dir, &enclaves).unwrap();
+        let folders = init(&dir, &enclaves, Protection::Encrypt).unwrap();
         assert_eq!(folders.len(), 4);
         let robot = dir.join("enclaves/cell/robot");
         let p7s = std::fs::read_to_string(robot.join("permissions.p7s")).unwrap();
@@ -498,7 +566,7 @@ mod tests {
             .mode();
         assert_eq!(mode & 0o077, 0);
         assert!(
-            init(&dir, &enclaves).is_err(),
+            init(&dir, &enclaves, Protection::Encrypt).is_err(),
             "a second init must not replace the authority"
         );
         std::fs::remove_dir_all(&dir).unwrap();

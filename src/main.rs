@@ -163,6 +163,10 @@ enum SecurityVerb {
         /// A machine's namespace (`lathe1`); repeat for each machine of the cell.
         #[arg(long = "machine", required = true)]
         machines: Vec<String>,
+        /// `encrypt` (the default): every message authenticated, the samples, submessages and
+        /// discovery encrypted; `sign`: every message authenticated, nothing encrypted.
+        #[arg(long, default_value = "encrypt", value_parser = cnc::keystore::Protection::parse)]
+        protection: cnc::keystore::Protection,
     },
 }
 
@@ -306,9 +310,14 @@ fn main() -> ExitCode {
         }) => audit_verify(&bag),
         Some(Verb::Operator { action, config }) => operator(action, config.as_deref()),
         Some(Verb::Security {
-            action: SecurityVerb::Init { keystore, machines },
+            action:
+                SecurityVerb::Init {
+                    keystore,
+                    machines,
+                    protection,
+                },
         }) => cnc::keystore::cell_enclaves(&machines)
-            .and_then(|enclaves| cnc::keystore::init(&keystore, &enclaves))
+            .and_then(|enclaves| cnc::keystore::init(&keystore, &enclaves, protection))
             .map(|folders| {
                 println!(
                     "keystore {}: {} enclaves",

@@ -6,6 +6,7 @@ use std::process::{Child, Command, Stdio};
 use cnc_runtime::LaunchConfig;
 
 pub mod cell_run;
+pub mod wire;
 #[allow(unused_imports)]
 pub use cell_run::robot_tends;
 

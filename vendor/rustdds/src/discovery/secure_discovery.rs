@@ -62,12 +62,19 @@ pub enum AuthenticationStatus {
   Rejected, // Could not authenticate & should not communicate to
 }
 
-// How many times an authentication message is resent if we don't get an answer
+// How many times an authentication message is resent every resend period if we don't get an
+// answer
 const STORED_AUTH_MESSAGE_MAX_RESEND_COUNT: u8 = 10;
+// cnc patch: after those, it is resent every this many periods for as long as the remote
+// participant is known. It used to be dropped, and a handshake whose answer came later (a
+// remote that discovered us after ten seconds, as on a busy host) never completed: both sides
+// waited for each other for ever and never matched.
+const STORED_AUTH_MESSAGE_SLOW_RESEND_PERIODS: u8 = 5;
 
 struct StoredAuthenticationMessage {
   message: ParticipantStatelessMessage,
   remaining_resend_counter: u8,
+  periods_to_slow_resend: u8,
 }
 
 impl StoredAuthenticationMessage {
@@ -75,6 +82,22 @@ impl StoredAuthenticationMessage {
     Self {
       message,
       remaining_resend_counter: STORED_AUTH_MESSAGE_MAX_RESEND_COUNT,
+      periods_to_slow_resend: STORED_AUTH_MESSAGE_SLOW_RESEND_PERIODS,
+    }
+  }
+
+  /// Whether to resend the message this period.
+  fn due(&mut self) -> bool {
+    if self.remaining_resend_counter > 0 {
+      self.remaining_resend_counter -= 1;
+      return true;
+    }
+    self.periods_to_slow_resend = self.periods_to_slow_resend.saturating_sub(1);
+    if self.periods_to_slow_resend == 0 {
+      self.periods_to_slow_resend = STORED_AUTH_MESSAGE_SLOW_RESEND_PERIODS;
+      true
+    } else {
+      false
     }
   }
 }
@@ -1506,21 +1529,28 @@ impl SecureDiscovery {
     &mut self,
     auth_msg_writer: &no_key::DataWriter<ParticipantStatelessMessage>,
     key_exchange_writer: &no_key::DataWriter<ParticipantVolatileMessageSecure>,
+    discovery_db: &Arc<RwLock<DiscoveryDB>>,
   ) {
+    // cnc patch: a message to a participant that is gone is dropped; any other is kept until
+    // answered (see STORED_AUTH_MESSAGE_SLOW_RESEND_PERIODS).
+    {
+      let db = discovery_db_read(discovery_db);
+      self
+        .stored_authentication_messages
+        .retain(|guid_prefix, _| db.get_authentication_status(*guid_prefix).is_some());
+    }
     // First resend authentication messages
     for (guid_prefix, stored_message) in self.stored_authentication_messages.iter_mut() {
       // Resend the message unless it's a final message (which needs to be requested
       // from us)
       if self.handshake_states.get(guid_prefix)
         != Some(&DiscHandshakeState::CompletedWithFinalMessageSent)
+        && stored_message.due()
       {
         match auth_msg_writer.write(stored_message.message.clone(), None) {
           Ok(()) => {
-            stored_message.remaining_resend_counter -= 1;
             debug!(
-              "Resent an unanswered authentication message to remote participant {:?}. Resending \
-               at most {} more times.",
-              guid_prefix, stored_message.remaining_resend_counter,
+              "Resent an unanswered authentication message to remote participant {guid_prefix:?}."
             );
           }
           Err(err) => {
@@ -1532,10 +1562,6 @@ impl SecureDiscovery {
         }
       }
     }
-    // Remove authentication messages with no more resends
-    self
-      .stored_authentication_messages
-      .retain(|_guid_prefix, message| message.remaining_resend_counter > 0);
 
     // Then try to send those key exchange messages that we haven't been able to
     // send yet

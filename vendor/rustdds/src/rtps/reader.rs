@@ -1285,6 +1285,16 @@ impl Reader {
     destination_guid: GUID,
     dst_locator_list: &[Locator],
   ) {
+    // cnc patch: until the keys of the remote writer have come there is nothing to encode with;
+    // the reader speaks again on the writer's next heartbeat.
+    if let Some(plugins) = &self.security_plugins {
+      if !plugins
+        .get_plugins()
+        .can_encode_for(&self.guid(), &destination_guid)
+      {
+        return;
+      }
+    }
     match self.security_encode(message, destination_guid) {
       Ok(message) => {
         let bytes = match message.write_to_vec_with_ctx(Endianness::LittleEndian) {

@@ -1799,8 +1799,24 @@ impl Writer {
     // pass to `security_encode`). In the default (non-security) build we iterate
     // the incoming iterator directly below, avoiding a per-sample Vec
     // allocation on the send hot path.
+    // cnc patch: a reader whose keys have not come yet is left out of this send (a reliable
+    // one gets the sample repaired once they have, see SecurityPlugins::can_encode_for)
+    // instead of failing the encoding for every reader.
     #[cfg(feature = "security")]
-    let readers = readers.collect::<Vec<_>>();
+    let readers = match &self.security_plugins {
+      Some(plugins) => {
+        let plugins = plugins.get_plugins();
+        let me = self.guid();
+        readers
+          .filter(|r| plugins.can_encode_for(&me, &r.remote_reader_guid))
+          .collect::<Vec<_>>()
+      }
+      None => readers.collect::<Vec<_>>(),
+    };
+    #[cfg(feature = "security")]
+    if readers.is_empty() {
+      return BTreeSet::new();
+    }
 
     let mut blocked: BTreeSet<SocketId> = BTreeSet::new();
 

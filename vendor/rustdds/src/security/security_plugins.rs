@@ -245,6 +245,34 @@ impl SecurityPlugins {
       .is_some_and(|found_handle| local_endpoint_crypto_handles.contains(found_handle))
   }
 
+  /// cnc patch: whether the local endpoint `local` can protect a message for the remote
+  /// endpoint `remote` now, i.e. the key exchange with it (and its participant) is done. A
+  /// reliable endpoint matched with several remote ones used to encode each message for all of
+  /// them at once, and a single one still waiting for its keys made the encoding fail for every
+  /// other: a service reply or a state sample went to nobody until then (or for ever, if those
+  /// keys never came).
+  pub fn can_encode_for(&self, local: &GUID, remote: &GUID) -> bool {
+    let submessage_ready = self.submessage_not_protected(local)
+      || self
+        .remote_endpoint_crypto_handle_cache
+        .contains_key(&(*local, *remote));
+    // The messages of these endpoints go out without RTPS protection (the special case of
+    // is_rtps_protection_special_case): they are how the keys come in the first place.
+    let unprotected_rtps = matches!(
+      local.entity_id,
+      EntityId::SPDP_BUILTIN_PARTICIPANT_WRITER
+        | EntityId::SPDP_BUILTIN_PARTICIPANT_READER
+        | EntityId::P2P_BUILTIN_PARTICIPANT_STATELESS_WRITER
+        | EntityId::P2P_BUILTIN_PARTICIPANT_STATELESS_READER
+    );
+    let rtps_ready = unprotected_rtps
+      || self.rtps_not_protected(&local.prefix)
+      || self
+        .remote_participant_crypto_handle_cache
+        .contains_key(&remote.prefix);
+    submessage_ready && rtps_ready
+  }
+
   /// The `local_proxy_guid_pair` should be `&(local_endpoint_guid,
   /// proxy_guid)`.
   fn get_remote_endpoint_crypto_handle(

@@ -776,6 +776,14 @@ impl CryptoTransform for CryptographicBuiltin {
     // have a fixed length. Footer is not allowed to have receiver specific MACs
     // here, which makes its size fixed.
 
+    // cnc patch: the DATA submessage pads the encoded payload to a multiple of 4 bytes
+    // (RTPS 9.4.2.11), after the footer, and nothing says how many bytes are padding. Taking the
+    // footer from the end of the buffer therefore read a shifted MAC whenever the encoded
+    // payload's length was not a multiple of 4, and the payload was refused (every encrypted or
+    // signed sample of such a length was lost). The encrypted form carries its length
+    // (CryptoContent), so its footer is read where the content ends; the signed form does not,
+    // so its footer is looked for at each of the four possible paddings, and the MAC decides.
+    const MAX_PADDING: usize = 3;
     let head_len = BuiltinCryptoHeader::serialized_len();
     let foot_len = BuiltinCryptoFooter::minimal_serialized_len();
 
@@ -785,10 +793,8 @@ impl CryptoTransform for CryptographicBuiltin {
       return Err(security_error("Encoded payload smaller than minimum size"));
     }
     let (header_bytes, content_and_footer_bytes) = encoded_buffer.split_at(head_len);
-    let (content_bytes, footer_bytes) =
-      content_and_footer_bytes.split_at(content_and_footer_bytes.len() - foot_len);
 
-    // Deserialize crypto header and footer
+    // Deserialize crypto header
 
     // .read_from_buffer() does not need endianness, because BuiltinCryptoHeader
     // only contains byte-oriented data, which is insensitive to endianness.
@@ -802,8 +808,6 @@ impl CryptoTransform for CryptographicBuiltin {
         },
       builtin_crypto_header_extra: BuiltinCryptoHeaderExtra(initialization_vector),
     } = crypto_header.try_into()?;
-
-    let BuiltinCryptoFooter { common_mac, .. } = BuiltinCryptoFooter::try_from(footer_bytes)?;
 
     // Get the payload decode key material
     let decode_key_material = self.session_decode_crypto_materials(
@@ -825,6 +829,7 @@ impl CryptoTransform for CryptographicBuiltin {
     }
 
     let decode_key = &decode_key_material.session_key;
+    let is_padding = |bytes: &[u8]| bytes.len() <= MAX_PADDING && bytes.iter().all(|b| *b == 0);
 
     match transformation_kind {
       BuiltinCryptoTransformationKind::CRYPTO_TRANSFORMATION_KIND_NONE => {
@@ -835,14 +840,46 @@ impl CryptoTransform for CryptographicBuiltin {
       }
       BuiltinCryptoTransformationKind::CRYPTO_TRANSFORMATION_KIND_AES128_GMAC
       | BuiltinCryptoTransformationKind::CRYPTO_TRANSFORMATION_KIND_AES256_GMAC => {
-        validate_mac(decode_key, initialization_vector, content_bytes, common_mac)
-          // if validate_mac succeeds, then map result to content bytes
-          .map(|()| Vec::from(content_bytes))
+        let len = content_and_footer_bytes.len();
+        for padding in 0..=MAX_PADDING.min(len - foot_len) {
+          let (unpadded, pad) = content_and_footer_bytes.split_at(len - padding);
+          if !is_padding(pad) {
+            continue;
+          }
+          let (content_bytes, footer_bytes) = unpadded.split_at(unpadded.len() - foot_len);
+          let Ok(BuiltinCryptoFooter { common_mac, .. }) =
+            BuiltinCryptoFooter::try_from(footer_bytes)
+          else {
+            continue;
+          };
+          if validate_mac(decode_key, initialization_vector, content_bytes, common_mac).is_ok() {
+            return Ok(Vec::from(content_bytes));
+          }
+        }
+        Err(security_error("The signed payload's MAC is not valid"))
       }
       BuiltinCryptoTransformationKind::CRYPTO_TRANSFORMATION_KIND_AES128_GCM
       | BuiltinCryptoTransformationKind::CRYPTO_TRANSFORMATION_KIND_AES256_GCM => {
-        let ciphertext = CryptoContent::read_from_buffer(content_bytes)?.data;
-        decrypt(decode_key, initialization_vector, &ciphertext, common_mac)
+        // CryptoContent: a big-endian length, then that many bytes
+        let Some(length) = content_and_footer_bytes
+          .get(..4)
+          .and_then(|b| <[u8; 4]>::try_from(b).ok())
+          .and_then(|b| usize::try_from(u32::from_be_bytes(b)).ok())
+        else {
+          return Err(security_error("Encrypted payload without its CryptoContent"));
+        };
+        let Some((ciphertext, rest)) = content_and_footer_bytes
+          .get(4..)
+          .filter(|b| b.len() >= length)
+          .map(|b| b.split_at(length))
+        else {
+          return Err(security_error("CryptoContent longer than the payload"));
+        };
+        if rest.len() < foot_len || !is_padding(&rest[foot_len..]) {
+          return Err(security_error("Encrypted payload: no footer after its CryptoContent"));
+        }
+        let BuiltinCryptoFooter { common_mac, .. } = BuiltinCryptoFooter::try_from(&rest[..foot_len])?;
+        decrypt(decode_key, initialization_vector, ciphertext, common_mac)
       }
     }
   }
