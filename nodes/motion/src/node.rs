@@ -90,10 +90,9 @@ struct Timing {
 
 impl Timing {
     fn from_launch(cfg: &LaunchConfig) -> Timing {
-        let period_ms = cfg.servo.period_ms;
         Timing {
             realtime: cfg.realtime.clone(),
-            warning_ns: (cfg.servo.late_warning_ms.unwrap_or(3.0 * period_ms) * 1e6) as u64,
+            warning_ns: (cfg.servo.late_warning() * 1e6) as u64,
             alarm_ticks: cfg.servo.late_alarm_ticks as usize,
         }
     }

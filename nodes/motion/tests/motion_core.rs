@@ -435,6 +435,56 @@ fn a_stalled_drive_raises_the_following_error_alarm() {
     assert_eq!(m.commanded()[1], 0.0);
 }
 
+/// Issue 45 item 3: a drive that reports no number (NaN) is the axis's servo alarm, the run
+/// stops, reset does not make it go away while the drive still reports none, and a jog is
+/// refused meanwhile; the setpoints keep their last valid values.
+#[test]
+fn a_drive_that_reports_no_valid_position_is_an_alarm_that_stays() {
+    let mut m = Motion::new(lathe(), &[25.0, 0.0]);
+    m.push(block(
+        1,
+        1,
+        Command::Rapid {
+            end: vec![50.0, -200.0],
+        },
+    ));
+    let g = GImage::released();
+    for _ in 0..10 {
+        let actual = m.commanded().to_vec();
+        m.tick(Some(&actual), &g);
+    }
+    assert_eq!(m.state(), RunState::Running);
+    let before = m.commanded().to_vec();
+    let mut broken = before.clone();
+    broken[0] = f64::NAN;
+    m.tick(Some(&broken), &g);
+    assert_eq!(m.state(), RunState::Alarm);
+    let events = m.take_events();
+    assert!(
+        matches!(&events[..], [MotionEvent::Alarm { number, text, .. }]
+            if *number == alarm::FOLLOWING_ERROR && text.contains("X: no valid position")),
+        "{events:?}"
+    );
+    assert!(
+        m.commanded().iter().all(|v| v.is_finite()),
+        "{:?}",
+        m.commanded()
+    );
+    for _ in 0..5 {
+        m.tick(Some(&broken), &g);
+    }
+    assert!(m.take_events().is_empty(), "raised once while it stands");
+    m.reset();
+    m.tick(Some(&broken), &g);
+    assert_eq!(
+        m.state(),
+        RunState::Alarm,
+        "reset does not hide a drive without position"
+    );
+    assert!(m.jog(0, true, 100.0, None).is_err(), "no jog meanwhile");
+    assert!(m.commanded().iter().all(|v| v.is_finite()));
+}
+
 /// Three lines at F600 on Z from Z0, each 10 mm long, then program end.
 fn three_lines(m: &mut Motion) {
     for k in 1..=3u64 {

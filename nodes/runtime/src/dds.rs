@@ -62,17 +62,20 @@ pub fn context(net: &NetworkConfig, enclave: Option<&str>) -> Result<Context, St
 }
 
 impl RosNode {
-    /// Node `name` of the machine in namespace `/namespace`, with its spinner (discovery,
-    /// parameters) running; under DDS Security it is the machine's identity, `/namespace`.
+    /// Node `name` of the machine in namespace `/namespace`, with its spinner (discovery)
+    /// running; under DDS Security it is the machine's identity, `/namespace`. It serves no
+    /// ROS 2 parameter services: they answered any participant, outside `allowed_clients` and
+    /// without a command event, and the machine's parameters have their own door, the bridge's
+    /// `get_parameters`/`set_parameter` (issue 45).
     pub fn new(net: &NetworkConfig, namespace: &str, name: &str) -> Result<Self, String> {
-        Self::with_options(net, namespace, name, Some(&format!("/{namespace}")), true)
+        Self::with_options(net, namespace, name, Some(&format!("/{namespace}")))
     }
 
     /// A node of a client of the machines (the `cnc` client, the supervisor, the robot): it
     /// serves no parameters, and under DDS Security it is the enclave its config or the
     /// environment names.
     pub fn client(net: &NetworkConfig, namespace: &str, name: &str) -> Result<Self, String> {
-        Self::with_options(net, namespace, name, None, false)
+        Self::with_options(net, namespace, name, None)
     }
 
     fn with_options(
@@ -80,14 +83,13 @@ impl RosNode {
         namespace: &str,
         name: &str,
         enclave: Option<&str>,
-        parameter_services: bool,
     ) -> Result<Self, String> {
         let context = context(net, enclave)?;
         let node_name = NodeName::new(&format!("/{namespace}"), name)
             .map_err(|e| format!("node name {name}: {e:?}"))?;
         let options = NodeOptions::new()
             .enable_rosout(true)
-            .start_parameter_services(parameter_services);
+            .start_parameter_services(false);
         let mut node = context
             .new_node(node_name, options)
             .map_err(|e| format!("node {name}: {e:?}"))?;

@@ -11,6 +11,7 @@ pub mod instance_lock;
 pub mod lifecycle;
 pub mod limits;
 pub mod overrides;
+pub mod parameter_rules;
 pub mod parameters;
 pub mod persist;
 pub mod program_store;

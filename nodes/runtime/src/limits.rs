@@ -9,6 +9,7 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 use crate::config::AxisEntry;
+use crate::parameter_rules::show;
 
 /// The lowest fraction of a rating a parameter may set: a move at 1 % of the rapid rate and
 /// acceleration still ends (300 mm at 60 mm/min: five minutes).
@@ -24,6 +25,12 @@ pub struct MachineLimits {
     /// clamped to it. Absent: 6000 rpm.
     #[serde(default = "default_spindle_max")]
     pub spindle_max_rpm: f64,
+    /// The builder's value of each monitor (`parameter_rules`: following error, in-position
+    /// window, lateness alarms, tolerances), by parameter name: the cell may tighten a monitor,
+    /// never loosen it beyond this. Taken from the machine's own file as read
+    /// ([`crate::parameters::builder_monitors`]) where the section does not name it.
+    #[serde(default)]
+    pub monitors: BTreeMap<String, f64>,
 }
 
 fn default_spindle_max() -> f64 {
@@ -35,6 +42,7 @@ impl Default for MachineLimits {
         MachineLimits {
             axes: BTreeMap::new(),
             spindle_max_rpm: default_spindle_max(),
+            monitors: BTreeMap::new(),
         }
     }
 }
@@ -82,7 +90,10 @@ impl MachineLimits {
     pub fn check(&self, axes: &[AxisEntry]) -> Result<(), String> {
         let s = self.spindle_max_rpm;
         if !(s.is_finite() && s > 0.0 && s <= 100_000.0) {
-            return Err(format!("limits.spindle_max_rpm {s}: 0 < rpm ≤ 100000"));
+            return Err(format!(
+                "limits.spindle_max_rpm {}: 0 < rpm ≤ 100000",
+                show(s)
+            ));
         }
         for (name, l) in &self.axes {
             let Some(a) = axes.iter().find(|a| &a.name == name) else {
@@ -116,8 +127,10 @@ fn check_axis(a: &AxisEntry, l: &AxisLimits) -> Result<(), String> {
             Ok(())
         } else {
             Err(format!(
-                "machine.axes.{n}.{what} {v}: outside the rated travel {}..{}",
-                l.min, l.max
+                "machine.axes.{n}.{what} {}: outside the rated travel {}..{}",
+                show(v),
+                show(l.min),
+                show(l.max)
             ))
         }
     };
@@ -129,8 +142,11 @@ fn check_axis(a: &AxisEntry, l: &AxisLimits) -> Result<(), String> {
             Ok(())
         } else {
             Err(format!(
-                "machine.axes.{n}.{what} {v}: the machine is rated {low}..{rated} \
-                 (limits.axes.{n}.{what})"
+                "machine.axes.{n}.{what} {}: the machine is rated {}..{} \
+                 (limits.axes.{n}.{what})",
+                show(v),
+                show(low),
+                show(rated)
             ))
         }
     };

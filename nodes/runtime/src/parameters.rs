@@ -1,8 +1,9 @@
 //! The machine's parameters as the cell reads and writes them: the launch config's machine,
 //! servo, PLC and simulator settings under dotted names (`machine.axes.X.max_velocity`,
-//! `servo.lookahead`). A write is checked against the whole config (type and the config's own
-//! rules), stored in the parameter file and taken at the next start of the cell, as a control
-//! asks for a power-off after a parameter change (decisions D44). Pure except for
+//! `servo.lookahead`). A write is checked against the table of who may write what within which
+//! bounds ([`crate::parameter_rules`], D124) and against the whole config (type and the config's
+//! own rules), stored in the parameter file and taken at the next start of the cell, as a
+//! control asks for a power-off after a parameter change (decisions D44). Pure except for
 //! [`load_file`] and [`save_file`].
 
 use std::collections::BTreeMap;
@@ -10,6 +11,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
+use crate::parameter_rules;
 use crate::LaunchConfig;
 
 /// The sections that hold parameters. Network, HMI access and recording are the cell's and
@@ -114,36 +116,76 @@ fn leaf<'a>(root: &'a mut Value, name: &str) -> Option<&'a mut Value> {
     Some(node)
 }
 
-/// `cfg` with parameter `name` set to `value` (a YAML scalar), checked as the launch config
-/// is at start; `cfg` itself is not touched.
+/// `cfg` with parameter `name` set to `value` (a YAML scalar) as the cell writes it (the
+/// bridge's `set_parameter`, the web panel, the parameter file at start): refused unless the
+/// table lets the cell write it within its bounds ([`parameter_rules`]), then checked as the
+/// launch config is at start; `cfg` itself is not touched. A refusal names the rule.
 pub fn set(cfg: &LaunchConfig, name: &str, value: &str) -> Result<LaunchConfig, String> {
-    if !list(cfg).iter().any(|(n, _)| n == name) {
+    if name.len() > 128 || !list(cfg).iter().any(|(n, _)| n == name) {
         return Err(format!(
-            "unknown parameter {name:?} (GetParameters lists them)"
+            "unknown parameter {:?} (GetParameters lists them)",
+            name.chars().take(64).collect::<String>()
         ));
     }
     if value.len() > 256 || value.chars().any(char::is_control) {
         return Err(format!("{name}: a value is one line of at most 256 bytes"));
     }
-    let scalar: serde_yaml::Value = serde_yaml::from_str(value)
-        .map_err(|e| format!("{name}: {value:?} is not a value: {e}"))?;
-    if scalar.as_f64().is_some_and(|v| !v.is_finite()) {
-        return Err(format!("{name} = {value}: not a finite number"));
-    }
-    let new: Value = serde_json::to_value(&scalar)
-        .map_err(|e| format!("{name}: {value:?} is not a value: {e}"))?;
+    let scalar: serde_yaml::Value =
+        serde_yaml::from_str(value).map_err(|e| format!("{name}: not a value: {e}"))?;
+    let number = scalar.as_f64();
+    parameter_rules::check_cell_write(cfg, name, number, cfg.limits.monitors.get(name).copied())?;
+    let new: Value =
+        serde_json::to_value(&scalar).map_err(|e| format!("{name}: not a value: {e}"))?;
     if matches!(new, Value::Array(_) | Value::Object(_)) {
         return Err(format!("{name}: give one value, not a list or map"));
     }
     let mut root = serde_json::to_value(cfg).map_err(|e| e.to_string())?;
     let slot = leaf(&mut root, name).ok_or_else(|| format!("unknown parameter {name:?}"))?;
     *slot = new;
-    let changed: LaunchConfig =
-        serde_json::from_value(root).map_err(|e| format!("{name} = {value}: {e}"))?;
+    let changed: LaunchConfig = serde_json::from_value(root).map_err(|e| format!("{name}: {e}"))?;
     changed
         .validate()
-        .map_err(|e| format!("{name} = {value} refused: {e}"))?;
+        .map_err(|e| format!("{name} refused: {e}"))?;
     Ok(changed)
+}
+
+/// Every number of `cfg`'s parameters against its range in the table (any writer: the
+/// launch config as read, and every write).
+pub fn check_ranges(cfg: &LaunchConfig) -> Result<(), String> {
+    for (name, value) in list(cfg) {
+        if let Ok(v) = value.parse::<f64>() {
+            parameter_rules::check_range(cfg, &name, v)?;
+        }
+    }
+    Ok(())
+}
+
+/// The builder's value of every monitor of `cfg` (the launch config as read): its own value,
+/// or what the machine takes where the file leaves it out.
+pub fn builder_monitors(cfg: &LaunchConfig) -> BTreeMap<String, f64> {
+    let mut out = BTreeMap::new();
+    for (name, value) in list(cfg) {
+        if !parameter_rules::rule(&name).monitor {
+            continue;
+        }
+        let v = value.parse::<f64>().ok().or_else(|| derived(cfg, &name));
+        if let Some(v) = v {
+            out.insert(name, v);
+        }
+    }
+    out
+}
+
+/// The value the machine takes for a monitor the file leaves out (`null`).
+fn derived(cfg: &LaunchConfig, name: &str) -> Option<f64> {
+    if name == "servo.late_warning_ms" {
+        return Some(cfg.servo.late_warning());
+    }
+    let axis = name
+        .strip_prefix("machine.axes.")?
+        .strip_suffix(".following_error")?;
+    let a = cfg.machine.axes.iter().find(|a| a.name == axis)?;
+    Some(a.following_error_limit())
 }
 
 /// `cfg` with every written value of `overlay` applied in name order.
@@ -237,10 +279,16 @@ mod tests {
         assert!(e.contains("unknown parameter"), "{e}");
         let e = set(&cfg, "hmi.allowed_clients.0", "*").unwrap_err();
         assert!(e.contains("unknown parameter"), "{e}");
-        let e = set(&cfg, "machine.dialect", "klingon-lathe").unwrap_err();
-        assert!(e.contains("dialect"), "{e}");
-        assert!(set(&cfg, "machine.tool_post", "front").is_ok());
-        assert!(set(&cfg, "machine.tool_post", "sideways").is_err());
+        // The dialect and the geometry are the builder's (D124), whatever the value.
+        for (name, value) in [
+            ("machine.dialect", "klingon-lathe"),
+            ("machine.dialect", "fanuc-mill"),
+            ("machine.tool_post", "front"),
+            ("machine.tool_post", "sideways"),
+        ] {
+            let e = set(&cfg, name, value).unwrap_err();
+            assert!(e.contains("the machine builder's"), "{e}");
+        }
     }
 
     #[test]
@@ -251,9 +299,16 @@ mod tests {
         let cfg = apply(lathe(), &overlay).expect("applies");
         assert_eq!(cfg.servo.lookahead, 12);
         assert_eq!(cfg.machine.axes[1].max_acceleration, 1200.0);
-        overlay.insert("servo.period_ms".into(), "99".into());
+        overlay.insert("servo.lookahead".into(), "99999".into());
         let e = apply(lathe(), &overlay).unwrap_err();
-        assert!(e.contains("servo.period_ms = 99"), "{e}");
+        assert!(e.contains("servo.lookahead = 99999 outside 2..256"), "{e}");
+        overlay.insert("servo.lookahead".into(), "12".into());
+        overlay.insert("servo.period_ms".into(), "8".into());
+        let e = apply(lathe(), &overlay).unwrap_err();
+        assert!(
+            e.contains("servo.period_ms is the machine builder's"),
+            "{e}"
+        );
 
         let dir = std::env::temp_dir().join(format!("cnc_params_{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

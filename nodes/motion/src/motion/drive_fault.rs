@@ -6,6 +6,21 @@ use super::*;
 impl Motion {
     /// Compares each slide with the setpoint it was given (the one sent last tick).
     pub(super) fn check_following_error(&mut self) {
+        // A position that is no number (a drive that reports NaN, a setpoint gone infinite)
+        // is the axis's servo alarm too, whether or not the servo is on: every comparison
+        // with it is false, so without this the machine would run on blind (issue 45).
+        let lost = (0..self.cfg.axes.len())
+            .find(|&i| !(self.actual[i].is_finite() && self.drive[i].is_finite()));
+        if let Some(i) = lost {
+            if !self.servo_off || self.state() != RunState::Alarm {
+                let text = format!(
+                    "{}: no valid position (drive {}, setpoint {})",
+                    self.cfg.axes[i].name, self.actual[i], self.drive[i]
+                );
+                self.drive_fault(alarm::FOLLOWING_ERROR, text);
+            }
+            return;
+        }
         if self.servo_off {
             return;
         }
@@ -34,6 +49,16 @@ impl Motion {
         self.drive_fault(alarm::SERVO_OVERRUN, text);
     }
 
+    /// The setpoints put where the slides are, so nothing jumps when the servo comes back; an
+    /// axis with no valid position keeps its last setpoint.
+    pub(super) fn hold_where_slides_are(&mut self) {
+        for (c, a) in self.commanded.iter_mut().zip(&self.actual) {
+            if a.is_finite() {
+                *c = *a;
+            }
+        }
+    }
+
     /// A drive fault: servo off, the run dropped, the setpoints held where the slides are
     /// (`000` §11.2: servo alarms switch the servo off).
     pub(super) fn drive_fault(&mut self, number: u32, text: String) {
@@ -41,7 +66,7 @@ impl Motion {
         self.raise(number, text, line);
         self.queue.clear();
         self.servo_off = true;
-        self.commanded.clone_from(&self.actual);
+        self.hold_where_slides_are();
         let here = self.commanded_point();
         self.planner.reset(here);
     }

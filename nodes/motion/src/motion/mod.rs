@@ -451,7 +451,7 @@ impl Motion {
         self.compressor = false;
         self.fifo_fill = false;
         self.handwheel.stop();
-        self.commanded.clone_from(&self.actual);
+        self.hold_where_slides_are();
         let here = self.commanded_point();
         self.planner.reset(here);
         self.planner.set_shape(self.cfg.shape);

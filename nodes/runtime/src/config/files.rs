@@ -9,8 +9,12 @@ impl LaunchConfig {
     pub fn from_yaml(text: &str) -> Result<Self, String> {
         let mut cfg: LaunchConfig =
             serde_yaml::from_str(text).map_err(|e| format!("launch config: {e}"))?;
-        // The machine's own file rates the axes it does not rate explicitly at its values.
+        // The machine's own file rates the axes it does not rate explicitly at its values, and
+        // sets the monitors the cell may tighten but not loosen (D124).
         cfg.limits.complete(&cfg.machine.axes);
+        for (name, v) in crate::parameters::builder_monitors(&cfg) {
+            cfg.limits.monitors.entry(name).or_insert(v);
+        }
         cfg.validate()?;
         Ok(cfg)
     }

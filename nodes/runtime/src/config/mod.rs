@@ -44,6 +44,7 @@ impl LaunchConfig {
     pub(crate) fn validate(&self) -> Result<(), String> {
         self.machine.validate()?;
         self.limits.check(&self.machine.axes)?;
+        crate::parameters::check_ranges(self)?;
         nodes::validate(self)
     }
 

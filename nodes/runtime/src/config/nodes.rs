@@ -560,6 +560,11 @@ impl RealtimeConfig {
 }
 
 impl ServoConfig {
+    /// The servo tick lateness that is a warning, ms: `late_warning_ms`, else three periods.
+    pub fn late_warning(&self) -> f64 {
+        self.late_warning_ms.unwrap_or(3.0 * self.period_ms)
+    }
+
     fn validate(&self) -> Result<(), String> {
         if self.late_alarm_ticks == 0 {
             return Err("servo.late_alarm_ticks must be at least 1".into());
