@@ -121,10 +121,9 @@ fn leaf<'a>(root: &'a mut Value, name: &str) -> Option<&'a mut Value> {
 /// table lets the cell write it within its bounds ([`parameter_rules`]), then checked as the
 /// launch config is at start; `cfg` itself is not touched. A refusal names the rule.
 pub fn set(cfg: &LaunchConfig, name: &str, value: &str) -> Result<LaunchConfig, String> {
-    if name.len() > 128 || !list(cfg).iter().any(|(n, _)| n == name) {
+    if !list(cfg).iter().any(|(n, _)| n == name) {
         return Err(format!(
-            "unknown parameter {:?} (GetParameters lists them)",
-            name.chars().take(64).collect::<String>()
+            "unknown parameter {name:?} (GetParameters lists them)"
         ));
     }
     if value.len() > 256 || value.chars().any(char::is_control) {

@@ -8,25 +8,41 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc};
 
+/// The temporary file a durable write of `path` goes through: `.<name>.tmp` beside it. The
+/// leading dot puts it where no program name reaches (a name never starts with `.`,
+/// `program_store::valid_program_name`), so `PART.nc.tmp` is a program like any other and
+/// the leftover of a cut-short write is told apart from it (issue 45).
+pub fn temporary_of(path: &Path) -> PathBuf {
+    let mut name = std::ffi::OsString::from(".");
+    name.push(path.file_name().unwrap_or_default());
+    name.push(".tmp");
+    path.with_file_name(name)
+}
+
+/// Whether a file name is the leftover of a durable write a crash cut short.
+pub fn is_leftover(file_name: &str) -> bool {
+    file_name.starts_with('.') && file_name.ends_with(".tmp")
+}
+
 /// Writes `bytes` to `path` durably: temporary file, `fsync`, rename, `fsync` of the folder.
+/// A write that fails leaves no temporary file behind.
 pub fn write_durable(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let dir = match path.parent().filter(|d| !d.as_os_str().is_empty()) {
         Some(d) => d.to_path_buf(),
         None => PathBuf::from("."),
     };
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(".tmp");
-    let tmp = dir.join(name);
-    let written = std::fs::File::create(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.sync_all()
-    });
+    let tmp = temporary_of(path);
+    let written = std::fs::File::create(&tmp)
+        .and_then(|mut f| {
+            f.write_all(bytes)?;
+            f.sync_all()
+        })
+        .and_then(|()| std::fs::rename(&tmp, path));
     if let Err(e) = written {
         let _ = std::fs::remove_file(&tmp);
-        return Err(format!("{}: {e}", tmp.display()));
+        return Err(format!("{}: {e}", path.display()));
     }
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))?;
     sync_dir(&dir)
 }
 

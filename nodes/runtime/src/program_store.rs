@@ -167,7 +167,7 @@ impl Walk {
             let name = format!("{prefix}{file}");
             let path = entry.path();
             // Left over by a write a crash cut short: the old file is still there.
-            if file.ends_with(".tmp") {
+            if crate::persist::is_leftover(&file) {
                 if self.tidy {
                     let _ = std::fs::remove_file(&path);
                 }
@@ -268,6 +268,38 @@ mod tests {
         assert!(check_store(&sizes, "b", 400, 1000).is_ok());
     }
 
+    /// Issue 45 item 6: a name ending in `.tmp` is a program like any other: storing `PART.nc`
+    /// after `PART.nc.tmp` does not use the latter as its temporary file, neither is removed
+    /// at the next start, and a store that fails leaves nothing behind.
+    #[test]
+    fn a_program_named_like_a_temporary_file_is_kept() {
+        let root = std::env::temp_dir().join(format!("cnc_programs_tmp_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let dir = ProgramDir::new(&root);
+        dir.store("PART.nc.tmp", "G0 X1\nM30\n").unwrap();
+        dir.store("PART.nc", "G0 X2\nM30\n").unwrap();
+        dir.store("half.tmp", "M30\n").unwrap();
+        let (programs, problems) = dir.read_all();
+        assert_eq!(
+            programs.keys().collect::<Vec<_>>(),
+            ["PART.nc", "PART.nc.tmp", "half.tmp"],
+            "{problems:?}"
+        );
+        assert_eq!(programs["PART.nc.tmp"], "G0 X1\nM30\n");
+        // A store that cannot be made (a folder stands where the file would go) leaves no
+        // stray file.
+        std::fs::create_dir_all(root.join("BUSY.nc/inside")).unwrap();
+        assert!(dir.store("BUSY.nc", "M30\n").is_err());
+        let stray: Vec<_> = std::fs::read_dir(&root)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().to_string())
+            .filter(|n| n.starts_with('.'))
+            .collect();
+        assert!(stray.is_empty(), "{stray:?}");
+        let _ = std::fs::remove_dir_all(&root);
+    }
+
     #[test]
     fn programs_and_their_folders_come_back_from_the_disk() {
         let root = std::env::temp_dir().join(format!("cnc_programs_{}", std::process::id()));
@@ -275,7 +307,7 @@ mod tests {
         let dir = ProgramDir::new(&root);
         dir.store("O0001", "G0 X1\nM30\n").unwrap();
         dir.store("shafts/O0010.nc", "M99\n").unwrap();
-        std::fs::write(root.join("half.tmp"), "cut").unwrap();
+        std::fs::write(root.join(".O0001.tmp"), "cut").unwrap();
         std::fs::write(root.join(".hidden"), "x").unwrap();
         let (programs, problems) = dir.read_all();
         assert_eq!(
@@ -283,7 +315,10 @@ mod tests {
             ["O0001", "shafts/O0010.nc"]
         );
         assert_eq!(problems.len(), 1, "{problems:?}");
-        assert!(!root.join("half.tmp").exists());
+        assert!(
+            !root.join(".O0001.tmp").exists(),
+            "a cut-short write's leftover"
+        );
         dir.remove("shafts/O0010.nc").unwrap();
         assert!(!root.join("shafts").exists());
         let _ = std::fs::remove_dir_all(&root);
