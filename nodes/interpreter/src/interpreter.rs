@@ -100,6 +100,15 @@ impl Interpreter {
         self.front.core().program_origin()
     }
 
+    /// Every program the run has called so far (its name in the library) and the text it ran.
+    pub fn called_programs(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.front
+            .core()
+            .called
+            .iter()
+            .map(|(n, t)| (n.as_str(), t.as_ref()))
+    }
+
     /// See [`cnc_interpreter_core::Core::work_frame`].
     pub fn work_frame(&self) -> Vec<f64> {
         self.front.core().work_frame()

@@ -27,6 +27,9 @@ pub struct ProgramPosition {
     pub text_hash: String,
     #[serde(default)]
     pub kept_at_start: BTreeMap<i64, f64>,
+    /// The fingerprint of every program the run called, by its name in program memory.
+    #[serde(default)]
+    pub called: BTreeMap<String, String>,
 }
 
 /// A program text's fingerprint (FNV-1a, 64 bits, hex): a restart refuses a program edited
@@ -67,6 +70,7 @@ impl ProgramPosition {
             block: 0,
             text_hash: String::new(),
             kept_at_start: BTreeMap::new(),
+            called: BTreeMap::new(),
         })
     }
 
@@ -225,6 +229,9 @@ mod tests {
             block: 97,
             text_hash: text_hash("O0010\nM30\n"),
             kept_at_start: [(500, 2.5)].into_iter().collect(),
+            called: [("O2000".to_string(), text_hash("O2000\nM99\n"))]
+                .into_iter()
+                .collect(),
         };
         assert_eq!(ProgramPosition::from_yaml(&p.to_yaml()).unwrap(), p);
         assert!(ProgramPosition::from_yaml("program: [").is_err());

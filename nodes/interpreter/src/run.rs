@@ -78,8 +78,26 @@ struct Run {
     /// restart at its interrupted block needs to run it again as it ran (decisions D67).
     text_hash: String,
     kept_at_start: BTreeMap<i64, f64>,
+    /// The fingerprint of every program the run has called so far, by name: a restart after
+    /// one of them was edited is refused like one after the main program was (issue 45).
+    called: BTreeMap<String, String>,
     /// Stopped by an alarm or a cycle stop: nothing more is sent.
     failed: bool,
+}
+
+impl Run {
+    /// Takes the fingerprints of the programs the run has called since the last time.
+    fn note_called(&mut self) {
+        let interp = self.stream.interpreter();
+        if interp.called_programs().count() == self.called.len() {
+            return;
+        }
+        for (name, text) in interp.called_programs() {
+            if !self.called.contains_key(name) {
+                self.called.insert(name.to_string(), text_hash(text));
+            }
+        }
+    }
 }
 
 /// The interpreter node's logic.
@@ -597,6 +615,7 @@ impl RunCore {
             failed: false,
             text_hash: text_hash(&text),
             kept_at_start: kept,
+            called: BTreeMap::new(),
         });
         self.program_name = name;
         self.execution = MachineState::ACTIVE;
@@ -627,6 +646,19 @@ impl RunCore {
                 "{} was edited since it was interrupted at line {}: start it by line",
                 p.program, p.line
             ));
+        }
+        // Every program the interrupted run called, as it ran (a subprogram's edit changes
+        // the path as much as the main program's).
+        let library = self.library();
+        for (called, hash) in &p.called {
+            let now = library.text_of(called).map(|t| text_hash(&t));
+            if now.as_deref() != Some(hash.as_str()) {
+                return Err(format!(
+                    "{called}, which {} called, was edited or removed since it was interrupted \
+                     at line {}: start it by line",
+                    p.program, p.line
+                ));
+            }
         }
         // The file may have been edited by hand: only kept variables, only numbers.
         let kept = p
@@ -755,6 +787,9 @@ impl RunCore {
         let Some(mut p) = ProgramPosition::of(&self.state()) else {
             return;
         };
+        if let Some(r) = self.run.as_mut() {
+            r.note_called();
+        }
         let run = self.run.as_ref().filter(|r| r.program == p.program);
         let old = self
             .position_kept
@@ -773,16 +808,20 @@ impl RunCore {
             (None, Some(o)) => o.block,
             (None, None) => 0,
         };
-        let same = old.is_some_and(|o| (o.line, o.block, &o.state) == (p.line, p.block, &p.state));
-        if same {
-            return;
-        }
         if let Some(r) = run {
             p.text_hash.clone_from(&r.text_hash);
             p.kept_at_start.clone_from(&r.kept_at_start);
+            p.called.clone_from(&r.called);
         } else if let Some(o) = old {
             p.text_hash.clone_from(&o.text_hash);
             p.kept_at_start.clone_from(&o.kept_at_start);
+            p.called.clone_from(&o.called);
+        }
+        let same = old.is_some_and(|o| {
+            (o.line, o.block, &o.state, &o.called) == (p.line, p.block, &p.state, &p.called)
+        });
+        if same {
+            return;
         }
         if self.position_kept.as_ref() != Some(&p) {
             self.position_kept = Some(p);

@@ -873,3 +873,71 @@ fn a_msg_service_text_goes_out_when_its_block_runs() {
     assert!(effects.iter().any(|e| matches!(e,
         Effect::MessageService(cnc_interpreter_core::ServiceOutput::File, t) if t == "at X10")));
 }
+
+/// Issue 45 item 5: a main program and the subprogram it calls.
+const MAIN_CALLING: &str = "G00 X100 Z20\nS500 M03\nM98 P2000\nG00 X150 Z50\nM05\nM30\n";
+const SUB: &str = "O2000\nG01 X90 Z10 F3000\nG01 Z5\nG01 Z0\nG01 X95\nG01 Z-5\nM99\n";
+const SUB_EDITED: &str = "O2000\nG01 X80 Z10 F3000\nG01 Z5\nG01 Z0\nG01 X95\nG01 Z-5\nM99\n";
+
+fn calling_core() -> RunCore {
+    let mut c = core();
+    assert!(command(&mut c, 1, ProgramCommand::LOAD, "main.nc", MAIN_CALLING).accepted);
+    assert!(command(&mut c, 2, ProgramCommand::LOAD, "O2000", SUB).accepted);
+    c.plc_scanned();
+    c.axes(&[200.0, 100.0]);
+    c
+}
+
+/// An interruption inside a subprogram restarts at the subprogram's interrupted block (not at
+/// the main program's call line), and the rest is the uninterrupted run's; a restart after the
+/// subprogram was edited is refused.
+#[test]
+fn an_interrupted_subprogram_restarts_at_its_block_and_an_edit_of_it_is_refused() {
+    let mut whole = calling_core();
+    assert!(command(&mut whole, 3, ProgramCommand::START, "main.nc", "").accepted);
+    let full = run_to_end(&mut whole, 1001);
+
+    // Interrupted with 5 blocks done: inside O2000 (its third move).
+    let mut first = calling_core();
+    assert!(command(&mut first, 3, ProgramCommand::START, "main.nc", "").accepted);
+    first.motion_status(status_at(1001, 0, 1, MotionStatus::STATE_RUNNING));
+    first.step();
+    assert!(blocks(&first.take_effects()).len() > 6);
+    first.motion_status(status_at(1001, 5, 3, MotionStatus::STATE_RUNNING));
+    first.step();
+    let kept = first.position().cloned().expect("a kept position");
+    assert!(kept.interrupted() && kept.block == 6, "{kept:?}");
+
+    let fresh = |sub: &str| {
+        let c = RunCore::new(
+            Dialect::HuaxingLathe,
+            Setup::lathe([200.0, 100.0]),
+            first.memory().clone(),
+            2000,
+        );
+        let mut c = c.with_kept_position(Some(kept.clone()));
+        assert!(command(&mut c, 1, ProgramCommand::LOAD, "main.nc", MAIN_CALLING).accepted);
+        assert!(command(&mut c, 2, ProgramCommand::LOAD, "O2000", sub).accepted);
+        c.plc_scanned();
+        c.axes(&[250.0, 150.0]);
+        c
+    };
+    let mut again = fresh(SUB);
+    let r = command(&mut again, 3, ProgramCommand::START, "", "interrupted");
+    assert!(r.accepted, "{}", r.message);
+    assert!(r.message.contains("block 6"), "{}", r.message);
+    let rest = run_to_end(&mut again, 2001);
+    // After the preamble, the uninterrupted run's blocks from block 6 on: the subprogram is
+    // not run again from its top.
+    assert!(rest.len() >= full.len() - 5, "{rest:?}");
+    assert_eq!(rest[rest.len() - (full.len() - 5)..], full[5..], "{rest:?}");
+
+    // The subprogram edited since: refused, naming it.
+    let mut edited = fresh(SUB_EDITED);
+    let r = command(&mut edited, 3, ProgramCommand::START, "", "interrupted");
+    assert!(
+        !r.accepted && r.message.contains("O2000") && r.message.contains("edited"),
+        "{}",
+        r.message
+    );
+}

@@ -288,6 +288,9 @@ impl Core {
     }
 
     fn push_level(&mut self, name: String, text: Arc<str>, count: u32, locals: Option<Vec<Value>>) {
+        self.called
+            .entry(name.clone())
+            .or_insert_with(|| text.clone());
         self.levels.push(CallLevel {
             text,
             name,

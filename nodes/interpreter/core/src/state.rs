@@ -103,6 +103,10 @@ pub struct Core {
     pub library: Library,
     /// The main program and the programs it has called, innermost last.
     pub levels: Vec<CallLevel>,
+    /// Every program this run has called so far, by the name the library gives it, with the
+    /// text it was read from: a restart at an interrupted block checks that none was edited
+    /// since (issue 45).
+    pub called: std::collections::BTreeMap<String, Arc<str>>,
     /// Commanded machine position per axis (X as diameter on a diameter axis).
     pub pos: Vec<f64>,
     /// Work position at the program start.
@@ -219,6 +223,7 @@ impl Core {
         let common = setup.kept.iter().map(|(&k, &v)| (k, v)).collect();
         let mut core = Core {
             levels: vec![CallLevel::main(Arc::from(text), rules.locals)],
+            called: std::collections::BTreeMap::new(),
             pos: setup.start.clone(),
             program_start: Vec::new(),
             work_system: setup.work_system.min(5),

@@ -95,6 +95,15 @@ impl Library {
             .insert(number, (name.to_string(), Arc::from(text)));
     }
 
+    /// The text of the program the library calls `name` (by number or by name), if any.
+    pub fn text_of(&self, name: &str) -> Option<Arc<str>> {
+        self.programs
+            .values()
+            .chain(self.named.values())
+            .find(|(n, _)| n == name)
+            .map(|(_, t)| t.clone())
+    }
+
     pub fn get(&self, number: u32) -> Option<(&str, Arc<str>)> {
         self.programs
             .get(&number)
