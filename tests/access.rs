@@ -19,7 +19,7 @@ const PROGRAM: &str = "O0001\nG00 X60 Z5\nG01 X50 Z0 F900\nM30\n";
 #[test]
 fn only_allowed_clients_move_the_machine_and_every_command_is_an_event() {
     let mut cfg = common::sim_lathe(52);
-    cfg.hmi.allowed_clients = vec!["/lathe1/supervisor_ok".into()];
+    cfg.hmi.allowed_clients = Some(vec!["/lathe1/supervisor_ok".into()]);
     let cell = Cell::start(&cfg).unwrap();
     let mut auditor = common::Auditor::new(&cfg);
     let mut good = CellClient::new(

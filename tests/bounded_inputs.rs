@@ -31,7 +31,7 @@ fn fuzzed_services_and_inputs_never_take_the_machine_outside_its_ratings() {
     let _alone = one_cell_at_a_time();
     let mut cfg = common::sim_lathe(72);
     // Allowed, so the fuzzed commands reach the machine instead of stopping at the door.
-    cfg.hmi.allowed_clients = vec!["*".into()];
+    cfg.hmi.allowed_clients = Some(vec!["*".into()]);
     // A parameter file, so every written value is checked (and kept for the next start).
     let dir = std::env::temp_dir().join(format!("cnc_fuzz_{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);

@@ -36,7 +36,7 @@ fn mode_mdi_offsets_parameters_and_alarms_are_served_to_the_cell() {
     let parameter_file = dir.join("parameters.yaml");
     let mut cfg = common::sim_lathe(55);
     cfg.machine.parameter_file = Some(parameter_file.clone());
-    cfg.hmi.allowed_clients = vec!["/lathe1/setter".into()];
+    cfg.hmi.allowed_clients = Some(vec!["/lathe1/setter".into()]);
     let cell = Cell::start(&cfg).unwrap();
     let mut c =
         CellClient::new(&cfg.network, "lathe1", "setter", ServiceMapping::Enhanced).unwrap();

@@ -23,7 +23,7 @@ const PART: &str = "O0001\nG00 X60 Z5\nS800 M03\nG01 X50 Z0 F900\nZ-10\nG00 X60\
 fn a_foreign_participant_neither_runs_nor_moves_the_machine() {
     let domain = 61;
     let mut cfg = common::sim_lathe(domain);
-    cfg.hmi.allowed_clients = vec!["/lathe1/supervisor".into()];
+    cfg.hmi.allowed_clients = Some(vec!["/lathe1/supervisor".into()]);
     let cell = Cell::start(&cfg).unwrap();
     let auditor = common::Auditor::new(&cfg);
     let mut supervisor = CellClient::new(

@@ -130,7 +130,7 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
     cfg.hmi.web_address = PANEL.into();
     cfg.hmi.operators_file = Some(operators.clone());
     cfg.hmi.session_seconds = 8;
-    cfg.hmi.allowed_clients = vec!["web:anna@*".into()];
+    cfg.hmi.allowed_clients = Some(vec!["web:anna@*".into()]);
 
     // 1. No operators: the cell does not start.
     let e = Cell::start(&cfg).err().expect("refused without logins");

@@ -151,7 +151,7 @@ pub fn run(cfg: LaunchConfig, shutdown: Shutdown) -> Result<(), String> {
     // whenever the bridge looks (ros2-client's node events drop what a full queue cannot take).
     let discovery = discovery_reader(&participant)?;
     let mut clients = Clients::default();
-    let allowed = cfg.hmi.allowed_clients.clone();
+    let allowed = cfg.hmi.allowed_clients();
     let secured = cfg.network.effective_security()?.is_some();
     if !allowed.iter().any(|p| p == "*") && !secured {
         log::warn!(

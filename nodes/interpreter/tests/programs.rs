@@ -328,6 +328,43 @@ fn endless_or_runaway_programs_end_in_an_alarm() {
     assert_eq!((e.number, e.line), (20, 1), "{e}");
 }
 
+/// Issue 45 item 10: a feed below the least increment is an alarm, not a move that never ends.
+#[test]
+fn a_feed_below_the_least_increment_is_an_alarm() {
+    for text in [
+        "G98 G01 X10 Z5 F0.0000000000000000001\nM30\n",
+        "G99 G01 X10 Z5 F0.0001\nM30\n",
+    ] {
+        let e = cnc_interpreter::check(Dialect::HuaxingLathe, text, Setup::lathe([100.0, 50.0]))
+            .unwrap_err();
+        assert_eq!(e.line, 1, "{e}");
+        assert!(e.text.contains("out of range (min 0.001)"), "{e}");
+    }
+    assert!(cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "G98 G01 X10 Z5 F0.001\nM30\n",
+        Setup::lathe([100.0, 50.0])
+    )
+    .is_ok());
+}
+
+/// Issue 45 item 10: two million blank lines read once are no endless loop; a loop that
+/// comes back over the same text without a move still is one.
+#[test]
+fn a_long_stretch_of_blank_lines_is_no_endless_loop() {
+    let text = format!("G0 X10 Z5\n{}G0 X20\nM30\n", "\n".repeat(2_000_000));
+    let cmds = cnc_interpreter::check(Dialect::HuaxingLathe, &text, Setup::lathe([100.0, 50.0]))
+        .expect("runs to its end");
+    assert_eq!(cmds.last().map(|c| c.line), Some(2_000_003));
+    let e = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        &format!("N10 #1=1\n{}GOTO10\n", "\n".repeat(1000)),
+        Setup::lathe([100.0, 50.0]),
+    )
+    .unwrap_err();
+    assert_eq!(e.number, 20, "{e}");
+}
+
 /// Chamfer L and corner rounding D in G01 (`000` §5.11, decision D31).
 #[test]
 fn chamfer_and_corner_rounding_in_g01() {

@@ -18,6 +18,91 @@ use sha2::{Digest, Sha256};
 pub const ITERATIONS: u32 = 200_000;
 /// Sessions held at once; the oldest goes when a new login would exceed it.
 const MAX_SESSIONS: usize = 64;
+/// Failed logins of one operator before each further try must wait (the wait doubles with
+/// every failure after these, from [`FIRST_WAIT`] up to [`LONGEST_WAIT`]).
+const FREE_FAILURES: u32 = 5;
+const FIRST_WAIT: Duration = Duration::from_secs(2);
+const LONGEST_WAIT: Duration = Duration::from_secs(300);
+/// Password checks (key derivations, a tenth of a second of a core each) the panel makes per
+/// second at most, whoever asks, and in a burst: guessing from many addresses and connections
+/// at once can neither go faster nor take the machine's CPU.
+const CHECKS_PER_SECOND: f64 = 2.0;
+const CHECK_BURST: f64 = 4.0;
+
+/// Why a login was refused before any password was checked.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Throttled {
+    /// Too many failed logins of this operator: wait this long.
+    Operator(Duration),
+    /// Too many logins at the panel at once.
+    Panel,
+}
+
+/// Failed logins per operator name, and the panel's budget of password checks (D125).
+struct Throttle {
+    failures: BTreeMap<String, (u32, Instant)>,
+    budget: f64,
+    filled: Option<Instant>,
+    /// Password checks made (for the tests: unknown names cost as much as known ones).
+    checks: u64,
+}
+
+impl Throttle {
+    fn new() -> Throttle {
+        Throttle {
+            failures: BTreeMap::new(),
+            budget: CHECK_BURST,
+            filled: None,
+            checks: 0,
+        }
+    }
+
+    /// Whether a password of `name` may be checked now; takes one check of the budget.
+    fn admit(&mut self, name: &str, now: Instant) -> Result<(), Throttled> {
+        if let Some(&(count, last)) = self.failures.get(name) {
+            if count >= FREE_FAILURES {
+                let doublings = (count - FREE_FAILURES).min(16);
+                let wait = FIRST_WAIT.saturating_mul(1 << doublings).min(LONGEST_WAIT);
+                let since = now.saturating_duration_since(last);
+                if since < wait {
+                    return Err(Throttled::Operator(wait - since));
+                }
+            }
+        }
+        let elapsed = self
+            .filled
+            .map_or(0.0, |t| now.saturating_duration_since(t).as_secs_f64());
+        self.budget = (self.budget + elapsed * CHECKS_PER_SECOND).min(CHECK_BURST);
+        self.filled = Some(now);
+        if self.budget < 1.0 {
+            return Err(Throttled::Panel);
+        }
+        self.budget -= 1.0;
+        self.checks += 1;
+        Ok(())
+    }
+
+    fn outcome(&mut self, name: &str, ok: bool, now: Instant) {
+        if ok {
+            self.failures.remove(name);
+            return;
+        }
+        // Bounded: a name is any string a client sends.
+        if self.failures.len() >= 4096 && !self.failures.contains_key(name) {
+            let oldest = self
+                .failures
+                .iter()
+                .min_by_key(|(_, (_, t))| *t)
+                .map(|(n, _)| n.clone());
+            if let Some(n) = oldest {
+                self.failures.remove(&n);
+            }
+        }
+        let entry = self.failures.entry(name.to_string()).or_insert((0, now));
+        entry.0 = entry.0.saturating_add(1);
+        entry.1 = now;
+    }
+}
 
 fn hmac(key: &[u8], message: &[&[u8]]) -> [u8; 32] {
     let mut block = [0u8; 64];
@@ -172,6 +257,11 @@ pub struct Gate {
     origins: Vec<String>,
     lifetime: Duration,
     sessions: Mutex<BTreeMap<String, (String, Instant)>>,
+    throttle: Mutex<Throttle>,
+    /// What a name without an operator is checked against, so that a wrong name costs the
+    /// same time as a wrong password (no telling which names exist); made at the first need.
+    decoy: std::sync::OnceLock<String>,
+    decoy_iterations: u32,
     /// What `/session` also tells the page: the machine and the cell's other panels.
     pub cell: serde_json::Value,
 }
@@ -193,12 +283,21 @@ impl Gate {
         for o in &mut origins {
             *o = o.trim_end_matches('/').to_string();
         }
+        // The decoy costs what the operators' own hashes cost.
+        let decoy_iterations = operators
+            .values()
+            .filter_map(|h| h.split('$').nth(1)?.parse::<u32>().ok())
+            .max()
+            .unwrap_or(ITERATIONS);
         Gate {
             required: !bound.ip().is_loopback(),
             operators,
             origins,
             lifetime,
             sessions: Mutex::new(BTreeMap::new()),
+            throttle: Mutex::new(Throttle::new()),
+            decoy: std::sync::OnceLock::new(),
+            decoy_iterations,
             cell: serde_json::Value::Null,
         }
     }
@@ -213,16 +312,45 @@ impl Gate {
         }
     }
 
-    /// A new session token for `name` with `password`, or why not.
-    pub fn login(&self, name: &str, password: &str, now: Instant) -> Result<String, String> {
-        let ok = self
-            .operators
-            .get(name)
-            .is_some_and(|stored| verify(stored, password));
-        if !ok {
-            return Err("unknown operator or wrong password".into());
+    /// A new session token for `name` with `password`, or why not. Before any password is
+    /// checked the throttle decides (an operator's failures, the panel's budget of checks):
+    /// such a refusal is `Err(Some(..))` with the wait, a wrong name or password `Err(None)`.
+    pub fn login(
+        &self,
+        name: &str,
+        password: &str,
+        now: Instant,
+    ) -> Result<String, (String, Option<Throttled>)> {
+        let mut throttle = self.throttle.lock().unwrap_or_else(|e| e.into_inner());
+        if let Err(t) = throttle.admit(name, now) {
+            let why = match &t {
+                Throttled::Operator(wait) => format!(
+                    "too many failed logins for this operator: try again in {} s",
+                    wait.as_secs().max(1)
+                ),
+                Throttled::Panel => "too many logins at once: try again in a second".into(),
+            };
+            return Err((why, Some(t)));
         }
-        let token = hex(&random(32)?);
+        drop(throttle);
+        // Known or not, the name costs one check of the same weight.
+        let ok = match self.operators.get(name) {
+            Some(stored) => verify(stored, password),
+            None => {
+                let decoy = self.decoy.get_or_init(|| {
+                    hash_password("", b"no operator of this name", self.decoy_iterations)
+                });
+                let _ = verify(decoy, password);
+                false
+            }
+        };
+        let mut throttle = self.throttle.lock().unwrap_or_else(|e| e.into_inner());
+        throttle.outcome(name, ok, now);
+        drop(throttle);
+        if !ok {
+            return Err(("unknown operator or wrong password".into(), None));
+        }
+        let token = hex(&random(32).map_err(|e| (e, None))?);
         let mut sessions = self.sessions.lock().unwrap_or_else(|e| e.into_inner());
         sessions.retain(|_, (_, until)| *until > now);
         while sessions.len() >= MAX_SESSIONS {
@@ -260,6 +388,14 @@ impl Gate {
     pub fn lifetime(&self) -> Duration {
         self.lifetime
     }
+
+    /// Password checks made so far.
+    pub fn checks(&self) -> u64 {
+        self.throttle
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .checks
+    }
 }
 
 /// The session token in a `Cookie` header.
@@ -295,6 +431,56 @@ mod tests {
         assert!(!verify("pbkdf2-sha256$0$00$00", ""));
         assert!(!verify("plain", "plain"));
         assert!(!verify(&h.replace("pbkdf2", "md5"), "s3cret"));
+    }
+
+    /// Issue 45 item 7: 200 guesses from many addresses and connections at once. The panel
+    /// checks at most its budget of passwords per second whoever asks, an operator's account
+    /// waits longer after every failure past five, a name without an operator costs a check
+    /// like one with, and the operator gets in once the guessing stops.
+    #[test]
+    fn password_guessing_is_paced_per_operator_and_for_the_panel() {
+        let bound: SocketAddr = "10.0.0.5:8080".parse().unwrap();
+        let ops = BTreeMap::from([("anna".to_string(), hash_password("pw", b"salt", 10))]);
+        let gate = Gate::new(bound, ops, vec![], Duration::from_secs(60));
+        let t0 = Instant::now();
+        // A burst: 200 guesses within one second.
+        let (mut checked, mut paced) = (0, 0);
+        for k in 0..200u32 {
+            let at = t0 + Duration::from_millis(u64::from(k) * 5);
+            match gate.login("anna", &format!("guess{k}"), at) {
+                Err((_, None)) => checked += 1,
+                Err((_, Some(_))) => paced += 1,
+                Ok(_) => panic!("a guess got in"),
+            }
+        }
+        assert!(checked <= 6, "{checked} passwords checked in a second");
+        assert_eq!(checked + paced, 200);
+        // A minute of one guess a second: the account's wait grows past the pace.
+        let mut later_checks = 0;
+        for s in 1..=60u64 {
+            if let Err((_, None)) = gate.login("anna", "guess", t0 + Duration::from_secs(s)) {
+                later_checks += 1;
+            }
+        }
+        assert!(later_checks <= 6, "{later_checks} checks in a minute");
+        let e = gate
+            .login("anna", "pw", t0 + Duration::from_secs(61))
+            .unwrap_err();
+        assert!(e.0.contains("try again in"), "{}", e.0);
+        // The operator gets in once the wait is over, and the count starts again.
+        let after = t0 + Duration::from_secs(61) + LONGEST_WAIT;
+        assert!(gate.login("anna", "pw", after).is_ok());
+        assert!(gate
+            .login("anna", "nope", after + Duration::from_secs(2))
+            .is_err());
+        assert!(gate
+            .login("anna", "pw", after + Duration::from_secs(4))
+            .is_ok());
+        // A wrong name costs one check, as a wrong password does.
+        let before = gate.checks();
+        let later = after + Duration::from_secs(10);
+        assert_eq!(gate.login("bob", "pw", later).unwrap_err().1, None);
+        assert_eq!(gate.checks(), before + 1);
     }
 
     #[test]

@@ -126,7 +126,7 @@ fn accept_loop(
     while !stop.load(Ordering::Relaxed) {
         match listener.accept() {
             Ok((mut stream, peer)) => {
-                let Some(slot) = Slot::take(&open, peer.ip()) else {
+                let Some((slot, reading)) = Slot::take(&open, peer.ip(), &stream) else {
                     let _ = stream.set_nonblocking(false);
                     let _ = stream.set_write_timeout(Some(Duration::from_millis(200)));
                     let _ = respond(
@@ -146,7 +146,7 @@ fn accept_loop(
                     .name(format!("web-hmi-{id}"))
                     .spawn(move || {
                         let _slot = slot;
-                        if let Err(e) = serve(stream, peer, id, &events, &stop, &gate) {
+                        if let Err(e) = serve(stream, peer, id, &events, &stop, &gate, &reading) {
                             log::debug!("web HMI connection {peer}: {e}");
                         }
                     });
@@ -165,40 +165,75 @@ fn accept_loop(
     }
 }
 
-/// Connections open, in all and per address.
+/// Connections open, each with its address, when it came and whether its request is still
+/// being read.
 #[derive(Default)]
 struct Open {
-    total: usize,
-    per_address: BTreeMap<IpAddr, usize>,
+    next: u64,
+    conns: BTreeMap<u64, Conn>,
+}
+
+struct Conn {
+    ip: IpAddr,
+    since: Instant,
+    /// Its request head has not come whole yet (a slow or idle client).
+    reading: Arc<AtomicBool>,
+    /// To close it from here when it is evicted.
+    stream: Option<TcpStream>,
 }
 
 /// One of the [`MAX_CONNECTIONS`] (and of its address's [`MAX_PER_ADDRESS`]), given back when
 /// the connection's thread ends (or was never started).
-struct Slot(Arc<Mutex<Open>>, IpAddr);
+struct Slot(Arc<Mutex<Open>>, u64);
 
 impl Slot {
-    fn take(open: &Arc<Mutex<Open>>, ip: IpAddr) -> Option<Slot> {
+    /// A slot for a connection from `ip`. When every slot is taken, the connection that has
+    /// been reading its request longest is closed to make room: slow sockets (a byte at a
+    /// time, from many addresses) cannot lock the operator out, while a connection that has
+    /// sent its request (a page's WebSocket) keeps its slot (issue 45 item 8).
+    fn take(
+        open: &Arc<Mutex<Open>>,
+        ip: IpAddr,
+        stream: &TcpStream,
+    ) -> Option<(Slot, Arc<AtomicBool>)> {
         let mut o = open.lock().unwrap_or_else(|e| e.into_inner());
-        let mine = o.per_address.get(&ip).copied().unwrap_or(0);
-        if o.total >= MAX_CONNECTIONS || mine >= MAX_PER_ADDRESS {
+        let mine = o.conns.values().filter(|c| c.ip == ip).count();
+        if mine >= MAX_PER_ADDRESS {
             return None;
         }
-        o.total += 1;
-        o.per_address.insert(ip, mine + 1);
-        Some(Slot(open.clone(), ip))
+        if o.conns.len() >= MAX_CONNECTIONS {
+            let slowest = o
+                .conns
+                .iter()
+                .filter(|(_, c)| c.reading.load(Ordering::Relaxed))
+                .min_by_key(|(_, c)| c.since)
+                .map(|(id, _)| *id)?;
+            if let Some(c) = o.conns.remove(&slowest) {
+                if let Some(s) = c.stream {
+                    let _ = s.shutdown(std::net::Shutdown::Both);
+                }
+            }
+        }
+        o.next += 1;
+        let id = o.next;
+        let reading = Arc::new(AtomicBool::new(true));
+        o.conns.insert(
+            id,
+            Conn {
+                ip,
+                since: Instant::now(),
+                reading: reading.clone(),
+                stream: stream.try_clone().ok(),
+            },
+        );
+        Some((Slot(open.clone(), id), reading))
     }
 }
 
 impl Drop for Slot {
     fn drop(&mut self) {
         let mut o = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        o.total = o.total.saturating_sub(1);
-        if let Some(n) = o.per_address.get_mut(&self.1) {
-            *n = n.saturating_sub(1);
-            if *n == 0 {
-                o.per_address.remove(&self.1);
-            }
-        }
+        o.conns.remove(&self.1);
     }
 }
 
@@ -294,6 +329,7 @@ fn serve(
     events: &Sender<WebEvent>,
     stop: &AtomicBool,
     gate: &Gate,
+    reading: &AtomicBool,
 ) -> Result<(), String> {
     stream.set_nonblocking(false).map_err(|e| e.to_string())?;
     stream
@@ -301,6 +337,7 @@ fn serve(
         .map_err(|e| e.to_string())?;
     let deadline = Instant::now() + HEAD_DEADLINE;
     let head = read_head(&mut stream, deadline)?;
+    reading.store(false, Ordering::Relaxed);
     let path = head.path.split('?').next().unwrap_or_default().to_string();
     let token = session_cookie(head.header("Cookie")).map(str::to_string);
     let operator = token
@@ -445,7 +482,7 @@ fn login(
         accepted: result.is_ok(),
         message: match &result {
             Ok(_) => "logged in".into(),
-            Err(why) => why.clone(),
+            Err((why, _)) => why.clone(),
         },
     });
     match result {
@@ -463,7 +500,14 @@ fn login(
                 body.as_bytes(),
             )
         }
-        Err(why) => {
+        // Refused before any check: at once, with the wait (the throttle keeps the pace).
+        Err((why, Some(_))) => respond(
+            stream,
+            "429 Too Many Requests",
+            "text/plain",
+            why.as_bytes(),
+        ),
+        Err((why, None)) => {
             std::thread::sleep(LOGIN_FAILURE_DELAY);
             respond(stream, "401 Unauthorized", "text/plain", why.as_bytes())
         }
@@ -566,6 +610,34 @@ mod tests {
         drop(idle);
         std::thread::sleep(Duration::from_millis(300));
         assert!(get(a, "GET / HTTP/1.1\r\n\r\n").starts_with("HTTP/1.1 200"));
+    }
+
+    /// Issue 45 item 8: 64 slow sockets from 8 addresses (each at its own cap) take every
+    /// slot; the operator's requests are still served, every one of 12, each by closing the
+    /// connection that has been reading longest.
+    #[test]
+    fn slow_sockets_from_many_addresses_do_not_lock_the_operator_out() {
+        use socket2::{Domain, Socket, Type};
+        let server = WebServer::start("127.0.0.1:0", open_gate).expect("listens");
+        let a = server.address;
+        let mut slow = Vec::new();
+        for host in 2..=9u8 {
+            for _ in 0..MAX_PER_ADDRESS {
+                let s = Socket::new(Domain::IPV4, Type::STREAM, None).expect("socket");
+                let from: SocketAddr = format!("127.0.0.{host}:0").parse().unwrap();
+                s.bind(&from.into()).expect("bind a loopback address");
+                s.connect(&a.into()).expect("connect");
+                let mut t: TcpStream = s.into();
+                let _ = t.write_all(b"GET / HT");
+                slow.push(t);
+            }
+        }
+        assert_eq!(slow.len(), MAX_CONNECTIONS);
+        std::thread::sleep(Duration::from_millis(300));
+        for k in 0..12 {
+            let answer = get(a, "GET / HTTP/1.1\r\nHost: x\r\n\r\n");
+            assert!(answer.starts_with("HTTP/1.1 200"), "try {k}: {answer:.40}");
+        }
     }
 
     #[test]

@@ -30,6 +30,7 @@ pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>
                     *h -= 1;
                 }
                 core.silent_blocks = 0;
+                core.silent_reread = false;
                 core.emitted += 1;
                 return Ok(Some(c));
             }
@@ -39,16 +40,37 @@ pub fn next_command<F: FrontEnd + ?Sized>(front: &mut F) -> Result<Option<Canon>
             return Ok(None);
         }
         core.silent_blocks += 1;
+        if core.silent_blocks > MAX_SILENT_BLOCKS && !core.silent_reread {
+            // Only new text read since the last command: long, but no loop.
+            core.silent_blocks = 1;
+        }
         let result = if core.silent_blocks > MAX_SILENT_BLOCKS {
             Err(core.fault(Fault::Macro, "program loops without producing any command"))
         } else {
             front.read_block()
         };
+        let core = front.core_mut();
         if let Err(e) = result {
-            let core = front.core_mut();
             core.error = Some(e.clone());
             core.pending.clear();
             return Err(e);
+        }
+        core.note_progress();
+    }
+}
+
+impl Core {
+    /// Notes whether the block just read was text read before (a loop can only be that).
+    fn note_progress(&mut self) {
+        let Some(level) = self.levels.last() else {
+            return;
+        };
+        let text = std::sync::Arc::as_ptr(&level.text) as *const u8 as usize;
+        let far = self.furthest.entry(text).or_insert(0);
+        if level.pos.offset > *far {
+            *far = level.pos.offset;
+        } else {
+            self.silent_reread = true;
         }
     }
 }

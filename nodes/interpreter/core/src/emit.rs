@@ -73,6 +73,8 @@ pub enum MoveKind {
 
 /// Largest feed per revolution, mm/rev.
 const MAX_FEED_PER_REV: f64 = 500.0;
+/// Smallest feed of either unit (mm/min, mm/rev): the least increment F takes.
+const MIN_FEED: f64 = 0.001;
 
 impl Core {
     /// Emits a move to work position `end` and makes it the current position (stage 1).
@@ -250,6 +252,14 @@ impl Core {
             return Err(self.fault(
                 Fault::FeedRange,
                 "no feed programmed for a cutting move (F missing or 0)",
+            ));
+        }
+        // Below the least increment the controls take (the 802D's F range starts there, the
+        // others' input increment is 0.001): a move that would not end (issue 45).
+        if feed < MIN_FEED {
+            return Err(self.fault(
+                Fault::FeedRange,
+                format!("feed F{} out of range (min {MIN_FEED})", show(feed)),
             ));
         }
         let limit = self.feed_limit();

@@ -175,6 +175,11 @@ pub struct Core {
     pub(crate) done: bool,
     pub(crate) error: Option<ProgramError>,
     pub(crate) silent_blocks: u32,
+    /// How far into each program text (by the text's address) reading has come, and whether
+    /// the silent blocks since the last command read any text again: only a stretch that did
+    /// is a loop (2,000,000 blank lines read once are none).
+    pub(crate) furthest: std::collections::HashMap<usize, usize>,
+    pub(crate) silent_reread: bool,
     /// A program end has been read.
     pub saw_end: bool,
     /// Commands handed out by [`crate::next_command`] so far.
@@ -260,6 +265,8 @@ impl Core {
             done: false,
             error: None,
             silent_blocks: 0,
+            furthest: std::collections::HashMap::new(),
+            silent_reread: false,
             saw_end: false,
             emitted: 0,
             operator_messages: Vec::new(),

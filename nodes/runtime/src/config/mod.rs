@@ -187,6 +187,26 @@ mod tests {
         }
     }
 
+    /// Issue 45 item 10: off loopback, who may move the machine is named, not assumed.
+    #[test]
+    fn dds_off_loopback_needs_the_allowed_clients_named() {
+        let text = include_str!("../../../../launch_configs/sim_lathe.yaml")
+            .replace("  allowed_clients: [\"*\"]\n", "");
+        let cfg = LaunchConfig::from_yaml(&text).expect("loopback: anyone");
+        assert_eq!(cfg.hmi.allowed_clients(), ["*"]);
+        let off = text.replace("interfaces: [127.0.0.1]", "interfaces: [10.0.0.5]");
+        let e = LaunchConfig::from_yaml(&off).unwrap_err();
+        assert!(
+            e.contains("hmi.allowed_clients") && e.contains("10.0.0.5"),
+            "{e}"
+        );
+        let deliberate = off.replace("hmi:\n", "hmi:\n  allowed_clients: [\"*\"]\n");
+        assert!(LaunchConfig::from_yaml(&deliberate).is_ok());
+        let named = off.replace("hmi:\n", "hmi:\n  allowed_clients: [/cell/supervisor]\n");
+        let cfg = LaunchConfig::from_yaml(&named).expect("named");
+        assert_eq!(cfg.hmi.allowed_clients(), ["/cell/supervisor"]);
+    }
+
     /// The simulated machine's mechanical stops (D118): on a machine axis, within its travel.
     #[test]
     fn fixed_stops_are_on_an_axis_within_its_travel() {

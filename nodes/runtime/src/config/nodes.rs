@@ -53,9 +53,11 @@ impl Default for RealtimeConfig {
 pub struct HmiConfig {
     /// ROS 2 node names (`/cell/supervisor`; `*` matches anything) whose commands that move
     /// the machine (program start, RunProgram goals) are accepted. Stop, feed hold and reset
-    /// are taken from anyone: stopping a machine is never refused. Default `["*"]`.
-    #[serde(default = "default_allowed")]
-    pub allowed_clients: Vec<String>,
+    /// are taken from anyone: stopping a machine is never refused. Absent: `["*"]` while DDS
+    /// stays on loopback; a config whose DDS leaves loopback must name them (`["*"]` too, but
+    /// deliberately), as the web panel must name its operators there (issue 45).
+    #[serde(default)]
+    pub allowed_clients: Option<Vec<String>>,
     /// Where the operator's web HMI is served (`host:port`); empty: no web HMI. Default
     /// `127.0.0.1:8080`: the machine's own panel PC, nothing off the machine.
     #[serde(default = "default_web_address")]
@@ -101,14 +103,19 @@ fn default_web_address() -> String {
     "127.0.0.1:8080".into()
 }
 
-fn default_allowed() -> Vec<String> {
-    vec!["*".into()]
+impl HmiConfig {
+    /// Who may move the machine: the config's list, else anyone (a loopback-only machine).
+    pub fn allowed_clients(&self) -> Vec<String> {
+        self.allowed_clients
+            .clone()
+            .unwrap_or_else(|| vec!["*".into()])
+    }
 }
 
 impl Default for HmiConfig {
     fn default() -> Self {
         HmiConfig {
-            allowed_clients: default_allowed(),
+            allowed_clients: None,
             web_address: default_web_address(),
             operators_file: default_operators_file(),
             session_seconds: default_session_seconds(),
@@ -684,6 +691,14 @@ impl NetworkConfig {
 /// Each node section's own rules, in the order the file lists them.
 pub(super) fn validate(cfg: &super::LaunchConfig) -> Result<(), String> {
     cfg.network.validate()?;
+    if cfg.hmi.allowed_clients.is_none() && cfg.network.interfaces.iter().any(|a| !a.is_loopback())
+    {
+        return Err(format!(
+            "hmi.allowed_clients: DDS leaves loopback (network.interfaces {:?}): name the \
+             clients that may move the machine, or [\"*\"] to let any participant do so",
+            cfg.network.interfaces
+        ));
+    }
     cfg.servo.validate()?;
     cfg.sim.validate()?;
     for (k, stop) in cfg.sim.fixed_stops.iter().enumerate() {
