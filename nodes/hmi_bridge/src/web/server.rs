@@ -126,7 +126,7 @@ fn accept_loop(
     while !stop.load(Ordering::Relaxed) {
         match listener.accept() {
             Ok((mut stream, peer)) => {
-                let Some((slot, reading)) = Slot::take(&open, peer.ip(), &stream) else {
+                let Some((slot, flags)) = Slot::take(&open, peer.ip()) else {
                     let _ = stream.set_nonblocking(false);
                     let _ = stream.set_write_timeout(Some(Duration::from_millis(200)));
                     let _ = respond(
@@ -146,7 +146,7 @@ fn accept_loop(
                     .name(format!("web-hmi-{id}"))
                     .spawn(move || {
                         let _slot = slot;
-                        if let Err(e) = serve(stream, peer, id, &events, &stop, &gate, &reading) {
+                        if let Err(e) = serve(stream, peer, id, &events, &stop, &gate, &flags) {
                             log::debug!("web HMI connection {peer}: {e}");
                         }
                     });
@@ -178,8 +178,18 @@ struct Conn {
     since: Instant,
     /// Its request head has not come whole yet (a slow or idle client).
     reading: Arc<AtomicBool>,
-    /// To close it from here when it is evicted.
-    stream: Option<TcpStream>,
+    /// Set when it is evicted: its thread stops reading within [`READ_SLICE`].
+    evicted: Arc<AtomicBool>,
+}
+
+/// How long a read waits before the connection's thread looks whether it was evicted.
+const READ_SLICE: Duration = Duration::from_millis(100);
+
+/// What a connection's thread is told by the slots: whether its request is still being read
+/// (set by the thread), and whether it was evicted (set by the slots).
+pub(crate) struct Flags {
+    reading: Arc<AtomicBool>,
+    evicted: Arc<AtomicBool>,
 }
 
 /// One of the [`MAX_CONNECTIONS`] (and of its address's [`MAX_PER_ADDRESS`]), given back when
@@ -191,11 +201,7 @@ impl Slot {
     /// been reading its request longest is closed to make room: slow sockets (a byte at a
     /// time, from many addresses) cannot lock the operator out, while a connection that has
     /// sent its request (a page's WebSocket) keeps its slot (issue 45 item 8).
-    fn take(
-        open: &Arc<Mutex<Open>>,
-        ip: IpAddr,
-        stream: &TcpStream,
-    ) -> Option<(Slot, Arc<AtomicBool>)> {
+    fn take(open: &Arc<Mutex<Open>>, ip: IpAddr) -> Option<(Slot, Flags)> {
         let mut o = open.lock().unwrap_or_else(|e| e.into_inner());
         let mine = o.conns.values().filter(|c| c.ip == ip).count();
         if mine >= MAX_PER_ADDRESS {
@@ -209,24 +215,25 @@ impl Slot {
                 .min_by_key(|(_, c)| c.since)
                 .map(|(id, _)| *id)?;
             if let Some(c) = o.conns.remove(&slowest) {
-                if let Some(s) = c.stream {
-                    let _ = s.shutdown(std::net::Shutdown::Both);
-                }
+                c.evicted.store(true, Ordering::Relaxed);
             }
         }
         o.next += 1;
         let id = o.next;
-        let reading = Arc::new(AtomicBool::new(true));
+        let flags = Flags {
+            reading: Arc::new(AtomicBool::new(true)),
+            evicted: Arc::new(AtomicBool::new(false)),
+        };
         o.conns.insert(
             id,
             Conn {
                 ip,
                 since: Instant::now(),
-                reading: reading.clone(),
-                stream: stream.try_clone().ok(),
+                reading: flags.reading.clone(),
+                evicted: flags.evicted.clone(),
             },
         );
-        Some((Slot(open.clone(), id), reading))
+        Some((Slot(open.clone(), id), flags))
     }
 }
 
@@ -253,11 +260,13 @@ impl Head {
     }
 }
 
-/// Reads until `done(buf)` or `limit` bytes, all within `deadline`.
+/// Reads until `done(buf)` or `limit` bytes, all within `deadline`, unless the connection is
+/// evicted meanwhile.
 fn read_until(
     stream: &mut TcpStream,
     deadline: Instant,
     limit: usize,
+    evicted: &AtomicBool,
     done: impl Fn(&[u8]) -> bool,
 ) -> Result<Vec<u8>, String> {
     let mut buf = Vec::with_capacity(1024);
@@ -266,24 +275,38 @@ fn read_until(
         if buf.len() >= limit {
             return Err("request too long".into());
         }
+        if evicted.load(Ordering::Relaxed) {
+            return Err("evicted: the slowest request when every slot was taken".into());
+        }
         let left = deadline.saturating_duration_since(Instant::now());
         if left.is_zero() {
             return Err("request not complete in time".into());
         }
         stream
-            .set_read_timeout(Some(left))
+            .set_read_timeout(Some(left.min(READ_SLICE)))
             .map_err(|e| e.to_string())?;
         match stream.read(&mut chunk) {
             Ok(0) => return Err("closed before the request was complete".into()),
             Ok(_) => buf.push(chunk[0]),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
             Err(e) => return Err(e.to_string()),
         }
     }
     Ok(buf)
 }
 
-fn read_head(stream: &mut TcpStream, deadline: Instant) -> Result<Head, String> {
-    let buf = read_until(stream, deadline, MAX_HEAD, |b| b.ends_with(b"\r\n\r\n"))?;
+fn read_head(
+    stream: &mut TcpStream,
+    deadline: Instant,
+    evicted: &AtomicBool,
+) -> Result<Head, String> {
+    let buf = read_until(stream, deadline, MAX_HEAD, evicted, |b| {
+        b.ends_with(b"\r\n\r\n")
+    })?;
     let text = std::str::from_utf8(&buf).map_err(|_| "request head is not UTF-8".to_string())?;
     let mut lines = text.split("\r\n");
     let mut first = lines.next().unwrap_or_default().split(' ');
@@ -329,22 +352,25 @@ fn serve(
     events: &Sender<WebEvent>,
     stop: &AtomicBool,
     gate: &Gate,
-    reading: &AtomicBool,
+    flags: &Flags,
 ) -> Result<(), String> {
     stream.set_nonblocking(false).map_err(|e| e.to_string())?;
     stream
         .set_write_timeout(Some(HEAD_DEADLINE))
         .map_err(|e| e.to_string())?;
     let deadline = Instant::now() + HEAD_DEADLINE;
-    let head = read_head(&mut stream, deadline)?;
-    reading.store(false, Ordering::Relaxed);
+    let head = read_head(&mut stream, deadline, &flags.evicted)?;
+    flags.reading.store(false, Ordering::Relaxed);
     let path = head.path.split('?').next().unwrap_or_default().to_string();
     let token = session_cookie(head.header("Cookie")).map(str::to_string);
     let operator = token
         .as_deref()
         .and_then(|t| gate.operator(t, Instant::now()));
     match (head.method.as_str(), path.as_str()) {
-        ("POST", "/login") => return login(&mut stream, &head, peer, deadline, events, gate),
+        ("POST", "/login") => {
+            let reader = (deadline, &*flags.evicted);
+            return login(&mut stream, &head, peer, reader, events, gate);
+        }
         ("POST", "/logout") => {
             if let Some(t) = &token {
                 gate.logout(t);
@@ -450,7 +476,7 @@ fn login(
     stream: &mut TcpStream,
     head: &Head,
     peer: SocketAddr,
-    deadline: Instant,
+    (deadline, evicted): (Instant, &AtomicBool),
     events: &Sender<WebEvent>,
     gate: &Gate,
 ) -> Result<(), String> {
@@ -469,7 +495,7 @@ fn login(
             b"Content-Length up to 4096\n",
         );
     };
-    let body = read_until(stream, deadline, length, |b| b.len() >= length)?;
+    let body = read_until(stream, deadline, length, evicted, |b| b.len() >= length)?;
     let value: serde_json::Value = serde_json::from_slice(&body).unwrap_or_default();
     let field = |k: &str| value.get(k).and_then(|v| v.as_str()).unwrap_or_default();
     let (name, password) = (field("name"), field("password"));
