@@ -201,7 +201,7 @@ fn thread_milling_alarms() {
 #[test]
 fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
     // POCKET4(3, 0, 0, -20, 25, 50, 60, 6, 0, 0, 200, 100, 1, 21, 0, 0, 0, 2, 3): R25 at
-    // X50 Y60 to Z−20, MID 6, no allowances, conventional milling under M3 (against it: G3), helical
+    // X50 Y60 to Z−20, MID 6, no allowances, conventional milling under M3 (inside a pocket: G2), helical
     // insertion R2 at 3 mm a turn, with a 20 mm cutter (T1 D1) of length 0.
     let r = go(&fixture("115")).ok();
     let mut stock = Stock::new((50.0, 60.0), 40.0, 0.0, 10.0, circle((50.0, 60.0), 25.0));
@@ -214,7 +214,8 @@ fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
     assert_within(min, -20.0, "nothing deeper");
     // Cutting levels at most MID apart from RFP down.
     stock.assert_infeeds_within(0.0, 6.0);
-    // Conventional under M3: against the spindle, counter-clockwise rings.
+    // Conventional under M3 inside a pocket: clockwise rings (D87; the engagement itself is
+    // `sinumerik_milling_direction.rs`'s).
     assert!(r
         .out
         .iter()
@@ -222,7 +223,7 @@ fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
         .all(|c| matches!(
             c,
             Command::Arc {
-                clockwise: false,
+                clockwise: true,
                 ..
             }
         )));
@@ -232,7 +233,7 @@ fn f115_pocket4_helical_roughing_clears_the_pocket_to_its_floor_and_wall() {
 #[test]
 fn pocket4_roughing_leaves_the_allowances_and_finishing_takes_them() {
     let head = "G17 G90 T1 D1 S800 M3\nG0 X0 Y0 Z10\n";
-    // R30 to Z−12 from RFP 0, MID 5, FAL 1, FALD 0.5, climb (with the spindle: G2 under M3).
+    // R30 to Z−12 from RFP 0, MID 5, FAL 1, FALD 0.5, climb (inside a pocket under M3: G3).
     let rough = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 11, 12)\n";
     let finish = "POCKET4(10, 0, 1, -12, 30, 0, 0, 5, 1, 0.5, 300, 100, 0, 12, 12)\n";
     let r = go(&format!("{head}{rough}")).ok();
@@ -251,7 +252,7 @@ fn pocket4_roughing_leaves_the_allowances_and_finishing_takes_them() {
         .all(|c| matches!(
             c,
             Command::Arc {
-                clockwise: true,
+                clockwise: false,
                 ..
             }
         )));
@@ -308,7 +309,7 @@ fn cutter5() -> cnc_interpreter::Setup {
 fn f114_pocket3_roughing_leaves_the_allowances_on_a_60_by_40_pocket() {
     // POCKET3(5, 0, 0.5, −17.5, 60, 40, 8, 60, 40, 0, 4, 0.75, 0.2, 1000, 750, 0, 11, 5):
     // 60 × 40 about X60 Y40, corners R8, to Z−17.5; MID 4, FAL 0.75, FALD 0.2, climb under
-    // M4 (with the spindle: G3), vertical insertion at F750, MIDA 5; a 10 mm cutter.
+    // M4 (inside a pocket: G2), vertical insertion at F750, MIDA 5; a 10 mm cutter.
     let r = run_with(&fixture("114"), cutter5(), Library::new()).ok();
     let wall = rounded_rect((60.0, 40.0), 29.25, 19.25, 7.25, 0.0);
     let mut stock = Stock::new((60.0, 40.0), 40.0, 0.0, 5.0, wall);
@@ -327,7 +328,7 @@ fn f114_pocket3_roughing_leaves_the_allowances_on_a_60_by_40_pocket() {
         .all(|c| matches!(
             c,
             Command::Arc {
-                clockwise: false,
+                clockwise: true,
                 ..
             }
         )));
@@ -362,7 +363,7 @@ fn pocket3_turned_helical_then_finished_on_size() {
 fn f109_cycle76_clears_the_blank_round_a_turned_spigot() {
     // CYCLE76(10, 0, 2, −17.5, , 60, 40, 15, 80, 60, 10, 11, , , 900, 800, 0, 1, 80, 50):
     // 60 × 40, corners R15, about X80 Y60 turned 10°, to Z−17.5 in levels within 11, from a
-    // blank 80 × 50, climb under M3 (G3); T20 D1 a 12 mm cutter.
+    // blank 80 × 50, climb under M3 (round a spigot: G2); T20 D1 a 12 mm cutter.
     let r = run_with(&fixture("109"), with_edge(201, 6.0), Library::new()).ok();
     let spigot = rounded_rect((80.0, 60.0), 30.0, 20.0, 15.0, 10.0);
     let blank = rounded_rect((80.0, 60.0), 40.0, 25.0, 0.0, 10.0);
@@ -384,7 +385,7 @@ fn f109_cycle76_clears_the_blank_round_a_turned_spigot() {
         .any(|c| matches!(
             c,
             Command::Arc {
-                clockwise: false,
+                clockwise: true,
                 ..
             }
         )));
@@ -416,12 +417,12 @@ fn f110_cycle77_roughs_with_an_allowance_then_finishes_to_50() {
     let (lo, hi) = stock.floor_where(ring);
     assert_within(lo, -20.0, "floor");
     assert_within(hi, -20.0, "floor all round");
-    // Conventional under M3 round a spigot: G2.
+    // Conventional under M3 round a spigot: G3.
     assert!(r
         .out
         .iter()
         .filter(|c| matches!(c, Command::Arc { center, .. } if (center[0] - 60.0).abs() < 1e-9 && (center[1] - 70.0).abs() < 1e-9))
-        .all(|c| matches!(c, Command::Arc { clockwise: true, .. })));
+        .all(|c| matches!(c, Command::Arc { clockwise: false, .. })));
     let r = run_with(&text, s, Library::new()).ok();
     let mut stock = Stock::new((60.0, 70.0), 45.0, 0.0, 8.0, circle((60.0, 70.0), -1.0));
     stock.wall = Box::new(|p| 25.0 - (p.0 - 60.0).hypot(p.1 - 70.0));

@@ -175,10 +175,11 @@ impl Sinumerik {
         let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
             (2, _) => false,
             (3, _) => true,
-            // Climb milling inside a pocket goes the way the spindle turns (§10.6.9): M3 G2,
-            // M4 G3; conventional the other way.
-            (0, SpindleDir::Cw | SpindleDir::Stopped) | (1, SpindleDir::Ccw) => false,
-            (0, SpindleDir::Ccw) | (1, _) => true,
+            // Climb: the tooth leaves the wall it finishes, the chip thick to thin (D87, issue
+            // 46). Inside a pocket that is counter-clockwise under M3 (the wall on the right
+            // of the travel), clockwise under M4; conventional the other way.
+            (0, SpindleDir::Cw | SpindleDir::Stopped) | (1, SpindleDir::Ccw) => true,
+            (0, SpindleDir::Ccw) | (1, _) => false,
             _ => {
                 return Err(wrong(
                     61109,
@@ -205,12 +206,14 @@ impl Sinumerik {
             2 => false,
             _ => return Err(wrong("VARI is 1 roughing or 2 finishing")),
         };
-        // Climb round a spigot under M3 is G3 (§10.6.4: M3→G3), conventional G2.
+        // Climb round a spigot is clockwise under M3 (the spigot on the right of the travel),
+        // counter-clockwise under M4; conventional the other way (D87, issue 46: §10.6.4's
+        // table "M3→G3" is the pocket's, against the definition it gives).
         let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
             (2, _) => false,
             (3, _) => true,
-            (0, SpindleDir::Cw | SpindleDir::Stopped) | (1, SpindleDir::Ccw) => true,
-            (0, SpindleDir::Ccw) | (1, _) => false,
+            (0, SpindleDir::Cw | SpindleDir::Stopped) | (1, SpindleDir::Ccw) => false,
+            (0, SpindleDir::Ccw) | (1, _) => true,
             _ => return Err(wrong("CDIR is 0 climb, 1 conventional, 2 G2 or 3 G3")),
         };
         let (rtp, rfp) = (c.or("RTP", 0.0), c.or("RFP", 0.0));
