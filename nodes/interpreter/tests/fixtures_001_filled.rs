@@ -807,6 +807,41 @@ fn f052_chamfers_by_length_and_by_legs_with_their_feed() {
     assert!(near(&r.end(), &[40.0, -40.0, 0.0]));
 }
 
+/// Issue 46 item 2 (D126): without FRC/FRCM an inserted chamfer or rounding is cut at the feed
+/// of the block leaving the corner (§9.5.1: "normally the F of the following block"), whether
+/// that block is a line or an arc; FRC still wins.
+#[test]
+fn a_corner_element_takes_the_feed_of_the_block_leaving_the_corner() {
+    let r = run("G17 G94 G90 G1 X0 Y0 F300\nX40 CHF=5\nY40 F150\nX0 RND=4 F200\n        G2 X-10 Y30 I-10 J0 F120\nG1 X-10 Y0 RND=3\nX-30 F90 FRC=60\nM30\n")
+        .ok();
+    let p = pieces(&r);
+    let feed_to = |at: (f64, f64)| {
+        p.iter()
+            .find(|q| dist(q.0, at) < 1e-6)
+            .unwrap_or_else(|| panic!("no piece ends at {at:?}: {p:?}"))
+            .3
+    };
+    let leg = 5.0 / 2f64.sqrt();
+    // The line into the corner keeps its own F300; the chamfer and the line after it F150.
+    assert_eq!(feed_to((40.0 - leg, 0.0)), 300.0);
+    assert_eq!(feed_to((40.0, leg)), 150.0, "the chamfer at the leaving block's F");
+    assert_eq!(feed_to((40.0, 40.0)), 150.0);
+    // A rounding into an arc (about (−10, 40), leaving (0, 40) downwards): the arc's F120.
+    let rounding = p
+        .iter()
+        .position(|q| q.1.is_some_and(|c| dist(c, (3.4, 36.0)) < 0.1))
+        .unwrap_or_else(|| panic!("the rounding at (0, 40): {p:?}"));
+    assert_eq!(p[rounding - 1].3, 200.0, "the line into it keeps F200");
+    assert_eq!(p[rounding].3, 120.0, "the rounding at the arc's F");
+    // The last rounding takes the leaving block's F90: FRC=60 there is that block's own
+    // corner feed (it has none), not this one's.
+    let last = p
+        .iter()
+        .rposition(|q| q.1.is_some())
+        .expect("the last rounding");
+    assert_eq!(p[last].3, 90.0);
+}
+
 #[test]
 fn f053_roundings_single_and_modal_between_lines_and_arcs() {
     let text = filled(

@@ -365,6 +365,28 @@ fn a_long_stretch_of_blank_lines_is_no_endless_loop() {
     assert_eq!(e.number, 20, "{e}");
 }
 
+/// D126: the Huaxing manual (§5.11) gives no feed for the chamfer or rounding it inserts, and
+/// the FANUC family's do not either; they are cut at the feed of the block that carries the
+/// L or D word (the block entering the corner), as FANUC controls cut ,C and ,R, unlike the
+/// 802D (the block leaving it).
+#[test]
+fn a_huaxing_chamfer_takes_the_feed_of_the_block_that_commands_it() {
+    let cmds = cnc_interpreter::check(
+        Dialect::HuaxingLathe,
+        "G98 G01 Z-10 L2 F100\nX40 F200\nM30\n",
+        Setup::lathe([20.0, 5.0]),
+    )
+    .unwrap();
+    let feeds: Vec<f64> = cmds
+        .iter()
+        .filter_map(|c| match c.command {
+            cnc_interpreter::Command::Linear { feed, .. } => Some(feed),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(feeds, [100.0, 100.0, 200.0], "the line, the chamfer, the next line");
+}
+
 /// Chamfer L and corner rounding D in G01 (`000` §5.11, decision D31).
 #[test]
 fn chamfer_and_corner_rounding_in_g01() {
