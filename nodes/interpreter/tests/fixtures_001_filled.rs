@@ -824,7 +824,11 @@ fn a_corner_element_takes_the_feed_of_the_block_leaving_the_corner() {
     let leg = 5.0 / 2f64.sqrt();
     // The line into the corner keeps its own F300; the chamfer and the line after it F150.
     assert_eq!(feed_to((40.0 - leg, 0.0)), 300.0);
-    assert_eq!(feed_to((40.0, leg)), 150.0, "the chamfer at the leaving block's F");
+    assert_eq!(
+        feed_to((40.0, leg)),
+        150.0,
+        "the chamfer at the leaving block's F"
+    );
     assert_eq!(feed_to((40.0, 40.0)), 150.0);
     // A rounding into an arc (about (−10, 40), leaving (0, 40) downwards): the arc's F120.
     let rounding = p

@@ -384,7 +384,11 @@ fn a_huaxing_chamfer_takes_the_feed_of_the_block_that_commands_it() {
             _ => None,
         })
         .collect();
-    assert_eq!(feeds, [100.0, 100.0, 200.0], "the line, the chamfer, the next line");
+    assert_eq!(
+        feeds,
+        [100.0, 100.0, 200.0],
+        "the line, the chamfer, the next line"
+    );
 }
 
 /// Chamfer L and corner rounding D in G01 (`000` §5.11, decision D31).

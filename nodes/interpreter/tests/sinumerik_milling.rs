@@ -768,3 +768,101 @@ fn variants_slot1_finishing_alone_cycle71_along_the_2nd_axis_cycle72_finishing_a
         61115
     );
 }
+
+/// Issue 46 item 3: where each milling cycle leaves the tool, where its section says. CYCLE72
+/// (§10.6.3): after roughing above the departure point at RTP, after finishing at the
+/// contour's start point at RTP. CYCLE71 (§10.6.2), LONGHOLE (§10.6.6), SLOT1 (§10.6.7),
+/// SLOT2 (§10.6.8), CYCLE76/77 (§10.6.4–5) and CYCLE90 external (§10.6.11): at G0 from the
+/// last position in the plane back to RTP. CYCLE90 internal: to the thread's centre, then to
+/// RTP.
+#[test]
+fn each_milling_cycle_ends_where_its_section_says() {
+    let cutter = || with_edge(11, 5.0);
+    let head = "G17 G90 T1 D1 S1000 M3\nG0 X0 Y0 Z20\n";
+    // The last cutting move's end in the plane, and where the run ends.
+    let ends = |r: &Run| {
+        let last_cut = r
+            .out
+            .iter()
+            .rev()
+            .find(|c| matches!(c, Command::Linear { .. } | Command::Arc { .. }))
+            .and_then(|c| c.end())
+            .expect("a cut")
+            .to_vec();
+        (last_cut, r.end())
+    };
+    let above_the_last_cut = |what: &str, r: &Run, rtp: f64| {
+        let (cut, end) = ends(r);
+        assert!(
+            near(&end, &[cut[0], cut[1], rtp]),
+            "{what}: ends at {end:?}, its last cut at {cut:?}"
+        );
+    };
+    for (what, call) in [
+        (
+            "CYCLE71",
+            "CYCLE71(10, 0, 2, -2, 0, 0, 60, 40, 0, 2, 8, 5, 0, 300, 31, 5)",
+        ),
+        (
+            "LONGHOLE",
+            "LONGHOLE(10, 0, 2, -6, , 2, 30, 40, 45, 20, 45, 90, 100, 320, 6)",
+        ),
+        (
+            "SLOT1",
+            "SLOT1(10, 0, 2, -6, , 2, 30, 15, 40, 45, 20, 45, 90, 100, 320, 6, 2, 0.5, 0, , 0, )",
+        ),
+        (
+            "SLOT2",
+            "SLOT2(10, 0, 2, -6, , 2, 70, 15, 60, 60, 42, 0, 120, 100, 300, 6, 2, 0.5, 0, , 0, )",
+        ),
+        (
+            "CYCLE77",
+            "CYCLE77(10, 0, 2, -6, , 40, 50, 40, 6, 0, 0, 300, 100, 0, 1, 56)",
+        ),
+        (
+            "CYCLE76",
+            "CYCLE76(10, 0, 2, -6, , 40, 30, 6, 50, 40, 20, 6, 0, 0, 300, 100, 0, 1, 60, 50)",
+        ),
+        (
+            "CYCLE90 external",
+            "CYCLE90(10, 0, 2, -10, , 20, 17.3, 2.5, 200, 2, 1, 50, 40)",
+        ),
+    ] {
+        let r = run_with(&format!("{head}{call}\nM30\n"), cutter(), Library::new()).ok();
+        above_the_last_cut(what, &r, 10.0);
+    }
+    let r = run_with(
+        &format!("{head}CYCLE90(10, 0, 2, -10, , 20, 17.3, 2.5, 200, 2, 0, 50, 40)\nM30\n"),
+        cutter(),
+        Library::new(),
+    )
+    .ok();
+    assert!(
+        near(&r.end(), &[50.0, 40.0, 10.0]),
+        "CYCLE90 internal: {:?}",
+        r.end()
+    );
+    // CYCLE72 round a 40 × 30 block from X30 Y40.
+    let contour = || {
+        let mut lib = Library::new();
+        lib.insert_named(
+            "BLOCK",
+            "BLOCK.SPF",
+            "G1 X30 Y40\nY55\nX70\nY25\nX30\nY40\nM2\n",
+        );
+        lib
+    };
+    let cycle72 = |vari: u32| {
+        format!(
+            "{head}CYCLE72(\"BLOCK\", 10, 0, 2, -6, 6, 0, 0, 300, 100, {vari}, 41, 2, 12, 300, 2, 12)\nM30\n"
+        )
+    };
+    let r = run_with(&cycle72(1), cutter(), contour()).ok();
+    above_the_last_cut("CYCLE72 roughing", &r, 10.0);
+    let r = run_with(&cycle72(2), cutter(), contour()).ok();
+    assert!(
+        near(&r.end(), &[30.0, 40.0, 10.0]),
+        "CYCLE72 finishing: at the contour's start at RTP, not {:?}",
+        r.end()
+    );
+}

@@ -392,7 +392,13 @@ impl Sinumerik {
             self,
             at(self, Pt::new(end[h], end[v]), rtp),
             MoveKind::Rapid,
-        )
+        )?;
+        // §10.6.3: after roughing the tool stands above the departure point at RTP; after
+        // finishing, at the contour's start point at RTP (issue 46).
+        if units == 2 {
+            go(self, at(self, p0, rtp), MoveKind::Rapid)?;
+        }
+        Ok(())
     }
 }
 
