@@ -195,6 +195,10 @@ struct ProgramArgs {
     /// `machine.tool_table`: H<n> is the length, D<n> the radius of entry n.
     #[arg(long)]
     tools: Option<PathBuf>,
+    /// The tool in the spindle when the program starts, as the machine would hold it
+    /// (default: the config's `machine.tool_in_spindle`, else none).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=32000))]
+    tool_in_spindle: Option<u32>,
 }
 
 /// The dialects `--dialect` takes, with `sinumerik` for the 802D.
@@ -222,7 +226,10 @@ struct LoadedProgram {
 impl ProgramArgs {
     fn load(&self) -> Result<LoadedProgram, String> {
         use cnc_interpreter::Dialect;
-        let (cfg, _) = machines::load(self.config.as_deref(), self.tools.as_deref())?;
+        let (mut cfg, _) = machines::load(self.config.as_deref(), self.tools.as_deref())?;
+        if let Some(t) = self.tool_in_spindle {
+            cfg.machine.tool_in_spindle = t;
+        }
         let text = read_program(&self.program)?;
         let name = self.dialect.as_deref().unwrap_or(&cfg.machine.dialect);
         let dialect = Dialect::from_name(name).ok_or_else(|| {

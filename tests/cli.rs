@@ -315,3 +315,37 @@ fn the_802d_manuals_cycle_examples_run_as_printed_on_the_built_in_mill() {
         }
     }
 }
+
+/// Issue 46 item 4: `cnc check` starts with the tool the machine holds: given by
+/// `--tool-in-spindle` (or the config's `machine.tool_in_spindle`); without one, a program
+/// that selects an edge of the tool in the spindle is refused with 17190.
+#[test]
+fn check_starts_with_the_tool_in_the_spindle() {
+    let dir = std::env::temp_dir().join(format!("cnc_cli_spindle_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let config = std::fs::read_to_string(format!("{root}/launch_configs/sim_mill_802d.yaml"))
+        .unwrap()
+        .replace("tool_change_with_m6: false", "tool_change_with_m6: true");
+    let config_path = dir.join("m6.yaml");
+    std::fs::write(&config_path, config).unwrap();
+    let program = dir.join("EDGE.MPF");
+    std::fs::write(&program, "D1\nG0 X0 Y0 Z10\nM30\n").unwrap();
+    let args = |extra: &[&str]| {
+        let mut a = vec![
+            "check",
+            program.to_str().unwrap(),
+            "--config",
+            config_path.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        cnc(&a)
+    };
+    let (ok, text) = args(&[]);
+    assert!(!ok && text.contains("17190"), "{text}");
+    let (ok, text) = args(&["--tool-in-spindle", "1"]);
+    assert!(ok, "{text}");
+    let (ok, text) = args(&["--tool-in-spindle", "40000"]);
+    assert!(!ok, "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

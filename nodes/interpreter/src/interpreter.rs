@@ -91,6 +91,7 @@ impl Interpreter {
                 .collect(),
             tools: core.setup.offsets.tools.clone(),
             work: core.setup.offsets.work.clone(),
+            spindle_tool: core.setup.active_tool,
         }
     }
 

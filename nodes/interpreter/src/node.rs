@@ -46,6 +46,7 @@ pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
     setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
     setup.tool_change_macro = cfg.machine.tool_change_macro;
     setup.tool_change_with_m6 = cfg.machine.tool_change_with_m6;
+    setup.active_tool = cfg.machine.tool_in_spindle;
     setup.contour_tolerance = cfg.machine.contour_tolerance;
     setup.calculator_decimal_point = cfg
         .machine
@@ -86,6 +87,7 @@ pub fn load_memory(cfg: &LaunchConfig) -> (Memory, Option<String>) {
         kept: BTreeMap::new(),
         tools: offsets.tools,
         work: offsets.work,
+        spindle_tool: cfg.machine.tool_in_spindle,
     };
     let Some(path) = &cfg.machine.memory_file else {
         return (base, None);

@@ -587,6 +587,7 @@ impl RunCore {
         setup.kept = kept.clone();
         setup.offsets.tools = self.memory.tools.clone();
         setup.offsets.work = self.memory.work.clone();
+        setup.active_tool = self.memory.spindle_tool;
         // The cell runs programs as the operator would: M99 or G27 loops go on until stop.
         setup.single_pass = false;
         let mut interp = Interpreter::with_library(self.dialect, &text, setup, self.library());

@@ -941,3 +941,44 @@ fn an_interrupted_subprogram_restarts_at_its_block_and_an_edit_of_it_is_refused(
         r.message
     );
 }
+
+/// Issue 46 item 4: the tool in the spindle is kept with the machine's memory: a run that
+/// changes the tool leaves it there, and the next run starts with it.
+#[test]
+fn the_tool_in_the_spindle_is_kept_from_run_to_run() {
+    let mut base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0, 0.0, 100.0]);
+    base.tool_change_with_m6 = true;
+    for (entry, z) in [(11, 50.0), (31, 10.0), (32, 12.0)] {
+        base.offsets.tools.insert(
+            entry,
+            ToolOffset {
+                z,
+                ..ToolOffset::default()
+            },
+        );
+    }
+    let memory = Memory {
+        tools: base.offsets.tools.clone(),
+        spindle_tool: 1,
+        ..Memory::default()
+    };
+    let mut c = RunCore::new(Dialect::Sinumerik802d, base, memory, 1000);
+    for (id, name, text) in [
+        (1, "CHANGE.MPF", "T3\nM6\nG0 Z0\nM30\n"),
+        (2, "EDGE.MPF", "D2\nG0 Z0\nM30\n"),
+    ] {
+        assert!(command(&mut c, id, ProgramCommand::LOAD, name, text).accepted);
+    }
+    c.plc_scanned();
+    c.axes(&[0.0, 0.0, 100.0]);
+    assert!(command(&mut c, 3, ProgramCommand::START, "CHANGE.MPF", "").accepted);
+    let first = run_to_end(&mut c, 1001);
+    let last_z = |blocks: &[(u8, Vec<f64>, u32)]| {
+        blocks.iter().rev().find(|b| b.1.len() == 3).map(|b| b.1[2])
+    };
+    assert_eq!(last_z(&first), Some(10.0), "T3 D1 {first:?}");
+    assert_eq!(c.memory().spindle_tool, 3);
+    assert!(command(&mut c, 4, ProgramCommand::START, "EDGE.MPF", "").accepted);
+    let second = run_to_end(&mut c, 1002);
+    assert_eq!(last_z(&second), Some(12.0), "T3 D2 {second:?}");
+}

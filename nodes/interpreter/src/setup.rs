@@ -20,6 +20,10 @@ pub struct Memory {
     pub tools: BTreeMap<u32, ToolOffset>,
     /// Work offsets G54–G59 (0–5) per axis letter.
     pub work: BTreeMap<u8, BTreeMap<char, f64>>,
+    /// The tool in the spindle, 0 none: a machine that changes tools with M6 starts every
+    /// program with the tool it holds (`001` §9.6.2: "the tool stays active after the program's
+    /// end and after power-off"; issue 46).
+    pub spindle_tool: u32,
 }
 
 impl Memory {
@@ -47,6 +51,9 @@ impl Memory {
                 && t.tip <= 9
         });
         self.work.retain(|n, _| *n <= 5);
+        if self.spindle_tool > 32_000 {
+            self.spindle_tool = 0;
+        }
         for row in self.work.values_mut() {
             row.retain(|c, v| "XYZABC".contains(*c) && v.is_finite());
         }

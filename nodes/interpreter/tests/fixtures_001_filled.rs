@@ -433,6 +433,130 @@ fn f057_with_m6_the_new_tool_and_its_edge_take_effect_at_m6() {
     assert_eq!(r.front.tool_edge(), (4, 3));
 }
 
+/// Issue 46 item 4 (D127): on a machine that changes tools with M6, the tool it holds is the
+/// start state, and the edge a preselecting block names is the new tool's, active at M6
+/// unless the M6 block names another; without either the new tool comes with D1. A D in any
+/// other block is the active tool's edge.
+#[test]
+fn the_edge_named_with_the_preselected_tool_takes_effect_at_m6() {
+    let mut s = with_edges(
+        mill(),
+        &[
+            (12, 45.0, 0.0),
+            (31, 10.0, 0.0),
+            (32, 12.0, 0.0),
+            (33, 14.0, 0.0),
+        ],
+    );
+    s.tool_change_with_m6 = true;
+    let z = |text: &str, holding: u32| {
+        let mut s = s.clone();
+        s.active_tool = holding;
+        let r = run_with(text, s, Library::new()).ok();
+        (r.end()[2], r.front.tool_edge())
+    };
+    // The spindle empty: `T3 D2` then M6 runs (it stopped with 17190) and cuts with T3 D2.
+    assert_eq!(
+        z(
+            "T3 D2
+M6
+G0 Z0
+",
+            0
+        ),
+        (12.0, (3, 2))
+    );
+    // The spindle holding T1: the same, T1's length not touched by the D meanwhile.
+    assert_eq!(
+        z(
+            "T3 D2
+G0 Z0
+",
+            1
+        ),
+        (50.0, (1, 1)),
+        "before M6 T1 D1"
+    );
+    assert_eq!(
+        z(
+            "T3 D2
+M6
+G0 Z0
+",
+            1
+        ),
+        (12.0, (3, 2))
+    );
+    // The M6 block's D wins; without any, D1.
+    assert_eq!(
+        z(
+            "T3 D2
+D3 M6
+G0 Z0
+",
+            1
+        ),
+        (14.0, (3, 3))
+    );
+    assert_eq!(
+        z(
+            "T3
+M6
+G0 Z0
+",
+            1
+        ),
+        (10.0, (3, 1))
+    );
+    // A D between the preselection and M6 is the active tool's edge.
+    assert_eq!(
+        z(
+            "T3
+D2
+G0 Z0
+",
+            1
+        ),
+        (45.0, (1, 2))
+    );
+    assert_eq!(
+        z(
+            "T3
+D2
+M6
+G0 Z0
+",
+            1
+        ),
+        (10.0, (3, 1))
+    );
+    // The tool the machine holds is the start state: D2 of T1 at once.
+    assert_eq!(
+        z(
+            "D2
+G0 Z0
+",
+            1
+        ),
+        (45.0, (1, 2))
+    );
+    // And the run leaves the tool it changed to in the machine's memory.
+    let mut s1 = s.clone();
+    s1.active_tool = 1;
+    let mut interp = cnc_interpreter::Interpreter::with_library(
+        cnc_interpreter::Dialect::Sinumerik802d,
+        "T3
+M6
+G0 Z0
+M30
+",
+        s1,
+        Library::new(),
+    );
+    while let Ok(Some(_)) = interp.next_command() {}
+    assert_eq!(interp.memory().spindle_tool, 3);
+}
+
 /// 035 (§9.3.15): G42 with a cutter of radius 5 right of a clockwise arc (the cutter inside,
 /// radius 15) and a counter-clockwise one (outside, radius 25), then after N70 CFTCP another
 /// clockwise arc (appended). CFC is also the program-start setting (D98).

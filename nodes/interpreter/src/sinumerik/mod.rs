@@ -90,6 +90,8 @@ pub struct Sinumerik {
     edge: u32,
     /// A T word waiting for M6 (when the machine changes tools with M6).
     preselected: Option<u32>,
+    /// The edge a preselecting block named for the tool to come (D127).
+    preselected_edge: Option<u32>,
     /// The cutting edges used since the last SETPIECE (§9.13.3).
     setpiece_memory: Vec<(u32, u32)>,
     /// G41/G42 asked for; started with the next move.
@@ -239,6 +241,7 @@ impl Sinumerik {
             tool,
             edge: u32::from(tool > 0),
             preselected: None,
+            preselected_edge: None,
             setpiece_memory: Vec::new(),
             comp_side: None,
             comp_again: false,

@@ -12,8 +12,19 @@ use super::exec::Words;
 use super::{plane_of, Motion, Sinumerik};
 
 impl Sinumerik {
-    /// T, D, M6 and the G40/G41/G42 choice of the block.
+    /// T, D, M6 and the G40/G41/G42 choice of the block. With M6 changing tools (D127): a D
+    /// in the block that preselects the tool is that tool's edge and waits for M6 with it; a D
+    /// in the M6 block wins over it; with neither the new tool comes with D1 (§9.6.3's
+    /// "N55 D3 M6 ; T4 and its D3"); a D in any other block is the active tool's edge.
     pub(super) fn tool_words(&mut self, w: &Words) -> Result<(), ProgramError> {
+        let d = match w.get("D") {
+            Some(d) if d.fract() != 0.0 || !(0.0..=9.0).contains(&d) => {
+                return Err(self.fault(Fault::ToolNumber, "D is 0…9: a cutting edge of the tool"))
+            }
+            d => d.map(|d| d as u32),
+        };
+        let m6 = w.m.contains(&6);
+        let mut d_for_active = d;
         if let Some(t) = w.get("T") {
             if t.fract() != 0.0 || !(0.0..=32_000.0).contains(&t) {
                 return Err(self.fault(Fault::ToolNumber, "T is 0…32000"));
@@ -22,24 +33,30 @@ impl Sinumerik {
             self.core.aux(Aux::T(t as i32));
             if self.core.setup.tool_change_with_m6 {
                 self.preselected = Some(t);
+                self.preselected_edge = None;
+                if !m6 {
+                    // The edge of the tool to come, not of the one in the spindle.
+                    self.preselected_edge = d_for_active.take();
+                }
             } else {
                 self.change_tool(t)?;
             }
         }
-        if w.m.contains(&6) {
+        if m6 {
             self.core.aux(Aux::M(6));
             if let Some(t) = self.preselected.take() {
                 self.change_tool(t)?;
+                let held = self.preselected_edge.take();
+                if d_for_active.is_none() {
+                    d_for_active = held;
+                }
             }
         }
-        if let Some(d) = w.get("D") {
-            if d.fract() != 0.0 || !(0.0..=9.0).contains(&d) {
-                return Err(self.fault(Fault::ToolNumber, "D is 0…9: a cutting edge of the tool"));
-            }
-            if d > 0.0 && self.tool == 0 {
+        if let Some(d) = d_for_active {
+            if d > 0 && self.tool == 0 {
                 return Err(self.fault(Fault::ToolNumber, "D without an active tool: T first"));
             }
-            self.edge = d as u32;
+            self.edge = d;
             self.edge_loaded();
             self.apply_length();
             self.change_compensation_radius()?;
@@ -70,6 +87,8 @@ impl Sinumerik {
         }
         self.check_not_disabled(t)?;
         self.tool = t;
+        // The machine now holds it: the next program starts with it (kept across power-off).
+        self.core.setup.active_tool = t;
         self.edge = u32::from(t > 0);
         self.edge_loaded();
         self.apply_length();

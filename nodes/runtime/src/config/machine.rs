@@ -66,6 +66,11 @@ pub struct MachineConfig {
     /// with a magazine); false: T changes the tool at once (D94).
     #[serde(default)]
     pub tool_change_with_m6: bool,
+    /// The tool in the spindle when the kept memory says none (the machine's first power-up,
+    /// and `cnc check`/`simulate`, which read no kept memory; `--tool-in-spindle` overrides):
+    /// a program that selects its edge before M6 finds the tool it expects (issue 46).
+    #[serde(default)]
+    pub tool_in_spindle: u32,
     /// Where parameters written from the cell (SetParameter) are stored; they are applied over
     /// this file at start (decisions D44), relative to the config file's folder. Absent:
     /// parameters cannot be written.
