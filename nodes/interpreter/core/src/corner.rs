@@ -34,8 +34,8 @@ pub struct Corner {
     pub chamfer: Chamfer,
     /// The held element: a line at `feed`, or an arc.
     pub kind: MoveKind,
-    /// The corner element's own feed (FRC/FRCM); else, on the general corner, the feed of the
-    /// move leaving the corner, on the FANUC family's, the element's (D126).
+    /// The corner element's own feed; else, on the general corner, the feed of the move leaving
+    /// the corner, on the line-only corner, the element's (D126).
     pub corner_feed: Option<f64>,
     /// Arcs may take part on either side (`fillet.rs`); else only a line is held and only a
     /// chamfer meets an arc after it.
@@ -318,8 +318,7 @@ impl Core {
         if cut.first.start().dist(cut.first.end()) > 1e-9 {
             self.after_corner(&self.with_point(&base, cut.first.end()), corner.kind)?;
         }
-        // The element's own feed (FRC/FRCM), else the block leaving the corner's (the 802D's
-        // §9.5.1: "normally the F of the following block"; D126).
+        // The element's own feed, else the feed of the move leaving the corner (D126).
         let leaving = match next_kind {
             MoveKind::Feed(f) | MoveKind::Arc { feed: f, .. } => f,
             _ => corner.feed,

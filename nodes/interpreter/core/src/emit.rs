@@ -254,8 +254,7 @@ impl Core {
                 "no feed programmed for a cutting move (F missing or 0)",
             ));
         }
-        // Below the least increment the controls take (the 802D's F range starts there, the
-        // others' input increment is 0.001): a move that would not end (issue 45).
+        // Below the least increment F takes (D125): a move that would not end (issue 45).
         if feed < MIN_FEED {
             return Err(self.fault(
                 Fault::FeedRange,
