@@ -91,6 +91,17 @@ impl<T: RosType> RosType for Vec<T> {
 ///     }
 /// }
 /// ```
+/// What a message needs to travel on DDS: ros2-client's message trait with the `ros2`
+/// feature, nothing without it (the pure cores' build).
+#[cfg(feature = "ros2")]
+pub trait Transport: ros2_client::Message {}
+#[cfg(feature = "ros2")]
+impl<T: ros2_client::Message> Transport for T {}
+#[cfg(not(feature = "ros2"))]
+pub trait Transport {}
+#[cfg(not(feature = "ros2"))]
+impl<T> Transport for T {}
+
 #[macro_export]
 macro_rules! ros_message {
     (
@@ -108,6 +119,7 @@ macro_rules! ros_message {
         impl $name {
             $(pub const $cname: $cty = $cval;)*
         }
+        #[cfg(feature = "ros2")]
         impl ros2_client::Message for $name {}
         impl $crate::RosType for $name {
             fn ros_type() -> String {

@@ -1,14 +1,15 @@
 //! Servo payloads between motion and io over iceoryx2: fixed size, `#[repr(C)]`, no heap.
 
+#[cfg(feature = "shm")]
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Most axes a channel can drive.
 pub const MAX_AXES: usize = 8;
 
 /// Position command for every axis, sent by motion every servo period.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "shm", derive(ZeroCopySend), type_name("cnc_msgs::ServoSetpoint"))]
 #[repr(C)]
-#[type_name("cnc_msgs::ServoSetpoint")]
 pub struct ServoSetpoint {
     /// Tick number, from 1; io echoes it in the feedback.
     pub seq: u64,
@@ -42,9 +43,9 @@ impl Default for ServoSetpoint {
 }
 
 /// Drive feedback, sent by io in answer to each setpoint.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "shm", derive(ZeroCopySend), type_name("cnc_msgs::ServoFeedback"))]
 #[repr(C)]
-#[type_name("cnc_msgs::ServoFeedback")]
 pub struct ServoFeedback {
     /// `seq` of the setpoint this answers.
     pub seq: u64,

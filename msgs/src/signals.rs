@@ -7,6 +7,7 @@
 //! uses are named in [`f`] and [`g`]; [`x`] and [`y`] name the standard lathe's bits that the
 //! simulated machine drives (the full wiring table is `docs/plc.md`).
 
+#[cfg(feature = "shm")]
 use iceoryx2::prelude::ZeroCopySend;
 
 pub const F_BYTES: usize = 256;
@@ -73,9 +74,9 @@ pub trait SignalTable {
 macro_rules! image {
     ($(#[$doc:meta])* $name:ident, $type_name:literal, $size:ident, { $($(#[$fdoc:meta])* $field:ident: $ty:ty),* }) => {
         $(#[$doc])*
-        #[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        #[cfg_attr(feature = "shm", derive(ZeroCopySend), type_name($type_name))]
         #[repr(C)]
-        #[type_name($type_name)]
         pub struct $name {
             /// Increments with every image the sender writes.
             pub seq: u64,

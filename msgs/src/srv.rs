@@ -6,8 +6,8 @@ use crate::ros_message;
 
 /// A service: its ROS name and its request and response types.
 pub trait RosService {
-    type Request: crate::RosMessage + ros2_client::Message + Clone + std::fmt::Debug + 'static;
-    type Response: crate::RosMessage + ros2_client::Message + Clone + std::fmt::Debug + 'static;
+    type Request: crate::RosMessage + crate::Transport + Clone + std::fmt::Debug + 'static;
+    type Response: crate::RosMessage + crate::Transport + Clone + std::fmt::Debug + 'static;
     /// `cnc_msgs/srv/Name`.
     const TYPE_NAME: &'static str;
     /// Name of the `.srv` file without extension.
