@@ -15,7 +15,7 @@ use std::time::Instant;
 use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_motion::path::{self, Point, Segment, MAX_AXES};
-use cnc_motion::{Aux, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
+use cnc_motion::{Aux, Block, Command, FromLaunch, Motion, MotionConfig, MotionEvent, RunState};
 use cnc_msgs::signals::{f, g, GImage, SignalTable};
 use cnc_runtime::config::ProfileShape;
 use cnc_runtime::LaunchConfig;

@@ -13,7 +13,7 @@ mod common;
 use cnc_io::node::sim_config;
 use cnc_io::SimLathe;
 use cnc_motion::motion::ReferenceInputs;
-use cnc_motion::{Block, Command, Motion, MotionConfig, MotionEvent, RunState};
+use cnc_motion::{Block, Command, FromLaunch, Motion, MotionConfig, MotionEvent, RunState};
 use cnc_msgs::servo::ServoSetpoint;
 use cnc_msgs::signals::{f, GImage, SignalTable, YImage};
 use cnc_runtime::LaunchConfig;

@@ -9,7 +9,7 @@ use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
-use cnc_motion::{Block, Motion, MotionConfig, MotionEvent, Panel, RunState};
+use cnc_motion::{Block, FromLaunch, Motion, MotionConfig, MotionEvent, Panel, RunState};
 use cnc_msgs::servo::{ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{f, g, y as out, GImage, SignalTable, YImage};
 use cnc_runtime::LaunchConfig;

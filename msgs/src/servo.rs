@@ -8,7 +8,11 @@ pub const MAX_AXES: usize = 8;
 
 /// Position command for every axis, sent by motion every servo period.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "shm", derive(ZeroCopySend), type_name("cnc_msgs::ServoSetpoint"))]
+#[cfg_attr(
+    feature = "shm",
+    derive(ZeroCopySend),
+    type_name("cnc_msgs::ServoSetpoint")
+)]
 #[repr(C)]
 pub struct ServoSetpoint {
     /// Tick number, from 1; io echoes it in the feedback.
@@ -44,7 +48,11 @@ impl Default for ServoSetpoint {
 
 /// Drive feedback, sent by io in answer to each setpoint.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "shm", derive(ZeroCopySend), type_name("cnc_msgs::ServoFeedback"))]
+#[cfg_attr(
+    feature = "shm",
+    derive(ZeroCopySend),
+    type_name("cnc_msgs::ServoFeedback")
+)]
 #[repr(C)]
 pub struct ServoFeedback {
     /// `seq` of the setpoint this answers.

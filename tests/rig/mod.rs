@@ -10,7 +10,7 @@ use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
 
 use cnc_motion::motion::ProbeInput;
-use cnc_motion::{Block, Motion, MotionConfig, RunState};
+use cnc_motion::{Block, FromLaunch, Motion, MotionConfig, RunState};
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{g, FImage, GImage, SignalTable, XImage, YImage};
 use cnc_plc::memory::Retained;

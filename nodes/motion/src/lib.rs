@@ -1,24 +1,37 @@
-//! Motion: block queue, look-ahead planning, interpolation at the servo period.
-//!
-//! A block's path: [`block`] (what arrives) → [`motion`] (queue, limits, handshake) →
-//! [`planner`] (look-ahead window, corner blends) → [`profile`] (speed this tick) →
-//! [`path`] (the point on the path) → setpoint; threads go through [`thread`], locked to the
-//! spindle encoder ([`encoder`]) instead; [`alarm`] is motion's alarm table. [`servo`]
-//! measures the loop;
-//! [`node`] runs it on its own thread against iceoryx2.
+//! Motion's shell: the servo loop on its own thread against the drives (iceoryx2), the machine
+//! bus and DDS ([`node`]), and the loop's statistics ([`servo`]). Everything it runs is
+//! `cnc_motion_core`'s, re-exported here.
 
-pub mod alarm;
-pub mod block;
-pub mod config;
-mod encoder;
-pub mod motion;
 pub mod node;
-pub mod path;
-pub mod planner;
-pub mod profile;
 pub mod servo;
-pub mod thread;
 
-pub use block::{Aux, Block, Command};
-pub use config::{AxisConfig, MotionConfig};
-pub use motion::{Motion, MotionEvent, Panel, RunState, RunTimers};
+pub use cnc_motion_core::*;
+
+use cnc_runtime::LaunchConfig;
+
+/// Motion's parameters from the launch config.
+pub trait FromLaunch {
+    fn from_launch(cfg: &LaunchConfig) -> Self;
+}
+
+impl FromLaunch for MotionConfig {
+    fn from_launch(cfg: &LaunchConfig) -> Self {
+        let idx = |n: &str| cfg.axis_index(n).unwrap_or(0);
+        MotionConfig {
+            axes: cfg.machine.axes.clone(),
+            period: cfg.servo.period_ms / 1000.0,
+            queue_capacity: cfg.servo.queue_capacity,
+            arc_plane: (
+                idx(&cfg.machine.arc_plane[0]),
+                idx(&cfg.machine.arc_plane[1]),
+            ),
+            lookahead: cfg.servo.lookahead,
+            tolerance: cfg.servo.tolerance,
+            shape: cfg.servo.profile,
+            feedback_lost_ticks: cfg.servo.feedback_lost_ticks,
+            dry_run_feed: cfg.servo.dry_run_feed,
+            reference_order: cfg.reference_order(),
+            spindle_max_rpm: cfg.limits.spindle_max_rpm,
+        }
+    }
+}

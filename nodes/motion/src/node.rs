@@ -23,6 +23,7 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 use crate::motion::alarm;
 use crate::motion::{BlockResult, ProbeInput, ReferenceInputs};
 use crate::servo::{LateWatch, Lateness, ServoStatistics};
+use crate::FromLaunch;
 use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 
 /// The PLC must answer within this time, else motion takes it as an emergency stop.

@@ -1,14 +1,13 @@
 //! The launch config: one YAML file describes the machine, the network and the nodes.
-//! `machine.rs` holds the machine section (what the control's setting pages hold), `nodes.rs`
+//! The machine section (what the control's setting pages hold) is `cnc_machine`'s, `nodes.rs`
 //! the sections of the cell's nodes (network, servo, simulator, PLC, recorder, HMI, real
 //! time), `files.rs` reading the file and the files it names; the ratings are
 //! [`crate::limits`].
 
 mod files;
-mod machine;
 mod nodes;
 
-pub use machine::*;
+pub use cnc_machine::machine::*;
 pub use nodes::*;
 
 use serde::Deserialize;

@@ -300,16 +300,7 @@ fn default_dry_run_feed() -> f64 {
     1000.0
 }
 
-/// How speed changes along the path.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ProfileShape {
-    /// Acceleration limited: the acceleration jumps between +a, 0 and −a.
-    Trapezoidal,
-    /// Jerk limited: the acceleration ramps, so the drives see no steps in force.
-    #[default]
-    SCurve,
-}
+pub use cnc_machine::ProfileShape;
 
 fn default_period() -> f64 {
     4.0

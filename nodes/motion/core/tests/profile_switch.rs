@@ -4,8 +4,8 @@
 
 mod support;
 
-use cnc_motion::profile::Shape;
-use cnc_motion::{Block, Command, Motion, RunState};
+use cnc_motion_core::profile::Shape;
+use cnc_motion_core::{Block, Command, Motion, RunState};
 use support::*;
 
 const DT: f64 = 0.004;
@@ -62,7 +62,7 @@ fn slowest_at_x50(x: &[f64]) -> f64 {
 fn soft_and_brisk_switch_the_profile_at_a_stop_and_a_new_run_starts_in_the_machines() {
     // The axes' jerk limit: acceleration over DEFAULT_JERK_TIME (1000 / 0.05 = 20 000 mm/s³);
     // a trapezoidal start steps the acceleration to 1000 mm/s² within one tick (250 000).
-    let jerk = 1000.0 / cnc_runtime::config::DEFAULT_JERK_TIME;
+    let jerk = 1000.0 / cnc_machine::DEFAULT_JERK_TIME;
     let (before, after) = (0.0..49.5, 50.5..100.0);
     for machine in [Shape::Trapezoidal, Shape::SCurve] {
         let machine_soft = machine == Shape::SCurve;

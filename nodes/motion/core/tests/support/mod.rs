@@ -3,7 +3,7 @@
 
 #![allow(dead_code)] // each test file uses its own part
 
-use cnc_motion::{AxisConfig, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
+use cnc_motion_core::{AxisConfig, Block, Command, Motion, MotionConfig, MotionEvent, RunState};
 use cnc_msgs::signals::{f, g, GImage, SignalTable};
 
 /// A two-axis lathe (X on diameter, Z) with the S-curve profile, a 4 ms period.
@@ -35,7 +35,7 @@ pub fn lathe() -> MotionConfig {
         arc_plane: (1, 0),
         lookahead: 16,
         tolerance: 0.01,
-        shape: cnc_motion::profile::Shape::SCurve,
+        shape: cnc_motion_core::profile::Shape::SCurve,
         feedback_lost_ticks: 3,
         dry_run_feed: 1000.0,
         reference_order: vec![0, 1],

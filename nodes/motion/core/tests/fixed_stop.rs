@@ -1,8 +1,8 @@
 //! Travel to a fixed stop (FXS, D118) on the mill with a stop modelled here: Z's slide
 //! cannot go below `STOP`; otherwise the drive follows its setpoint exactly.
 
-use cnc_motion::motion::alarm;
-use cnc_motion::{Block, Command, Motion, RunState};
+use cnc_motion_core::motion::alarm;
+use cnc_motion_core::{Block, Command, Motion, RunState};
 use cnc_msgs::signals::GImage;
 
 mod support;

@@ -1,13 +1,11 @@
-//! Machine parameters motion needs, taken from the launch config.
-
-use cnc_runtime::LaunchConfig;
+//! Machine parameters motion needs (the shell takes them from the launch config).
 
 use crate::path::MAX_AXES;
 use crate::planner::{AxisLimits, PlannerConfig};
 use crate::profile::Shape;
 
 /// One axis, as the launch config describes it (limits in display units, X in diameter).
-pub use cnc_runtime::config::AxisEntry as AxisConfig;
+pub use cnc_machine::AxisEntry as AxisConfig;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct MotionConfig {
@@ -34,26 +32,6 @@ pub struct MotionConfig {
 }
 
 impl MotionConfig {
-    pub fn from_launch(cfg: &LaunchConfig) -> Self {
-        let idx = |n: &str| cfg.axis_index(n).unwrap_or(0);
-        MotionConfig {
-            axes: cfg.machine.axes.clone(),
-            period: cfg.servo.period_ms / 1000.0,
-            queue_capacity: cfg.servo.queue_capacity,
-            arc_plane: (
-                idx(&cfg.machine.arc_plane[0]),
-                idx(&cfg.machine.arc_plane[1]),
-            ),
-            lookahead: cfg.servo.lookahead,
-            tolerance: cfg.servo.tolerance,
-            shape: cfg.servo.profile,
-            feedback_lost_ticks: cfg.servo.feedback_lost_ticks,
-            dry_run_feed: cfg.servo.dry_run_feed,
-            reference_order: cfg.reference_order(),
-            spindle_max_rpm: cfg.limits.spindle_max_rpm,
-        }
-    }
-
     /// The planner's view: limits per axis in slide travel, mm/s.
     pub fn planner(&self) -> PlannerConfig {
         let mut limits = AxisLimits {

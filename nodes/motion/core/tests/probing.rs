@@ -2,8 +2,8 @@
 //! at Z `FACE` the stylus is deflected below, its edge latched where the period's straight
 //! path crossed it (as the drive latches it).
 
-use cnc_motion::motion::{alarm, ProbeInput};
-use cnc_motion::{Block, Command, Motion, RunState};
+use cnc_motion_core::motion::{alarm, ProbeInput};
+use cnc_motion_core::{Block, Command, Motion, RunState};
 use cnc_msgs::servo::MAX_AXES;
 use cnc_msgs::signals::GImage;
 

@@ -3,7 +3,7 @@
 //! override 0 or under dry run; the preprocessing stop reports once every block before it is
 //! done.
 
-use cnc_motion::{Block, Command, Motion, Panel, RunState};
+use cnc_motion_core::{Block, Command, Motion, Panel, RunState};
 use cnc_msgs::signals::GImage;
 
 mod support;

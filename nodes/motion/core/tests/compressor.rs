@@ -1,7 +1,7 @@
 //! COMPCAD and STOPFIFO in motion (D119): lines on a circle cut as its arc; a STOPFIFO
 //! section waits in the queue until it is whole.
 
-use cnc_motion::{Block, Command, Motion, RunState};
+use cnc_motion_core::{Block, Command, Motion, RunState};
 use cnc_msgs::signals::GImage;
 
 mod support;

@@ -1,7 +1,7 @@
 //! Motion core on a perfect drive. `Motion::new` takes slide positions (X as radius): X50 is 25.
 //! (actual = commanded) and a simple PLC that answers strobes.
 
-use cnc_motion::{motion::alarm, Aux, Block, Command, Motion, MotionEvent, Panel, RunState};
+use cnc_motion_core::{motion::alarm, Aux, Block, Command, Motion, MotionEvent, Panel, RunState};
 use cnc_msgs::signals::{f, g, GImage, SignalTable};
 
 mod support;
@@ -302,8 +302,8 @@ fn travelled(trace: &[Vec<f64>]) -> f64 {
 #[test]
 fn feed_hold_mid_arc_stops_within_the_braking_distance_and_resumes_on_the_same_path() {
     for shape in [
-        cnc_motion::profile::Shape::Trapezoidal,
-        cnc_motion::profile::Shape::SCurve,
+        cnc_motion_core::profile::Shape::Trapezoidal,
+        cnc_motion_core::profile::Shape::SCurve,
     ] {
         let mut cfg = lathe();
         cfg.shape = shape;
@@ -339,7 +339,7 @@ fn feed_hold_mid_arc_stops_within_the_braking_distance_and_resumes_on_the_same_p
         // Braking from 20 mm/s: v²/2a (+ v·a/2j for the S-curve, with j = a / 0.05 s) plus a
         // tick of travel.
         let v: f64 = 20.0;
-        let a = 1000.0 * cnc_runtime::config::DEFAULT_JERK_TIME;
+        let a = 1000.0 * cnc_machine::DEFAULT_JERK_TIME;
         let allowed = v * v / 2000.0 + v * a / 2.0 / 1000.0 + v * 0.004;
         let braked = travelled(&trace) - at_hold;
         assert!(

@@ -21,7 +21,7 @@ pub struct MachineConfig {
     /// The offset page: tool offsets by offset number (T0101 → 1; on the mill H/D 1–200).
     #[serde(default)]
     pub tools: BTreeMap<u32, ToolEntry>,
-    /// A mill tool table file (`number length_mm diameter_mm` per line, [`crate::tool_table`]),
+    /// A mill tool table file (`number length_mm diameter_mm` per line, (`cnc_runtime::tool_table`)),
     /// relative to the config file's folder; its entries join `tools` when the config loads.
     #[serde(default)]
     pub tool_table: Option<std::path::PathBuf>,
@@ -47,7 +47,7 @@ pub struct MachineConfig {
     #[serde(default = "default_msg_file_kib")]
     pub msg_file_kib: u32,
     /// Program memory: a folder of plain program files, relative to the config file's
-    /// folder ([`crate::program_store`]); absent: programs are kept for this run only.
+    /// folder ((`cnc_runtime::program_store`)); absent: programs are kept for this run only.
     #[serde(default)]
     pub program_directory: Option<std::path::PathBuf>,
     /// External drives for EXTCALL (the 802D's CF card `D:`, USB device `G:`): a drive letter
@@ -366,7 +366,7 @@ fn default_drive_lag() -> f64 {
 
 impl MachineConfig {
     /// The machine section's own rules; an error names the setting and what it may be.
-    pub(crate) fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), String> {
         if ![10, 100, 1024].contains(&self.msg_file_kib) {
             return Err(format!(
                 "machine.msg_file_kib {}: 10, 100 or 1024 (the MSG service's sizes)",
@@ -504,7 +504,7 @@ impl MachineConfig {
             let finite = [t.x, t.z, t.wear_x, t.wear_z, t.radius]
                 .iter()
                 .all(|v| v.is_finite() && v.abs() <= 10_000.0);
-            crate::tool_table::check_entry(&self.dialect, *n)
+            crate::tools::check_entry(&self.dialect, *n)
                 .map_err(|e| format!("machine.tools[{n}]: {e}"))?;
             if !finite || t.radius < 0.0 || t.tip > 9 {
                 return Err(format!(

@@ -7,7 +7,7 @@
 //! (acceleration and jerk limited), chosen per machine.
 
 /// The profile shape is chosen in the launch config (`servo.profile`).
-pub use cnc_runtime::config::ProfileShape as Shape;
+pub use cnc_machine::ProfileShape as Shape;
 
 /// Limits along the path for this tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
