@@ -6,6 +6,7 @@
 //! (issue 47).
 
 pub mod machine;
+pub mod programs;
 pub mod tools;
 
 pub use machine::*;

@@ -24,8 +24,4 @@ pub mod topics;
 pub use config::LaunchConfig;
 pub use lifecycle::Shutdown;
 
-/// Largest program text accepted into program memory, bytes.
-pub const MAX_PROGRAM_BYTES: usize = 4 * 1024 * 1024;
-
-/// The name an MDI entry runs under in program memory (decisions D43).
-pub const MDI_PROGRAM: &str = "MDI";
+pub use cnc_machine::programs::{MAX_PROGRAM_BYTES, MDI_PROGRAM};

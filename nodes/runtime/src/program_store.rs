@@ -1,93 +1,13 @@
 //! Program memory on disk, as a control's program memory is: one folder per machine
 //! (`machine.program_directory`), a plain file per program (folders in a name such as
 //! `shafts/O0010.nc` are folders on disk), written durably, its total bounded by
-//! `machine.program_capacity_kib` (decisions D60). The rules ([`check_store`],
-//! [`valid_program_name`]) are pure, so the interpreter's core and `cnc program import`
-//! apply the same ones.
+//! `machine.program_capacity_kib` (decisions D60). The rules are `cnc_machine::programs`'s,
+//! so the task's core and `cnc program import` apply the same ones.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use crate::MAX_PROGRAM_BYTES;
-
-/// Programs program memory holds at most (besides the byte capacity).
-pub const MAX_PROGRAMS: usize = 1000;
-
-/// Folder levels a program name may have (`a/b/c/NAME`).
-pub const MAX_FOLDER_DEPTH: usize = 4;
-
-/// A program name: folders and a file name separated by `/`, each of letters, digits, `.`,
-/// `_` and `-`, not starting with `.`; at most 128 characters and four folders.
-pub fn valid_program_name(name: &str) -> bool {
-    let parts: Vec<&str> = name.split('/').collect();
-    name.len() <= 128
-        && parts.len() <= MAX_FOLDER_DEPTH + 1
-        && parts.iter().all(|p| {
-            !p.is_empty()
-                && p.len() <= 64
-                && !p.starts_with('.')
-                && p.chars()
-                    .all(|c| c.is_ascii_alphanumeric() || "._-".contains(c))
-        })
-}
-
-/// Why `text` may not be stored as `name` in a memory holding `sizes` (bytes by name) of at
-/// most `capacity` bytes, if it may not: name, size, count and capacity, each with its limit
-/// (alarm 70, FANUC's "no program space in memory").
-pub fn check_store(
-    sizes: &BTreeMap<String, usize>,
-    name: &str,
-    len: usize,
-    capacity: u64,
-) -> Result<(), String> {
-    if !valid_program_name(name) {
-        return Err(format!(
-            "invalid program name {name:?}: folders and a name separated by '/', each of \
-             letters, digits, '.', '_', '-', not starting with '.'; at most 128 characters \
-             and {MAX_FOLDER_DEPTH} folders"
-        ));
-    }
-    if len > MAX_PROGRAM_BYTES {
-        return Err(format!(
-            "program too large: {len} bytes, limit {MAX_PROGRAM_BYTES}"
-        ));
-    }
-    let replaced = sizes.get(name).copied();
-    if replaced.is_none() && sizes.len() >= MAX_PROGRAMS {
-        return Err(format!(
-            "program memory full: {MAX_PROGRAMS} programs (alarm 70)"
-        ));
-    }
-    let used: u64 = sizes.values().map(|&n| n as u64).sum();
-    let after = used - replaced.unwrap_or(0) as u64 + len as u64;
-    if after > capacity {
-        return Err(format!(
-            "program memory full: {name} needs {len} bytes, {} of {capacity} bytes free \
-             (alarm 70: delete programs first)",
-            capacity.saturating_sub(used - replaced.unwrap_or(0) as u64)
-        ));
-    }
-    Ok(())
-}
-
-/// Where program memory keeps what is stored in it: the interpreter's core calls it inside
-/// a load or a delete, so the answer says whether the program is kept.
-pub trait ProgramStorage: Send {
-    fn store(&mut self, name: &str, text: &str) -> Result<(), String>;
-    fn remove(&mut self, name: &str) -> Result<(), String>;
-}
-
-/// Program memory for this run of the cell only (no `machine.program_directory`).
-pub struct InRam;
-
-impl ProgramStorage for InRam {
-    fn store(&mut self, _: &str, _: &str) -> Result<(), String> {
-        Ok(())
-    }
-    fn remove(&mut self, _: &str) -> Result<(), String> {
-        Ok(())
-    }
-}
+pub use cnc_machine::programs::*;
 
 impl ProgramStorage for ProgramDir {
     fn store(&mut self, name: &str, text: &str) -> Result<(), String> {
@@ -226,11 +146,6 @@ impl ProgramDir {
         }
         Ok(())
     }
-}
-
-/// The size in bytes of each program.
-pub fn sizes(programs: &BTreeMap<String, String>) -> BTreeMap<String, usize> {
-    programs.iter().map(|(n, t)| (n.clone(), t.len())).collect()
 }
 
 #[cfg(test)]
