@@ -99,7 +99,7 @@ impl Cell {
             "interpreter",
             spawn(
                 "interpreter",
-                Box::new(move || cnc_interpreter::node::run(c, i, s).map(|_| String::new())),
+                Box::new(move || cnc_task::node::run(c, i, s).map(|_| String::new())),
             )?,
         ));
         let (c, s) = (cfg.clone(), shutdown);

@@ -246,7 +246,7 @@ impl ProgramArgs {
                 .to_path_buf(),
         };
         // Files that are not programs or repeat a number are left out of the library.
-        let (library, _skipped) = cnc_interpreter::library::load_dir(&dir)
+        let (library, _skipped) = cnc_task::library::load_dir(&dir)
             .map_err(|e| format!("library {}: {e}", dir.display()))?;
         Ok(LoadedProgram {
             cfg,
@@ -443,7 +443,7 @@ fn check(args: &ProgramArgs, trace: Option<&str>) -> Result<(), String> {
     } = args.load()?;
     let program = args.program.as_path();
     let letters = cfg.axis_letters();
-    let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
+    let setup = cnc_task::node::setup_from_config(&cfg, &cfg.home());
     let errors = diagnose(dialect, &text, setup.clone(), lib.clone());
     if let Some(format) = trace {
         use std::io::Write;
@@ -570,7 +570,7 @@ fn run_node(node: NodeName, config: Option<&Path>) -> Result<(), String> {
         NodeName::Io => cnc_io::node::run(cfg, inst, s).map(|_| String::new()),
         NodeName::Plc => cnc_plc::node::run(cfg, inst, s).map(|_| String::new()),
         NodeName::Motion => cnc_motion::node::run(cfg, inst, s),
-        NodeName::Interpreter => cnc_interpreter::node::run(cfg, inst, s).map(|_| String::new()),
+        NodeName::Interpreter => cnc_task::node::run(cfg, inst, s).map(|_| String::new()),
         NodeName::HmiBridge => cnc_hmi_bridge::node::run(cfg, s).map(|_| String::new()),
         NodeName::Recorder => {
             cnc_recorder::node::run(cfg, s).map(|dir| format!("recorded into {}", dir.display()))

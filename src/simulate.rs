@@ -12,13 +12,13 @@
 use std::collections::VecDeque;
 use std::time::Instant;
 
-use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_motion::path::{self, Point, Segment, MAX_AXES};
 use cnc_motion::{Aux, Block, Command, FromLaunch, Motion, MotionConfig, MotionEvent, RunState};
 use cnc_msgs::signals::{f, g, GImage, SignalTable};
 use cnc_runtime::config::ProfileShape;
 use cnc_runtime::LaunchConfig;
+use cnc_task::run::ProgramRun;
 
 /// Simulated time after which a program is taken as endless (a real cycle is minutes).
 const MAX_SIMULATED_SECONDS: f64 = 24.0 * 3600.0;
@@ -163,7 +163,7 @@ pub fn simulate(
         (Some(x), Some(z)) if dialect.is_lathe() => Some((x, z)),
         _ => None,
     };
-    let setup = cnc_interpreter::node::setup_from_config(cfg, &cfg.home());
+    let setup = cnc_task::node::setup_from_config(cfg, &cfg.home());
     let mut stream = ProgramRun::new(Interpreter::with_library(dialect, text, setup, library));
     let mut mcfg = MotionConfig::from_launch(cfg);
     if let Some(shape) = options.profile {

@@ -16,10 +16,10 @@
 
 use std::path::{Path, PathBuf};
 
-use cnc_interpreter::node::setup_from_config;
-use cnc_interpreter::search::{search, Approach, SearchTarget};
 use cnc_interpreter::{Aux, Canon, Command, Dialect, Interpreter, Library, Setup};
 use cnc_runtime::LaunchConfig;
+use cnc_task::node::setup_from_config;
+use cnc_task::search::{search, Approach, SearchTarget};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -249,7 +249,7 @@ fn check_restarts(p: &Program, here: &[f64]) -> usize {
 fn lathe_family(dir: &str, dialect: Dialect, names: &[&str]) -> usize {
     let setup = machine("sim_lathe.yaml", None);
     let library_dir = root().join("../shared/fixtures").join(dir);
-    let (library, _) = cnc_interpreter::library::load_dir(&library_dir).expect("library");
+    let (library, _) = cnc_task::library::load_dir(&library_dir).expect("library");
     let here = [260.0, 150.0];
     names
         .iter()

@@ -9,7 +9,16 @@ use std::process::Command;
 fn tree(package: &str) -> Vec<String> {
     let out = Command::new(env!("CARGO"))
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .args(["tree", "-p", package, "-e", "normal", "--prefix", "none", "--offline"])
+        .args([
+            "tree",
+            "-p",
+            package,
+            "-e",
+            "normal",
+            "--prefix",
+            "none",
+            "--offline",
+        ])
         .output()
         .expect("cargo tree runs");
     assert!(
@@ -28,7 +37,13 @@ const TRANSPORTS: [&str; 5] = ["ros2-client", "rustdds", "iceoryx2", "cnc_runtim
 
 #[test]
 fn the_pure_cores_cannot_reach_dds_iceoryx2_or_the_runtime() {
-    for package in ["cnc_machine", "cnc_interpreter_core", "cnc_motion_core"] {
+    for package in [
+        "cnc_machine",
+        "cnc_interpreter_core",
+        "cnc_interpreter",
+        "cnc_task_core",
+        "cnc_motion_core",
+    ] {
         let crates = tree(package);
         assert!(crates.iter().any(|c| c == package), "{package}: {crates:?}");
         let reached: Vec<&String> = crates

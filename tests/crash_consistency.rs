@@ -24,13 +24,13 @@ use std::time::{Duration, Instant};
 mod common;
 
 use cnc::client::CellClient;
-use cnc_interpreter::position::ProgramPosition;
 use cnc_msgs::msg::ToolOffset;
 use cnc_msgs::srv::{
     GetOffsets, GetOffsetsRequest, GetParameters, GetParametersRequest, SetParameter,
     SetParameterRequest, SetToolOffset, SetToolOffsetRequest,
 };
 use cnc_runtime::LaunchConfig;
+use cnc_task::position::ProgramPosition;
 use ros2_client::ServiceMapping;
 
 const DOMAIN: u16 = 71;

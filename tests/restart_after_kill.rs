@@ -11,11 +11,11 @@ use std::time::{Duration, Instant};
 mod common;
 
 use cnc::client::CellClient;
-use cnc_interpreter::position::ProgramPosition;
 use cnc_msgs::action::RunProgramGoal;
 use cnc_msgs::msg::{MachineState, SpindleState};
 use cnc_runtime::dds::RosNode;
 use cnc_runtime::LaunchConfig;
+use cnc_task::position::ProgramPosition;
 use ros2_client::action_msgs::GoalStatusEnum;
 
 const DOMAIN: u16 = 77;

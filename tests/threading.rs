@@ -5,7 +5,6 @@
 //! 0.1 µm per revolution, measured on the simulated slides against the spindle encoder, with
 //! the feed override at 50 % (threads ignore it).
 
-use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
@@ -13,6 +12,7 @@ use cnc_motion::{Block, FromLaunch, Motion, MotionConfig, MotionEvent, Panel, Ru
 use cnc_msgs::servo::{ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{f, g, y as out, GImage, SignalTable, YImage};
 use cnc_runtime::LaunchConfig;
+use cnc_task::run::ProgramRun;
 
 fn fixture(name: &str) -> String {
     let path = format!(
@@ -45,7 +45,7 @@ fn run(program: &str, factors: &[f64]) -> Vec<Pass> {
     )))
     .expect("config");
     let zi = cfg.axis_index("Z").expect("a Z axis");
-    let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
+    let setup = cnc_task::node::setup_from_config(&cfg, &cfg.home());
     let mut stream = ProgramRun::new(Interpreter::with_library(
         Dialect::HuaxingLathe,
         program,

@@ -4,10 +4,10 @@
 //! (the 802D mill's spindle, taps, H functions, feedforward).
 #![allow(dead_code)]
 
-use cnc_interpreter::run::ProgramRun;
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library, MachineTimers, Measurement};
 use cnc_io::node::sim_config;
 use cnc_io::sim::SimLathe;
+use cnc_task::run::ProgramRun;
 
 use cnc_motion::motion::ProbeInput;
 use cnc_motion::{Block, FromLaunch, Motion, MotionConfig, RunState};
@@ -49,7 +49,7 @@ impl Rig {
     }
 
     pub fn on(cfg: LaunchConfig, program: &str, retained: Option<&Retained>) -> Rig {
-        let setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
+        let setup = cnc_task::node::setup_from_config(&cfg, &cfg.home());
         let dialect = Dialect::from_name(&cfg.machine.dialect).unwrap();
         let interp = Interpreter::with_library(dialect, program, setup, Library::new());
         let mcfg = MotionConfig::from_launch(&cfg);

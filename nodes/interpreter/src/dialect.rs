@@ -174,6 +174,6 @@ mod tests {
     #[test]
     fn the_configs_dialect_list_is_the_interpreters() {
         let names: Vec<&str> = Dialect::ALL.iter().map(|d| d.name()).collect();
-        assert_eq!(names, cnc_runtime::config::DIALECTS);
+        assert_eq!(names, cnc_machine::DIALECTS);
     }
 }

@@ -5,13 +5,14 @@
 //! that read the dialects and lower them onto the core: the FANUC family base ([`fanuc`]) and
 //! its dialects [`huaxing`], [`gtc2e`], [`iso`] and [`mill`], and the SINUMERIK 802D's own
 //! front end [`sinumerik`], named in one place
-//! ([`dialect`]). Around them: the public [`interpreter`], program libraries ([`library`]),
-//! the program run ([`run`]) and where it is ([`position`]), [`trace`] (the stream as text for checks and golden files) and
-//! [`node`] (the ROS 2 shell).
+//! ([`dialect`]). Around them: the public [`interpreter`], program libraries ([`library`]) and
+//! [`trace`] (the stream as text for checks and golden files). Text in, canonical commands
+//! out: the program's run, its memory and its shell are the task's (`cnc_task_core`,
+//! `cnc_task`), and Cargo keeps this crate from the runtime and the transports
+//! (`tests/boundaries.rs`).
 
 pub mod dialect;
 pub mod error;
-pub mod external;
 pub mod fanuc;
 pub mod gtc2e;
 pub mod huaxing;
@@ -19,15 +20,8 @@ pub mod interpreter;
 pub mod iso;
 pub mod library;
 pub mod mill;
-pub mod msg_service;
-pub mod node;
-pub mod offset_page;
-pub mod position;
-pub mod run;
-pub mod search;
 pub mod setup;
 pub mod sinumerik;
-pub mod stream;
 pub mod trace;
 
 pub use cnc_interpreter_core::{

@@ -71,38 +71,6 @@ pub fn file_number(path: &Path) -> Option<u32> {
     stem.parse().ok()
 }
 
-/// Reads every program of a folder (the shell's job; the core never touches files).
-/// Unreadable or nameless files are skipped and listed in the second value.
-pub fn load_dir(dir: &Path) -> std::io::Result<(Library, Vec<String>)> {
-    let mut lib = Library::new();
-    let mut skipped = Vec::new();
-    let mut entries: Vec<_> = std::fs::read_dir(dir)?.filter_map(Result::ok).collect();
-    entries.sort_by_key(|e| e.path());
-    for entry in entries {
-        let path = entry.path();
-        if !path.is_file() {
-            continue;
-        }
-        let Ok(bytes) = std::fs::read(&path) else {
-            skipped.push(format!("{}: unreadable", path.display()));
-            continue;
-        };
-        let Ok(text) = String::from_utf8(bytes) else {
-            skipped.push(format!("{}: not UTF-8 text", path.display()));
-            continue;
-        };
-        let name = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("?")
-            .to_string();
-        if let Err(taken) = add_program(&mut lib, &name, &text) {
-            skipped.push(taken);
-        }
-    }
-    Ok((lib, skipped))
-}
-
 /// Adds one stored program to `lib`: by its program number (the `O` number on its first line
 /// or in its file name), and by its name, the file name without its extension (`L10.SPF` is
 /// called as `L10`, `RAHMEN7.SPF` as `RAHMEN7`: the programs of controls that call by
@@ -119,6 +87,17 @@ pub fn add_program(lib: &mut Library, file_name: &str, text: &str) -> Result<(),
         None => {}
     }
     Ok(())
+}
+
+/// The name EXTCALL gives a program: `d:/Externe_UP/bohrung.spf ` → `D:\EXTERNE_UP\BOHRUNG`.
+pub fn external_name(path: &str) -> String {
+    let mut name = path.trim().replace('/', "\\").to_ascii_uppercase();
+    for ext in [".SPF", ".MPF"] {
+        if let Some(stem) = name.strip_suffix(ext) {
+            name = stem.to_string();
+        }
+    }
+    name
 }
 
 #[cfg(test)]

@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 
+use cnc_machine::MachineConfig;
 use serde::{Deserialize, Serialize};
 
 pub use cnc_interpreter_core::setup::{Offsets, Setup, ToolOffset};
@@ -44,7 +45,7 @@ impl Memory {
             .retain(|&n, v| Memory::is_kept(n) && v.is_finite());
         self.tools.retain(|n, t| {
             // Entries the offset page or a program of any dialect could have stored.
-            (1..=cnc_runtime::tool_table::MAX_EDGE_ENTRY).contains(n)
+            (1..=cnc_machine::tools::MAX_EDGE_ENTRY).contains(n)
                 && [t.x, t.z, t.wear_x, t.wear_z, t.radius]
                     .iter()
                     .all(|v| v.is_finite())
@@ -59,4 +60,47 @@ impl Memory {
         }
         self
     }
+}
+
+/// The interpreter's view of the machine from the launch config's machine section: axes,
+/// reference point, tool post, the offset page and the work offsets; the program starts at
+/// `start`.
+pub fn of_machine(machine: &MachineConfig, start: &[f64]) -> Setup {
+    let letters = machine.axis_letters();
+    let mut setup = Setup::new(&letters, &machine.diameter_axes(), start);
+    setup.reference = machine.home();
+    setup.second_reference = machine.second_reference();
+    setup.fixed_points = machine.fixed_points();
+    setup.front_tool_post = machine.tool_post == cnc_machine::ToolPost::Front;
+    setup.tool_change_macro = machine.tool_change_macro;
+    setup.tool_change_with_m6 = machine.tool_change_with_m6;
+    setup.active_tool = machine.tool_in_spindle;
+    setup.contour_tolerance = machine.contour_tolerance;
+    setup.calculator_decimal_point = machine
+        .decimal_point
+        .map(|d| d == cnc_machine::DecimalPoint::Calculator);
+    for (&n, t) in &machine.tools {
+        setup.offsets.tools.insert(
+            n,
+            ToolOffset {
+                x: t.x,
+                z: t.z,
+                wear_x: t.wear_x,
+                wear_z: t.wear_z,
+                radius: t.radius,
+                tip: t.tip,
+            },
+        );
+    }
+    for (code, axes) in &machine.work_offsets {
+        if let Some(i) = cnc_machine::work_offset_index(code) {
+            let row = setup.offsets.work.entry(i).or_default();
+            for (axis, &v) in axes {
+                if let Some(c) = axis.chars().next() {
+                    row.insert(c, v);
+                }
+            }
+        }
+    }
+    setup
 }

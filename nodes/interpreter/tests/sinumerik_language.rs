@@ -412,9 +412,11 @@ fn f031_g75_approaches_the_fixed_points_of_the_machine_data() {
         env!("CARGO_MANIFEST_DIR"),
         "/../../launch_configs/sim_mill_802d.yaml"
     );
-    let cfg = cnc_runtime::LaunchConfig::from_yaml(&std::fs::read_to_string(path).unwrap())
-        .expect("sim_mill_802d");
-    let mut setup = cnc_interpreter::node::setup_from_config(&cfg, &cfg.home());
+    let file: serde_yaml::Value =
+        serde_yaml::from_str(&std::fs::read_to_string(path).unwrap()).expect("sim_mill_802d");
+    let machine: cnc_machine::MachineConfig =
+        serde_yaml::from_value(file["machine"].clone()).expect("its machine section");
+    let mut setup = cnc_interpreter::setup::of_machine(&machine, &machine.home());
     // A work offset and a frame, which G75 ignores.
     setup
         .offsets
@@ -444,7 +446,7 @@ fn f031_g75_approaches_the_fixed_points_of_the_machine_data() {
             _ => None,
         })
         .collect();
-    let fp = cfg.fixed_points();
+    let fp = machine.fixed_points();
     // X1 Y2 Z3 in G54 + TRANS: machine X101 Y9 Z−47; then Z to FP 1, then X and Y to FP 2.
     assert_eq!(rapids[0], [101.0, 9.0, -47.0]);
     assert_eq!(rapids[1], [101.0, 9.0, fp[2][0]]);

@@ -365,6 +365,34 @@ fn default_drive_lag() -> f64 {
 }
 
 impl MachineConfig {
+    /// The axis address letters in machine order, e.g. `['X', 'Z']`.
+    pub fn axis_letters(&self) -> Vec<char> {
+        self.axes.iter().map(AxisEntry::letter).collect()
+    }
+
+    /// Per axis: programmed and displayed in diameter.
+    pub fn diameter_axes(&self) -> Vec<bool> {
+        self.axes.iter().map(|a| a.diameter).collect()
+    }
+
+    /// The second reference point per axis (G30), display units.
+    pub fn second_reference(&self) -> Vec<f64> {
+        self.axes
+            .iter()
+            .map(|a| a.second_reference.unwrap_or(a.home))
+            .collect()
+    }
+
+    /// Each axis's fixed points (G75), machine coordinates, display units.
+    pub fn fixed_points(&self) -> Vec<Vec<f64>> {
+        self.axes.iter().map(|a| a.fixed_points.clone()).collect()
+    }
+
+    /// Power-on position in display units.
+    pub fn home(&self) -> Vec<f64> {
+        self.axes.iter().map(|a| a.home).collect()
+    }
+
     /// The machine section's own rules; an error names the setting and what it may be.
     pub fn validate(&self) -> Result<(), String> {
         if ![10, 100, 1024].contains(&self.msg_file_kib) {

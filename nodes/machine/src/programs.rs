@@ -90,8 +90,6 @@ impl ProgramStorage for InRam {
     }
 }
 
-
-
 /// The size in bytes of each program.
 pub fn sizes(programs: &BTreeMap<String, String>) -> BTreeMap<String, usize> {
     programs.iter().map(|(n, t)| (n.clone(), t.len())).collect()

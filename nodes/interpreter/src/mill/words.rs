@@ -90,7 +90,7 @@ impl Fanuc<Mill> {
             return Ok(None);
         };
         integer_word(v)
-            .filter(|&n| n <= cnc_runtime::tool_table::MAX_TOOL_NUMBER)
+            .filter(|&n| n <= cnc_machine::tools::MAX_TOOL_NUMBER)
             .map(Some)
             .ok_or_else(|| {
                 self.fault(

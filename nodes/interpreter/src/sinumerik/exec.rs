@@ -460,7 +460,7 @@ impl Sinumerik {
                 ))
             }
         };
-        let name = crate::external::external_name(&path);
+        let name = crate::library::external_name(&path);
         if name.as_bytes().get(1) != Some(&b':') {
             return Err(self.fault(
                 Fault::ProgramNotFound,

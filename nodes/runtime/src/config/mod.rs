@@ -71,34 +71,27 @@ impl LaunchConfig {
 
     /// The axis address letters in machine order, e.g. `['X', 'Z']`.
     pub fn axis_letters(&self) -> Vec<char> {
-        self.machine.axes.iter().map(AxisEntry::letter).collect()
+        self.machine.axis_letters()
     }
 
     /// Per axis: programmed and displayed in diameter.
     pub fn diameter_axes(&self) -> Vec<bool> {
-        self.machine.axes.iter().map(|a| a.diameter).collect()
+        self.machine.diameter_axes()
     }
 
-    /// Power-on position in display units.
+    /// The second reference point per axis (G30), display units.
     pub fn second_reference(&self) -> Vec<f64> {
-        self.machine
-            .axes
-            .iter()
-            .map(|a| a.second_reference.unwrap_or(a.home))
-            .collect()
+        self.machine.second_reference()
     }
 
     /// Each axis's fixed points (G75), machine coordinates, display units.
     pub fn fixed_points(&self) -> Vec<Vec<f64>> {
-        self.machine
-            .axes
-            .iter()
-            .map(|a| a.fixed_points.clone())
-            .collect()
+        self.machine.fixed_points()
     }
 
+    /// Power-on position in display units.
     pub fn home(&self) -> Vec<f64> {
-        self.machine.axes.iter().map(|a| a.home).collect()
+        self.machine.home()
     }
 
     /// Axis indices in reference-return order (`machine.reference_order`, D68): the named

@@ -9,8 +9,8 @@
 
 use cnc_interpreter_core::{Fault, Turn};
 
-use crate::interpreter::MAX_CHECK_COMMANDS;
-use crate::{Aux, Canon, Command, Dialect, Interpreter, ProgramError, Setup};
+use cnc_interpreter::interpreter::MAX_CHECK_COMMANDS;
+use cnc_interpreter::{Aux, Canon, Command, Dialect, Interpreter, ProgramError, Setup};
 
 /// Where a program starts.
 #[derive(Debug, Clone, PartialEq)]

@@ -3,9 +3,9 @@
 //! work offsets G54–G59. Every value is checked before anything changes, so a bad entry leaves
 //! the page as it was.
 
-use crate::fanuc::lathe::MAX_OFFSET;
-use crate::setup::{Memory, ToolOffset};
-use crate::Dialect;
+use cnc_interpreter::fanuc::lathe::MAX_OFFSET;
+use cnc_interpreter::setup::{Memory, ToolOffset};
+use cnc_interpreter::Dialect;
 
 /// Largest offset value accepted, mm (the address table's 4+3 digits).
 pub const LIMIT_MM: f64 = 9999.999;
@@ -63,7 +63,7 @@ pub fn set_tool(
             "offset number {number:?} out of range 1-{MAX_OFFSET} (alarm 62)"
         ));
     }
-    cnc_runtime::tool_table::check_entry(dialect.name(), n)?;
+    cnc_machine::tools::check_entry(dialect.name(), n)?;
     let words: Vec<&str> = text.split_whitespace().collect();
     let [x, z, wx, wz, r, tip] = words[..] else {
         return Err(format!(
@@ -99,7 +99,7 @@ pub fn set_work(
     text: &str,
     axes: &[char],
 ) -> Result<String, String> {
-    let index = cnc_runtime::config::work_offset_index(code)
+    let index = cnc_machine::work_offset_index(code)
         .ok_or_else(|| format!("work offset {code:?} is not G54-G59 (alarm 62)"))?;
     let mut changes = Vec::new();
     for word in text.split_whitespace() {

@@ -13,16 +13,7 @@ use cnc_runtime::program_store::ProgramDir;
 /// keeps program memory's limit, 4 MiB, and its rules for names and folders).
 const MAX_TOTAL_BYTES: usize = 256 << 20;
 
-/// The name EXTCALL gives a program: `d:/Externe_UP/bohrung.spf ` → `D:\EXTERNE_UP\BOHRUNG`.
-pub fn external_name(path: &str) -> String {
-    let mut name = path.trim().replace('/', "\\").to_ascii_uppercase();
-    for ext in [".SPF", ".MPF"] {
-        if let Some(stem) = name.strip_suffix(ext) {
-            name = stem.to_string();
-        }
-    }
-    name
-}
+pub use cnc_interpreter::library::external_name;
 
 /// Every part program (`.SPF`, `.MPF`) on the drives (letter → folder) by its EXTCALL name,
 /// and what could not be read (a missing drive is no problem: nothing is plugged in). The

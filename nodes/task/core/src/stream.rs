@@ -7,7 +7,7 @@ use std::collections::VecDeque;
 
 use cnc_interpreter_core::{Measurement, ServiceOutput};
 
-use crate::{Canon, Command, Interpreter, ProgramError};
+use cnc_interpreter::{Canon, Command, Interpreter, ProgramError};
 
 /// One program run's block stream: commands go to motion while fewer than the queue's
 /// capacity are unfinished; the run is complete when motion has finished the program end.

@@ -11,22 +11,22 @@
 
 use std::collections::{BTreeMap, VecDeque};
 
+use cnc_machine::programs::MDI_PROGRAM;
 use cnc_msgs::canon::to_motion_block;
 use cnc_msgs::msg::{
     Alarm, AlarmEvent, CommandResult, MachineState, MotionBlock, MotionStatus, ProgramCommand,
 };
-use cnc_runtime::MDI_PROGRAM;
 
 use crate::offset_page;
 use crate::position::{text_hash, ProgramPosition};
 use crate::search::{search, Approach, SearchTarget};
-use crate::setup::Memory;
-use crate::{Dialect, Interpreter, Library, Setup};
+use cnc_interpreter::setup::Memory;
+use cnc_interpreter::{Dialect, Interpreter, Library, Setup};
 
 pub use crate::stream::ProgramRun;
-pub use cnc_runtime::program_store::{valid_program_name, MAX_PROGRAMS};
-use cnc_runtime::program_store::{InRam, ProgramStorage};
-pub use cnc_runtime::MAX_PROGRAM_BYTES;
+pub use cnc_machine::programs::MAX_PROGRAM_BYTES;
+pub use cnc_machine::programs::{valid_program_name, MAX_PROGRAMS};
+use cnc_machine::programs::{InRam, ProgramStorage};
 /// The longest MDI entry: a few blocks typed at the panel.
 pub const MAX_MDI_BYTES: usize = 4096;
 /// Answers remembered so that a repeated command (same id) is answered, not executed again.
@@ -528,10 +528,10 @@ impl RunCore {
     }
 
     fn load(&mut self, name: &str, text: &str) -> Result<String, String> {
-        let mut sizes = cnc_runtime::program_store::sizes(&self.programs);
+        let mut sizes = cnc_machine::programs::sizes(&self.programs);
         // The MDI entry is the panel's, not a stored program: it takes no capacity.
         sizes.remove(MDI_PROGRAM);
-        cnc_runtime::program_store::check_store(&sizes, name, text.len(), self.capacity)?;
+        cnc_machine::programs::check_store(&sizes, name, text.len(), self.capacity)?;
         if name == MDI_PROGRAM {
             return Err(format!(
                 "{MDI_PROGRAM} is the MDI entry's name (decisions D43)"
@@ -932,7 +932,7 @@ impl RunCore {
         let mut lib = Library::new();
         for (name, text) in &self.programs {
             // A second program of a taken number stays callable by name only.
-            let _ = crate::library::add_program(&mut lib, name, text);
+            let _ = cnc_interpreter::library::add_program(&mut lib, name, text);
         }
         for (name, text) in &self.external {
             lib.insert_named(name, name, text);

@@ -1,7 +1,7 @@
 //! The run core without DDS: commands in, effects and state out, motion played by hand.
 
 use super::*;
-use crate::setup::ToolOffset;
+use cnc_interpreter::setup::ToolOffset;
 
 const PART: &str = "G00 X100 Z20\nS500 M03\nG01 Z10 F3000\nG01 Z5\nM05\nM30\n";
 
@@ -353,7 +353,7 @@ struct Disk {
     broken: bool,
 }
 
-impl cnc_runtime::program_store::ProgramStorage for Disk {
+impl cnc_machine::programs::ProgramStorage for Disk {
     fn store(&mut self, name: &str, text: &str) -> Result<(), String> {
         if self.broken {
             return Err("No space left on device".into());

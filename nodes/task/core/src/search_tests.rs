@@ -1,5 +1,5 @@
 use super::*;
-use crate::Setup;
+use cnc_interpreter::Setup;
 
 const LATHE: Dialect = Dialect::HuaxingLathe;
 
@@ -166,7 +166,7 @@ fn a_target_the_program_never_reaches_is_refused_with_the_alarm_and_nothing_runs
 fn main_lines_name_the_calling_line_inside_a_subprogram() {
     // Line 2 calls O0002 twice; its moves are on the subprogram's lines 2 and 3 but on the
     // main program's line 2.
-    let mut lib = crate::Library::new();
+    let mut lib = cnc_interpreter::Library::new();
     lib.insert(2, "O0002", "O0002\nG01 U-2 F0.1\nG00 U2\nM99\n");
     let main = "G00 X50 Z5\nM98 P20002\nG00 X80\nM30\n";
     let mut interp =
@@ -240,7 +240,7 @@ fn the_restart_gives_the_last_spindle_position_and_an_incremental_one_as_m5() {
 /// the program ran up to there; the same program run from its top counts them once.
 #[test]
 fn setpiece_does_not_count_during_a_block_search() {
-    use crate::sinumerik::monitor::kept_key;
+    use cnc_interpreter::sinumerik::monitor::kept_key;
     let text = "T1 D1\nSETPIECE(1)\nG1 X10 F500\nM30\n";
     let mut setup = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
     setup.offsets.tools.insert(11, Default::default());

@@ -26,56 +26,19 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 use crate::position::{PositionTracker, ProgramPosition};
 use crate::run::{self, Effect, RunCore, StateView};
 use crate::search::Approach;
-use crate::setup::Memory;
-use crate::{Dialect, Setup};
+use cnc_interpreter::setup::Memory;
+use cnc_interpreter::{Dialect, Setup};
 
 pub use crate::run::{valid_program_name, MAX_MDI_BYTES, MAX_PROGRAMS, MAX_PROGRAM_BYTES};
 
-/// The interpreter's view of the machine from the launch config: axes, reference point, tool
-/// post, the offset page and the work offsets; the program starts at `start`.
 /// A program's text for an output of the message service that is off (a warning: nothing
 /// else changes; our number, the manual has a prompt line, not an alarm).
 pub const MSG_SERVICE_OFF: u32 = 1096;
 
+/// The interpreter's view of the machine from the launch config (`Setup::of_machine`); the
+/// program starts at `start`.
 pub fn setup_from_config(cfg: &LaunchConfig, start: &[f64]) -> Setup {
-    let letters = cfg.axis_letters();
-    let mut setup = Setup::new(&letters, &cfg.diameter_axes(), start);
-    setup.reference = cfg.home();
-    setup.second_reference = cfg.second_reference();
-    setup.fixed_points = cfg.fixed_points();
-    setup.front_tool_post = cfg.machine.tool_post == cnc_runtime::config::ToolPost::Front;
-    setup.tool_change_macro = cfg.machine.tool_change_macro;
-    setup.tool_change_with_m6 = cfg.machine.tool_change_with_m6;
-    setup.active_tool = cfg.machine.tool_in_spindle;
-    setup.contour_tolerance = cfg.machine.contour_tolerance;
-    setup.calculator_decimal_point = cfg
-        .machine
-        .decimal_point
-        .map(|d| d == cnc_runtime::config::DecimalPoint::Calculator);
-    for (&n, t) in &cfg.machine.tools {
-        setup.offsets.tools.insert(
-            n,
-            crate::setup::ToolOffset {
-                x: t.x,
-                z: t.z,
-                wear_x: t.wear_x,
-                wear_z: t.wear_z,
-                radius: t.radius,
-                tip: t.tip,
-            },
-        );
-    }
-    for (code, axes) in &cfg.machine.work_offsets {
-        if let Some(i) = cnc_runtime::config::work_offset_index(code) {
-            let row = setup.offsets.work.entry(i).or_default();
-            for (axis, &v) in axes {
-                if let Some(c) = axis.chars().next() {
-                    row.insert(c, v);
-                }
-            }
-        }
-    }
-    setup
+    cnc_interpreter::setup::of_machine(&cfg.machine, start)
 }
 
 /// The machine memory at start: the config's offset page, then what the memory file holds.
@@ -386,7 +349,7 @@ fn report_state(state: &mut StateReporter, view: StateView, latest: Option<&Prog
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Interpreter;
+    use cnc_interpreter::Interpreter;
 
     fn config(memory_file: &std::path::Path) -> LaunchConfig {
         let path = concat!(
