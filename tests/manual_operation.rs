@@ -573,9 +573,41 @@ fn an_axis_on_its_overtravel_switch_stops_with_the_alarm_and_jogs_off_it_only_th
         .expect("X+ again, off the switch");
 }
 
+/// Asks the web panel at `address` for a jog of X and returns its reply frame.
+fn panel_jog(address: &str, direction: i8, increment: f64) -> serde_json::Value {
+    use std::time::{Duration, Instant};
+    let url = format!("ws://{address}/ws");
+    let t0 = Instant::now();
+    let (mut ws, _) = loop {
+        match tungstenite::connect(url.as_str()) {
+            Ok(c) => break c,
+            Err(e) if t0.elapsed() < Duration::from_secs(10) => {
+                println!("panel not there yet: {e}");
+                std::thread::sleep(Duration::from_millis(200));
+            }
+            Err(e) => panic!("no panel at {address}: {e}"),
+        }
+    };
+    let request = serde_json::json!({"id": 41, "op": "jog", "axis": "X",
+        "direction": direction, "feed": 3000.0, "increment": increment});
+    ws.send(tungstenite::Message::text(request.to_string()))
+        .expect("request sent");
+    while t0.elapsed() < Duration::from_secs(20) {
+        if let Ok(tungstenite::Message::Text(t)) = ws.read() {
+            let v: serde_json::Value = serde_json::from_str(&t).unwrap();
+            if v["type"] == "reply" && v["id"] == 41 {
+                return v;
+            }
+        }
+    }
+    panic!("no reply from the panel");
+}
+
 /// Overtravel through the cell (runs in scripts/test.sh's network namespace): a robot holds
 /// X+ until X runs onto its switch; the alarm comes, `axes` shows X on its + switch, and a jog
-/// is refused until the reset; then X+ is refused by name and X− takes it off the switch.
+/// is refused until the reset; then X+ is refused by name, through ROS 2 and through the web
+/// panel alike — motion refuses it, and its reason is the answer (issue 47) — and X− takes it
+/// off the switch.
 #[test]
 fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way() {
     use cnc::cell::Cell;
@@ -586,6 +618,8 @@ fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way
 
     let mut cfg = common::sim_lathe(80);
     cfg.machine.axes[0].overtravel = Some([-5.0, 220.0]);
+    let panel = "127.0.0.1:18780";
+    cfg.hmi.web_address = panel.into();
     let cell = Cell::start(&cfg).expect("cell starts");
     let mut c = common::ready_client(&cfg, "robot", Duration::from_secs(30));
     common::set_mode(&mut c, MachineState::MODE_JOG);
@@ -633,6 +667,15 @@ fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way
         !r.accepted && r.message.contains("overtravel"),
         "{}",
         r.message
+    );
+    let reply = panel_jog(panel, 1, 0.5);
+    println!("X+ from the panel: {reply}");
+    assert_eq!(reply["accepted"], false);
+    assert!(
+        reply["message"]
+            .as_str()
+            .is_some_and(|m| m.contains("X is on its + overtravel switch")),
+        "{reply}"
     );
     let r = ask(-1, 2.0);
     assert!(r.accepted, "{}", r.message);

@@ -1,6 +1,6 @@
-//! A jog request in the text form it takes through the cell (`ProgramCommand::JOG`): the
-//! bridge writes it, the interpreter checks the mode and passes it on, motion moves the axis.
-//! Every value is checked here once: it may come from any client.
+//! A jog request's values (`TaskRequest::Jog`): the bridge takes them from a client, the task
+//! checks the mode and passes the jog on to motion, which moves the axis. Every value is
+//! checked here once: it may come from any client.
 
 /// The feed of a jog that names none, mm/min.
 pub const DEFAULT_JOG_FEED: f64 = 1000.0;
@@ -8,7 +8,7 @@ pub const DEFAULT_JOG_FEED: f64 = 1000.0;
 pub const MAX_INCREMENT: f64 = 1000.0;
 
 #[derive(Debug, Clone, PartialEq)]
-pub struct JogText {
+pub struct Jog {
     /// The axis letter.
     pub axis: String,
     /// +1, -1, or 0 (stop).
@@ -19,9 +19,9 @@ pub struct JogText {
     pub increment: f64,
 }
 
-impl JogText {
+impl Jog {
     /// A request's values, checked; `feed` 0 is [`DEFAULT_JOG_FEED`].
-    pub fn new(axis: &str, direction: i8, feed: f64, increment: f64) -> Result<JogText, String> {
+    pub fn new(axis: &str, direction: i8, feed: f64, increment: f64) -> Result<Jog, String> {
         let axis = axis.trim().to_ascii_uppercase();
         if axis.len() != 1 || !axis.chars().all(|c| c.is_ascii_uppercase()) {
             return Err(format!("jog: axis {axis:?} is not an axis letter"));
@@ -36,39 +36,12 @@ impl JogText {
         if !(increment.is_finite() && (0.0..=MAX_INCREMENT).contains(&increment)) {
             return Err(format!("jog: increment {increment}: 0–{MAX_INCREMENT} mm"));
         }
-        Ok(JogText {
+        Ok(Jog {
             axis,
             direction,
             feed,
             increment,
         })
-    }
-
-    pub fn to_text(&self) -> String {
-        let sign = match self.direction {
-            1 => "+",
-            -1 => "-",
-            _ => "0",
-        };
-        format!("{} {sign} {} {}", self.axis, self.feed, self.increment)
-    }
-
-    pub fn parse(text: &str) -> Result<JogText, String> {
-        let words: Vec<&str> = text.split_whitespace().collect();
-        let [axis, sign, feed, increment] = words[..] else {
-            return Err(format!("jog {text:?}: `<axis> <+|-|0> <feed> <increment>`"));
-        };
-        let direction = match sign {
-            "+" => 1,
-            "-" => -1,
-            "0" => 0,
-            _ => return Err(format!("jog {text:?}: direction + - or 0")),
-        };
-        let number = |w: &str| {
-            w.parse::<f64>()
-                .map_err(|_| format!("jog {text:?}: {w:?} is not a number"))
-        };
-        JogText::new(axis, direction, number(feed)?, number(increment)?)
     }
 }
 
@@ -77,24 +50,23 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_jog_reads_back_and_bad_values_are_refused() {
-        let j = JogText::new("x", 1, 0.0, 0.0).unwrap();
-        assert_eq!(j.to_text(), "X + 1000 0");
-        assert_eq!(JogText::parse(&j.to_text()), Ok(j));
-        assert_eq!(JogText::parse("Z - 600 0.1").unwrap().increment, 0.1);
-        for bad in [
-            "",
-            "X + 600",
-            "XY + 600 0",
-            "X * 600 0",
-            "X + nan 0",
-            "X + 600 -1",
-            "X + 1e9 0",
-            "X + 600 2000",
-            "X + inf 0",
+    fn bad_jog_values_are_refused() {
+        let j = Jog::new("x", 1, 0.0, 0.0).unwrap();
+        assert_eq!((j.axis.as_str(), j.direction, j.feed), ("X", 1, 1000.0));
+        for (axis, direction, feed, increment) in [
+            ("", 1, 600.0, 0.0),
+            ("XY", 1, 600.0, 0.0),
+            ("X", 2, 600.0, 0.0),
+            ("X", 1, f64::NAN, 0.0),
+            ("X", 1, 600.0, -1.0),
+            ("X", 1, 1e9, 0.0),
+            ("X", 1, 600.0, 2000.0),
+            ("X", 1, f64::INFINITY, 0.0),
         ] {
-            assert!(JogText::parse(bad).is_err(), "{bad}");
+            assert!(
+                Jog::new(axis, direction, feed, increment).is_err(),
+                "{axis} {direction} {feed} {increment}"
+            );
         }
-        assert!(JogText::new("X", 2, 100.0, 0.0).is_err());
     }
 }

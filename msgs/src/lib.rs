@@ -15,6 +15,7 @@ pub mod msg;
 pub mod servo;
 pub mod signals;
 pub mod srv;
+pub mod task;
 
 /// The ROS 2 package name of these interfaces.
 pub const PACKAGE: &str = "cnc_msgs";
@@ -33,18 +34,19 @@ pub const MSG_FILES: &[(&str, &str)] = &[
     ("CommandResult", include_str!("../msg/CommandResult.msg")),
     ("MachineState", include_str!("../msg/MachineState.msg")),
     ("MotionBlock", include_str!("../msg/MotionBlock.msg")),
+    ("MotionCommand", include_str!("../msg/MotionCommand.msg")),
     ("MotionStatus", include_str!("../msg/MotionStatus.msg")),
     ("Overrides", include_str!("../msg/Overrides.msg")),
     ("PartCount", include_str!("../msg/PartCount.msg")),
     ("PlcProgram", include_str!("../msg/PlcProgram.msg")),
     ("PlcSignals", include_str!("../msg/PlcSignals.msg")),
     ("PlcStatus", include_str!("../msg/PlcStatus.msg")),
-    ("ProgramCommand", include_str!("../msg/ProgramCommand.msg")),
     ("ProgramEvent", include_str!("../msg/ProgramEvent.msg")),
     ("RobotHandshake", include_str!("../msg/RobotHandshake.msg")),
     ("ServoStats", include_str!("../msg/ServoStats.msg")),
     ("SimInput", include_str!("../msg/SimInput.msg")),
     ("SpindleState", include_str!("../msg/SpindleState.msg")),
+    ("TaskCommand", include_str!("../msg/TaskCommand.msg")),
     ("ToolOffset", include_str!("../msg/ToolOffset.msg")),
     ("WorkOffset", include_str!("../msg/WorkOffset.msg")),
 ];

@@ -284,8 +284,8 @@ ros_message! {
 }
 
 ros_message! {
-    /// Internal command from hmi_bridge to the nodes.
-    pub struct ProgramCommand("cnc_msgs/msg/ProgramCommand") {
+    /// A command to the task from hmi_bridge (typed; `task::TaskRequest` converts it).
+    pub struct TaskCommand("cnc_msgs/msg/TaskCommand") {
         consts {
             LOAD: u8 = 1,
             START: u8 = 2,
@@ -300,24 +300,57 @@ ros_message! {
             OFFSETS: u8 = 11,
             SET_TOOL_OFFSET: u8 = 12,
             SET_WORK_OFFSET: u8 = 13,
-            REFERENCE_RETURN: u8 = 14,
-            JOG: u8 = 15,
-            MOTION_JOG: u8 = 16,
-            MOTION_MODE: u8 = 17,
+            JOG: u8 = 14,
         }
         id: u64,
-        command: u8,
+        kind: u8,
         program: String,
         text: String,
+        start_at: String,
+        mode: u8,
+        axis: String,
+        direction: i8,
+        feed: f64,
+        increment: f64,
+        tool_offset: ToolOffset,
+        work_offset: WorkOffset,
     }
 }
 
 ros_message! {
+    /// What the task decided motion must do (typed; `task::MotionRequest` converts it).
+    pub struct MotionCommand("cnc_msgs/msg/MotionCommand") {
+        consts {
+            FEED_HOLD: u8 = 1,
+            RESUME: u8 = 2,
+            CYCLE_STOP: u8 = 3,
+            RESET: u8 = 4,
+            REFERENCE_RETURN: u8 = 5,
+            JOG: u8 = 6,
+            MODE: u8 = 7,
+        }
+        id: u64,
+        kind: u8,
+        axis: u8,
+        direction: i8,
+        feed: f64,
+        increment: f64,
+        mode: u8,
+    }
+}
+
+ros_message! {
+    /// The answer to a `TaskCommand` (or a `MotionCommand`), with the same id; a LIST or
+    /// OFFSETS answer brings its rows typed.
     pub struct CommandResult("cnc_msgs/msg/CommandResult") {
         consts {}
         id: u64,
         accepted: bool,
         message: String,
+        programs: Vec<String>,
+        program_sizes: Vec<u64>,
+        tool_offsets: Vec<ToolOffset>,
+        work_offsets: Vec<WorkOffset>,
     }
 }
 

@@ -119,7 +119,8 @@ fn every_msg_file_matches_its_rust_type() {
     check_msg::<ServoStats>("ServoStats.msg");
     check_msg::<MotionBlock>("MotionBlock.msg");
     check_msg::<MotionStatus>("MotionStatus.msg");
-    check_msg::<ProgramCommand>("ProgramCommand.msg");
+    check_msg::<TaskCommand>("TaskCommand.msg");
+    check_msg::<MotionCommand>("MotionCommand.msg");
     check_msg::<CommandResult>("CommandResult.msg");
     check_msg::<SimInput>("SimInput.msg");
     check_msg::<PlcStatus>("PlcStatus.msg");
@@ -195,7 +196,8 @@ fn every_interface_file_is_checked_and_listed_in_cmake() {
         "ServoStats",
         "MotionBlock",
         "MotionStatus",
-        "ProgramCommand",
+        "TaskCommand",
+        "MotionCommand",
         "CommandResult",
         "SimInput",
         "PlcStatus",

@@ -51,27 +51,39 @@ def main():
     def writer(path, msg):
         return DataWriter(peer.dp, Topic(peer.dp, f"rt/{ns}/{path}", peer.ifc.msg("cnc_msgs", msg)), qos=COMMANDS)
 
-    command_t, block_t = peer.ifc.msg("cnc_msgs", "ProgramCommand"), peer.ifc.msg("cnc_msgs", "MotionBlock")
+    command_t, block_t = peer.ifc.msg("cnc_msgs", "TaskCommand"), peer.ifc.msg("cnc_msgs", "MotionBlock")
+    motion_t = peer.ifc.msg("cnc_msgs", "MotionCommand")
     overrides_t, event_t = peer.ifc.msg("cnc_msgs", "Overrides"), peer.ifc.msg("cnc_msgs", "AlarmEvent")
     alarm_t, time_t = peer.ifc.msg("cnc_msgs", "Alarm"), peer.ifc.msg("builtin_interfaces", "Time")
     input_t = peer.ifc.msg("cnc_msgs", "SimInput")
-    w_cmd, w_block = writer("_internal/program_command", "ProgramCommand"), writer("_internal/motion_blocks", "MotionBlock")
+    w_cmd, w_block = writer("_internal/task_command", "TaskCommand"), writer("_internal/motion_blocks", "MotionBlock")
     w_over, w_alarm = writer("_internal/panel_overrides", "Overrides"), writer("alarm_events", "AlarmEvent")
     w_input = writer("sim/input", "SimInput")
-    w_motion = writer("_internal/motion_command", "ProgramCommand")
+    w_motion = writer("_internal/motion_command", "MotionCommand")
 
     def block(run_id, seq, kind, end, feed=0.0):
         return block_t(run_id=run_id, seq=seq, program="O0666", line=seq, kind=kind, end=end, center=[],
                        plane=[], feed=feed, dwell_seconds=0.0, lead=0.0, start_angle=0.0, flag=False,
                        aux_kind=0, aux_code=0, aux_value=0.0, origin=[], work_frame=[])
 
+    offset_t, work_t = peer.ifc.msg("cnc_msgs", "ToolOffset"), peer.ifc.msg("cnc_msgs", "WorkOffset")
+
+    def task_command(id, kind, program="", text=""):
+        return command_t(id=id, kind=kind, program=program, text=text, start_at="", mode=0, axis="",
+                         direction=0, feed=0.0, increment=0.0,
+                         tool_offset=offset_t(number=0, x=0.0, z=0.0, wear_x=0.0, wear_z=0.0, radius=0.0, tip=0),
+                         work_offset=work_t(code="", axes=[], values=[]))
+
+    def motion_command(id, kind, axis=0, direction=0, feed=0.0):
+        return motion_t(id=id, kind=kind, axis=axis, direction=direction, feed=feed, increment=0.0, mode=0)
+
     fake = alarm_t(number=9999, severity=2, text="fake", source="interpreter", program="", line=0,
                    stamp=time_t(sec=0, nanosec=0), acknowledged=False)
     for i in range(20):  # over two seconds: writes before discovery matched a reader are lost
-        w_cmd.write(command_t(id=900 + i, command=1, program="evil.nc", text=PROGRAM))
-        w_cmd.write(command_t(id=950 + i, command=2, program="evil.nc", text=""))
-        w_motion.write(command_t(id=970 + i, command=16, program="", text="X + 5000 0"))  # jog
-        w_motion.write(command_t(id=990 + i, command=14, program="", text=""))  # reference return
+        w_cmd.write(task_command(900 + i, 1, program="evil.nc", text=PROGRAM))  # load
+        w_cmd.write(task_command(950 + i, 2, program="evil.nc"))  # start
+        w_motion.write(motion_command(970 + i, 6, axis=0, direction=1, feed=5000.0))  # jog
+        w_motion.write(motion_command(990 + i, 5))  # reference return
         w_block.write(block(1, 1 + i, 0, [150.0, 90.0]))
         w_block.write(block(2**64 - 1, 1, 0, [150.0, 90.0]))
         w_over.write(overrides_t(feed_percent=255, spindle_percent=255, rapid_percent=255))

@@ -7,7 +7,7 @@ use std::collections::VecDeque;
 
 use byteorder::LittleEndian;
 use cnc_msgs::action::*;
-use cnc_msgs::msg::{Alarm, MachineState, ProgramCommand, Time};
+use cnc_msgs::msg::{Alarm, MachineState, Time};
 use cnc_runtime::dds::stamp;
 use cnc_runtime::raw::{Raw, RawAdapter};
 use ros2_client::dds::rustdds::{
@@ -15,16 +15,15 @@ use ros2_client::dds::rustdds::{
 };
 use serde::Serialize;
 
+use crate::access::Who;
+use crate::doors::Front;
+use crate::operation::Operation;
 use crate::run_program::{check, start_at, GoalRun, Step, View};
 use crate::server::{DualServer, Request};
+use cnc_msgs::srv::StopRequest;
 
 /// Finished goals whose results can still be asked for.
 const RESULTS_KEPT: usize = 16;
-
-/// Where commands go: the bridge's command path to the interpreter and motion.
-pub trait CommandPath {
-    fn call(&mut self, command: u8, program: &str, text: &str) -> (bool, String);
-}
 
 struct Topic {
     writer: DataWriter<Raw, RawAdapter>,
@@ -97,13 +96,12 @@ pub struct RunProgramServer {
     goal: Option<(GoalRun, Time)>,
     done: VecDeque<Done>,
     waiting: Vec<Request<RunProgramGetResultRequest>>,
-    /// Lines of each program loaded through this bridge, for the feedback's percentage.
-    pub program_lines: std::collections::BTreeMap<String, u32>,
 }
 
 /// A request the action server decided on, for the caller's command events.
 pub struct Event {
-    /// `run_program` or `run_program/cancel`.
+    /// `run_program` or `run_program/cancel`, or the action service that refused a malformed
+    /// request.
     pub command: &'static str,
     pub detail: String,
     /// The client's writer GUID.
@@ -143,7 +141,6 @@ impl RunProgramServer {
             goal: None,
             done: VecDeque::new(),
             waiting: Vec::new(),
-            program_lines: Default::default(),
         })
     }
 
@@ -240,12 +237,11 @@ impl RunProgramServer {
     }
 
     /// Serves requests and follows the running goal; returns the requests decided, for
-    /// events. `may_move` says whether a client (writer GUID) may start the machine.
-    #[allow(clippy::too_many_arguments)]
+    /// events. Each request becomes an [`Operation`] carried out by `front`, which also says
+    /// whether a client may start the machine.
     pub fn poll(
         &mut self,
-        commands: &mut dyn CommandPath,
-        may_move: &dyn Fn(&[u8; 16]) -> Result<(), String>,
+        front: &mut dyn Front,
         state: Option<&MachineState>,
         (run_id, done_blocks): (u64, u64),
         part_count: u32,
@@ -253,20 +249,47 @@ impl RunProgramServer {
         now: f64,
     ) -> Vec<Event> {
         let mut events = Vec::new();
+        let malformed = [
+            (
+                "run_program/_action/send_goal",
+                self.send_goal.take_malformed(),
+            ),
+            (
+                "run_program/_action/cancel_goal",
+                self.cancel_goal.take_malformed(),
+            ),
+            (
+                "run_program/_action/get_result",
+                self.get_result.take_malformed(),
+            ),
+        ];
+        for (command, list) in malformed {
+            for (writer, why) in list {
+                events.push(Event {
+                    command,
+                    detail: "malformed".into(),
+                    writer,
+                    accepted: false,
+                    message: why,
+                });
+            }
+        }
         if let Some(r) = self.send_goal.receive() {
             let goal = r.request.goal.clone();
-            let outcome = if let Err(why) = may_move(&r.writer) {
+            let outcome = if let Err(why) = front.may_move(&Who::Dds(r.writer)) {
                 Err(why)
             } else if self.goal.is_some() {
                 Err("a RunProgram goal is running: cancel it first".to_string())
             } else {
                 check(&goal, true).and_then(|()| {
-                    let at = start_at(&goal);
-                    let (ok, msg) = commands.call(ProgramCommand::START, &goal.program, &at);
-                    if ok {
-                        Ok(msg)
+                    let a = front.carry_out(&Operation::Start {
+                        name: goal.program.clone(),
+                        at: start_at(&goal),
+                    });
+                    if a.accepted {
+                        Ok(a.message)
                     } else {
-                        Err(msg)
+                        Err(a.message)
                     }
                 })
             };
@@ -276,7 +299,7 @@ impl RunProgramServer {
                 stamp: stamp(),
             };
             if accepted {
-                let lines = self.program_lines.get(&goal.program).copied().unwrap_or(0);
+                let lines = front.program_lines(&goal.program);
                 let run = GoalRun::new(r.request.goal_id, goal.clone(), lines, run_id, now);
                 self.goal = Some((run, response.stamp.clone()));
             } else if let (Err(why), false) = (&outcome, self.knows(&r.request.goal_id)) {
@@ -344,10 +367,12 @@ impl RunProgramServer {
             if canceling {
                 self.publish_status();
                 // Stop on the path, then reset: the machine is ready for the next goal.
-                let (_, stop) = commands.call(ProgramCommand::CYCLE_STOP, "", "");
-                let (_, reset) = commands.call(ProgramCommand::RESET, "", "");
+                let stop = front.carry_out(&Operation::Stop {
+                    mode: StopRequest::CYCLE_STOP,
+                });
+                let reset = front.carry_out(&Operation::Reset);
                 if let Some((g, _)) = self.goal.as_mut() {
-                    g.canceled(&format!("{stop}, {reset}"));
+                    g.canceled(&format!("{}, {}", stop.message, reset.message));
                 }
             }
         }
@@ -372,11 +397,14 @@ impl RunProgramServer {
                         feedback,
                     }),
                     Step::StartCycle => {
-                        let (ok, msg) = commands.call(ProgramCommand::START, &g.goal.program, "");
-                        if ok {
+                        let a = front.carry_out(&Operation::Start {
+                            name: g.goal.program.clone(),
+                            at: String::new(),
+                        });
+                        if a.accepted {
                             g.cycle_started(now, run_id);
                         } else {
-                            g.abort(&format!("next cycle refused: {msg}"), alarms);
+                            g.abort(&format!("next cycle refused: {}", a.message), alarms);
                         }
                     }
                 }

@@ -4,14 +4,15 @@
 pub mod access;
 pub mod action_server;
 pub mod alarm_list;
+pub mod doors;
 pub mod mapping;
 pub mod node;
-pub mod offsets;
 pub mod operation;
 pub use cnc_runtime::overrides;
 pub mod parameters;
 pub mod program_events;
 pub mod robot;
+pub mod robot_door;
 pub mod run_program;
 pub mod server;
 pub mod web;

@@ -2,7 +2,9 @@
 //! service, the `RunProgram` action, a robot request or a button of the web HMI), as one
 //! value: so every door gets the same checks, the same refusals and the same event.
 
-use cnc_msgs::msg::{MachineState, Overrides};
+use cnc_msgs::msg::{MachineState, Overrides, ToolOffset, WorkOffset};
+use cnc_msgs::srv::StopRequest;
+use cnc_msgs::task::TaskRequest;
 
 /// One command to the machine.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,14 +50,8 @@ pub enum Operation {
         name: String,
     },
     Offsets,
-    SetToolOffset {
-        number: String,
-        values: String,
-    },
-    SetWorkOffset {
-        code: String,
-        values: String,
-    },
+    SetToolOffset(ToolOffset),
+    SetWorkOffset(WorkOffset),
     /// Parameters whose names start with `prefix`.
     Parameters {
         prefix: String,
@@ -87,8 +83,8 @@ impl Operation {
             Operation::Mdi { .. } => "mdi",
             Operation::Read { .. } => "read_program",
             Operation::Offsets => "get_offsets",
-            Operation::SetToolOffset { .. } => "set_tool_offset",
-            Operation::SetWorkOffset { .. } => "set_work_offset",
+            Operation::SetToolOffset(_) => "set_tool_offset",
+            Operation::SetWorkOffset(_) => "set_work_offset",
             Operation::Parameters { .. } => "get_parameters",
             Operation::SetParameter { .. } => "set_parameter",
             Operation::Acknowledge { .. } => "acknowledge_alarm",
@@ -116,8 +112,19 @@ impl Operation {
             ),
             Operation::Mode { mode } => MachineState::mode_name_of(*mode).into(),
             Operation::Mdi { text } => text.chars().take(200).collect(),
-            Operation::SetToolOffset { number, values } => format!("{number}: {values}"),
-            Operation::SetWorkOffset { code, values } => format!("{code}: {values}"),
+            Operation::SetToolOffset(t) => format!(
+                "{}: {} {} {} {} {} {}",
+                t.number, t.x, t.z, t.wear_x, t.wear_z, t.radius, t.tip
+            ),
+            Operation::SetWorkOffset(w) => {
+                let values: Vec<String> = w
+                    .axes
+                    .iter()
+                    .zip(&w.values)
+                    .map(|(a, v)| format!("{a}={v}"))
+                    .collect();
+                format!("{}: {}", w.code, values.join(" "))
+            }
             Operation::Parameters { prefix } => prefix.clone(),
             Operation::SetParameter { name, value } => format!("{name} = {value}"),
             Operation::Acknowledge { source, number } => format!("{source} {number}"),
@@ -139,10 +146,55 @@ impl Operation {
                 | Operation::Overrides(_)
                 | Operation::Mode { .. }
                 | Operation::Mdi { .. }
-                | Operation::SetToolOffset { .. }
-                | Operation::SetWorkOffset { .. }
+                | Operation::SetToolOffset(_)
+                | Operation::SetWorkOffset(_)
                 | Operation::SetParameter { .. }
         )
+    }
+
+    /// The task's request this operation is (`Ok(None)`: the bridge's own — overrides,
+    /// parameters, the alarm list); values a request cannot carry are refused here.
+    pub fn task_request(&self) -> Result<Option<TaskRequest>, String> {
+        Ok(Some(match self {
+            Operation::Load { name, text } => TaskRequest::Load {
+                name: name.clone(),
+                text: text.clone(),
+            },
+            Operation::Start { name, at } => TaskRequest::Start {
+                name: name.clone(),
+                at: at.clone(),
+            },
+            Operation::Jog {
+                axis,
+                direction,
+                feed,
+                increment,
+            } => TaskRequest::Jog(cnc_msgs::jog::Jog::new(
+                axis, *direction, *feed, *increment,
+            )?),
+            Operation::Stop { mode } => match *mode {
+                StopRequest::FEED_HOLD => TaskRequest::FeedHold,
+                StopRequest::CYCLE_STOP => TaskRequest::CycleStop,
+                other => {
+                    return Err(format!(
+                        "unknown stop mode {other}: use 1 (FEED_HOLD) or 2 (CYCLE_STOP)"
+                    ))
+                }
+            },
+            Operation::Reset => TaskRequest::Reset,
+            Operation::List => TaskRequest::List,
+            Operation::Delete { name } => TaskRequest::Delete { name: name.clone() },
+            Operation::Mode { mode } => TaskRequest::Mode(*mode),
+            Operation::Mdi { text } => TaskRequest::Mdi { text: text.clone() },
+            Operation::Read { name } => TaskRequest::Read { name: name.clone() },
+            Operation::Offsets => TaskRequest::Offsets,
+            Operation::SetToolOffset(t) => TaskRequest::SetToolOffset(t.clone()),
+            Operation::SetWorkOffset(w) => TaskRequest::SetWorkOffset(w.clone()),
+            Operation::Overrides(_)
+            | Operation::Parameters { .. }
+            | Operation::SetParameter { .. }
+            | Operation::Acknowledge { .. } => return Ok(None),
+        }))
     }
 
     /// Reading changes nothing: it is an event only when refused.
@@ -154,30 +206,44 @@ impl Operation {
     }
 }
 
-/// Parameter rows as one text (`name<TAB>value<TAB>pending` lines), as `List` answers.
-pub fn parameter_text(rows: &[crate::parameters::Row]) -> String {
-    rows.iter()
-        .map(|(n, v, p)| format!("{n}\t{v}\t{p}"))
-        .collect::<Vec<_>>()
-        .join("\n")
+/// An operation's answer: accepted or refused with why, and the rows a reading brings, typed.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Answer {
+    pub accepted: bool,
+    pub message: String,
+    /// `List`: the stored programs and their sizes, bytes.
+    pub programs: Vec<(String, u64)>,
+    /// `Offsets`: the offset pages.
+    pub tools: Vec<ToolOffset>,
+    pub work: Vec<WorkOffset>,
+    /// `Parameters`: name, value, pending value.
+    pub parameters: Vec<crate::parameters::Row>,
 }
 
-/// The rows of [`parameter_text`] again.
-pub fn parameter_rows(text: &str) -> Vec<crate::parameters::Row> {
-    text.lines()
-        .filter_map(|line| {
-            let mut f = line.splitn(3, '\t');
-            Some((f.next()?.into(), f.next()?.into(), f.next()?.into()))
-        })
-        .collect()
-}
+impl Answer {
+    pub fn said(accepted: bool, message: impl Into<String>) -> Answer {
+        Answer {
+            accepted,
+            message: message.into(),
+            ..Answer::default()
+        }
+    }
 
-/// The interpreter's program list (`name<TAB>size` lines) as names and sizes.
-pub fn program_list(text: &str) -> Vec<(String, u64)> {
-    text.lines()
-        .filter_map(|line| line.rsplit_once('\t'))
-        .map(|(name, size)| (name.to_string(), size.parse().unwrap_or(0)))
-        .collect()
+    pub fn refused(why: impl Into<String>) -> Answer {
+        Answer::said(false, why)
+    }
+
+    /// The task's answer.
+    pub fn of_task(r: cnc_msgs::msg::CommandResult) -> Answer {
+        Answer {
+            accepted: r.accepted,
+            message: r.message,
+            programs: r.programs.into_iter().zip(r.program_sizes).collect(),
+            tools: r.tool_offsets,
+            work: r.work_offsets,
+            parameters: Vec::new(),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -218,14 +284,17 @@ mod tests {
             number: 0
         }
         .moves());
-        let rows = vec![
-            ("a.b".to_string(), "1.0".to_string(), String::new()),
-            ("c".to_string(), "x y".to_string(), "z".to_string()),
-        ];
-        assert_eq!(parameter_rows(&parameter_text(&rows)), rows);
         assert_eq!(
-            program_list("O0001\t95\nMDI\t12\nbroken line\n"),
-            [("O0001".to_string(), 95), ("MDI".to_string(), 12)]
+            Operation::Stop { mode: 1 }.task_request(),
+            Ok(Some(TaskRequest::FeedHold))
+        );
+        assert!(Operation::Stop { mode: 7 }.task_request().is_err());
+        assert_eq!(
+            Operation::Parameters {
+                prefix: String::new()
+            }
+            .task_request(),
+            Ok(None)
         );
     }
 }

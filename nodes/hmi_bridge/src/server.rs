@@ -67,7 +67,7 @@ pub struct DualServer<S: RosService> {
     writer: DataWriter<Raw, RawAdapter>,
     name: String,
     /// How to say no to a request that cannot be decoded, if the response type can say it.
-    refuse: Option<fn(String) -> S::Response>,
+    refuse: Option<Box<dyn Fn(String) -> S::Response>>,
     /// Undecodable requests seen since the last [`DualServer::take_malformed`]: writer GUID and
     /// what was wrong.
     malformed: RefCell<Vec<([u8; 16], String)>>,
@@ -148,9 +148,14 @@ where
 
     /// Answers undecodable requests (a string that is not UTF-8, a payload of the wrong type)
     /// with `refuse(reason)` instead of only logging them.
-    pub fn refusing(mut self, refuse: fn(String) -> S::Response) -> Self {
-        self.refuse = Some(refuse);
+    pub fn refusing(mut self, refuse: impl Fn(String) -> S::Response + 'static) -> Self {
+        self.refuse = Some(Box::new(refuse));
         self
+    }
+
+    /// The service's name under the machine's namespace.
+    pub fn name(&self) -> &str {
+        &self.name
     }
 
     /// The undecodable requests seen since the last call, for command events.
@@ -178,7 +183,7 @@ where
                 "busy: {QUEUE_LIMIT} {} requests are waiting; try again",
                 self.name
             );
-            match self.refuse {
+            match &self.refuse {
                 Some(refuse) => {
                     if let Err(e) = self.reply(&r, &refuse(why)) {
                         log::warn!("{e}");
@@ -241,7 +246,7 @@ where
                     self.malformed
                         .borrow_mut()
                         .push((dcc_writer.to_bytes(), why.clone()));
-                    if let Some(refuse) = self.refuse {
+                    if let Some(refuse) = &self.refuse {
                         let mapping = guess_mapping(&raw.bytes, raw.little_endian, related_seq);
                         let identity = match related {
                             Some(r) if r.sequence_number != SequenceNumber::UNKNOWN => r,

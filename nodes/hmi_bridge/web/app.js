@@ -141,14 +141,11 @@ const handlers = {
     $("programs").innerHTML = m.programs.map((p) => `<option value="${escape(p.name)}">${escape(p.name)} (${p.size} B)</option>`).join("");
   },
   offsets(m) {
-    const tools = [], works = [];
-    for (const line of m.text.split("\n")) {
-      const w = line.trim().split(/\s+/);
-      if (w[0] === "T") tools.push(`<tr>${w.slice(1).map((v) => `<td>${escape(v)}</td>`).join("")}</tr>`);
-      if (w[0] === "W") works.push(`<tr><th>${escape(w[1])}</th>${w.slice(2).map((v) => `<td>${escape(v)}</td>`).join("")}</tr>`);
-    }
-    $("tools").innerHTML = tools.join("");
-    $("works").innerHTML = works.join("");
+    const mm = (v) => `<td>${escape(Number(v).toFixed(3))}</td>`;
+    $("tools").innerHTML = m.tools.map((t) =>
+      `<tr><td>${escape(String(t.number))}</td>${[t.x, t.z, t.wear_x, t.wear_z, t.radius].map(mm).join("")}<td>${escape(String(t.tip))}</td></tr>`).join("");
+    $("works").innerHTML = m.work.map((w) =>
+      `<tr><th>${escape(w.code)}</th>${w.axes.map((a, i) => `<td>${escape(`${a}=${Number(w.values[i]).toFixed(3)}`)}</td>`).join("")}</tr>`).join("");
   },
   parameters(m) {
     parameters = m.rows || [];

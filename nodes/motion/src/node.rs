@@ -9,10 +9,11 @@ use std::time::Duration;
 
 use cnc_msgs::canon::from_motion_block;
 use cnc_msgs::msg::{
-    Alarm, Axis, AxisState, MotionBlock, MotionStatus, ProgramCommand, ServoStats,
+    Alarm, Axis, AxisState, CommandResult, MotionBlock, MotionCommand, MotionStatus, ServoStats,
 };
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{FImage, GImage};
+use cnc_msgs::task::MotionRequest;
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
 use cnc_runtime::dds::{stamp, RosNode};
@@ -31,11 +32,8 @@ const PLC_TIMEOUT_NS: u64 = 500_000_000;
 
 enum Input {
     Block(Block),
-    Command(u8),
-    /// Axis index, direction (+1, -1, 0 stops), feed mm/min, increment mm (0: continuous).
-    Jog(usize, i8, f64, f64),
-    /// The mode the interpreter accepted.
-    Mode(u8),
+    /// A command of the task's, with its id: answered by [`Report::Answer`].
+    Command(u64, MotionRequest),
 }
 
 enum Report {
@@ -59,6 +57,8 @@ enum Report {
     /// A warning raised with its reason (`Some`) or cleared (`None`).
     Warning(u32, Option<String>),
     Stats(ServoStats),
+    /// The answer to the task's command of this id: accepted (what was done) or refused (why).
+    Answer(u64, Result<String, String>),
 }
 
 /// Runs the motion node until shutdown (blocking). Returns the servo statistics line.
@@ -107,10 +107,9 @@ fn dds_loop(
 ) -> Result<(), String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "motion")?;
     let blocks = ros.subscription::<MotionBlock>(&topics::MOTION_BLOCKS)?;
-    // The operator's commands from the bridge (feed hold, cycle start, reset) and the
-    // interpreter's own (reference return, jog, mode, cycle stop).
-    let commands = ros.subscription::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
-    let motion_commands = ros.subscription::<ProgramCommand>(&topics::MOTION_COMMAND)?;
+    // Motion takes commands from the task only (issue 47), and answers each.
+    let commands = ros.subscription::<MotionCommand>(&topics::MOTION_COMMAND)?;
+    let results_pub = ros.publisher::<CommandResult>(&topics::MOTION_RESULT)?;
     let status_pub = ros.publisher::<MotionStatus>(&topics::MOTION_STATUS)?;
     let axes_pub = ros.publisher::<AxisState>(&topics::AXES)?;
     let stats_pub = ros.publisher::<ServoStats>(&topics::SERVO_STATS)?;
@@ -147,37 +146,19 @@ fn dds_loop(
                 }
             }
         }
-        let take = || match commands.take() {
-            Ok(Some(c)) => Some(c),
-            _ => motion_commands.take().ok().flatten(),
-        };
-        while let Some(c) = take() {
+        while let Ok(Some(c)) = commands.take() {
             idle = false;
-            if c.command == ProgramCommand::RESET {
-                for number in std::mem::take(&mut raised) {
-                    alarms.clear(number);
-                }
-            }
-            if c.command == ProgramCommand::MOTION_MODE {
-                if let Ok(m) = c.text.trim().parse::<u8>() {
-                    let _ = to_servo.send(Input::Mode(m));
-                }
-                continue;
-            }
-            if c.command == ProgramCommand::MOTION_JOG {
-                // The interpreter checked the mode; the values are checked again here.
-                match cnc_msgs::jog::JogText::parse(&c.text) {
-                    Ok(j) => match axes.iter().position(|a| a.name == j.axis) {
-                        Some(i) => {
-                            let _ = to_servo.send(Input::Jog(i, j.direction, j.feed, j.increment));
+            match MotionRequest::from_command(&c, axes.len()) {
+                Ok(request) => {
+                    if request == MotionRequest::Reset {
+                        for number in std::mem::take(&mut raised) {
+                            alarms.clear(number);
                         }
-                        None => log::warn!("motion: jog of unknown axis {}", j.axis),
-                    },
-                    Err(e) => log::warn!("motion: {e}"),
+                    }
+                    let _ = to_servo.send(Input::Command(c.id, request));
                 }
-                continue;
+                Err(message) => publish(&results_pub, answer(c.id, Err(message))),
             }
-            let _ = to_servo.send(Input::Command(c.command));
         }
         loop {
             match from_servo.try_recv() {
@@ -240,6 +221,7 @@ fn dds_loop(
                     );
                 }
                 Ok(Report::Stats(s)) => publish(&stats_pub, s),
+                Ok(Report::Answer(id, result)) => publish(&results_pub, answer(id, result)),
                 Ok(Report::Alarm(number, text, line)) => {
                     raised.insert(number);
                     alarms.raise(alarms.alarm(number, Alarm::SEVERITY_ERROR, &text, "", line))
@@ -298,6 +280,43 @@ impl PlcLink {
             && self
                 .last_heard
                 .is_some_and(|t| now.saturating_sub(t) > PLC_TIMEOUT_NS)
+    }
+}
+
+/// The task's command carried out: what was done, or why not.
+fn obey(motion: &mut Motion, request: &MotionRequest) -> Result<String, String> {
+    match *request {
+        MotionRequest::FeedHold => motion.feed_hold(),
+        MotionRequest::Resume => motion.cycle_start(),
+        MotionRequest::CycleStop => motion.cycle_stop(),
+        MotionRequest::Reset => motion.reset(),
+        MotionRequest::Mode(m) => motion.set_mode(m),
+        MotionRequest::ReferenceReturn => return motion.reference_return(),
+        MotionRequest::Jog { direction: 0, .. } => motion.jog_stop(),
+        MotionRequest::Jog {
+            axis,
+            direction,
+            feed,
+            increment,
+        } => {
+            let step = (increment > 0.0).then_some(increment);
+            motion.jog(usize::from(axis), direction > 0, feed, step)?;
+            return Ok("jog".into());
+        }
+    }
+    Ok("done".into())
+}
+
+fn answer(id: u64, result: Result<String, String>) -> CommandResult {
+    let (accepted, message) = match result {
+        Ok(m) => (true, m),
+        Err(m) => (false, m),
+    };
+    CommandResult {
+        id,
+        accepted,
+        message,
+        ..CommandResult::default()
     }
 }
 
@@ -415,42 +434,20 @@ fn servo_loop(
         while let Ok(input) = inputs.try_recv() {
             match input {
                 Input::Block(b) => motion.push(b),
-                Input::Command(ProgramCommand::FEED_HOLD) => motion.feed_hold(),
-                Input::Command(ProgramCommand::CYCLE_STOP) => motion.cycle_stop(),
-                Input::Command(ProgramCommand::RESET) => {
-                    motion.reset();
-                    watch.reset();
-                    // A PLC still silent is reported again (its alarm was cleared by reset).
-                    plc.reported = false;
-                }
-                Input::Command(ProgramCommand::START) => motion.cycle_start(),
-                Input::Command(ProgramCommand::REFERENCE_RETURN) => {
-                    let warning = match motion.reference_return() {
-                        Ok(m) => {
-                            log::info!("motion: {m}");
-                            None
-                        }
-                        Err(e) => {
-                            log::warn!("motion: {e}");
-                            Some(e)
-                        }
-                    };
-                    let _ = reports.send(Report::Warning(alarm::REFERENCE_REFUSED, warning));
-                }
-                Input::Jog(axis, direction, feed, increment) => {
-                    let result = if direction == 0 {
-                        motion.jog_stop();
-                        Ok(())
-                    } else {
-                        let step = (increment > 0.0).then_some(increment);
-                        motion.jog(axis, direction > 0, feed, step)
-                    };
-                    if let Err(e) = result {
-                        log::warn!("motion: {e}");
+                Input::Command(id, request) => {
+                    if request == MotionRequest::Reset {
+                        watch.reset();
+                        // A PLC still silent is reported again (its alarm was cleared by reset).
+                        plc.reported = false;
                     }
+                    let result = obey(&mut motion, &request);
+                    if request == MotionRequest::ReferenceReturn {
+                        // A refused reference return is also a warning on the alarm list.
+                        let warning = result.as_ref().err().cloned();
+                        let _ = reports.send(Report::Warning(alarm::REFERENCE_REFUSED, warning));
+                    }
+                    let _ = reports.send(Report::Answer(id, result));
                 }
-                Input::Mode(m) => motion.set_mode(m),
-                Input::Command(_) => {}
             }
         }
         match g_in.latest()? {

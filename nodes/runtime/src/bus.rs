@@ -23,7 +23,7 @@ use iceoryx2::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
-use crate::topics::{Delivery, Topic, MOTION_BLOCKS, PROGRAM_COMMAND};
+use crate::topics::{Delivery, Topic, MOTION_BLOCKS, TASK_COMMAND};
 
 /// Ports of one service: the nodes of a machine and the recorder, with room for a node that
 /// restarts before its old ports are cleaned up.
@@ -46,16 +46,16 @@ pub fn depth(topic: &Topic) -> usize {
         Delivery::Commands if topic.path == MOTION_BLOCKS.path => 1024,
         // Program texts travel here (up to 4 MiB; the bridge repeats a command until it is
         // answered): few, since every sample slot of a publisher grows to the largest sample.
-        Delivery::Commands if topic.path == PROGRAM_COMMAND.path => 4,
+        Delivery::Commands if topic.path == TASK_COMMAND.path => 4,
         Delivery::Commands => 16,
     }
 }
 
-/// Ports of `topic`'s service: the program command stream has two writers (bridge,
-/// interpreter) and three readers (interpreter, motion, recorder), and few ports keep its
-/// shared memory small when a large program passes.
+/// Ports of `topic`'s service: the task command stream has one writer (the bridge) and two
+/// readers (the task, the recorder), and few ports keep its shared memory small when a large
+/// program passes.
 fn ports(topic: &Topic) -> usize {
-    match topic.path == PROGRAM_COMMAND.path {
+    match topic.path == TASK_COMMAND.path {
         true => 4,
         false => MAX_PORTS,
     }
@@ -232,7 +232,7 @@ impl<M: DeserializeOwned> Subscription<M> {
 mod tests {
     use super::*;
     use crate::topics;
-    use cnc_msgs::msg::{MachineState, MotionBlock, ProgramCommand};
+    use cnc_msgs::msg::{MachineState, MotionBlock, TaskCommand};
 
     fn bus(tag: &str) -> Bus {
         Bus::new(&format!("test_bus_{tag}_{}", std::process::id()), "t").unwrap()
@@ -242,16 +242,17 @@ mod tests {
     fn messages_cross_the_bus_as_dds_would_carry_them() {
         let bus = bus("cross");
         let sub = bus
-            .subscription::<ProgramCommand>(&topics::PROGRAM_COMMAND)
+            .subscription::<TaskCommand>(&topics::TASK_COMMAND)
             .unwrap();
-        let publisher = bus.raw_publisher(&topics::PROGRAM_COMMAND).unwrap();
+        let publisher = bus.raw_publisher(&topics::TASK_COMMAND).unwrap();
         // A program near the memory's limit grows the publisher's slices.
         let text = "G01 X1. Z2.\n".repeat(300_000);
-        let command = ProgramCommand {
+        let command = TaskCommand {
             id: 7,
-            command: ProgramCommand::LOAD,
+            kind: TaskCommand::LOAD,
             program: "O0001".into(),
             text,
+            ..TaskCommand::default()
         };
         publisher.send(&encode(&command).unwrap(), 42).unwrap();
         let got = sub.take().unwrap().unwrap();

@@ -108,18 +108,25 @@ pub const SIM_INPUT_CHECKED: Topic = topic(
     "cnc_msgs/msg/SimInput",
     Delivery::Events(10),
 );
-pub const PROGRAM_COMMAND: Topic = topic(
-    "_internal/program_command",
-    "cnc_msgs/msg/ProgramCommand",
+/// The bridge's commands to the task (typed: `cnc_msgs::task::TaskRequest`), each answered on
+/// [`COMMAND_RESULT`]; the task alone reads them.
+pub const TASK_COMMAND: Topic = topic(
+    "_internal/task_command",
+    "cnc_msgs/msg/TaskCommand",
     Delivery::Commands,
 );
-/// The interpreter's commands to motion (reference return, jog, mode, cycle stop) on a
-/// stream of their own, with one writer: the bridge repeats its commands on
-/// [`PROGRAM_COMMAND`] until answered, and those copies could crowd one of these out of a
-/// reader's buffer there.
+/// What the task decided motion must do (feed hold, resume, cycle stop, reset, reference
+/// return, jog, mode), each answered on [`MOTION_RESULT`]; motion takes commands from here
+/// only (issue 47: one node judges a command).
 pub const MOTION_COMMAND: Topic = topic(
     "_internal/motion_command",
-    "cnc_msgs/msg/ProgramCommand",
+    "cnc_msgs/msg/MotionCommand",
+    Delivery::Commands,
+);
+/// Motion's answer to each [`MOTION_COMMAND`]: a refusal reaches the command's caller.
+pub const MOTION_RESULT: Topic = topic(
+    "_internal/motion_result",
+    "cnc_msgs/msg/CommandResult",
     Delivery::Commands,
 );
 pub const COMMAND_RESULT: Topic = topic(
@@ -160,8 +167,9 @@ pub const ALL: &[Topic] = &[
     ROBOT_HANDSHAKE,
     SIM_INPUT_CHECKED,
     ROBOT_SIGNALS,
-    PROGRAM_COMMAND,
+    TASK_COMMAND,
     MOTION_COMMAND,
+    MOTION_RESULT,
     COMMAND_RESULT,
     MOTION_BLOCKS,
     MOTION_STATUS,

@@ -1,19 +1,22 @@
 //! interpreter node shell: binds the run core ([`crate::run::RunCore`]: program memory, program
 //! runs, the credit-based block stream to motion, the machine state) to DDS and the memory file.
 //!
-//! Commands arrive from hmi_bridge on `_internal/program_command`, each answered on
-//! `_internal/command_result`; what motion must do (reference return, jog, mode, cycle stop)
-//! goes to it on `_internal/motion_command`. During a run, at most `capacity` unfinished blocks are in flight:
-//! motion's `done_seq` returns the credit.
+//! Commands arrive from hmi_bridge on `_internal/task_command`, each answered on
+//! `_internal/command_result`; what motion must do (feed hold, resume, cycle stop, reset,
+//! reference return, jog, mode) goes to it on `_internal/motion_command`, and motion's answers
+//! come back on `_internal/motion_result` (a refusal there is the caller's answer). During a
+//! run, at most `capacity` unfinished blocks are in flight: motion's `done_seq` returns the
+//! credit.
 
 use std::collections::BTreeMap;
 use std::time::Duration;
 
 use cnc_msgs::msg::{
-    Alarm, AlarmEvent, AxisState, CommandResult, MachineState, MotionBlock, MotionStatus,
-    ProgramCommand,
+    Alarm, AlarmEvent, AxisState, CommandResult, MachineState, MotionBlock, MotionCommand,
+    MotionStatus, TaskCommand,
 };
 use cnc_msgs::signals::{g, GImage, SignalTable};
+use cnc_msgs::task::TaskRequest;
 use cnc_runtime::alarms::AlarmReporter;
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::dds::{stamp, RosNode};
@@ -133,9 +136,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let dialect = Dialect::from_name(&cfg.machine.dialect)
         .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
-    let commands = ros.subscription::<ProgramCommand>(&topics::PROGRAM_COMMAND)?;
+    let commands = ros.subscription::<TaskCommand>(&topics::TASK_COMMAND)?;
     let results = ros.publisher::<CommandResult>(&topics::COMMAND_RESULT)?;
-    let to_motion_cmd = ros.publisher::<ProgramCommand>(&topics::MOTION_COMMAND)?;
+    let to_motion_cmd = ros.publisher::<MotionCommand>(&topics::MOTION_COMMAND)?;
+    let motion_results = ros.subscription::<CommandResult>(&topics::MOTION_RESULT)?;
     let blocks = ros.publisher::<MotionBlock>(&topics::MOTION_BLOCKS)?;
     let status_sub = ros.subscription::<MotionStatus>(&topics::MOTION_STATUS)?;
     let axes_sub = ros.subscription::<AxisState>(&topics::AXES)?;
@@ -253,13 +257,6 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         while let Ok(Some(a)) = axes_sub.take() {
             let commanded: Vec<f64> = a.axes.iter().map(|x| x.commanded_position).collect();
             core.axes(&commanded);
-            core.overtravel_axes(
-                a.axes
-                    .iter()
-                    .filter(|x| x.overtravel != 0)
-                    .map(|x| (x.name.clone(), x.overtravel))
-                    .collect(),
-            );
             core.unreferenced_axes(
                 a.axes
                     .iter()
@@ -277,10 +274,26 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             core.block_skip_switch(g.get(g::BDT1));
         }
         carry_out(&mut core);
+        while let Ok(Some(r)) = motion_results.take() {
+            if let Some(answer) = core.motion_result(&r) {
+                let _ = results.publish(answer);
+            }
+        }
         while let Ok(Some(c)) = commands.take() {
             busy = true;
-            if c.command == ProgramCommand::START
-                && !c.program.is_empty()
+            let request = match TaskRequest::from_command(&c) {
+                Ok(r) => r,
+                Err(message) => {
+                    let _ = results.publish(CommandResult {
+                        id: c.id,
+                        accepted: false,
+                        message,
+                        ..CommandResult::default()
+                    });
+                    continue;
+                }
+            };
+            if matches!(&request, TaskRequest::Start { name, .. } if !name.is_empty())
                 && !cfg.machine.external_drives.is_empty()
             {
                 // The external drives as they are at this start (D110).
@@ -291,9 +304,11 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 }
                 core.set_external_programs(programs);
             }
-            let result = core.command(c);
+            let result = core.command(c.id, request);
             carry_out(&mut core);
-            let _ = results.publish(result);
+            if let Some(result) = result {
+                let _ = results.publish(result);
+            }
         }
         // A start is reported before any block of it runs: a program that fails in its first
         // blocks still shows ACTIVE, then STOPPED, in that order.

@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use serde_json::{json, Value};
 
 use crate::access::Who;
-use crate::operation::Operation;
+use crate::operation::{Answer, Operation};
 use server::{Outbox, Payload, WebEvent, WebServer};
 use view::View;
 
@@ -172,22 +172,39 @@ impl WebHmi {
     }
 
     /// Answers a page's request; reads bring their data in a frame of their own.
-    pub fn answer(&mut self, pending: Pending, accepted: bool, message: String) {
-        let data = match (&pending.op, accepted) {
+    pub fn answer(&mut self, pending: Pending, answer: Answer) {
+        let data = match (&pending.op, answer.accepted) {
             (Operation::Read { name }, true) => {
-                Some(json!({"type": "program", "name": name, "text": message}))
+                Some(json!({"type": "program", "name": name, "text": answer.message}))
             }
-            (Operation::Offsets, true) => Some(json!({"type": "offsets", "text": message})),
+            (Operation::Offsets, true) => {
+                let tools: Vec<Value> = answer
+                    .tools
+                    .iter()
+                    .map(|t| {
+                        json!({"number": t.number, "x": t.x, "z": t.z, "wear_x": t.wear_x,
+                               "wear_z": t.wear_z, "radius": t.radius, "tip": t.tip})
+                    })
+                    .collect();
+                let work: Vec<Value> = answer
+                    .work
+                    .iter()
+                    .map(|w| json!({"code": w.code, "axes": w.axes, "values": w.values}))
+                    .collect();
+                Some(json!({"type": "offsets", "tools": tools, "work": work}))
+            }
             (Operation::Parameters { .. }, true) => {
-                let rows: Vec<Value> = crate::operation::parameter_rows(&message)
-                    .into_iter()
+                let rows: Vec<Value> = answer
+                    .parameters
+                    .iter()
                     .map(|(name, value, pending)| json!([name, value, pending]))
                     .collect();
                 Some(json!({"type": "parameters", "rows": rows}))
             }
             (Operation::List, true) => {
-                let list: Vec<Value> = crate::operation::program_list(&message)
-                    .into_iter()
+                let list: Vec<Value> = answer
+                    .programs
+                    .iter()
                     .map(|(name, size)| json!({"name": name, "size": size}))
                     .collect();
                 Some(json!({"type": "programs", "programs": list}))
@@ -197,13 +214,13 @@ impl WebHmi {
         let shown = if data.is_some() {
             "ok".to_string()
         } else {
-            message
+            answer.message
         };
         let reply = json!({
             "type": "reply",
             "id": pending.id,
             "op": pending.op.command(),
-            "accepted": accepted,
+            "accepted": answer.accepted,
             "message": shown,
         });
         if let Some(d) = data {

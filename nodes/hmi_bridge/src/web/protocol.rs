@@ -2,7 +2,7 @@
 //! Each request becomes the same [`Operation`] a ROS 2 service makes; a request that does not
 //! parse is answered with why, and nothing happens.
 
-use cnc_msgs::msg::{MachineState, Overrides};
+use cnc_msgs::msg::{MachineState, Overrides, ToolOffset, WorkOffset};
 use serde_json::Value;
 
 use crate::operation::Operation;
@@ -123,14 +123,12 @@ fn operation(v: &Value) -> Result<Operation, String> {
             }
         }
         "offsets" => Operation::Offsets,
-        "set_tool_offset" => Operation::SetToolOffset {
-            number: string(v, "number")?,
-            values: string(v, "values")?,
-        },
-        "set_work_offset" => Operation::SetWorkOffset {
-            code: string(v, "code")?,
-            values: string(v, "values")?,
-        },
+        "set_tool_offset" => {
+            Operation::SetToolOffset(tool_row(&string(v, "number")?, &string(v, "values")?)?)
+        }
+        "set_work_offset" => {
+            Operation::SetWorkOffset(work_row(&string(v, "code")?, &string(v, "values")?)?)
+        }
         "parameters" => Operation::Parameters {
             prefix: string(v, "prefix").unwrap_or_default(),
         },
@@ -151,6 +149,55 @@ fn operation(v: &Value) -> Result<Operation, String> {
         },
         other => return Err(format!("unknown op {other:?}")),
     })
+}
+
+fn number(word: &str, what: &str) -> Result<f64, String> {
+    word.trim()
+        .parse()
+        .map_err(|_| format!("{what}: {word:?} is not a number"))
+}
+
+/// A tool row as the panel's fields give it: the offset number, and `x z wear_x wear_z radius
+/// tip` (the task checks the ranges).
+fn tool_row(entry: &str, values: &str) -> Result<ToolOffset, String> {
+    let n = entry
+        .trim()
+        .parse()
+        .map_err(|_| format!("offset number {entry:?} is not a number"))?;
+    let words: Vec<&str> = values.split_whitespace().collect();
+    let [x, z, wx, wz, r, tip] = words[..] else {
+        return Err(format!(
+            "tool offset needs 6 values: x z wear_x wear_z radius tip, got {}",
+            words.len()
+        ));
+    };
+    Ok(ToolOffset {
+        number: n,
+        x: number(x, "X")?,
+        z: number(z, "Z")?,
+        wear_x: number(wx, "X wear")?,
+        wear_z: number(wz, "Z wear")?,
+        radius: number(r, "nose radius")?,
+        tip: tip
+            .parse()
+            .map_err(|_| format!("tip direction {tip:?} out of range 0-9"))?,
+    })
+}
+
+/// A work offset as the panel's fields give it: the code, and `X=.. Z=..`.
+fn work_row(code: &str, values: &str) -> Result<WorkOffset, String> {
+    let mut row = WorkOffset {
+        code: code.trim().to_string(),
+        ..WorkOffset::default()
+    };
+    for word in values.split_whitespace() {
+        let (axis, v) = word
+            .split_once('=')
+            .ok_or_else(|| format!("{word:?}: write axis=value, e.g. Z=-120.5"))?;
+        row.values.push(number(v, &format!("{code} {axis}"))?);
+        row.axes.push(axis.trim().to_string());
+    }
+    Ok(row)
 }
 
 #[cfg(test)]
@@ -207,6 +254,27 @@ mod tests {
         );
         assert!(parse(r#"{"op":"acknowledge","number":-3}"#).1.is_err());
         assert_eq!(
+            parse(r#"{"op":"set_tool_offset","number":"3","values":"-120.5 40 0.02 -0.01 0.4 3"}"#)
+                .1,
+            Ok(Operation::SetToolOffset(ToolOffset {
+                number: 3,
+                x: -120.5,
+                z: 40.0,
+                wear_x: 0.02,
+                wear_z: -0.01,
+                radius: 0.4,
+                tip: 3
+            }))
+        );
+        assert_eq!(
+            parse(r#"{"op":"set_work_offset","code":"g55","values":"X=10 Z=-200.25"}"#).1,
+            Ok(Operation::SetWorkOffset(WorkOffset {
+                code: "g55".into(),
+                axes: vec!["X".into(), "Z".into()],
+                values: vec![10.0, -200.25]
+            }))
+        );
+        assert_eq!(
             parse(r#"{"id":4,"op":"mode","mode":"mdi"}"#).1,
             Ok(Operation::Mode {
                 mode: MachineState::MODE_MDI
@@ -234,6 +302,18 @@ mod tests {
                 "feed missing",
             ),
             (r#"{"op":"mode","mode":"TURBO"}"#, "unknown mode"),
+            (
+                r#"{"op":"set_tool_offset","number":"3","values":"1 2 3"}"#,
+                "needs 6 values",
+            ),
+            (
+                r#"{"op":"set_tool_offset","number":"3","values":"x 0 0 0 0 3"}"#,
+                "not a number",
+            ),
+            (
+                r#"{"op":"set_work_offset","code":"G54","values":"Z:1"}"#,
+                "axis=value",
+            ),
         ] {
             let err = parse(text).1.unwrap_err();
             assert!(err.contains(why), "{text}: {err}");

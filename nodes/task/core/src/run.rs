@@ -13,9 +13,8 @@ use std::collections::{BTreeMap, VecDeque};
 
 use cnc_machine::programs::MDI_PROGRAM;
 use cnc_msgs::canon::to_motion_block;
-use cnc_msgs::msg::{
-    Alarm, AlarmEvent, CommandResult, MachineState, MotionBlock, MotionStatus, ProgramCommand,
-};
+use cnc_msgs::msg::{Alarm, AlarmEvent, CommandResult, MachineState, MotionBlock, MotionStatus};
+use cnc_msgs::task::{MotionRequest, TaskRequest};
 
 use crate::offset_page;
 use crate::position::{text_hash, ProgramPosition};
@@ -39,8 +38,8 @@ pub const SOURCE: &str = "interpreter";
 pub enum Effect {
     /// Send this block to motion.
     Block(MotionBlock),
-    /// Send this command to motion (a cycle stop when an alarm ends the run).
-    ToMotion(ProgramCommand),
+    /// Send this command to motion; motion answers it ([`RunCore::motion_result`]).
+    ToMotion(cnc_msgs::msg::MotionCommand),
     /// Raise the interpreter's alarm (error severity).
     Raise {
         number: u32,
@@ -130,7 +129,7 @@ pub struct RunCore {
     execution: u8,
     mode: u8,
     program_name: String,
-    stop_command_id: u64,
+    motion_command_id: u64,
     memory: Memory,
     effects: Vec<Effect>,
     /// How a restarted program approaches its restart block.
@@ -140,8 +139,33 @@ pub struct RunCore {
     position_kept: Option<ProgramPosition>,
     /// Axes motion reports not referenced (incremental encoders after power-on, D68).
     unreferenced: Vec<String>,
-    /// Axes on an overtravel switch, with the side (+1, -1; D70).
-    overtravel: Vec<(String, i8)>,
+    /// Callers' commands passed on to motion, by the motion command's id: answered when
+    /// motion answers (a jog toward a pressed overtravel switch is motion's to refuse).
+    awaiting_motion: BTreeMap<u64, AwaitingMotion>,
+}
+
+/// A caller's command waiting for motion's answer.
+struct AwaitingMotion {
+    caller: u64,
+    /// The answer if motion accepts.
+    message: String,
+}
+
+/// How the core answers a command it accepted.
+enum Reply {
+    /// Now: the answer (its id is filled in by [`RunCore::command`]).
+    Done(CommandResult),
+    /// When motion answers the command just sent to it; `String` is the answer if it accepts.
+    AfterMotion(String),
+}
+
+/// An accepted command's answer: a message only.
+fn done(message: impl Into<String>) -> Result<Reply, String> {
+    Ok(Reply::Done(CommandResult {
+        accepted: true,
+        message: message.into(),
+        ..CommandResult::default()
+    }))
 }
 
 impl RunCore {
@@ -167,7 +191,8 @@ impl RunCore {
             // without an operator turning the switch).
             mode: MachineState::MODE_AUTO,
             program_name: String::new(),
-            stop_command_id: 0,
+            // Motion's command ids continue across restarts of the task, as run ids do.
+            motion_command_id: first_run_id,
             message: String::new(),
             memory,
             effects: Vec::new(),
@@ -175,14 +200,8 @@ impl RunCore {
             base,
             position_kept: None,
             unreferenced: Vec::new(),
-            overtravel: Vec::new(),
+            awaiting_motion: BTreeMap::new(),
         }
-    }
-
-    /// The axes motion reports on an overtravel switch (`Axis.overtravel`): a jog toward the
-    /// switch is refused (D70).
-    pub fn overtravel_axes(&mut self, axes: Vec<(String, i8)>) {
-        self.overtravel = axes;
     }
 
     /// The axes motion reports without a reference point yet (`AxisState.homed` false): no
@@ -301,64 +320,110 @@ impl RunCore {
         if let Some(r) = self.run.as_mut() {
             if !r.failed {
                 r.failed = true;
-                self.send_motion(ProgramCommand::CYCLE_STOP, "");
+                self.send_motion(MotionRequest::CycleStop);
             }
         }
         self.stop_execution();
     }
 
-    /// A command from hmi_bridge, answered. hmi_bridge repeats a command until it is
-    /// answered: a repeat gets the same answer again and is not acted on twice.
-    pub fn command(&mut self, c: ProgramCommand) -> CommandResult {
-        if let Some(done) = self.answered.iter().find(|r| r.id == c.id) {
-            return done.clone();
+    /// A command from hmi_bridge (`id` is the caller's), answered now, or `None` while motion
+    /// has yet to answer what the task passed on to it ([`RunCore::motion_result`] answers
+    /// then). hmi_bridge repeats a command until it is answered: a repeat gets the same answer
+    /// again and is not acted on twice.
+    pub fn command(&mut self, id: u64, request: TaskRequest) -> Option<CommandResult> {
+        if let Some(done) = self.answered.iter().find(|r| r.id == id) {
+            return Some(done.clone());
         }
-        let (accepted, message) = match self.carry_out(c.clone()) {
-            Ok(m) => (true, m),
-            Err(m) => (false, m),
+        if self.awaiting_motion.values().any(|w| w.caller == id) {
+            return None;
+        }
+        let result = match self.carry_out(request) {
+            Ok(Reply::Done(mut r)) => {
+                r.id = id;
+                r
+            }
+            Ok(Reply::AfterMotion(message)) => {
+                // Motion not answering (not running) leaves the caller to time out; the oldest
+                // waiting are let go so the map stays small.
+                if self.awaiting_motion.len() == ANSWERS_KEPT {
+                    self.awaiting_motion.pop_first();
+                }
+                let w = AwaitingMotion {
+                    caller: id,
+                    message,
+                };
+                self.awaiting_motion.insert(self.motion_command_id, w);
+                return None;
+            }
+            Err(message) => CommandResult {
+                id,
+                accepted: false,
+                message,
+                ..CommandResult::default()
+            },
         };
+        self.keep_answer(result.clone());
+        Some(result)
+    }
+
+    /// Motion's answer to one of the task's commands: the answer to the caller whose command
+    /// it was, if any (motion's refusal, with its reason, is the caller's answer).
+    pub fn motion_result(&mut self, r: &CommandResult) -> Option<CommandResult> {
+        let waiting = self.awaiting_motion.remove(&r.id)?;
         let result = CommandResult {
-            id: c.id,
-            accepted,
-            message,
+            id: waiting.caller,
+            accepted: r.accepted,
+            message: if r.accepted {
+                waiting.message
+            } else {
+                r.message.clone()
+            },
+            ..CommandResult::default()
         };
+        self.keep_answer(result.clone());
+        Some(result)
+    }
+
+    fn keep_answer(&mut self, result: CommandResult) {
         if self.answered.len() == ANSWERS_KEPT {
             self.answered.pop_front();
         }
-        self.answered.push_back(result.clone());
-        result
+        self.answered.push_back(result);
     }
 
-    fn carry_out(&mut self, c: ProgramCommand) -> Result<String, String> {
+    fn carry_out(&mut self, request: TaskRequest) -> Result<Reply, String> {
         let running = self.running();
-        match c.command {
-            // An MDI entry is stored as the program `MDI` and started as a program is
-            // (decisions D43); cycle start runs programs in AUTO only.
-            // At power-up the PLC's interface holds the emergency stop until its first scan:
-            // a start then would be refused by motion, or wait unseen.
-            ProgramCommand::START | ProgramCommand::MDI if !self.plc_scanned => {
-                Err("the machine is not ready: the PLC has not scanned its inputs yet".into())
+        let starts = matches!(request, TaskRequest::Start { .. } | TaskRequest::Mdi { .. });
+        // An MDI entry is stored as the program `MDI` and started as a program is (decisions
+        // D43); cycle start runs programs in AUTO only.
+        if starts {
+            // At power-up the PLC's interface holds the emergency stop until its first scan: a
+            // start then would be refused by motion, or wait unseen.
+            if !self.plc_scanned {
+                return Err(
+                    "the machine is not ready: the PLC has not scanned its inputs yet".into(),
+                );
             }
-            ProgramCommand::START | ProgramCommand::MDI if self.mode == MachineState::MODE_HOME => {
-                self.reference_return()
+            if self.mode == MachineState::MODE_HOME {
+                return self.reference_return();
             }
-            ProgramCommand::START | ProgramCommand::MDI
-                if !self.unreferenced.is_empty() && self.execution != MachineState::FEED_HOLD =>
-            {
-                Err(format!(
+            if !self.unreferenced.is_empty() && self.execution != MachineState::FEED_HOLD {
+                return Err(format!(
                     "alarm 224: reference return not done ({}): select HOME and press cycle \
                      start",
                     self.unreferenced.join(", ")
-                ))
+                ));
             }
-            ProgramCommand::MDI => {
-                if let Some(why) = mdi_refusal(self.mode, running, &c.text) {
+        }
+        match request {
+            TaskRequest::Mdi { text } => {
+                if let Some(why) = mdi_refusal(self.mode, running, &text) {
                     return Err(why);
                 }
-                self.programs.insert(MDI_PROGRAM.into(), c.text.clone());
-                self.start(MDI_PROGRAM, "")
+                self.programs.insert(MDI_PROGRAM.into(), text);
+                done(self.start(MDI_PROGRAM, "")?)
             }
-            ProgramCommand::START
+            TaskRequest::Start { .. }
                 if self.mode != MachineState::MODE_AUTO
                     && self.execution != MachineState::FEED_HOLD =>
             {
@@ -367,98 +432,133 @@ impl RunCore {
                     MachineState::mode_name_of(self.mode)
                 ))
             }
-            ProgramCommand::START => self.start(&c.program, &c.text),
-            ProgramCommand::MODE => self.set_mode(&c.text),
-            ProgramCommand::JOG => self.jog(&c.text),
-            ProgramCommand::READ => self
-                .programs
-                .get(&c.program)
-                .cloned()
-                .ok_or_else(|| not_found(&c.program)),
-            ProgramCommand::OFFSETS => Ok(offset_page::format(&self.memory, &self.base.axes)),
-            ProgramCommand::SET_TOOL_OFFSET | ProgramCommand::SET_WORK_OFFSET => {
-                if running {
-                    return Err("offsets cannot change while a program runs (stop it first)".into());
-                }
-                // A stopped run's offsets are taken first, so the edit is not overwritten by
-                // them later.
-                self.remember();
-                self.run = None;
-                let mut edited = self.memory.clone();
-                let message = if c.command == ProgramCommand::SET_TOOL_OFFSET {
-                    offset_page::set_tool(&mut edited, self.dialect, &c.program, &c.text)
-                } else {
-                    offset_page::set_work(&mut edited, &c.program, &c.text, &self.base.axes)
-                }?;
-                self.memory = edited;
-                self.effects.push(Effect::StoreMemory);
-                Ok(message)
+            TaskRequest::Start { name, at } => done(self.start(&name, &at)?),
+            TaskRequest::Mode(m) => done(self.set_mode(m)?),
+            TaskRequest::Jog(j) => self.jog(&j),
+            TaskRequest::Read { name } => done(
+                self.programs
+                    .get(&name)
+                    .cloned()
+                    .ok_or_else(|| not_found(&name))?,
+            ),
+            TaskRequest::Offsets => {
+                let (tools, work) = offset_page::page(&self.memory, &self.base.axes);
+                Ok(Reply::Done(CommandResult {
+                    accepted: true,
+                    message: format!("{} tool offsets, {} work offsets", tools.len(), work.len()),
+                    tool_offsets: tools,
+                    work_offsets: work,
+                    ..CommandResult::default()
+                }))
             }
-            ProgramCommand::LOAD => self.load(&c.program, &c.text),
-            ProgramCommand::FEED_HOLD => {
-                if self.execution == MachineState::ACTIVE {
-                    self.execution = MachineState::FEED_HOLD;
-                    Ok("feed hold".into())
-                } else {
-                    Err("no program running".into())
-                }
+            TaskRequest::SetToolOffset(row) => {
+                let dialect = self.dialect;
+                done(self.edit_offsets(|m, _| offset_page::set_tool(m, dialect, &row))?)
             }
-            ProgramCommand::CYCLE_STOP => {
+            TaskRequest::SetWorkOffset(row) => {
+                done(self.edit_offsets(|m, axes| offset_page::set_work(m, &row, axes))?)
+            }
+            TaskRequest::Load { name, text } => done(self.load(&name, &text)?),
+            TaskRequest::FeedHold => {
+                if self.execution != MachineState::ACTIVE {
+                    return Err("no program running".into());
+                }
+                self.execution = MachineState::FEED_HOLD;
+                self.send_motion(MotionRequest::FeedHold);
+                done("feed hold")
+            }
+            TaskRequest::CycleStop => {
                 if let Some(r) = self.run.as_mut() {
                     r.failed = true;
                 }
                 self.stop_execution();
-                Ok("cycle stop".into())
+                self.send_motion(MotionRequest::CycleStop);
+                done("cycle stop")
             }
-            ProgramCommand::RESET => {
-                self.remember();
-                self.run = None;
-                self.message.clear();
-                // Program alarms are cleared by reset; alarms whose cause persists (emergency
-                // stop) stay until their source clears them.
-                for (source, number) in self.active_alarms.clone() {
-                    if source == SOURCE {
-                        self.effects.push(Effect::Clear(number));
-                        self.active_alarms
-                            .retain(|k| k != &(source.clone(), number));
-                    }
-                }
-                self.execution = if self.position.is_some() && self.plc_scanned {
-                    MachineState::READY
-                } else {
-                    MachineState::WAIT
-                };
-                Ok("reset".into())
+            TaskRequest::Reset => {
+                self.reset();
+                done("reset")
             }
-            ProgramCommand::LIST => Ok(self
-                .programs
-                .iter()
-                .map(|(name, text)| format!("{name}\t{}", text.len()))
-                .collect::<Vec<_>>()
-                .join("\n")),
-            ProgramCommand::DELETE => {
-                let this_runs = self.run.as_ref().is_some_and(|r| r.program == c.program);
-                if this_runs && running {
-                    Err(format!("{} is running: stop it first", c.program))
-                } else if self.programs.contains_key(&c.program) {
-                    if c.program != MDI_PROGRAM {
-                        self.storage
-                            .remove(&c.program)
-                            .map_err(|e| format!("{} not deleted: {e}", c.program))?;
-                    }
-                    self.programs.remove(&c.program);
-                    Ok(format!("{} deleted", c.program))
-                } else {
-                    Err(not_found(&c.program))
-                }
+            TaskRequest::List => {
+                let (programs, program_sizes) = self
+                    .programs
+                    .iter()
+                    .map(|(name, text)| (name.clone(), text.len() as u64))
+                    .unzip();
+                Ok(Reply::Done(CommandResult {
+                    accepted: true,
+                    message: format!("{} programs", self.programs.len()),
+                    programs,
+                    program_sizes,
+                    ..CommandResult::default()
+                }))
             }
-            other => Err(format!("unknown command {other}")),
+            TaskRequest::Delete { name } => done(self.delete(&name, running)?),
         }
     }
 
+    /// Reset: the run is dropped, the interpreter's alarms cleared, motion reset.
+    fn reset(&mut self) {
+        self.remember();
+        self.run = None;
+        self.message.clear();
+        // Program alarms are cleared by reset; alarms whose cause persists (emergency stop)
+        // stay until their source clears them.
+        for (source, number) in self.active_alarms.clone() {
+            if source == SOURCE {
+                self.effects.push(Effect::Clear(number));
+                self.active_alarms
+                    .retain(|k| k != &(source.clone(), number));
+            }
+        }
+        self.execution = if self.position.is_some() && self.plc_scanned {
+            MachineState::READY
+        } else {
+            MachineState::WAIT
+        };
+        self.send_motion(MotionRequest::Reset);
+    }
+
+    fn delete(&mut self, name: &str, running: bool) -> Result<String, String> {
+        let this_runs = self.run.as_ref().is_some_and(|r| r.program == name);
+        if this_runs && running {
+            return Err(format!("{name} is running: stop it first"));
+        }
+        if !self.programs.contains_key(name) {
+            return Err(not_found(name));
+        }
+        if name != MDI_PROGRAM {
+            self.storage
+                .remove(name)
+                .map_err(|e| format!("{name} not deleted: {e}"))?;
+        }
+        self.programs.remove(name);
+        Ok(format!("{name} deleted"))
+    }
+
+    /// An edit of the offset pages, refused while a program runs; `edit` changes a copy, so a
+    /// refused value leaves the pages as they were.
+    fn edit_offsets(
+        &mut self,
+        edit: impl FnOnce(&mut Memory, &[char]) -> Result<String, String>,
+    ) -> Result<String, String> {
+        if self.running() {
+            return Err("offsets cannot change while a program runs (stop it first)".into());
+        }
+        // A stopped run's offsets are taken first, so the edit is not overwritten by them
+        // later.
+        self.remember();
+        self.run = None;
+        let mut edited = self.memory.clone();
+        let message = edit(&mut edited, &self.base.axes)?;
+        self.memory = edited;
+        self.effects.push(Effect::StoreMemory);
+        Ok(message)
+    }
+
     /// Cycle start in HOME mode: motion returns the axes with incremental encoders to their
-    /// reference point, in the config's order (D68).
-    fn reference_return(&mut self) -> Result<String, String> {
+    /// reference point, in the config's order (D68); motion's refusal is the answer.
+    fn reference_return(&mut self) -> Result<Reply, String> {
         if !self.active_alarms.is_empty() {
             return Err(format!(
                 "alarm active ({} alarms): reset first",
@@ -468,13 +568,14 @@ impl RunCore {
         if self.running() {
             return Err("a program is running".into());
         }
-        self.send_motion(ProgramCommand::REFERENCE_RETURN, "");
-        Ok("reference return started".into())
+        self.send_motion(MotionRequest::ReferenceReturn);
+        Ok(Reply::AfterMotion("reference return started".into()))
     }
 
-    /// A jog request, passed on to motion in JOG and HANDWHEEL modes (D69): `text` is
-    /// `<axis> <+|-|0> <feed> <increment>`, checked by [`cnc_msgs::jog::JogText::parse`].
-    fn jog(&mut self, text: &str) -> Result<String, String> {
+    /// A jog, passed on to motion in JOG and HANDWHEEL modes (D69). Motion judges what
+    /// depends on the axes (an alarm, an overtravel switch pressed, D70, an axis moving): its
+    /// refusal is the answer.
+    fn jog(&mut self, j: &cnc_msgs::jog::Jog) -> Result<Reply, String> {
         if !matches!(
             self.mode,
             MachineState::MODE_JOG | MachineState::MODE_HANDWHEEL
@@ -487,44 +588,39 @@ impl RunCore {
         if self.running() {
             return Err("jog refused: a program is running".into());
         }
-        let j = cnc_msgs::jog::JogText::parse(text)?;
-        if !self.base.axes.iter().any(|a| a.to_string() == j.axis) {
+        let Some(axis) = self.base.axes.iter().position(|a| a.to_string() == j.axis) else {
             return Err(format!("jog refused: no axis {}", j.axis));
-        }
-        if self.status.state == MotionStatus::STATE_ALARM {
-            return Err("jog refused: motion alarm (reset first)".into());
-        }
-        if let Some((_, side)) = self
-            .overtravel
-            .iter()
-            .find(|(a, side)| *a == j.axis && *side == j.direction)
-        {
-            return Err(format!(
-                "jog refused: {} is on its {} overtravel switch: jog it the other way",
-                j.axis,
-                if *side > 0 { "+" } else { "−" }
-            ));
-        }
-        self.send_motion(ProgramCommand::MOTION_JOG, &j.to_text());
-        Ok(format!("jog {}", j.to_text()))
+        };
+        self.send_motion(MotionRequest::Jog {
+            axis: axis as u8,
+            direction: j.direction,
+            feed: j.feed,
+            increment: j.increment,
+        });
+        let sign = match j.direction {
+            1 => "+",
+            -1 => "-",
+            _ => "0",
+        };
+        Ok(Reply::AfterMotion(format!(
+            "jog {} {sign} {} {}",
+            j.axis, j.feed, j.increment
+        )))
     }
 
-    fn set_mode(&mut self, text: &str) -> Result<String, String> {
-        match text.trim().parse::<u8>() {
-            Ok(m) if m <= MachineState::MODE_HANDWHEEL => {
-                if self.running() && m != self.mode {
-                    Err("mode change refused: a program is running (stop it first)".into())
-                } else {
-                    self.mode = m;
-                    // Motion acts on the PLC's jog keys in JOG and HANDWHEEL modes (D71).
-                    self.send_motion(ProgramCommand::MOTION_MODE, &m.to_string());
-                    Ok(format!("mode {}", MachineState::mode_name_of(m)))
-                }
-            }
-            _ => Err(format!(
-                "unknown mode {text:?}: 0 AUTO, 1 MDI, 2 JOG, 3 HOME, 4 EDIT, 5 HANDWHEEL"
-            )),
+    fn set_mode(&mut self, m: u8) -> Result<String, String> {
+        if m > MachineState::MODE_HANDWHEEL {
+            return Err(format!(
+                "unknown mode {m}: 0 AUTO, 1 MDI, 2 JOG, 3 HOME, 4 EDIT, 5 HANDWHEEL"
+            ));
         }
+        if self.running() && m != self.mode {
+            return Err("mode change refused: a program is running (stop it first)".into());
+        }
+        self.mode = m;
+        // Motion acts on the PLC's jog keys in JOG and HANDWHEEL modes (D71).
+        self.send_motion(MotionRequest::Mode(m));
+        Ok(format!("mode {}", MachineState::mode_name_of(m)))
     }
 
     fn load(&mut self, name: &str, text: &str) -> Result<String, String> {
@@ -565,6 +661,7 @@ impl RunCore {
         }
         if self.execution == MachineState::FEED_HOLD && name.is_empty() && at.is_empty() {
             self.execution = MachineState::ACTIVE;
+            self.send_motion(MotionRequest::Resume);
             return Ok("resumed".into());
         }
         // What the last run left is taken first: this run starts from it.
@@ -771,15 +868,11 @@ impl RunCore {
         busy
     }
 
-    /// Sends motion `command` with `text` (numbered in the interpreter's own series).
-    fn send_motion(&mut self, command: u8, text: &str) {
-        self.stop_command_id += 1;
-        self.effects.push(Effect::ToMotion(ProgramCommand {
-            id: self.stop_command_id,
-            command,
-            program: String::new(),
-            text: text.into(),
-        }));
+    /// Sends motion `request` (numbered in the task's own series).
+    fn send_motion(&mut self, request: MotionRequest) {
+        self.motion_command_id += 1;
+        let command = request.to_command(self.motion_command_id);
+        self.effects.push(Effect::ToMotion(command));
     }
 
     /// Notes where the program is, if the state shows one worth keeping: with the block in

@@ -2,6 +2,7 @@
 
 use super::*;
 use cnc_interpreter::setup::ToolOffset;
+use cnc_msgs::msg::MotionCommand;
 
 const PART: &str = "G00 X100 Z20\nS500 M03\nG01 Z10 F3000\nG01 Z5\nM05\nM30\n";
 
@@ -22,13 +23,23 @@ fn core() -> RunCore {
     RunCore::new(Dialect::HuaxingLathe, base, memory, 1000)
 }
 
-fn command(core: &mut RunCore, id: u64, command: u8, program: &str, text: &str) -> CommandResult {
-    core.command(ProgramCommand {
-        id,
-        command,
-        program: program.into(),
+/// A command the core answers at once (not one it passes on to motion).
+fn command(core: &mut RunCore, id: u64, request: TaskRequest) -> CommandResult {
+    core.command(id, request).expect("answered at once")
+}
+
+fn load(name: &str, text: &str) -> TaskRequest {
+    TaskRequest::Load {
+        name: name.into(),
         text: text.into(),
-    })
+    }
+}
+
+fn start(name: &str, at: &str) -> TaskRequest {
+    TaskRequest::Start {
+        name: name.into(),
+        at: at.into(),
+    }
 }
 
 fn status(run_id: u64, done_seq: u64, capacity: u32, state: u8) -> MotionStatus {
@@ -57,9 +68,9 @@ fn blocks(effects: &[Effect]) -> Vec<&MotionBlock> {
 fn ready() -> RunCore {
     let mut c = core();
     assert_eq!(c.execution(), MachineState::WAIT);
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "part.nc", PART).accepted);
+    assert!(command(&mut c, 1, load("part.nc", PART)).accepted);
     c.plc_scanned();
-    let refused = command(&mut c, 2, ProgramCommand::START, "part.nc", "");
+    let refused = command(&mut c, 2, start("part.nc", ""));
     assert!(!refused.accepted && refused.message.contains("no axis position"));
     c.axes(&[200.0, 100.0]);
     assert_eq!(c.execution(), MachineState::READY);
@@ -69,26 +80,26 @@ fn ready() -> RunCore {
 #[test]
 fn the_machine_is_ready_only_once_the_plc_has_scanned() {
     let mut c = core();
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "part.nc", PART).accepted);
+    assert!(command(&mut c, 1, load("part.nc", PART)).accepted);
     c.axes(&[200.0, 100.0]);
     // Motion knows the axes, but the PLC's interface still holds the power-up emergency
     // stop: a start now would be refused by motion (1095) or wait unseen.
     assert_eq!(c.execution(), MachineState::WAIT);
-    let refused = command(&mut c, 2, ProgramCommand::START, "part.nc", "");
+    let refused = command(&mut c, 2, start("part.nc", ""));
     assert!(!refused.accepted && refused.message.contains("PLC has not scanned"));
     assert!(blocks(&c.take_effects()).is_empty());
-    let reset = command(&mut c, 3, ProgramCommand::RESET, "", "");
+    let reset = command(&mut c, 3, TaskRequest::Reset);
     assert!(reset.accepted);
     assert_eq!(c.execution(), MachineState::WAIT);
     c.plc_scanned();
     assert_eq!(c.execution(), MachineState::READY);
-    assert!(command(&mut c, 4, ProgramCommand::START, "part.nc", "").accepted);
+    assert!(command(&mut c, 4, start("part.nc", "")).accepted);
 }
 
 #[test]
 fn credit_limits_the_blocks_in_flight_and_completion_follows_motion() {
     let mut c = ready();
-    assert!(command(&mut c, 3, ProgramCommand::START, "part.nc", "").accepted);
+    assert!(command(&mut c, 3, start("part.nc", "")).accepted);
     assert_eq!(c.execution(), MachineState::ACTIVE);
     c.motion_status(status(0, 0, 3, MotionStatus::STATE_IDLE));
     assert!(c.step());
@@ -133,7 +144,7 @@ fn credit_limits_the_blocks_in_flight_and_completion_follows_motion() {
     assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
     assert_eq!(c.state().program, "part.nc");
     // A new start is a new run id.
-    assert!(command(&mut c, 4, ProgramCommand::START, "part.nc", "").accepted);
+    assert!(command(&mut c, 4, start("part.nc", "")).accepted);
     c.motion_status(status(1001, last, 3, MotionStatus::STATE_IDLE));
     c.step();
     assert!(blocks(&c.take_effects()).iter().all(|b| b.run_id == 1002));
@@ -142,13 +153,13 @@ fn credit_limits_the_blocks_in_flight_and_completion_follows_motion() {
 #[test]
 fn feed_hold_follows_motion_and_resumes_on_cycle_start() {
     let mut c = ready();
-    command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    command(&mut c, 3, start("part.nc", ""));
     c.motion_status(status(1001, 0, 2, MotionStatus::STATE_RUNNING));
     c.step();
-    assert!(command(&mut c, 4, ProgramCommand::FEED_HOLD, "", "").accepted);
+    assert!(command(&mut c, 4, TaskRequest::FeedHold).accepted);
     assert_eq!(c.execution(), MachineState::FEED_HOLD);
     // A start while held with no program named resumes.
-    let r = command(&mut c, 5, ProgramCommand::START, "", "");
+    let r = command(&mut c, 5, start("", ""));
     assert!(r.accepted && r.message == "resumed", "{r:?}");
     assert_eq!(c.execution(), MachineState::ACTIVE);
     // Motion holding (panel feed hold) shows as FEED_HOLD, running again as ACTIVE.
@@ -158,17 +169,17 @@ fn feed_hold_follows_motion_and_resumes_on_cycle_start() {
     c.motion_status(status(1001, 0, 2, MotionStatus::STATE_RUNNING));
     c.step();
     assert_eq!(c.execution(), MachineState::ACTIVE);
-    assert!(command(&mut c, 6, ProgramCommand::FEED_HOLD, "", "").accepted);
+    assert!(command(&mut c, 6, TaskRequest::FeedHold).accepted);
 }
 
 #[test]
 fn cycle_stop_ends_the_stream_and_reset_makes_the_machine_ready() {
     let mut c = ready();
-    command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    command(&mut c, 3, start("part.nc", ""));
     c.motion_status(status(1001, 0, 2, MotionStatus::STATE_RUNNING));
     c.step();
     c.take_effects();
-    assert!(command(&mut c, 4, ProgramCommand::CYCLE_STOP, "", "").accepted);
+    assert!(command(&mut c, 4, TaskRequest::CycleStop).accepted);
     assert_eq!(c.execution(), MachineState::STOPPED);
     c.motion_status(status(1001, 2, 2, MotionStatus::STATE_IDLE));
     c.step();
@@ -177,8 +188,8 @@ fn cycle_stop_ends_the_stream_and_reset_makes_the_machine_ready() {
         "a stopped run sends nothing"
     );
     // Offsets and mode may change once stopped.
-    assert!(command(&mut c, 5, ProgramCommand::MODE, "", "1").accepted);
-    assert!(command(&mut c, 6, ProgramCommand::RESET, "", "").accepted);
+    assert!(command(&mut c, 5, TaskRequest::Mode(1)).accepted);
+    assert!(command(&mut c, 6, TaskRequest::Reset).accepted);
     assert_eq!(c.execution(), MachineState::READY);
     assert_eq!(c.state().line, 0);
 }
@@ -187,8 +198,8 @@ fn cycle_stop_ends_the_stream_and_reset_makes_the_machine_ready() {
 fn a_program_alarm_stops_the_run_and_blocks_starts_until_reset() {
     let mut c = ready();
     let bad = "G00 X100 Z20\nG01 Z10 F3000\nG02 X120 Z-20 R5\nM30\n";
-    command(&mut c, 3, ProgramCommand::LOAD, "bad.nc", bad);
-    command(&mut c, 4, ProgramCommand::START, "bad.nc", "");
+    command(&mut c, 3, load("bad.nc", bad));
+    command(&mut c, 4, start("bad.nc", ""));
     c.motion_status(status(0, 0, 16, MotionStatus::STATE_IDLE));
     c.step();
     let effects = c.take_effects();
@@ -206,19 +217,19 @@ fn a_program_alarm_stops_the_run_and_blocks_starts_until_reset() {
     assert_eq!(raised, Some((11, "bad.nc".to_string(), 3)));
     assert_eq!(c.execution(), MachineState::STOPPED);
     assert!(c.state().alarm_active);
-    let r = command(&mut c, 5, ProgramCommand::START, "part.nc", "");
+    let r = command(&mut c, 5, start("part.nc", ""));
     assert!(!r.accepted && r.message.contains("reset first"), "{r:?}");
     // Reset clears the interpreter's own alarm.
-    command(&mut c, 6, ProgramCommand::RESET, "", "");
+    command(&mut c, 6, TaskRequest::Reset);
     assert!(c.take_effects().contains(&Effect::Clear(11)));
     assert!(!c.state().alarm_active);
-    assert!(command(&mut c, 7, ProgramCommand::START, "part.nc", "").accepted);
+    assert!(command(&mut c, 7, start("part.nc", "")).accepted);
 }
 
 #[test]
 fn another_nodes_alarm_stops_the_run_with_a_cycle_stop_and_needs_its_source_to_clear() {
     let mut c = ready();
-    command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    command(&mut c, 3, start("part.nc", ""));
     let mut event = AlarmEvent {
         kind: AlarmEvent::RAISED,
         alarm: Alarm {
@@ -230,20 +241,20 @@ fn another_nodes_alarm_stops_the_run_with_a_cycle_stop_and_needs_its_source_to_c
     };
     c.alarm_event(&event);
     let effects = c.take_effects();
-    assert!(
-        matches!(&effects[..], [Effect::ToMotion(p)] if p.command == ProgramCommand::CYCLE_STOP)
-    );
+    assert!(matches!(&effects[..], [Effect::ToMotion(p)] if p.kind == MotionCommand::CYCLE_STOP));
     assert_eq!(c.execution(), MachineState::STOPPED);
     assert!(c.state().emergency_stop);
     // Reset does not clear another node's alarm; its CLEARED does.
-    command(&mut c, 4, ProgramCommand::RESET, "", "");
+    command(&mut c, 4, TaskRequest::Reset);
     assert!(c.state().alarm_active);
-    assert!(!command(&mut c, 5, ProgramCommand::START, "part.nc", "").accepted);
+    assert!(!command(&mut c, 5, start("part.nc", "")).accepted);
     event.kind = AlarmEvent::CLEARED;
     c.alarm_event(&event);
     assert!(!c.state().alarm_active && !c.state().emergency_stop);
     // A warning informs and stops nothing.
-    assert!(command(&mut c, 6, ProgramCommand::START, "part.nc", "").accepted);
+    assert!(command(&mut c, 6, start("part.nc", "")).accepted);
+    // (The reset's command to motion went before.)
+    c.take_effects();
     c.alarm_event(&AlarmEvent {
         kind: AlarmEvent::RAISED,
         alarm: Alarm {
@@ -260,60 +271,104 @@ fn another_nodes_alarm_stops_the_run_with_a_cycle_stop_and_needs_its_source_to_c
 #[test]
 fn mdi_runs_in_mdi_mode_only_and_programs_in_auto_only() {
     let mut c = ready();
-    let r = command(&mut c, 3, ProgramCommand::MDI, "", "G00 X80 Z20");
+    let r = command(
+        &mut c,
+        3,
+        TaskRequest::Mdi {
+            text: "G00 X80 Z20".into(),
+        },
+    );
     assert!(!r.accepted && r.message.contains("not MDI"), "{r:?}");
-    assert!(command(&mut c, 4, ProgramCommand::MODE, "", "1").accepted);
-    let r = command(&mut c, 5, ProgramCommand::START, "part.nc", "");
+    assert!(command(&mut c, 4, TaskRequest::Mode(1)).accepted);
+    let r = command(&mut c, 5, start("part.nc", ""));
     assert!(!r.accepted && r.message.contains("not AUTO"), "{r:?}");
-    assert!(!command(&mut c, 6, ProgramCommand::MDI, "", "  ").accepted);
-    assert!(command(&mut c, 7, ProgramCommand::MDI, "", "G00 X80 Z20").accepted);
+    assert!(!command(&mut c, 6, TaskRequest::Mdi { text: "  ".into() }).accepted);
+    assert!(
+        command(
+            &mut c,
+            7,
+            TaskRequest::Mdi {
+                text: "G00 X80 Z20".into()
+            }
+        )
+        .accepted
+    );
     assert_eq!(c.state().program, MDI_PROGRAM);
     // No mode change while it runs.
-    let r = command(&mut c, 8, ProgramCommand::MODE, "", "0");
+    let r = command(&mut c, 8, TaskRequest::Mode(0));
     assert!(!r.accepted && r.message.contains("running"), "{r:?}");
-    assert!(!command(&mut c, 9, ProgramCommand::MODE, "", "9").accepted);
+    assert!(!command(&mut c, 9, TaskRequest::Mode(9)).accepted);
 }
 
 #[test]
 fn a_repeated_command_is_answered_again_not_done_twice() {
     let mut c = ready();
-    let first = command(&mut c, 3, ProgramCommand::START, "part.nc", "");
-    let again = command(&mut c, 3, ProgramCommand::START, "part.nc", "");
+    let first = command(&mut c, 3, start("part.nc", ""));
+    let again = command(&mut c, 3, start("part.nc", ""));
     assert_eq!(first, again);
     assert!(first.accepted);
     // A new id is a new start, refused while one runs.
-    assert!(!command(&mut c, 4, ProgramCommand::START, "part.nc", "").accepted);
+    assert!(!command(&mut c, 4, start("part.nc", "")).accepted);
 }
 
 #[test]
 fn program_memory_refuses_bad_names_and_keeps_a_running_program() {
     let mut c = ready();
-    assert!(!command(&mut c, 3, ProgramCommand::LOAD, "../etc", "M30").accepted);
-    assert!(!command(&mut c, 4, ProgramCommand::LOAD, ".hidden", "M30").accepted);
+    assert!(!command(&mut c, 3, load("../etc", "M30")).accepted);
+    assert!(!command(&mut c, 4, load(".hidden", "M30")).accepted);
     let big = "G00 X1\n".repeat(MAX_PROGRAM_BYTES / 7 + 1);
-    assert!(!command(&mut c, 5, ProgramCommand::LOAD, "big.nc", &big).accepted);
-    command(&mut c, 6, ProgramCommand::START, "part.nc", "");
-    assert!(!command(&mut c, 7, ProgramCommand::LOAD, "part.nc", "M30").accepted);
-    assert!(!command(&mut c, 8, ProgramCommand::DELETE, "part.nc", "").accepted);
-    let list = command(&mut c, 9, ProgramCommand::LIST, "", "");
-    assert_eq!(list.message, format!("part.nc\t{}", PART.len()));
-    let read = command(&mut c, 10, ProgramCommand::READ, "part.nc", "");
+    assert!(!command(&mut c, 5, load("big.nc", &big)).accepted);
+    command(&mut c, 6, start("part.nc", ""));
+    assert!(!command(&mut c, 7, load("part.nc", "M30")).accepted);
+    assert!(
+        !command(
+            &mut c,
+            8,
+            TaskRequest::Delete {
+                name: "part.nc".into()
+            }
+        )
+        .accepted
+    );
+    let list = command(&mut c, 9, TaskRequest::List);
+    assert_eq!(
+        (list.programs, list.program_sizes),
+        (vec!["part.nc".to_string()], vec![PART.len() as u64])
+    );
+    let read = command(
+        &mut c,
+        10,
+        TaskRequest::Read {
+            name: "part.nc".into(),
+        },
+    );
     assert_eq!(read.message, PART);
-    assert!(!command(&mut c, 11, ProgramCommand::READ, "none.nc", "").accepted);
+    assert!(
+        !command(
+            &mut c,
+            11,
+            TaskRequest::Read {
+                name: "none.nc".into()
+            }
+        )
+        .accepted
+    );
 }
 
 #[test]
 fn what_a_run_leaves_in_memory_is_stored_and_offsets_wait_for_a_stop() {
     let mut c = ready();
-    command(
+    command(&mut c, 3, load("kept.nc", "#200=7\nG00 X100\nM30\n"));
+    command(&mut c, 4, start("kept.nc", ""));
+    let r = command(
         &mut c,
-        3,
-        ProgramCommand::LOAD,
-        "kept.nc",
-        "#200=7\nG00 X100\nM30\n",
+        5,
+        TaskRequest::SetToolOffset(cnc_msgs::msg::ToolOffset {
+            number: 1,
+            x: 0.5,
+            ..Default::default()
+        }),
     );
-    command(&mut c, 4, ProgramCommand::START, "kept.nc", "");
-    let r = command(&mut c, 5, ProgramCommand::SET_TOOL_OFFSET, "1", "x=0.5");
     assert!(
         !r.accepted && r.message.contains("while a program runs"),
         "{r:?}"
@@ -331,14 +386,8 @@ fn what_a_run_leaves_in_memory_is_stored_and_offsets_wait_for_a_stop() {
     assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
     assert_eq!(c.memory().kept.get(&200), Some(&7.0));
     // The next run starts from it.
-    command(
-        &mut c,
-        6,
-        ProgramCommand::LOAD,
-        "use.nc",
-        "G00 X[#200*10]\nM30\n",
-    );
-    command(&mut c, 7, ProgramCommand::START, "use.nc", "");
+    command(&mut c, 6, load("use.nc", "G00 X[#200*10]\nM30\n"));
+    command(&mut c, 7, start("use.nc", ""));
     c.motion_status(status(1001, last, 16, MotionStatus::STATE_IDLE));
     c.step();
     let b = c.take_effects();
@@ -382,56 +431,41 @@ fn program_memory_is_kept_bounded_by_its_capacity_and_a_failed_write_is_no_load(
     let disk = Disk::default();
     let held: BTreeMap<String, String> = [("O0001".to_string(), "M30\n".to_string())].into();
     let mut c = core().with_program_memory(held, Box::new(disk.clone()), 1000);
-    let r = command(&mut c, 1, ProgramCommand::LIST, "", "");
-    assert!(r.message.contains("O0001"), "{r:?}");
-    let r = command(
-        &mut c,
-        2,
-        ProgramCommand::LOAD,
-        "shafts/O0010.nc",
-        &"G0X1\n".repeat(100),
-    );
+    let r = command(&mut c, 1, TaskRequest::List);
+    assert!(r.programs.contains(&"O0001".to_string()), "{r:?}");
+    let r = command(&mut c, 2, load("shafts/O0010.nc", &"G0X1\n".repeat(100)));
     assert!(r.accepted, "{r:?}");
     assert!(disk.files.lock().unwrap().contains_key("shafts/O0010.nc"));
-    let r = command(
-        &mut c,
-        3,
-        ProgramCommand::LOAD,
-        "big.nc",
-        &"G0X1\n".repeat(100),
-    );
+    let r = command(&mut c, 3, load("big.nc", &"G0X1\n".repeat(100)));
     assert!(!r.accepted && r.message.contains("alarm 70"), "{r:?}");
     assert!(r.message.contains("of 1000 bytes free"), "{r:?}");
-    let r = command(&mut c, 4, ProgramCommand::LOAD, "../escape.nc", "M30\n");
+    let r = command(&mut c, 4, load("../escape.nc", "M30\n"));
     assert!(
         !r.accepted && r.message.contains("invalid program name"),
         "{r:?}"
     );
-    let r = command(&mut c, 5, ProgramCommand::DELETE, "shafts/O0010.nc", "");
+    let r = command(
+        &mut c,
+        5,
+        TaskRequest::Delete {
+            name: "shafts/O0010.nc".into(),
+        },
+    );
     assert!(r.accepted, "{r:?}");
     assert!(disk.files.lock().unwrap().is_empty());
     // Deleting made room.
-    assert!(
-        command(
-            &mut c,
-            6,
-            ProgramCommand::LOAD,
-            "big.nc",
-            &"G0X1\n".repeat(100)
-        )
-        .accepted
-    );
+    assert!(command(&mut c, 6, load("big.nc", &"G0X1\n".repeat(100))).accepted);
 
     let broken = Disk {
         broken: true,
         ..Disk::default()
     };
     let mut c = core().with_program_memory(BTreeMap::new(), Box::new(broken), 1 << 20);
-    let r = command(&mut c, 1, ProgramCommand::LOAD, "part.nc", "M30\n");
+    let r = command(&mut c, 1, load("part.nc", "M30\n"));
     assert!(!r.accepted && r.message.contains("No space left"), "{r:?}");
-    let r = command(&mut c, 2, ProgramCommand::LIST, "", "");
+    let r = command(&mut c, 2, TaskRequest::List);
     assert!(
-        !r.message.contains("part.nc"),
+        !r.programs.contains(&"part.nc".to_string()),
         "not in memory either: {r:?}"
     );
 }
@@ -454,16 +488,16 @@ fn the_block_skip_switch_applies_to_the_blocks_read_after_it() {
     };
     for (on, expected) in [(true, vec![1, 3, 5]), (false, vec![1, 2, 3, 4, 5])] {
         let mut c = ready();
-        assert!(command(&mut c, 3, ProgramCommand::LOAD, "skip.nc", SKIPPY).accepted);
+        assert!(command(&mut c, 3, load("skip.nc", SKIPPY)).accepted);
         c.block_skip_switch(on);
-        assert!(command(&mut c, 4, ProgramCommand::START, "skip.nc", "").accepted);
+        assert!(command(&mut c, 4, start("skip.nc", "")).accepted);
         c.motion_status(status(0, 0, 100, MotionStatus::STATE_IDLE));
         assert_eq!(lines_sent(&mut c, 100), expected, "switch {on}");
     }
     // Turned off during the run: the first skip block was read with it on, the second after.
     let mut c = ready();
-    assert!(command(&mut c, 3, ProgramCommand::LOAD, "skip.nc", SKIPPY).accepted);
-    assert!(command(&mut c, 4, ProgramCommand::START, "skip.nc", "").accepted);
+    assert!(command(&mut c, 3, load("skip.nc", SKIPPY)).accepted);
+    assert!(command(&mut c, 4, start("skip.nc", "")).accepted);
     c.motion_status(status(0, 0, 2, MotionStatus::STATE_IDLE));
     let first = lines_sent(&mut c, 2);
     assert_eq!(first, vec![1, 3]);
@@ -508,7 +542,7 @@ const COUNTED: &str =
 
 fn counted_core() -> RunCore {
     let mut c = core();
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "count.nc", COUNTED).accepted);
+    assert!(command(&mut c, 1, load("count.nc", COUNTED)).accepted);
     c.plc_scanned();
     c.axes(&[200.0, 100.0]);
     c
@@ -517,7 +551,7 @@ fn counted_core() -> RunCore {
 #[test]
 fn a_program_starts_at_a_line_with_its_preamble_then_the_rest_of_it() {
     let mut c = counted_core();
-    let r = command(&mut c, 2, ProgramCommand::START, "count.nc", "line 5");
+    let r = command(&mut c, 2, start("count.nc", "line 5"));
     assert!(r.accepted, "{}", r.message);
     assert!(r.message.contains("at line 5"), "{}", r.message);
     let sent = run_to_end(&mut c, 1001);
@@ -538,9 +572,9 @@ fn a_program_starts_at_a_line_with_its_preamble_then_the_rest_of_it() {
         ]
     );
     assert!(sent.iter().all(|b| b.2 >= 5), "{sent:?}");
-    let refused = command(&mut c, 3, ProgramCommand::START, "count.nc", "N999");
+    let refused = command(&mut c, 3, start("count.nc", "N999"));
     assert!(!refused.accepted && refused.message.contains("not found"));
-    let refused = command(&mut c, 4, ProgramCommand::START, "count.nc", "goto 3");
+    let refused = command(&mut c, 4, start("count.nc", "goto 3"));
     assert!(!refused.accepted);
 }
 
@@ -548,14 +582,14 @@ fn a_program_starts_at_a_line_with_its_preamble_then_the_rest_of_it() {
 fn an_interrupted_run_restarts_at_its_block_with_the_variables_it_started_with() {
     // The uninterrupted run, for comparison.
     let mut whole = counted_core();
-    assert!(command(&mut whole, 2, ProgramCommand::START, "count.nc", "").accepted);
+    assert!(command(&mut whole, 2, start("count.nc", "")).accepted);
     let full = run_to_end(&mut whole, 1001);
     assert_eq!(whole.memory().kept.get(&200), Some(&1.0));
 
     // The run that is interrupted: motion has finished 4 blocks, at line 4, when the power
     // goes (an emergency stop here; a kill leaves the same kept position).
     let mut first = counted_core();
-    assert!(command(&mut first, 2, ProgramCommand::START, "count.nc", "").accepted);
+    assert!(command(&mut first, 2, start("count.nc", "")).accepted);
     first.motion_status(status_at(1001, 0, 1, MotionStatus::STATE_RUNNING));
     first.step();
     assert!(blocks(&first.take_effects()).len() > 5);
@@ -580,13 +614,13 @@ fn an_interrupted_run_restarts_at_its_block_with_the_variables_it_started_with()
             2000,
         );
         let mut c = c.with_kept_position(Some(kept.clone()));
-        assert!(command(&mut c, 1, ProgramCommand::LOAD, "count.nc", COUNTED).accepted);
+        assert!(command(&mut c, 1, load("count.nc", COUNTED)).accepted);
         c.plc_scanned();
         c.axes(&[250.0, 150.0]);
         c
     };
     let mut again = fresh();
-    let r = command(&mut again, 2, ProgramCommand::START, "", "interrupted");
+    let r = command(&mut again, 2, start("", "interrupted"));
     assert!(r.accepted, "{}", r.message);
     assert!(r.message.contains("block 5"), "{}", r.message);
     let rest = run_to_end(&mut again, 2001);
@@ -596,7 +630,7 @@ fn an_interrupted_run_restarts_at_its_block_with_the_variables_it_started_with()
     assert_eq!(rest[rest.len() - (full.len() - 4)..], full[4..]);
     assert_eq!(again.memory().kept.get(&200), Some(&1.0));
     // Completed: nothing is left to restart.
-    let r = command(&mut again, 3, ProgramCommand::START, "", "interrupted");
+    let r = command(&mut again, 3, start("", "interrupted"));
     assert!(
         !r.accepted && r.message.contains("no interrupted program"),
         "{}",
@@ -605,26 +639,14 @@ fn an_interrupted_run_restarts_at_its_block_with_the_variables_it_started_with()
 
     // Another program's name, or an edited program, is refused.
     let mut other = fresh();
-    let r = command(
-        &mut other,
-        2,
-        ProgramCommand::START,
-        "part.nc",
-        "interrupted",
-    );
+    let r = command(&mut other, 2, start("part.nc", "interrupted"));
     assert!(
         !r.accepted && r.message.contains("not part.nc"),
         "{}",
         r.message
     );
-    assert!(command(&mut other, 3, ProgramCommand::LOAD, "count.nc", PART).accepted);
-    let r = command(
-        &mut other,
-        4,
-        ProgramCommand::START,
-        "count.nc",
-        "interrupted",
-    );
+    assert!(command(&mut other, 3, load("count.nc", PART)).accepted);
+    let r = command(&mut other, 4, start("count.nc", "interrupted"));
     assert!(!r.accepted && r.message.contains("edited"), "{}", r.message);
 }
 
@@ -634,10 +656,10 @@ fn an_802d_message_shows_as_its_block_runs_until_the_next_one_or_the_end() {
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
     let part = "MSG(\"ROUGHING\")\nG0 X10\nG1 X20 F100\nMSG(\"FINISHING \"<<2)\nG1 X30\n\
                 MSG()\nG1 X40\nM2\n";
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PART.MPF", part).accepted);
+    assert!(command(&mut c, 1, load("PART.MPF", part)).accepted);
     c.plc_scanned();
     c.axes(&[0.0; 3]);
-    assert!(command(&mut c, 2, ProgramCommand::START, "PART.MPF", "").accepted);
+    assert!(command(&mut c, 2, start("PART.MPF", "")).accepted);
     // Every block goes to motion at once; the messages wait for motion.
     c.motion_status(status(1001, 0, 100, MotionStatus::STATE_RUNNING));
     c.step();
@@ -670,11 +692,11 @@ fn an_802d_message_shows_as_its_block_runs_until_the_next_one_or_the_end() {
     assert_eq!(shown[x30 as usize], "");
     // A message at the end is gone with the run.
     let part = "G0 X10\nMSG(\"CHECK THE PART\")\nM2\n";
-    assert!(command(&mut c, 3, ProgramCommand::LOAD, "B.MPF", part).accepted);
+    assert!(command(&mut c, 3, load("B.MPF", part)).accepted);
     c.motion_status(status(1001, end, 100, MotionStatus::STATE_IDLE));
     c.step();
     assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
-    assert!(command(&mut c, 4, ProgramCommand::START, "B.MPF", "").accepted);
+    assert!(command(&mut c, 4, start("B.MPF", "")).accepted);
     c.step();
     let last = blocks(&c.take_effects()).last().map(|b| b.seq).unwrap();
     c.motion_status(status(1002, last - 1, 100, MotionStatus::STATE_RUNNING));
@@ -692,13 +714,13 @@ fn an_802d_part_is_counted_in_memory_before_its_m30_goes_to_motion() {
     // ahead) before the blocks of the run go to motion.
     let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PART.MPF", "G0 X10\nM30\n").accepted);
+    assert!(command(&mut c, 1, load("PART.MPF", "G0 X10\nM30\n")).accepted);
     c.plc_scanned();
     c.axes(&[0.0; 3]);
     let mut done = 0;
     for (k, run_id) in [(1.0, 1001), (2.0, 1002)] {
         let id = 2 + run_id - 1001;
-        assert!(command(&mut c, id, ProgramCommand::START, "PART.MPF", "").accepted);
+        assert!(command(&mut c, id, start("PART.MPF", "")).accepted);
         c.motion_status(status(run_id, 0, 100, MotionStatus::STATE_RUNNING));
         c.step();
         let effects = c.take_effects();
@@ -727,7 +749,7 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
     let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
     let main = "N10 G0 X1\nN20 EXTCALL (\"D:\\EXTERNE_UP\\BOHRUNG\")\nN30 G0 X3\nN40 M30\n";
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "MAIN.MPF", main).accepted);
+    assert!(command(&mut c, 1, load("MAIN.MPF", main)).accepted);
     c.plc_scanned();
     c.axes(&[0.0; 3]);
     c.set_external_programs(
@@ -738,7 +760,7 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
         .into_iter()
         .collect(),
     );
-    assert!(command(&mut c, 2, ProgramCommand::START, "MAIN.MPF", "").accepted);
+    assert!(command(&mut c, 2, start("MAIN.MPF", "")).accepted);
     c.motion_status(status(1001, 0, 100, MotionStatus::STATE_RUNNING));
     c.step();
     let xs: Vec<f64> = blocks(&c.take_effects())
@@ -750,10 +772,10 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
     // Without the drive (unplugged before the start) the call stops with 14011.
     let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0; 3]);
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 1000);
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "MAIN.MPF", main).accepted);
+    assert!(command(&mut c, 1, load("MAIN.MPF", main)).accepted);
     c.plc_scanned();
     c.axes(&[0.0; 3]);
-    assert!(command(&mut c, 2, ProgramCommand::START, "MAIN.MPF", "").accepted);
+    assert!(command(&mut c, 2, start("MAIN.MPF", "")).accepted);
     c.motion_status(status(1001, 0, 100, MotionStatus::STATE_RUNNING));
     c.step();
     let raised: Vec<u32> = c
@@ -771,10 +793,10 @@ fn extcall_runs_a_program_of_the_external_drives_read_at_the_start() {
 fn mill_running(program: &str) -> RunCore {
     let base = Setup::new(&['X', 'Y', 'Z'], &[false; 3], &[0.0, 0.0, 100.0]);
     let mut c = RunCore::new(Dialect::Sinumerik802d, base, Memory::default(), 10);
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "PROBE.MPF", program).accepted);
+    assert!(command(&mut c, 1, load("PROBE.MPF", program)).accepted);
     c.plc_scanned();
     c.axes(&[0.0, 0.0, 100.0]);
-    assert!(command(&mut c, 2, ProgramCommand::START, "PROBE.MPF", "").accepted);
+    assert!(command(&mut c, 2, start("PROBE.MPF", "")).accepted);
     c.motion_status(status(0, 0, 64, MotionStatus::STATE_IDLE));
     c
 }
@@ -881,8 +903,8 @@ const SUB_EDITED: &str = "O2000\nG01 X80 Z10 F3000\nG01 Z5\nG01 Z0\nG01 X95\nG01
 
 fn calling_core() -> RunCore {
     let mut c = core();
-    assert!(command(&mut c, 1, ProgramCommand::LOAD, "main.nc", MAIN_CALLING).accepted);
-    assert!(command(&mut c, 2, ProgramCommand::LOAD, "O2000", SUB).accepted);
+    assert!(command(&mut c, 1, load("main.nc", MAIN_CALLING)).accepted);
+    assert!(command(&mut c, 2, load("O2000", SUB)).accepted);
     c.plc_scanned();
     c.axes(&[200.0, 100.0]);
     c
@@ -894,12 +916,12 @@ fn calling_core() -> RunCore {
 #[test]
 fn an_interrupted_subprogram_restarts_at_its_block_and_an_edit_of_it_is_refused() {
     let mut whole = calling_core();
-    assert!(command(&mut whole, 3, ProgramCommand::START, "main.nc", "").accepted);
+    assert!(command(&mut whole, 3, start("main.nc", "")).accepted);
     let full = run_to_end(&mut whole, 1001);
 
     // Interrupted with 5 blocks done: inside O2000 (its third move).
     let mut first = calling_core();
-    assert!(command(&mut first, 3, ProgramCommand::START, "main.nc", "").accepted);
+    assert!(command(&mut first, 3, start("main.nc", "")).accepted);
     first.motion_status(status_at(1001, 0, 1, MotionStatus::STATE_RUNNING));
     first.step();
     assert!(blocks(&first.take_effects()).len() > 6);
@@ -916,14 +938,14 @@ fn an_interrupted_subprogram_restarts_at_its_block_and_an_edit_of_it_is_refused(
             2000,
         );
         let mut c = c.with_kept_position(Some(kept.clone()));
-        assert!(command(&mut c, 1, ProgramCommand::LOAD, "main.nc", MAIN_CALLING).accepted);
-        assert!(command(&mut c, 2, ProgramCommand::LOAD, "O2000", sub).accepted);
+        assert!(command(&mut c, 1, load("main.nc", MAIN_CALLING)).accepted);
+        assert!(command(&mut c, 2, load("O2000", sub)).accepted);
         c.plc_scanned();
         c.axes(&[250.0, 150.0]);
         c
     };
     let mut again = fresh(SUB);
-    let r = command(&mut again, 3, ProgramCommand::START, "", "interrupted");
+    let r = command(&mut again, 3, start("", "interrupted"));
     assert!(r.accepted, "{}", r.message);
     assert!(r.message.contains("block 6"), "{}", r.message);
     let rest = run_to_end(&mut again, 2001);
@@ -934,7 +956,7 @@ fn an_interrupted_subprogram_restarts_at_its_block_and_an_edit_of_it_is_refused(
 
     // The subprogram edited since: refused, naming it.
     let mut edited = fresh(SUB_EDITED);
-    let r = command(&mut edited, 3, ProgramCommand::START, "", "interrupted");
+    let r = command(&mut edited, 3, start("", "interrupted"));
     assert!(
         !r.accepted && r.message.contains("O2000") && r.message.contains("edited"),
         "{}",
@@ -967,18 +989,130 @@ fn the_tool_in_the_spindle_is_kept_from_run_to_run() {
         (1, "CHANGE.MPF", "T3\nM6\nG0 Z0\nM30\n"),
         (2, "EDGE.MPF", "D2\nG0 Z0\nM30\n"),
     ] {
-        assert!(command(&mut c, id, ProgramCommand::LOAD, name, text).accepted);
+        assert!(command(&mut c, id, load(name, text)).accepted);
     }
     c.plc_scanned();
     c.axes(&[0.0, 0.0, 100.0]);
-    assert!(command(&mut c, 3, ProgramCommand::START, "CHANGE.MPF", "").accepted);
+    assert!(command(&mut c, 3, start("CHANGE.MPF", "")).accepted);
     let first = run_to_end(&mut c, 1001);
     let last_z = |blocks: &[(u8, Vec<f64>, u32)]| {
         blocks.iter().rev().find(|b| b.1.len() == 3).map(|b| b.1[2])
     };
     assert_eq!(last_z(&first), Some(10.0), "T3 D1 {first:?}");
     assert_eq!(c.memory().spindle_tool, 3);
-    assert!(command(&mut c, 4, ProgramCommand::START, "EDGE.MPF", "").accepted);
+    assert!(command(&mut c, 4, start("EDGE.MPF", "")).accepted);
     let second = run_to_end(&mut c, 1002);
     assert_eq!(last_z(&second), Some(12.0), "T3 D2 {second:?}");
+}
+
+fn to_motion(effects: &[Effect]) -> Vec<MotionCommand> {
+    effects
+        .iter()
+        .filter_map(|e| match e {
+            Effect::ToMotion(m) => Some(m.clone()),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Issue 47: the task decides; what it passes on to motion is answered by motion, and a
+/// refusal there is the caller's answer, with motion's reason.
+#[test]
+fn a_jog_motion_refuses_is_refused_to_the_caller_with_motion_s_reason() {
+    let mut c = ready();
+    let jog =
+        |direction| TaskRequest::Jog(cnc_msgs::jog::Jog::new("z", direction, 600.0, 0.0).unwrap());
+    let r = command(&mut c, 3, jog(1));
+    assert!(!r.accepted && r.message.contains("not JOG"), "{r:?}");
+    assert!(command(&mut c, 4, TaskRequest::Mode(MachineState::MODE_JOG)).accepted);
+    c.take_effects();
+    assert_eq!(c.command(5, jog(1)), None, "waits for motion");
+    let sent = to_motion(&c.take_effects());
+    let [m] = &sent[..] else { panic!("{sent:?}") };
+    assert_eq!(
+        (m.kind, m.axis, m.direction, m.feed),
+        (MotionCommand::JOG, 1, 1, 600.0)
+    );
+    // The bridge repeats the command until answered: not sent twice.
+    assert_eq!(c.command(5, jog(1)), None);
+    assert!(c.take_effects().is_empty());
+    let why = "jog refused: Z is on its + overtravel switch: jog it the other way";
+    let refusal = CommandResult {
+        id: m.id,
+        accepted: false,
+        message: why.into(),
+        ..CommandResult::default()
+    };
+    let answer = c.motion_result(&refusal).expect("the caller's answer");
+    assert_eq!((answer.id, answer.accepted), (5, false));
+    assert_eq!(answer.message, why);
+    // Answered once: a repeat gets the same answer, a second answer of motion's is no one's.
+    assert_eq!(c.command(5, jog(1)), Some(answer));
+    assert_eq!(c.motion_result(&refusal), None);
+    // Accepted by motion: the task's words.
+    assert_eq!(c.command(6, jog(-1)), None);
+    let [m] = &to_motion(&c.take_effects())[..] else {
+        panic!()
+    };
+    let accepted = CommandResult {
+        id: m.id,
+        accepted: true,
+        message: "jog".into(),
+        ..CommandResult::default()
+    };
+    let answer = c.motion_result(&accepted).unwrap();
+    assert!(
+        answer.accepted && answer.message.starts_with("jog Z -"),
+        "{answer:?}"
+    );
+    // Refused by the task: nothing reaches motion.
+    let r = command(
+        &mut c,
+        7,
+        TaskRequest::Jog(cnc_msgs::jog::Jog::new("Y", 1, 0.0, 0.0).unwrap()),
+    );
+    assert!(!r.accepted && r.message.contains("no axis Y"), "{r:?}");
+    assert!(to_motion(&c.take_effects()).is_empty());
+    // Cycle start in HOME: the reference return is motion's to refuse too.
+    assert!(command(&mut c, 8, TaskRequest::Mode(MachineState::MODE_HOME)).accepted);
+    c.take_effects();
+    assert_eq!(c.command(9, start("", "")), None);
+    let [m] = &to_motion(&c.take_effects())[..] else {
+        panic!()
+    };
+    assert_eq!(m.kind, MotionCommand::REFERENCE_RETURN);
+    let refusal = CommandResult {
+        id: m.id,
+        accepted: false,
+        message: "reference return refused: a jog is moving an axis".into(),
+        ..CommandResult::default()
+    };
+    let answer = c.motion_result(&refusal).unwrap();
+    assert_eq!((answer.id, answer.accepted), (9, false));
+}
+
+/// Issue 47: one node judges a cycle start. A refused START reaches motion in no form; feed
+/// hold, and the start that resumes it, do.
+#[test]
+fn a_refused_start_sends_motion_nothing_and_a_resume_sends_it_on() {
+    let mut c = ready();
+    c.take_effects();
+    let r = command(&mut c, 3, start("none.nc", ""));
+    assert!(!r.accepted);
+    assert!(c.take_effects().is_empty());
+    assert!(command(&mut c, 4, start("part.nc", "")).accepted);
+    c.take_effects();
+    let r = command(&mut c, 5, start("part.nc", ""));
+    assert!(!r.accepted && r.message.contains("running"), "{r:?}");
+    assert!(to_motion(&c.take_effects()).is_empty());
+    assert!(command(&mut c, 6, TaskRequest::FeedHold).accepted);
+    let kinds = |c: &mut RunCore| -> Vec<u8> {
+        to_motion(&c.take_effects())
+            .iter()
+            .map(|m| m.kind)
+            .collect()
+    };
+    assert_eq!(kinds(&mut c), [MotionCommand::FEED_HOLD]);
+    assert!(command(&mut c, 7, start("", "")).accepted);
+    assert_eq!(kinds(&mut c), [MotionCommand::RESUME]);
 }
