@@ -11,8 +11,8 @@
 use std::net::IpAddr;
 use std::time::{Duration, Instant};
 
-use cnc::client::CellClient;
-use cnc::robot::Robot;
+use cnc_cell::client::CellClient;
+use cnc_cell::robot::Robot;
 use cnc_runtime::config::NetworkConfig;
 use ros2_client::ServiceMapping;
 
@@ -41,7 +41,7 @@ fn main() -> Result<(), String> {
     }
     let mut robot = Robot::new(arm.len(), 2.0, parts);
     let deadline = Instant::now() + Duration::from_secs(24 * 3600);
-    cnc::robot_node::tend(&mut arm, &mut robot, None, deadline)?;
+    cnc_cell::robot_node::tend(&mut arm, &mut robot, None, deadline)?;
     for (ns, m) in machines.iter().zip(&robot.machines) {
         println!("{ns}: {} parts loaded, {:?}", m.parts, m.phase);
     }

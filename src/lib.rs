@@ -1,14 +1,10 @@
-//! The `cnc` launcher library: starts a cell's nodes in one process ([`cell`]) and talks to a
-//! running cell over ROS 2 ([`client`]), as a supervisor or a robot would.
+//! The `cnc` launcher library: starts a cell's nodes in one process ([`cell`]), finds the
+//! built-in machines ([`machines`]), writes the DDS Security keystore ([`keystore`]) and proves
+//! programs without a machine ([`simulate`]). The cell's own programs (supervisor, robot, the
+//! client they share) are the `cnc_cell` crate.
 
 pub mod bench_paths;
 pub mod cell;
-pub mod cell_launch;
-pub mod client;
 pub mod keystore;
 pub mod machines;
-pub mod robot;
-pub mod robot_node;
 pub mod simulate;
-pub mod supervisor;
-pub mod supervisor_node;

@@ -13,8 +13,8 @@ use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 use cnc::cell::Cell;
-use cnc::client::CellClient;
 use cnc::machines;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::MachineState;
 use cnc_runtime::LaunchConfig;
 use ros2_client::ServiceMapping;
@@ -595,7 +595,7 @@ fn read_named_program(path: &Path) -> Result<NamedProgram, String> {
 }
 
 fn run(config: Option<&Path>, program: Option<NamedProgram>, cycles: u32) -> Result<(), String> {
-    if let Some(path) = config.filter(|p| cnc::cell_launch::is_cell_file(p)) {
+    if let Some(path) = config.filter(|p| cnc_cell::launch::is_cell_file(p)) {
         if program.is_some() {
             return Err("a cell launch file runs its work order: no --program".into());
         }
@@ -633,8 +633,8 @@ fn run(config: Option<&Path>, program: Option<NamedProgram>, cycles: u32) -> Res
 /// in this process, until the work order is complete (exit 0), Ctrl-C, or a node fails. The
 /// terminal shows the supervisor's view whenever it changes.
 fn run_cell(path: &Path) -> Result<(), String> {
-    use cnc::robot_node::CellWatch;
-    let launch = cnc::cell_launch::load(path)?;
+    use cnc_cell::robot_node::CellWatch;
+    let launch = cnc_cell::launch::load(path)?;
     for cfg in &launch.machines {
         if cfg.network.effective_security()?.is_some() {
             return Err(format!(
@@ -691,14 +691,17 @@ fn run_cell(path: &Path) -> Result<(), String> {
         .collect();
     let supervisor = {
         let net = net.clone();
-        std::thread::spawn(move || cnc::supervisor_node::supervise(&net, order, &options, &STOP))
+        std::thread::spawn(move || {
+            cnc_cell::supervisor_node::supervise(&net, order, &options, &STOP)
+        })
     };
     let robot_net = net.clone();
     let swap = launch.swap_seconds;
     let robot_names = names.clone();
     std::thread::spawn(move || {
         let forever = Instant::now() + Duration::from_secs(365 * 24 * 3600);
-        let served = cnc::robot_node::serve_cell(&robot_net, &robot_names, &parts, swap, forever);
+        let served =
+            cnc_cell::robot_node::serve_cell(&robot_net, &robot_names, &parts, swap, forever);
         if let Err(e) = served {
             eprintln!("cnc: robot: {e}");
         }
@@ -769,7 +772,7 @@ fn cell_line(s: &cnc_msgs::msg::CellState) -> String {
             format!(
                 "{} {}{why}: {}/{} parts{last}",
                 m.name,
-                cnc::supervisor::status_name(m.status),
+                cnc_cell::supervisor::status_name(m.status),
                 m.count,
                 m.target
             )

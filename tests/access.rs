@@ -7,7 +7,7 @@ mod common;
 use std::time::{Duration, Instant};
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::{CommandEvent, MachineState};
 use cnc_msgs::srv::StartProgramResponse;
 use cnc_runtime::dds::RosNode;

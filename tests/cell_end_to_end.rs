@@ -7,7 +7,7 @@ use std::time::Duration;
 mod common;
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::MachineState;
 use cnc_runtime::LaunchConfig;
 use ros2_client::ServiceMapping;

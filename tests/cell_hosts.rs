@@ -243,7 +243,7 @@ fn a_lathe_cut_off_for_10_s_finishes_its_cycle_and_is_taken_back_while_the_other
     let dir = common::fresh_dir("cnc_link_cut");
     let lathes = hosts.start_lathes(&dir, &["lathe1", "lathe2"], DOMAIN);
     let net = hosts.cell_network(DOMAIN);
-    let mut probe = cnc::client::CellClient::new(
+    let mut probe = cnc_cell::client::CellClient::new(
         &net,
         "lathe2",
         "probe",

@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::ToolOffset;
 use cnc_msgs::srv::{
     GetOffsets, GetOffsetsRequest, GetParameters, GetParametersRequest, SetParameter,

@@ -9,7 +9,7 @@ mod common;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::MachineState;
 use cnc_msgs::srv::RobotRequestRequest;
 use cnc_runtime::config::{DdsSecurity, NetworkConfig};

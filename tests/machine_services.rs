@@ -7,7 +7,7 @@ mod common;
 use std::time::Duration;
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::{MachineState, ToolOffset, WorkOffset};
 use cnc_msgs::srv::*;
 use ros2_client::ServiceMapping;

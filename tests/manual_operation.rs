@@ -235,7 +235,7 @@ fn a_missing_dog_ends_the_reference_return_on_the_overtravel_switch_or_within_th
 #[test]
 fn the_cell_powers_up_unreferenced_and_runs_a_part_after_its_reference_return() {
     use cnc::cell::Cell;
-    use cnc::client::CellClient;
+    use cnc_cell::client::CellClient;
     use cnc_msgs::msg::MachineState;
     use cnc_runtime::config::ReferenceEntry;
     use std::time::{Duration, Instant};
@@ -418,7 +418,7 @@ fn an_increment_moves_exactly_its_step_and_a_jog_stops_at_the_soft_limit() {
 #[test]
 fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
     use cnc::cell::Cell;
-    use cnc::client::CellClient;
+    use cnc_cell::client::CellClient;
     use cnc_msgs::msg::MachineState;
     use cnc_msgs::srv::{Jog, JogRequest};
     use std::time::{Duration, Instant};
@@ -439,7 +439,7 @@ fn a_robot_jogs_through_the_jog_service_and_its_disappearance_stops_the_axis() {
     };
     let mut robot = common::ready_client(&cfg, "robot", Duration::from_secs(30));
     let robot_jog = robot.service::<Jog>("jog").expect("jog client");
-    let jog = |client: &cnc::client::ServiceClient<Jog>, direction, feed, increment| {
+    let jog = |client: &cnc_cell::client::ServiceClient<Jog>, direction, feed, increment| {
         client
             .call(request(direction, feed, increment))
             .expect("jog answered")
@@ -611,7 +611,7 @@ fn panel_jog(address: &str, direction: i8, increment: f64) -> serde_json::Value 
 #[test]
 fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way() {
     use cnc::cell::Cell;
-    use cnc::client::CellClient;
+    use cnc_cell::client::CellClient;
     use cnc_msgs::msg::MachineState;
     use cnc_msgs::srv::{Jog, JogRequest};
     use std::time::{Duration, Instant};
@@ -705,7 +705,7 @@ fn the_cell_stops_an_axis_on_its_overtravel_switch_and_lets_it_off_the_other_way
 #[test]
 fn the_cell_moves_the_axis_the_handwheel_selects_by_its_detents() {
     use cnc::cell::Cell;
-    use cnc::client::CellClient;
+    use cnc_cell::client::CellClient;
     use cnc_msgs::msg::{MachineState, SimInput};
     use cnc_runtime::dds::RosNode;
     use cnc_runtime::topics;

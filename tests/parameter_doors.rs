@@ -14,7 +14,7 @@ use std::collections::BTreeMap;
 use std::time::Duration;
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::MachineState;
 use cnc_msgs::srv::*;
 use cnc_runtime::parameter_rules::{rule, Writer};

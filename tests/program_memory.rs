@@ -8,7 +8,7 @@ use std::time::Duration;
 
 mod common;
 
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_runtime::LaunchConfig;
 use ros2_client::ServiceMapping;
 

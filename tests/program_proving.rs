@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 mod common;
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::{MachineState, SimInput};
 use cnc_runtime::dds::RosNode;
 use cnc_runtime::topics;

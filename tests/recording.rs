@@ -12,7 +12,7 @@ use std::process::Command;
 use std::time::{Duration, Instant};
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::{MachineState, SimInput};
 use cnc_runtime::dds::{published_count, RosNode};
 use cnc_runtime::{topics, LaunchConfig};

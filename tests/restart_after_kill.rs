@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 mod common;
 
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::action::RunProgramGoal;
 use cnc_msgs::msg::{MachineState, SpindleState};
 use cnc_runtime::dds::RosNode;

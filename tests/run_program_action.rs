@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 mod common;
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::action::{RunProgramFeedback, RunProgramGoal, RunProgramResult};
 use cnc_msgs::msg::{MachineState, ProgramEvent};
 use cnc_runtime::dds::RosNode;

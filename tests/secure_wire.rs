@@ -21,7 +21,7 @@ use std::net::SocketAddrV4;
 use std::process::Command;
 use std::time::Duration;
 
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::MachineState;
 use cnc_msgs::srv::{LoadProgramRequest, StartProgramRequest};
 use cnc_runtime::config::{DdsSecurity, NetworkConfig};

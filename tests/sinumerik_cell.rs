@@ -13,7 +13,7 @@
 use std::time::Duration;
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::{MachineState, SpindleState};
 use ros2_client::ServiceMapping;
 

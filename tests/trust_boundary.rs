@@ -13,7 +13,7 @@ mod common;
 use std::time::{Duration, Instant};
 
 use cnc::cell::Cell;
-use cnc::client::CellClient;
+use cnc_cell::client::CellClient;
 use cnc_msgs::msg::MachineState;
 use ros2_client::ServiceMapping;
 

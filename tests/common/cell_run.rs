@@ -11,10 +11,10 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use cnc::robot::Robot;
-use cnc::robot_node::{Asked, CellWatch};
-use cnc::supervisor::{Order, OrderLine};
-use cnc::supervisor_node::Options;
+use cnc_cell::robot::Robot;
+use cnc_cell::robot_node::{Asked, CellWatch};
+use cnc_cell::supervisor::{Order, OrderLine};
+use cnc_cell::supervisor_node::Options;
 use cnc_msgs::msg::{CellState, PartCount, RobotHandshake};
 use cnc_msgs::srv::RobotRequestRequest;
 use cnc_runtime::config::NetworkConfig;
@@ -100,7 +100,7 @@ impl CellRun {
                 ..Options::default()
             };
             std::thread::spawn(move || {
-                cnc::supervisor_node::supervise(&net, order, &options, &stop)
+                cnc_cell::supervisor_node::supervise(&net, order, &options, &stop)
             })
         };
         let robot = {
@@ -110,7 +110,7 @@ impl CellRun {
             let each = vec![parts.saturating_sub(1); names.len()];
             let deadline = Instant::now() + Duration::from_secs(300);
             std::thread::spawn(move || {
-                cnc::robot_node::serve_cell(&net, &names, &each, 1.0, deadline)
+                cnc_cell::robot_node::serve_cell(&net, &names, &each, 1.0, deadline)
             })
         };
         CellRun {

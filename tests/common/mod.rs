@@ -178,8 +178,8 @@ pub fn ready_client(
     cfg: &LaunchConfig,
     name: &str,
     wait: std::time::Duration,
-) -> cnc::client::CellClient {
-    let mut c = cnc::client::CellClient::new(
+) -> cnc_cell::client::CellClient {
+    let mut c = cnc_cell::client::CellClient::new(
         &cfg.network,
         "lathe1",
         name,
@@ -193,7 +193,7 @@ pub fn ready_client(
 
 /// Turns the mode switch through the `set_mode` service; a refusal fails the test.
 #[allow(dead_code)]
-pub fn set_mode(c: &mut cnc::client::CellClient, mode: u8) {
+pub fn set_mode(c: &mut cnc_cell::client::CellClient, mode: u8) {
     let r = c
         .service::<cnc_msgs::srv::SetMode>("set_mode")
         .and_then(|s| s.call(cnc_msgs::srv::SetModeRequest { mode }))
@@ -235,10 +235,10 @@ pub fn run_program_client(ros: &mut cnc_runtime::dds::RosNode) -> RunProgramClie
 /// after `timeout`.
 #[allow(dead_code)]
 pub fn wait(
-    client: &mut cnc::client::CellClient,
+    client: &mut cnc_cell::client::CellClient,
     timeout: std::time::Duration,
     what: &str,
-    done: impl FnMut(&cnc::client::CellClient) -> bool,
+    done: impl FnMut(&cnc_cell::client::CellClient) -> bool,
 ) {
     let (ok, _) = client.wait_until(timeout, done);
     assert!(

@@ -19,7 +19,7 @@ use crate::access::Who;
 use crate::doors::Front;
 use crate::operation::Operation;
 use crate::run_program::{check, start_at, GoalRun, Step, View};
-use crate::server::{DualServer, Request};
+use crate::service_server::{DualServer, Request};
 use cnc_msgs::srv::StopRequest;
 
 /// Finished goals whose results can still be asked for.
@@ -248,6 +248,34 @@ impl RunProgramServer {
         alarms: &[Alarm],
         now: f64,
     ) -> Vec<Event> {
+        let mut events = self.malformed();
+        if let Some(r) = self.send_goal.receive() {
+            events.push(self.send_goal(r, front, run_id, now));
+        }
+        if let Some(r) = self.cancel_goal.receive() {
+            events.push(self.cancel_goal(r, front));
+        }
+        if let Some(r) = self.get_result.receive() {
+            self.waiting.push(r);
+            self.answer_waiting();
+        }
+        if let Some(state) = state {
+            let view = View {
+                state,
+                run_id,
+                done_blocks,
+                part_count,
+                alarms,
+                now,
+            };
+            self.follow(&view, front);
+        }
+        self.retire();
+        events
+    }
+
+    /// Malformed requests to the action's services since the last turn, as events.
+    fn malformed(&self) -> Vec<Event> {
         let mut events = Vec::new();
         let malformed = [
             (
@@ -274,146 +302,149 @@ impl RunProgramServer {
                 });
             }
         }
-        if let Some(r) = self.send_goal.receive() {
-            let goal = r.request.goal.clone();
-            let outcome = if let Err(why) = front.may_move(&Who::Dds(r.writer)) {
-                Err(why)
-            } else if self.goal.is_some() {
-                Err("a RunProgram goal is running: cancel it first".to_string())
-            } else {
-                check(&goal, true).and_then(|()| {
+        events
+    }
+
+    /// A goal: started if the client may and the machine accepts; refused with why.
+    fn send_goal(
+        &mut self,
+        r: Request<RunProgramSendGoalRequest>,
+        front: &mut dyn Front,
+        run_id: u64,
+        now: f64,
+    ) -> Event {
+        let goal = r.request.goal.clone();
+        let outcome = if let Err(why) = front.may_move(&Who::Dds(r.writer)) {
+            Err(why)
+        } else if self.goal.is_some() {
+            Err("a RunProgram goal is running: cancel it first".to_string())
+        } else {
+            check(&goal, true).and_then(|()| {
+                let a = front.carry_out(&Operation::Start {
+                    name: goal.program.clone(),
+                    at: start_at(&goal),
+                });
+                if a.accepted {
+                    Ok(a.message)
+                } else {
+                    Err(a.message)
+                }
+            })
+        };
+        let accepted = outcome.is_ok();
+        let response = RunProgramSendGoalResponse {
+            accepted,
+            stamp: stamp(),
+        };
+        if accepted {
+            let lines = front.program_lines(&goal.program);
+            let run = GoalRun::new(r.request.goal_id, goal.clone(), lines, run_id, now);
+            self.goal = Some((run, response.stamp.clone()));
+        } else if let (Err(why), false) = (&outcome, self.knows(&r.request.goal_id)) {
+            // The reason reaches the client through GetResult, not only the log.
+            if self.done.len() == RESULTS_KEPT {
+                self.done.pop_front();
+            }
+            self.done.push_back(Done {
+                id: r.request.goal_id,
+                accepted: response.stamp.clone(),
+                status: GoalStatus::STATUS_ABORTED,
+                result: RunProgramResult {
+                    message: format!("goal rejected: {why}"),
+                    ..Default::default()
+                },
+                rejected: true,
+            });
+        }
+        if let Err(e) = self.send_goal.reply(&r, &response) {
+            log::error!("{e}");
+        }
+        self.publish_status();
+        Event {
+            command: "run_program",
+            detail: format!("{} x{}", goal.program, goal.cycles),
+            writer: r.writer,
+            accepted,
+            message: match outcome {
+                Ok(m) | Err(m) => m,
+            },
+        }
+    }
+
+    /// A cancel: the goal stops on the path, then the machine is reset for the next goal.
+    fn cancel_goal(&mut self, r: Request<CancelGoalRequest>, front: &mut dyn Front) -> Event {
+        let wanted = r.request.goal_info.goal_id;
+        let all = wanted == [0; 16];
+        let mut response = CancelGoalResponse::default();
+        match self.goal.as_mut() {
+            Some((g, accepted)) if (all || g.id == wanted) && !g.finished() => {
+                g.cancel();
+                response.return_code = CancelGoalResponse::ERROR_NONE;
+                response.goals_canceling.push(GoalInfo {
+                    goal_id: g.id,
+                    stamp: accepted.clone(),
+                });
+            }
+            _ if self.done.iter().any(|d| d.id == wanted) => {
+                response.return_code = CancelGoalResponse::ERROR_GOAL_TERMINATED
+            }
+            _ => response.return_code = CancelGoalResponse::ERROR_UNKNOWN_GOAL_ID,
+        }
+        if let Err(e) = self.cancel_goal.reply(&r, &response) {
+            log::error!("{e}");
+        }
+        let event = Event {
+            command: "run_program/cancel",
+            detail: String::new(),
+            writer: r.writer,
+            accepted: response.return_code == CancelGoalResponse::ERROR_NONE,
+            message: format!("return code {}", response.return_code),
+        };
+        let canceling = self
+            .goal
+            .as_ref()
+            .is_some_and(|(g, _)| g.status() == GoalStatus::STATUS_CANCELING);
+        if canceling {
+            self.publish_status();
+            // Stop on the path, then reset: the machine is ready for the next goal.
+            let stop = front.carry_out(&Operation::Stop {
+                mode: StopRequest::CYCLE_STOP,
+            });
+            let reset = front.carry_out(&Operation::Reset);
+            if let Some((g, _)) = self.goal.as_mut() {
+                g.canceled(&format!("{}, {}", stop.message, reset.message));
+            }
+        }
+        event
+    }
+
+    /// The running goal through the machine's state: feedback, the next cycle's start.
+    fn follow(&mut self, view: &View, front: &mut dyn Front) {
+        let Some((g, _)) = self.goal.as_mut() else {
+            return;
+        };
+        let before = g.status();
+        for step in g.update(view) {
+            match step {
+                Step::Feedback(feedback) => self.feedback.publish(&RunProgramFeedbackMessage {
+                    goal_id: g.id,
+                    feedback,
+                }),
+                Step::StartCycle => {
                     let a = front.carry_out(&Operation::Start {
-                        name: goal.program.clone(),
-                        at: start_at(&goal),
+                        name: g.goal.program.clone(),
+                        at: String::new(),
                     });
                     if a.accepted {
-                        Ok(a.message)
+                        g.cycle_started(view.now, view.run_id);
                     } else {
-                        Err(a.message)
+                        g.abort(&format!("next cycle refused: {}", a.message), view.alarms);
                     }
-                })
-            };
-            let accepted = outcome.is_ok();
-            let response = RunProgramSendGoalResponse {
-                accepted,
-                stamp: stamp(),
-            };
-            if accepted {
-                let lines = front.program_lines(&goal.program);
-                let run = GoalRun::new(r.request.goal_id, goal.clone(), lines, run_id, now);
-                self.goal = Some((run, response.stamp.clone()));
-            } else if let (Err(why), false) = (&outcome, self.knows(&r.request.goal_id)) {
-                // The reason reaches the client through GetResult, not only the log.
-                if self.done.len() == RESULTS_KEPT {
-                    self.done.pop_front();
                 }
-                self.done.push_back(Done {
-                    id: r.request.goal_id,
-                    accepted: response.stamp.clone(),
-                    status: GoalStatus::STATUS_ABORTED,
-                    result: RunProgramResult {
-                        message: format!("goal rejected: {why}"),
-                        ..Default::default()
-                    },
-                    rejected: true,
-                });
             }
-            if let Err(e) = self.send_goal.reply(&r, &response) {
-                log::error!("{e}");
-            }
-            events.push(Event {
-                command: "run_program",
-                detail: format!("{} x{}", goal.program, goal.cycles),
-                writer: r.writer,
-                accepted,
-                message: match outcome {
-                    Ok(m) | Err(m) => m,
-                },
-            });
+        }
+        if g.status() != before {
             self.publish_status();
         }
-        if let Some(r) = self.cancel_goal.receive() {
-            let wanted = r.request.goal_info.goal_id;
-            let all = wanted == [0; 16];
-            let mut response = CancelGoalResponse::default();
-            match self.goal.as_mut() {
-                Some((g, accepted)) if (all || g.id == wanted) && !g.finished() => {
-                    g.cancel();
-                    response.return_code = CancelGoalResponse::ERROR_NONE;
-                    response.goals_canceling.push(GoalInfo {
-                        goal_id: g.id,
-                        stamp: accepted.clone(),
-                    });
-                }
-                _ if self.done.iter().any(|d| d.id == wanted) => {
-                    response.return_code = CancelGoalResponse::ERROR_GOAL_TERMINATED
-                }
-                _ => response.return_code = CancelGoalResponse::ERROR_UNKNOWN_GOAL_ID,
-            }
-            if let Err(e) = self.cancel_goal.reply(&r, &response) {
-                log::error!("{e}");
-            }
-            events.push(Event {
-                command: "run_program/cancel",
-                detail: String::new(),
-                writer: r.writer,
-                accepted: response.return_code == CancelGoalResponse::ERROR_NONE,
-                message: format!("return code {}", response.return_code),
-            });
-            let canceling = self
-                .goal
-                .as_ref()
-                .is_some_and(|(g, _)| g.status() == GoalStatus::STATUS_CANCELING);
-            if canceling {
-                self.publish_status();
-                // Stop on the path, then reset: the machine is ready for the next goal.
-                let stop = front.carry_out(&Operation::Stop {
-                    mode: StopRequest::CYCLE_STOP,
-                });
-                let reset = front.carry_out(&Operation::Reset);
-                if let Some((g, _)) = self.goal.as_mut() {
-                    g.canceled(&format!("{}, {}", stop.message, reset.message));
-                }
-            }
-        }
-        if let Some(r) = self.get_result.receive() {
-            self.waiting.push(r);
-            self.answer_waiting();
-        }
-        if let (Some((g, _)), Some(state)) = (self.goal.as_mut(), state) {
-            let view = View {
-                state,
-                run_id,
-                done_blocks,
-                part_count,
-                alarms,
-                now,
-            };
-            let before = g.status();
-            for step in g.update(&view) {
-                match step {
-                    Step::Feedback(feedback) => self.feedback.publish(&RunProgramFeedbackMessage {
-                        goal_id: g.id,
-                        feedback,
-                    }),
-                    Step::StartCycle => {
-                        let a = front.carry_out(&Operation::Start {
-                            name: g.goal.program.clone(),
-                            at: String::new(),
-                        });
-                        if a.accepted {
-                            g.cycle_started(now, run_id);
-                        } else {
-                            g.abort(&format!("next cycle refused: {}", a.message), alarms);
-                        }
-                    }
-                }
-            }
-            if g.status() != before {
-                self.publish_status();
-            }
-        }
-        self.retire();
-        events
     }
 }

@@ -14,7 +14,7 @@ use serde::{de::DeserializeOwned, Serialize};
 
 use crate::access::Who;
 use crate::operation::{Answer, Operation};
-use crate::server::{DualServer, Request};
+use crate::service_server::{DualServer, Request};
 
 /// What every door acts on: the bridge.
 pub trait Front {
@@ -137,8 +137,19 @@ macro_rules! said {
     };
 }
 
-/// The services' doors, one entry each.
+/// The services' doors, one entry each: program memory and the run, then the machine's
+/// switches, offsets, parameters and alarms.
 pub fn services(
+    p: &DomainParticipant,
+    ns: &str,
+    qos: &QosPolicies,
+) -> Result<Vec<Box<dyn Door>>, String> {
+    let mut doors = program_doors(p, ns, qos)?;
+    doors.extend(machine_doors(p, ns, qos)?);
+    Ok(doors)
+}
+
+fn program_doors(
     p: &DomainParticipant,
     ns: &str,
     qos: &QosPolicies,
@@ -214,6 +225,27 @@ pub fn services(
             },
             said!(DeleteProgramResponse),
         )?,
+        door::<Mdi>(
+            p,
+            ns,
+            qos,
+            "mdi",
+            |q| {
+                Ok(Operation::Mdi {
+                    text: q.text.clone(),
+                })
+            },
+            said!(MdiResponse),
+        )?,
+    ])
+}
+
+fn machine_doors(
+    p: &DomainParticipant,
+    ns: &str,
+    qos: &QosPolicies,
+) -> Result<Vec<Box<dyn Door>>, String> {
+    Ok(vec![
         door::<SetOverrides>(
             p,
             ns,

@@ -1,6 +1,6 @@
 //! The robot's requests as a door: the service, the robot signal that carries a request to
 //! the PLC, and the wait for the PLC's handshake to say it is done (the rules are
-//! [`crate::robot`]'s). Copies of a pending request (a client repeats one it has no answer to
+//! [`crate::robot_handshake`]'s). Copies of a pending request (a client repeats one it has no answer to
 //! yet) are answered together.
 
 use cnc_msgs::msg::{MachineState, RobotHandshake, SimInput};
@@ -13,14 +13,14 @@ use ros2_client::dds::rustdds::{DomainParticipant, QosPolicies};
 use crate::access::Who;
 use crate::doors::{reply, Front};
 use crate::operation::{Answer, Operation};
-use crate::robot;
-use crate::server::{DualServer, Request};
+use crate::robot_handshake;
+use crate::service_server::{DualServer, Request};
 
 const NAME: &str = "robot_request";
 
 /// A robot request waiting for the machine to carry it out.
 struct Pending {
-    op: robot::Op,
+    op: robot_handshake::Op,
     requests: Vec<Request<RobotRequestRequest>>,
     since: std::time::Instant,
 }
@@ -29,7 +29,7 @@ enum Decision {
     Refused(String),
     /// A copy of the pending request: answered with it.
     Joined,
-    Go(robot::Op),
+    Go(robot_handshake::Op),
 }
 
 pub struct RobotDoor {
@@ -80,7 +80,7 @@ impl RobotDoor {
                     front.record(NAME, "", &Who::Dds(r.writer), false, &why);
                     reply(&self.server, &r, &RobotRequestResponse::refused(why));
                 }
-                Decision::Go(robot::Op::CycleStart) => {
+                Decision::Go(robot_handshake::Op::CycleStart) => {
                     let a = cycle_start(front, machine, &r);
                     let response = RobotRequestResponse {
                         accepted: a.accepted,
@@ -96,7 +96,7 @@ impl RobotDoor {
     }
 
     fn decide(&mut self, r: &Request<RobotRequestRequest>, front: &dyn Front) -> Decision {
-        let op = match robot::Op::from_request(r.request.request) {
+        let op = match robot_handshake::Op::from_request(r.request.request) {
             Ok(op) => op,
             Err(why) => return Decision::Refused(why),
         };
@@ -115,18 +115,18 @@ impl RobotDoor {
         let Some(h) = &self.handshake else {
             return Decision::Refused("no handshake state from the PLC yet".into());
         };
-        match robot::refusal(op, h) {
+        match robot_handshake::refusal(op, h) {
             Some(why) => Decision::Refused(why),
             None => Decision::Go(op),
         }
     }
 
     /// Sets the robot signal that carries `op` to the PLC; the answer waits for the handshake.
-    fn signal(&mut self, op: robot::Op, r: Request<RobotRequestRequest>) {
+    fn signal(&mut self, op: robot_handshake::Op, r: Request<RobotRequestRequest>) {
         let Some((input, _)) = op.signal() else {
             return;
         };
-        let value = !matches!(op, robot::Op::Clear(false));
+        let value = !matches!(op, robot_handshake::Op::Clear(false));
         if let Err(e) = self.signals.publish(SimInput { input, value }) {
             log::error!("robot signal not sent: {e}");
         }
@@ -138,13 +138,13 @@ impl RobotDoor {
     }
 
     /// Answers the pending request once the handshake shows it done, or after
-    /// [`robot::ACTUATION_TIMEOUT`]; a signal not held is dropped then.
+    /// [`robot_handshake::ACTUATION_TIMEOUT`]; a signal not held is dropped then.
     fn finish(&mut self, front: &dyn Front) {
         let Some(p) = self.pending.take() else {
             return;
         };
         let done = self.handshake.as_ref().is_some_and(|h| p.op.done(h));
-        let late = p.since.elapsed().as_secs_f64() > robot::ACTUATION_TIMEOUT;
+        let late = p.since.elapsed().as_secs_f64() > robot_handshake::ACTUATION_TIMEOUT;
         if !(done || late) {
             self.pending = Some(p);
             return;
@@ -163,7 +163,7 @@ impl RobotDoor {
                 format!(
                     "{} not done within {} s (see the PLC's alarms)",
                     p.op.name(),
-                    robot::ACTUATION_TIMEOUT
+                    robot_handshake::ACTUATION_TIMEOUT
                 ),
             )
         };
@@ -201,7 +201,7 @@ fn cycle_start(
                 "cycle start refused: no program started yet (start_program or RunProgram first)";
             front.record(
                 NAME,
-                robot::Op::CycleStart.name(),
+                robot_handshake::Op::CycleStart.name(),
                 &Who::Dds(r.writer),
                 false,
                 why,

@@ -1,6 +1,7 @@
-//! io: the hardware boundary. The default backend is [`sim`], a simulated lathe.
+//! io: the hardware boundary. The default backend is the simulated machine, `cnc_sim_machine`
+//! (pure, re-exported here as [`sim`]); [`node`] is its shell on the servo and signal images.
 
 pub mod node;
-pub mod sim;
 
+pub use cnc_sim_machine as sim;
 pub use sim::{SimConfig, SimLathe};

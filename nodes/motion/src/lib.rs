@@ -2,8 +2,8 @@
 //! bus and DDS ([`node`]), and the loop's statistics ([`servo`]). Everything it runs is
 //! `cnc_motion_core`'s, re-exported here.
 
+pub mod loop_stats;
 pub mod node;
-pub mod servo;
 
 pub use cnc_motion_core::*;
 

@@ -21,9 +21,9 @@ use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::topics;
 use cnc_runtime::{LaunchConfig, Shutdown};
 
+use crate::loop_stats::{LateWatch, Lateness, ServoStatistics};
 use crate::motion::alarm;
 use crate::motion::{BlockResult, ProbeInput, ReferenceInputs};
-use crate::servo::{LateWatch, Lateness, ServoStatistics};
 use crate::FromLaunch;
 use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 
@@ -329,82 +329,93 @@ fn publish<M: ros2_client::Message + std::fmt::Debug + Send + Sync + 'static>(
     }
 }
 
-fn servo_loop(
-    mcfg: MotionConfig,
-    timing: Timing,
-    instance: String,
-    inputs: Receiver<Input>,
-    reports: Sender<Report>,
-    shutdown: Shutdown,
-) -> Result<String, String> {
-    let shm = ShmNode::new(&instance, "motion")?;
-    let setpoints = shm.sender::<ServoSetpoint>(channel::SETPOINT, true)?;
-    let feedback = shm.receiver::<ServoFeedback>(channel::FEEDBACK, true)?;
-    let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
-    let f_out = shm.sender::<FImage>(channel::F_IMAGE, false)?;
-    // After the setup, so no helper thread inherits the priority.
-    let rt = &timing.realtime;
-    let granted = cnc_runtime::realtime::enter(
-        "servo loop",
-        rt.servo_priority,
-        rt.servo_cpu,
-        rt.lock_memory,
-    );
-    let n = mcfg.axes.len();
-    let period_ns = (mcfg.period * 1e9) as u64;
-    // Start from where the drives are. Drives (io) may come up after motion, and a loaded
-    // machine can take seconds to start them: wait, but not past shutdown or 30 s.
-    let mut first = None;
-    for _ in 0..300 {
-        if shutdown.requested() {
-            return Ok("stopped before the drives reported".into());
-        }
-        first = feedback.wait(Duration::from_millis(100))?;
-        if first.is_some() {
-            break;
+/// The drives' latest feedback as motion reads it each tick.
+struct Latest {
+    actual: [f64; MAX_AXES],
+    spindle: (f64, f64),
+    /// The dogs and index marks; a mark is passed on once.
+    reference: ReferenceInputs,
+    /// The overtravel switches (+, −).
+    overtravel: (u32, u32),
+    handwheel: i32,
+    /// The touch probe's input and latches.
+    probe: ProbeInput,
+}
+
+impl Latest {
+    fn first(fb: &ServoFeedback) -> Latest {
+        Latest {
+            actual: fb.position,
+            spindle: (fb.spindle_rpm, fb.spindle_angle_deg),
+            reference: ReferenceInputs::default(),
+            overtravel: (fb.overtravel_plus, fb.overtravel_minus),
+            handwheel: fb.handwheel_count,
+            probe: ProbeInput::from_feedback(fb),
         }
     }
-    let first = first.ok_or("no feedback from the drives within 30 s (is io running?)")?;
-    let mut actual = first.position;
-    let mut spindle = (first.spindle_rpm, first.spindle_angle_deg);
-    // The dogs and index marks of the latest feedback; a mark is passed on once.
-    let mut reference = ReferenceInputs::default();
-    // The drives' overtravel switches of the latest feedback (+, −).
-    let mut overtravel = (first.overtravel_plus, first.overtravel_minus);
-    // The handwheel's counter of the latest feedback.
-    let mut handwheel = first.handwheel_count;
-    // The touch probe's input and latches of the latest feedback.
-    let mut probe = ProbeInput::from_feedback(&first);
-    let mut motion = Motion::new(mcfg.clone(), &actual[..n]);
-    // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
-    let mut g = GImage::default();
-    let mut plc = PlcLink::new(period_ns);
-    let mut stats = ServoStatistics {
-        realtime: granted.is_realtime(),
-        ..Default::default()
-    };
-    // One second of ticks is the window of the overrun alarm; five clear a warning.
-    let ticks_per_second = (1.0 / mcfg.period).round().max(1.0) as u64;
-    let mut watch = LateWatch::new(
-        timing.warning_ns,
-        timing.alarm_ticks,
-        ticks_per_second,
-        5 * ticks_per_second,
-    );
-    let mut seq = 0u64;
-    let mut last_status = None;
-    let mut last_tick: Option<u64> = None;
-    let mut next = monotonic_ns() + period_ns;
-    let mut have_feedback = true;
-    while !shutdown.requested() {
-        sleep_until_ns(next);
-        let now = monotonic_ns();
-        let late = now > next + period_ns / 2;
-        let wake_late_us = now.saturating_sub(next) as f64 / 1000.0;
-        if let Some(prev) = last_tick {
+
+    fn read(&mut self, fb: &ServoFeedback, n: usize) {
+        self.actual = fb.position;
+        self.spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
+        self.reference.dog = fb.reference_dog;
+        self.overtravel = (fb.overtravel_plus, fb.overtravel_minus);
+        self.handwheel = fb.handwheel_count;
+        self.probe = ProbeInput::from_feedback(fb);
+        if fb.marker != 0 {
+            self.reference.marker |= fb.marker;
+            for i in 0..n {
+                if fb.marker & (1 << i) != 0 {
+                    self.reference.marker_position[i] = fb.marker_position[i];
+                }
+            }
+        }
+    }
+
+    /// Hands motion the inputs of this tick (the spindle's only when the drives answered).
+    fn give(&mut self, motion: &mut Motion, have_feedback: bool) {
+        if have_feedback {
+            motion.spindle_feedback(self.spindle.0, self.spindle.1);
+        }
+        motion.reference_inputs(self.reference);
+        self.reference.marker = 0;
+        motion.overtravel_inputs(self.overtravel.0, self.overtravel.1);
+        motion.handwheel_input(self.handwheel);
+        motion.probe_input(self.probe);
+    }
+}
+
+/// Waits for the drives' first feedback: they (io) may come up after motion, and a loaded
+/// machine can take seconds to start them; not past shutdown or 30 s.
+fn first_feedback(
+    feedback: &cnc_runtime::shm::Receiver<ServoFeedback>,
+    shutdown: &Shutdown,
+) -> Result<Option<ServoFeedback>, String> {
+    for _ in 0..300 {
+        if shutdown.requested() {
+            return Ok(None);
+        }
+        if let Some(fb) = feedback.wait(Duration::from_millis(100))? {
+            return Ok(Some(fb));
+        }
+    }
+    Err("no feedback from the drives within 30 s (is io running?)".into())
+}
+
+/// The servo loop's own timing: its statistics and the lateness watch.
+struct Clockwork {
+    stats: ServoStatistics,
+    watch: LateWatch,
+    last_tick: Option<u64>,
+}
+
+impl Clockwork {
+    /// Counts the tick that woke at `now` (`late`: past half a period); a late warning or its
+    /// clearing is reported, an overrun is motion's alarm.
+    fn tick(&mut self, now: u64, late: bool, motion: &mut Motion, reports: &Sender<Report>) {
+        if let Some(prev) = self.last_tick {
             let interval = now - prev;
-            stats.interval.record(interval as f64 / 1000.0);
-            match watch.tick(stats.ticks, interval, late) {
+            self.stats.interval.record(interval as f64 / 1000.0);
+            match self.watch.tick(self.stats.ticks, interval, late) {
                 Lateness::OnTime => {}
                 Lateness::Warning(us) => {
                     let _ = reports.send(Report::Late(Some(us)));
@@ -414,7 +425,7 @@ fn servo_loop(
                 }
                 Lateness::Overrun(n) => motion.servo_overrun(format!(
                     "servo loop overrun: {n} late ticks within a second ({})",
-                    if stats.realtime {
+                    if self.stats.realtime {
                         "SCHED_FIFO"
                     } else {
                         "not real-time"
@@ -422,119 +433,96 @@ fn servo_loop(
                 )),
             }
         }
-        last_tick = Some(now);
-        stats.ticks += 1;
+        self.last_tick = Some(now);
+        self.stats.ticks += 1;
         if late {
-            stats.late_ticks += 1;
+            self.stats.late_ticks += 1;
         }
-        next += period_ns;
-        if now > next + 10 * period_ns {
-            next = now + period_ns; // far behind (machine suspended): resynchronise, counted as late
-        }
-        while let Ok(input) = inputs.try_recv() {
-            match input {
-                Input::Block(b) => motion.push(b),
-                Input::Command(id, request) => {
-                    if request == MotionRequest::Reset {
-                        watch.reset();
-                        // A PLC still silent is reported again (its alarm was cleared by reset).
-                        plc.reported = false;
-                    }
-                    let result = obey(&mut motion, &request);
-                    if request == MotionRequest::ReferenceReturn {
-                        // A refused reference return is also a warning on the alarm list.
-                        let warning = result.as_ref().err().cloned();
-                        let _ = reports.send(Report::Warning(alarm::REFERENCE_REFUSED, warning));
-                    }
-                    let _ = reports.send(Report::Answer(id, result));
+    }
+}
+
+/// The DDS thread's blocks and the task's commands, carried out; each command answered.
+fn take_inputs(
+    inputs: &Receiver<Input>,
+    motion: &mut Motion,
+    clock: &mut Clockwork,
+    plc: &mut PlcLink,
+    reports: &Sender<Report>,
+) {
+    while let Ok(input) = inputs.try_recv() {
+        match input {
+            Input::Block(b) => motion.push(b),
+            Input::Command(id, request) => {
+                if request == MotionRequest::Reset {
+                    clock.watch.reset();
+                    // A PLC still silent is reported again (its alarm was cleared by reset).
+                    plc.reported = false;
                 }
-            }
-        }
-        match g_in.latest()? {
-            Some(latest) => {
-                g = latest;
-                plc.heard(now);
-            }
-            None => plc.tick(),
-        }
-        if plc.silent(now) {
-            if !plc.reported {
-                plc.reported = true;
-                let quiet_ms = plc
-                    .last_heard
-                    .map_or(0, |t| now.saturating_sub(t) / 1_000_000);
-                let _ = reports.send(Report::Alarm(
-                    alarm::PLC_SILENT,
-                    format!(
-                        "the PLC stopped answering ({quiet_ms} ms, {} ticks without its signals): emergency stop",
-                        plc.ticks_since
-                    ),
-                    motion.line(),
-                ));
-            }
-            g = GImage::default();
-        }
-        motion.plc_signals(&g);
-        if have_feedback {
-            motion.spindle_feedback(spindle.0, spindle.1);
-        }
-        motion.reference_inputs(reference);
-        reference.marker = 0;
-        motion.overtravel_inputs(overtravel.0, overtravel.1);
-        motion.handwheel_input(handwheel);
-        motion.probe_input(probe);
-        // What the drives get; under machine lock it is not the commanded position.
-        let mut setpoint = [0.0; MAX_AXES];
-        setpoint[..n].copy_from_slice(motion.tick(have_feedback.then_some(&actual[..n]), &g));
-        let mut fi = *motion.f_image();
-        fi.seq = seq + 1;
-        f_out.send(fi)?;
-        seq += 1;
-        let computed = monotonic_ns();
-        let mut out = ServoSetpoint {
-            seq,
-            sent_ns: monotonic_ns(),
-            position: setpoint,
-            axis_count: n as u32,
-            ..ServoSetpoint::default()
-        };
-        motion.fill_setpoint(&mut out);
-        setpoints.send(out)?;
-        // The answer to this setpoint, within half a period; a late answer to an earlier one
-        // still updates the position but is not a round trip of this tick.
-        have_feedback = false;
-        let deadline = monotonic_ns() + period_ns / 2;
-        while let Some(fb) = feedback.wait(Duration::from_nanos(
-            deadline.saturating_sub(monotonic_ns()),
-        ))? {
-            actual = fb.position;
-            spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
-            reference.dog = fb.reference_dog;
-            overtravel = (fb.overtravel_plus, fb.overtravel_minus);
-            handwheel = fb.handwheel_count;
-            probe = ProbeInput::from_feedback(&fb);
-            if fb.marker != 0 {
-                reference.marker |= fb.marker;
-                for i in 0..n {
-                    if fb.marker & (1 << i) != 0 {
-                        reference.marker_position[i] = fb.marker_position[i];
-                    }
+                let result = obey(motion, &request);
+                if request == MotionRequest::ReferenceReturn {
+                    // A refused reference return is also a warning on the alarm list.
+                    let warning = result.as_ref().err().cloned();
+                    let _ = reports.send(Report::Warning(alarm::REFERENCE_REFUSED, warning));
                 }
-            }
-            have_feedback = true;
-            if fb.seq == seq {
-                stats
-                    .round_trip
-                    .record((monotonic_ns() - fb.setpoint_sent_ns) as f64 / 1000.0);
-                break;
+                let _ = reports.send(Report::Answer(id, result));
             }
         }
-        let exchanged = monotonic_ns();
-        stats.phases(
-            wake_late_us,
-            computed.saturating_sub(now) as f64 / 1000.0,
-            exchanged.saturating_sub(computed) as f64 / 1000.0,
-        );
+    }
+}
+
+/// The PLC's G image of this tick: its latest, or all zero (emergency stop) once it has been
+/// silent too long, reported once.
+fn plc_signals(
+    latest: Option<GImage>,
+    g: &mut GImage,
+    plc: &mut PlcLink,
+    now: u64,
+    line: u32,
+    reports: &Sender<Report>,
+) {
+    match latest {
+        Some(latest) => {
+            *g = latest;
+            plc.heard(now);
+        }
+        None => plc.tick(),
+    }
+    if !plc.silent(now) {
+        return;
+    }
+    if !plc.reported {
+        plc.reported = true;
+        let quiet_ms = plc
+            .last_heard
+            .map_or(0, |t| now.saturating_sub(t) / 1_000_000);
+        let _ = reports.send(Report::Alarm(
+            alarm::PLC_SILENT,
+            format!(
+                "the PLC stopped answering ({quiet_ms} ms, {} ticks without its signals): emergency stop",
+                plc.ticks_since
+            ),
+            line,
+        ));
+    }
+    *g = GImage::default();
+}
+
+/// What the DDS thread publishes: motion's alarms; the status on a change and every 25 ticks;
+/// the axes every 10; the servo statistics every 250.
+struct Reporter {
+    last_status: Option<(u64, u64, u64, RunState, u32, Option<BlockResult>)>,
+}
+
+impl Reporter {
+    fn report(
+        &mut self,
+        motion: &mut Motion,
+        seq: u64,
+        latest: &Latest,
+        clock: &Clockwork,
+        period: f64,
+        reports: &Sender<Report>,
+    ) {
         for e in motion.take_events() {
             let MotionEvent::Alarm { number, text, line } = e;
             let _ = reports.send(Report::Alarm(number, text, line));
@@ -547,8 +535,8 @@ fn servo_loop(
             motion.line(),
             motion.block_result().copied(),
         );
-        if last_status != Some(status) || seq.is_multiple_of(25) {
-            last_status = Some(status);
+        if self.last_status != Some(status) || seq.is_multiple_of(25) {
+            self.last_status = Some(status);
             let state = match status.3 {
                 RunState::Idle => MotionStatus::STATE_IDLE,
                 RunState::Running => MotionStatus::STATE_RUNNING,
@@ -575,27 +563,149 @@ fn servo_loop(
             let _ = reports.send(Report::Status(msg, status.5));
         }
         if seq.is_multiple_of(10) {
-            let mut commanded = [0.0; MAX_AXES];
-            commanded[..n].copy_from_slice(motion.commanded());
-            let mut machine = [0.0; MAX_AXES];
-            machine[..n].copy_from_slice(motion.actual());
-            let mut drive = [0.0; MAX_AXES];
-            drive[..n].copy_from_slice(motion.setpoint());
-            let locked = motion.locked_axes();
-            let referenced = motion
-                .referenced()
-                .iter()
-                .enumerate()
-                .fold(0u32, |bits, (i, r)| bits | (u32::from(*r) << i));
-            let limits = overtravel;
-            let _ = reports.send(Report::Axes(
-                commanded, machine, drive, locked, referenced, limits,
-            ));
+            report_axes(motion, latest.overtravel, reports);
         }
         if seq.is_multiple_of(250) {
-            let _ = reports.send(Report::Stats(stats.message(mcfg.period)));
+            let _ = reports.send(Report::Stats(clock.stats.message(period)));
         }
     }
+}
+
+fn report_axes(motion: &Motion, limits: (u32, u32), reports: &Sender<Report>) {
+    let n = motion.commanded().len();
+    let mut commanded = [0.0; MAX_AXES];
+    commanded[..n].copy_from_slice(motion.commanded());
+    let mut machine = [0.0; MAX_AXES];
+    machine[..n].copy_from_slice(motion.actual());
+    let mut drive = [0.0; MAX_AXES];
+    drive[..n].copy_from_slice(motion.setpoint());
+    let locked = motion.locked_axes();
+    let referenced = motion
+        .referenced()
+        .iter()
+        .enumerate()
+        .fold(0u32, |bits, (i, r)| bits | (u32::from(*r) << i));
+    let _ = reports.send(Report::Axes(
+        commanded, machine, drive, locked, referenced, limits,
+    ));
+}
+
+fn servo_loop(
+    mcfg: MotionConfig,
+    timing: Timing,
+    instance: String,
+    inputs: Receiver<Input>,
+    reports: Sender<Report>,
+    shutdown: Shutdown,
+) -> Result<String, String> {
+    let shm = ShmNode::new(&instance, "motion")?;
+    let setpoints = shm.sender::<ServoSetpoint>(channel::SETPOINT, true)?;
+    let feedback = shm.receiver::<ServoFeedback>(channel::FEEDBACK, true)?;
+    let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
+    let f_out = shm.sender::<FImage>(channel::F_IMAGE, false)?;
+    // After the setup, so no helper thread inherits the priority.
+    let rt = &timing.realtime;
+    let granted = cnc_runtime::realtime::enter(
+        "servo loop",
+        rt.servo_priority,
+        rt.servo_cpu,
+        rt.lock_memory,
+    );
+    let n = mcfg.axes.len();
+    let period_ns = (mcfg.period * 1e9) as u64;
+    // Start from where the drives are.
+    let Some(first) = first_feedback(&feedback, &shutdown)? else {
+        return Ok("stopped before the drives reported".into());
+    };
+    let mut latest = Latest::first(&first);
+    let mut motion = Motion::new(mcfg.clone(), &latest.actual[..n]);
+    // All zero: emergency stop until the PLC's first scan (`*ESP` is active low).
+    let mut g = GImage::default();
+    let mut plc = PlcLink::new(period_ns);
+    // One second of ticks is the window of the overrun alarm; five clear a warning.
+    let ticks_per_second = (1.0 / mcfg.period).round().max(1.0) as u64;
+    let mut clock = Clockwork {
+        stats: ServoStatistics {
+            realtime: granted.is_realtime(),
+            ..Default::default()
+        },
+        watch: LateWatch::new(
+            timing.warning_ns,
+            timing.alarm_ticks,
+            ticks_per_second,
+            5 * ticks_per_second,
+        ),
+        last_tick: None,
+    };
+    let mut reporter = Reporter { last_status: None };
+    let mut seq = 0u64;
+    let mut next = monotonic_ns() + period_ns;
+    let mut have_feedback = true;
+    while !shutdown.requested() {
+        sleep_until_ns(next);
+        let now = monotonic_ns();
+        let late = now > next + period_ns / 2;
+        let wake_late_us = now.saturating_sub(next) as f64 / 1000.0;
+        clock.tick(now, late, &mut motion, &reports);
+        next += period_ns;
+        if now > next + 10 * period_ns {
+            next = now + period_ns; // far behind (machine suspended): resynchronise, counted as late
+        }
+        take_inputs(&inputs, &mut motion, &mut clock, &mut plc, &reports);
+        plc_signals(
+            g_in.latest()?,
+            &mut g,
+            &mut plc,
+            now,
+            motion.line(),
+            &reports,
+        );
+        motion.plc_signals(&g);
+        latest.give(&mut motion, have_feedback);
+        // What the drives get; under machine lock it is not the commanded position.
+        let mut setpoint = [0.0; MAX_AXES];
+        let actual = have_feedback.then_some(&latest.actual[..n]);
+        setpoint[..n].copy_from_slice(motion.tick(actual, &g));
+        let mut fi = *motion.f_image();
+        fi.seq = seq + 1;
+        f_out.send(fi)?;
+        seq += 1;
+        let computed = monotonic_ns();
+        let mut out = ServoSetpoint {
+            seq,
+            sent_ns: monotonic_ns(),
+            position: setpoint,
+            axis_count: n as u32,
+            ..ServoSetpoint::default()
+        };
+        motion.fill_setpoint(&mut out);
+        setpoints.send(out)?;
+        // The answer to this setpoint, within half a period; a late answer to an earlier one
+        // still updates the position but is not a round trip of this tick.
+        have_feedback = false;
+        let deadline = monotonic_ns() + period_ns / 2;
+        while let Some(fb) = feedback.wait(Duration::from_nanos(
+            deadline.saturating_sub(monotonic_ns()),
+        ))? {
+            latest.read(&fb, n);
+            have_feedback = true;
+            if fb.seq == seq {
+                clock
+                    .stats
+                    .round_trip
+                    .record((monotonic_ns() - fb.setpoint_sent_ns) as f64 / 1000.0);
+                break;
+            }
+        }
+        let exchanged = monotonic_ns();
+        clock.stats.phases(
+            wake_late_us,
+            computed.saturating_sub(now) as f64 / 1000.0,
+            exchanged.saturating_sub(computed) as f64 / 1000.0,
+        );
+        reporter.report(&mut motion, seq, &latest, &clock, mcfg.period, &reports);
+    }
+    let stats = &clock.stats;
     let _ = reports.send(Report::Stats(stats.message(mcfg.period)));
     let period_us = mcfg.period * 1e6;
     Ok(format!(

@@ -1,20 +1,8 @@
-//! plc: the machine logic as a ladder program, FANUC-PMC style (`000` §18, inventory §9).
-//!
-//! [`program`] parses and checks the mnemonic text, [`engine`] executes its instructions over
-//! [`memory`], [`scan`] is the two-level scan cycle with the NC and machine images; [`node`]
-//! binds it to iceoryx2 images and ROS 2 topics. `programs/lathe_standard.plc` is the standard
-//! lathe logic.
+//! plc: the node that scans the ladder program. Its core, the program, instructions and scan,
+//! is `cnc_plc_core` (pure, re-exported here); [`node`] binds it to the iceoryx2 images, the
+//! machine bus and ROS 2 topics, keeps its retained memory and reloads its program file.
 
-pub mod address;
-pub mod engine;
-pub mod memory;
-pub mod monitor;
 pub mod node;
-pub mod program;
-pub mod scan;
 
-pub use program::{LoadError, Program};
-pub use scan::{Plc, PlcEvent, Value};
-
-/// The standard lathe program, built in so a machine runs without a PLC file.
-pub const LATHE_STANDARD: &str = include_str!("../programs/lathe_standard.plc");
+pub use cnc_plc_core::{address, engine, memory, monitor, program, scan};
+pub use cnc_plc_core::{LoadError, Plc, PlcEvent, Program, Value, LATHE_STANDARD};

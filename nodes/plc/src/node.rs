@@ -103,12 +103,13 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
     let mut next = t0;
     let mut scan_times = ScanTimes::default();
     let mut parts = PartCounter::default();
-    // The retained memory is kept at every change, the part count published once its count
-    // is on the disk: a part the cell was told of is never lost (decisions D59).
-    let mut keeper = memory_file
-        .clone()
-        .map(|p| cnc_runtime::persist::Keeper::new(p, "PLC memory"));
-    let mut held_parts: Option<(PartCount, u64)> = None;
+    let mut kept = Kept {
+        keeper: memory_file
+            .clone()
+            .map(|p| cnc_runtime::persist::Keeper::new(p, "PLC memory")),
+        saved,
+        held_parts: None,
+    };
     let mut last_spindle = None;
     // The scan keeps the machine's I/O in time: real time below the servo and drive loops.
     let rt = &cfg.realtime;
@@ -136,68 +137,10 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         scan_times.record((monotonic_ns() - start) as f64 / 1000.0);
         g_out.send(*plc.to_nc())?;
         y_out.send(*plc.outputs())?;
-        for e in plc.take_events() {
-            match e {
-                PlcEvent::MessageOn {
-                    number,
-                    address,
-                    text,
-                    alarm,
-                } => {
-                    let severity = if alarm {
-                        Alarm::SEVERITY_ERROR
-                    } else {
-                        Alarm::SEVERITY_INFO
-                    };
-                    alarms.raise(alarms.alarm(
-                        number,
-                        severity,
-                        &format!("{address} {text}"),
-                        "",
-                        0,
-                    ))
-                }
-                PlcEvent::MessageOff { number } => alarms.clear(number),
-                PlcEvent::EmergencyStop(true) => alarms.raise(alarms.alarm(
-                    EMERGENCY_STOP_ALARM,
-                    Alarm::SEVERITY_FATAL,
-                    "emergency stop",
-                    "",
-                    0,
-                )),
-                PlcEvent::EmergencyStop(false) => alarms.clear(EMERGENCY_STOP_ALARM),
-                PlcEvent::Fault { text } => {
-                    alarms.raise(alarms.alarm(PLC_FAULT_ALARM, Alarm::SEVERITY_FATAL, &text, "", 0))
-                }
-            }
-        }
+        raise_events(&mut plc, &alarms);
         let scans = plc.scans();
         let now_s = (monotonic_ns() - t0) as f64 * 1e-9;
-        let kept_version = match keeper.as_mut() {
-            Some(k) => {
-                if !saved.as_ref().is_some_and(|s| plc.retains(s)) {
-                    let now = plc.retained();
-                    if let Ok(text) = serde_yaml::to_string(&now) {
-                        k.keep(text.into_bytes());
-                    }
-                    saved = Some(now);
-                }
-                k.given()
-            }
-            None => 0,
-        };
-        if let Some(msg) = parts.update(&plc, &fi, now_s, scans.is_multiple_of(500)) {
-            held_parts = Some((msg, kept_version));
-        }
-        // A disk that refuses the write (logged as an error) does not hold the count back.
-        let durable =
-            keeper.as_ref().map_or(
-                u64::MAX,
-                |k| if k.failing() { u64::MAX } else { k.durable() },
-            );
-        if let Some((msg, _)) = held_parts.take_if(|(_, v)| *v <= durable) {
-            let _ = parts_pub.publish(msg);
-        }
+        kept.keep_and_count(&plc, &mut parts, &fi, now_s, &parts_pub);
         publish_spindle(
             &spindle_pub,
             plc.outputs(),
@@ -215,18 +158,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
             last_robot = Some(robot);
         }
         if scans.is_multiple_of(SIGNALS_EVERY) {
-            let table = |s| plc.table(s).to_vec();
-            let _ = signals_pub.publish(PlcSignals {
-                stamp: stamp(),
-                scan: scans,
-                x: table(Space::X),
-                y: table(Space::Y),
-                f: table(Space::F),
-                g: table(Space::G),
-                r: table(Space::R),
-                a: table(Space::A),
-                k: table(Space::K),
-            });
+            publish_signals(&plc, &signals_pub);
         }
         if scans.is_multiple_of(100) {
             // Once a second at 10 ms: status, program file, parameters.
@@ -247,6 +179,106 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         }
     }
     Ok(())
+}
+
+/// The scan's messages, emergency stop and faults as alarms.
+fn raise_events(plc: &mut Plc, alarms: &AlarmReporter) {
+    for e in plc.take_events() {
+        match e {
+            PlcEvent::MessageOn {
+                number,
+                address,
+                text,
+                alarm,
+            } => {
+                let severity = if alarm {
+                    Alarm::SEVERITY_ERROR
+                } else {
+                    Alarm::SEVERITY_INFO
+                };
+                alarms.raise(alarms.alarm(number, severity, &format!("{address} {text}"), "", 0))
+            }
+            PlcEvent::MessageOff { number } => alarms.clear(number),
+            PlcEvent::EmergencyStop(true) => alarms.raise(alarms.alarm(
+                EMERGENCY_STOP_ALARM,
+                Alarm::SEVERITY_FATAL,
+                "emergency stop",
+                "",
+                0,
+            )),
+            PlcEvent::EmergencyStop(false) => alarms.clear(EMERGENCY_STOP_ALARM),
+            PlcEvent::Fault { text } => {
+                alarms.raise(alarms.alarm(PLC_FAULT_ALARM, Alarm::SEVERITY_FATAL, &text, "", 0))
+            }
+        }
+    }
+}
+
+/// The retained memory, kept at every change, and the part count, published once its count
+/// is on the disk: a part the cell was told of is never lost (decisions D59).
+struct Kept {
+    keeper: Option<cnc_runtime::persist::Keeper>,
+    saved: Option<Retained>,
+    held_parts: Option<(PartCount, u64)>,
+}
+
+impl Kept {
+    fn keep_and_count(
+        &mut self,
+        plc: &Plc,
+        parts: &mut PartCounter,
+        fi: &FImage,
+        now_s: f64,
+        parts_pub: &cnc_runtime::dds::Publisher<PartCount>,
+    ) {
+        let scans = plc.scans();
+        let kept_version = match self.keeper.as_mut() {
+            Some(k) => {
+                if !self.saved.as_ref().is_some_and(|s| plc.retains(s)) {
+                    let now = plc.retained();
+                    if let Ok(text) = serde_yaml::to_string(&now) {
+                        k.keep(text.into_bytes());
+                    }
+                    self.saved = Some(now);
+                }
+                k.given()
+            }
+            None => 0,
+        };
+        if let Some(msg) = parts.update(plc, fi, now_s, scans.is_multiple_of(500)) {
+            self.held_parts = Some((msg, kept_version));
+        }
+        // A disk that refuses the write (logged as an error) does not hold the count back.
+        let durable =
+            self.keeper.as_ref().map_or(
+                u64::MAX,
+                |k| {
+                    if k.failing() {
+                        u64::MAX
+                    } else {
+                        k.durable()
+                    }
+                },
+            );
+        if let Some((msg, _)) = self.held_parts.take_if(|(_, v)| *v <= durable) {
+            let _ = parts_pub.publish(msg);
+        }
+    }
+}
+
+fn publish_signals(plc: &Plc, publisher: &cnc_runtime::dds::Publisher<PlcSignals>) {
+    let table = |s| plc.table(s).to_vec();
+    let _ = publisher.publish(PlcSignals {
+        stamp: stamp(),
+        scan: plc.scans(),
+        x: table(Space::X),
+        y: table(Space::Y),
+        f: table(Space::F),
+        g: table(Space::G),
+        r: table(Space::R),
+        a: table(Space::A),
+        k: table(Space::K),
+    });
 }
 
 /// The signal snapshot goes out every this many scans (5 a second at the 10 ms default).

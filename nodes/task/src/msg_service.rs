@@ -31,8 +31,9 @@ pub fn ring_append(text: &str, line: &str, max_bytes: usize) -> String {
     out
 }
 
-/// Appends `line` to the file at `path`, kept to `max_kib`: written to a new file and
-/// renamed over the old, so a crash leaves the old or the new, never half of one.
+/// Appends `line` to the file at `path`, kept to `max_kib`: written durably to a new file and
+/// renamed over the old ([`cnc_runtime::persist::write_atomic`]), so a crash leaves the old or
+/// the new, never half of one.
 pub fn append(path: &Path, line: &str, max_kib: u32) -> Result<(), String> {
     let old = match std::fs::read_to_string(path) {
         Ok(t) => t,
@@ -40,10 +41,7 @@ pub fn append(path: &Path, line: &str, max_kib: u32) -> Result<(), String> {
         Err(e) => return Err(format!("{}: {e}", path.display())),
     };
     let new = ring_append(&old, line, max_kib as usize * 1024);
-    let tmp = path.with_extension("new");
-    std::fs::write(&tmp, new)
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|e| format!("{}: {e}", path.display()))
+    cnc_runtime::persist::write_atomic(path, &new)
 }
 
 #[cfg(test)]

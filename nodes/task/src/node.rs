@@ -130,115 +130,46 @@ fn approach_from_config(cfg: &LaunchConfig, machine: &Setup) -> Approach {
     a
 }
 
-/// Runs the interpreter node of the machine `instance` ([`cnc_runtime::shm::instance`]) until
-/// `shutdown`.
-pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
-    let dialect = Dialect::from_name(&cfg.machine.dialect)
-        .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
-    let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
-    let commands = ros.subscription::<TaskCommand>(&topics::TASK_COMMAND)?;
-    let results = ros.publisher::<CommandResult>(&topics::COMMAND_RESULT)?;
-    let to_motion_cmd = ros.publisher::<MotionCommand>(&topics::MOTION_COMMAND)?;
-    let motion_results = ros.subscription::<CommandResult>(&topics::MOTION_RESULT)?;
-    let blocks = ros.publisher::<MotionBlock>(&topics::MOTION_BLOCKS)?;
-    let status_sub = ros.subscription::<MotionStatus>(&topics::MOTION_STATUS)?;
-    let axes_sub = ros.subscription::<AxisState>(&topics::AXES)?;
-    let alarm_sub = ros.subscription::<AlarmEvent>(&topics::ALARM_EVENTS)?;
-    let state_pub = ros.publisher::<MachineState>(&topics::MACHINE_STATE)?;
-    let alarms = AlarmReporter::new(&mut ros, run::SOURCE)?;
-    // The PLC's G image, for the block-skip switch (G44.0): the interpreter reads the blocks;
-    // its first arrival says the PLC has scanned (READY waits for it).
-    let shm = ShmNode::new(&instance, "interpreter")?;
-    let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
+/// What the task sends out: blocks and commands to motion, alarms, the message service, the
+/// machine memory file. Carries out the core's effects in order.
+struct Outputs {
+    blocks: cnc_runtime::dds::Publisher<MotionBlock>,
+    to_motion: cnc_runtime::dds::Publisher<MotionCommand>,
+    alarms: AlarmReporter,
+    msg_file: Option<std::path::PathBuf>,
+    msg_file_kib: u32,
+    memory_path: Option<std::path::PathBuf>,
+}
 
-    let (memory, memory_error) = load_memory(&cfg);
-    if let Some(e) = memory_error {
-        log::error!("interpreter: machine memory not read, using the config's offsets: {e}");
-    }
-    let memory_path = cfg.machine.memory_file.clone();
-    // Run ids grow across restarts of this node.
-    let base = setup_from_config(&cfg, &cfg.home());
-    let capacity = cfg.machine.program_capacity_kib.saturating_mul(1024);
-    let (programs, storage): (BTreeMap<String, String>, Box<dyn ProgramStorage>) =
-        match &cfg.machine.program_directory {
-            Some(dir) => {
-                let dir = ProgramDir::new(dir);
-                let (programs, problems) = dir.read_all();
-                for p in problems {
-                    log::error!("interpreter: program memory: {p}");
-                }
-                log::info!(
-                    "interpreter: program memory {}: {} programs",
-                    dir.root.display(),
-                    programs.len()
-                );
-                (programs, Box::new(dir))
-            }
-            None => (BTreeMap::new(), Box::new(InRam)),
-        };
-    let (keeper, kept) = kept_position(&cfg);
-    let approach = approach_from_config(&cfg, &base);
-    let mut core = RunCore::new(dialect, base, memory, monotonic_ns() / 1000)
-        .with_program_memory(programs, storage, capacity)
-        .with_approach(approach)
-        .with_kept_position(kept);
-    let mut state = StateReporter {
-        publisher: state_pub,
-        last: None,
-        last_ns: 0,
-        position: keeper,
-        tracker: PositionTracker::default(),
-    };
-    let msg_file = cfg.machine.msg_file.clone();
-    let msg_file_kib = cfg.machine.msg_file_kib;
-    let carry_out = |core: &mut RunCore| {
+impl Outputs {
+    fn carry_out(&self, core: &mut RunCore) {
         for effect in core.take_effects() {
             match effect {
                 Effect::Block(msg) => {
-                    if let Err(e) = blocks.publish(msg) {
+                    if let Err(e) = self.blocks.publish(msg) {
                         log::error!("interpreter: block not sent: {e:?}");
                     }
                 }
                 Effect::ToMotion(c) => {
-                    let _ = to_motion_cmd.publish(c);
+                    let _ = self.to_motion.publish(c);
                 }
                 Effect::Raise {
                     number,
                     text,
                     program,
                     line,
-                } => {
-                    alarms.raise(alarms.alarm(number, Alarm::SEVERITY_ERROR, &text, &program, line))
-                }
-                Effect::Clear(number) => alarms.clear(number),
-                Effect::MessageService(output, text) => match (output, &msg_file) {
-                    (cnc_interpreter_core::ServiceOutput::File, Some(path)) => {
-                        if let Err(e) = crate::msg_service::append(path, &text, msg_file_kib) {
-                            log::error!("interpreter: MSG service file: {e}");
-                        }
-                    }
-                    // An interface that is off: nothing goes out, and the operator is told
-                    // ("发生 MSG 指令处理故障", `001` §8.4.4).
-                    (output, _) => alarms.raise(alarms.alarm(
-                        MSG_SERVICE_OFF,
-                        Alarm::SEVERITY_WARNING,
-                        &format!(
-                            "MSG instruction processing fault: the {} output is off on this \
-                             machine ({text:?} not sent)",
-                            match output {
-                                cnc_interpreter_core::ServiceOutput::File => {
-                                    "File (machine.msg_file)"
-                                }
-                                cnc_interpreter_core::ServiceOutput::Serial => "V24 (RS232)",
-                            }
-                        ),
-                        "",
-                        0,
-                    )),
-                },
+                } => self.alarms.raise(self.alarms.alarm(
+                    number,
+                    Alarm::SEVERITY_ERROR,
+                    &text,
+                    &program,
+                    line,
+                )),
+                Effect::Clear(number) => self.alarms.clear(number),
+                Effect::MessageService(output, text) => self.message_service(output, &text),
                 Effect::StoreMemory => {
                     // Durable before the blocks that follow are published (write ahead).
-                    if let Some(p) = memory_path.as_deref() {
+                    if let Some(p) = self.memory_path.as_deref() {
                         if let Err(e) = save_memory(p, core.memory()) {
                             log::error!("interpreter: machine memory not stored: {e}");
                         }
@@ -246,15 +177,69 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 }
             }
         }
-    };
+    }
 
-    while !shutdown.requested() {
-        ros.refresh();
-        let mut busy = false;
-        while let Ok(Some(s)) = status_sub.take() {
+    fn message_service(&self, output: cnc_interpreter_core::ServiceOutput, text: &str) {
+        use cnc_interpreter_core::ServiceOutput;
+        if let (ServiceOutput::File, Some(path)) = (output, &self.msg_file) {
+            if let Err(e) = crate::msg_service::append(path, text, self.msg_file_kib) {
+                log::error!("interpreter: MSG service file: {e}");
+            }
+            return;
+        }
+        // An interface that is off: nothing goes out, and the operator is told ("发生 MSG
+        // 指令处理故障", `001` §8.4.4).
+        let interface = match output {
+            ServiceOutput::File => "File (machine.msg_file)",
+            ServiceOutput::Serial => "V24 (RS232)",
+        };
+        self.alarms.raise(self.alarms.alarm(
+            MSG_SERVICE_OFF,
+            Alarm::SEVERITY_WARNING,
+            &format!(
+                "MSG instruction processing fault: the {interface} output is off on this machine \
+                 ({text:?} not sent)"
+            ),
+            "",
+            0,
+        ));
+    }
+}
+
+/// Program memory as the config keeps it: a folder on disk, or RAM only.
+fn program_memory(cfg: &LaunchConfig) -> (BTreeMap<String, String>, Box<dyn ProgramStorage>) {
+    let Some(dir) = &cfg.machine.program_directory else {
+        return (BTreeMap::new(), Box::new(InRam));
+    };
+    let dir = ProgramDir::new(dir);
+    let (programs, problems) = dir.read_all();
+    for p in problems {
+        log::error!("interpreter: program memory: {p}");
+    }
+    log::info!(
+        "interpreter: program memory {}: {} programs",
+        dir.root.display(),
+        programs.len()
+    );
+    (programs, Box::new(dir))
+}
+
+/// What the task hears of the machine: motion's status and axes, alarms, the PLC's G image.
+struct Machine {
+    status: cnc_runtime::bus::Subscription<MotionStatus>,
+    axes: cnc_runtime::bus::Subscription<AxisState>,
+    alarms: cnc_runtime::bus::Subscription<AlarmEvent>,
+    /// The PLC's G image, for the block-skip switch (G44.0): its first arrival says the PLC
+    /// has scanned (READY waits for it).
+    g_in: cnc_runtime::shm::Receiver<GImage>,
+}
+
+impl Machine {
+    fn feed(&self, core: &mut RunCore) {
+        while let Ok(Some(s)) = self.status.take() {
             core.motion_status(s);
         }
-        while let Ok(Some(a)) = axes_sub.take() {
+        while let Ok(Some(a)) = self.axes.take() {
             let commanded: Vec<f64> = a.axes.iter().map(|x| x.commanded_position).collect();
             core.axes(&commanded);
             core.unreferenced_axes(
@@ -265,26 +250,40 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                     .collect(),
             );
         }
-        while let Ok(Some(e)) = alarm_sub.take() {
+        while let Ok(Some(e)) = self.alarms.take() {
             core.alarm_event(&e);
         }
-        if let Ok(Some(g)) = g_in.latest() {
+        if let Ok(Some(g)) = self.g_in.latest() {
             // The PLC writes its G image only after a scan: the machine can be ready.
             core.plc_scanned();
             core.block_skip_switch(g.get(g::BDT1));
         }
-        carry_out(&mut core);
-        while let Ok(Some(r)) = motion_results.take() {
+    }
+}
+
+/// The command path: the bridge's commands in, answers out (motion's too, for what the task
+/// passed on to it).
+struct Commands {
+    commands: cnc_runtime::bus::Subscription<TaskCommand>,
+    results: cnc_runtime::dds::Publisher<CommandResult>,
+    motion_results: cnc_runtime::bus::Subscription<CommandResult>,
+}
+
+impl Commands {
+    /// Serves what arrived; returns whether anything did.
+    fn serve(&self, core: &mut RunCore, out: &Outputs, cfg: &LaunchConfig) -> bool {
+        while let Ok(Some(r)) = self.motion_results.take() {
             if let Some(answer) = core.motion_result(&r) {
-                let _ = results.publish(answer);
+                let _ = self.results.publish(answer);
             }
         }
-        while let Ok(Some(c)) = commands.take() {
+        let mut busy = false;
+        while let Ok(Some(c)) = self.commands.take() {
             busy = true;
             let request = match TaskRequest::from_command(&c) {
                 Ok(r) => r,
                 Err(message) => {
-                    let _ = results.publish(CommandResult {
+                    let _ = self.results.publish(CommandResult {
                         id: c.id,
                         accepted: false,
                         message,
@@ -305,23 +304,79 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
                 core.set_external_programs(programs);
             }
             let result = core.command(c.id, request);
-            carry_out(&mut core);
+            out.carry_out(core);
             if let Some(result) = result {
-                let _ = results.publish(result);
+                let _ = self.results.publish(result);
             }
         }
+        busy
+    }
+}
+
+/// Runs the interpreter node of the machine `instance` ([`cnc_runtime::shm::instance`]) until
+/// `shutdown`.
+pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
+    let dialect = Dialect::from_name(&cfg.machine.dialect)
+        .ok_or_else(|| format!("unknown dialect {}", cfg.machine.dialect))?;
+    let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "interpreter")?;
+    let commands = Commands {
+        commands: ros.subscription(&topics::TASK_COMMAND)?,
+        results: ros.publisher(&topics::COMMAND_RESULT)?,
+        motion_results: ros.subscription(&topics::MOTION_RESULT)?,
+    };
+    let out = Outputs {
+        blocks: ros.publisher(&topics::MOTION_BLOCKS)?,
+        to_motion: ros.publisher(&topics::MOTION_COMMAND)?,
+        alarms: AlarmReporter::new(&mut ros, run::SOURCE)?,
+        msg_file: cfg.machine.msg_file.clone(),
+        msg_file_kib: cfg.machine.msg_file_kib,
+        memory_path: cfg.machine.memory_file.clone(),
+    };
+    let shm = ShmNode::new(&instance, "interpreter")?;
+    let machine = Machine {
+        status: ros.subscription(&topics::MOTION_STATUS)?,
+        axes: ros.subscription(&topics::AXES)?,
+        alarms: ros.subscription(&topics::ALARM_EVENTS)?,
+        g_in: shm.receiver::<GImage>(channel::G_IMAGE, false)?,
+    };
+    let (memory, memory_error) = load_memory(&cfg);
+    if let Some(e) = memory_error {
+        log::error!("interpreter: machine memory not read, using the config's offsets: {e}");
+    }
+    let base = setup_from_config(&cfg, &cfg.home());
+    let capacity = cfg.machine.program_capacity_kib.saturating_mul(1024);
+    let (programs, storage) = program_memory(&cfg);
+    let (keeper, kept) = kept_position(&cfg);
+    let approach = approach_from_config(&cfg, &base);
+    // Run ids grow across restarts of this node.
+    let mut core = RunCore::new(dialect, base, memory, monotonic_ns() / 1000)
+        .with_program_memory(programs, storage, capacity)
+        .with_approach(approach)
+        .with_kept_position(kept);
+    let mut state = StateReporter {
+        publisher: ros.publisher(&topics::MACHINE_STATE)?,
+        last: None,
+        last_ns: 0,
+        position: keeper,
+        tracker: PositionTracker::default(),
+    };
+    while !shutdown.requested() {
+        ros.refresh();
+        machine.feed(&mut core);
+        out.carry_out(&mut core);
+        let mut busy = commands.serve(&mut core, &out, &cfg);
         // A start is reported before any block of it runs: a program that fails in its first
         // blocks still shows ACTIVE, then STOPPED, in that order.
         report_state(&mut state, core.state(), core.position());
         busy |= core.step();
-        carry_out(&mut core);
+        out.carry_out(&mut core);
         report_state(&mut state, core.state(), core.position());
         if !busy {
             std::thread::sleep(Duration::from_millis(1));
         }
     }
     core.shutdown();
-    carry_out(&mut core);
+    out.carry_out(&mut core);
     Ok(())
 }
 

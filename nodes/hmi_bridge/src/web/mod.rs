@@ -3,9 +3,9 @@
 //! keeps what the page shows. [`WebHmi`] joins them for the bridge's loop.
 
 pub mod assets;
+pub mod http;
 pub mod login;
 pub mod protocol;
-pub mod server;
 pub mod view;
 
 use std::collections::BTreeMap;
@@ -15,7 +15,7 @@ use serde_json::{json, Value};
 
 use crate::access::Who;
 use crate::operation::{Answer, Operation};
-use server::{Outbox, Payload, WebEvent, WebServer};
+use http::{Outbox, Payload, WebEvent, WebServer};
 use view::View;
 
 /// How often pages get a state frame.

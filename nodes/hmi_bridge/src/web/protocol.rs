@@ -326,7 +326,7 @@ mod tests {
         let mut message = br#"{"id": 9, "op": "load", "name": "BIG.nc"}"#.to_vec();
         message.push(0);
         message.extend_from_slice(text.as_bytes());
-        let max = crate::web::server::MAX_MESSAGE;
+        let max = crate::web::http::MAX_MESSAGE;
         assert!(message.len() <= max);
         let escaped = serde_json::to_string(&text).unwrap();
         assert!(escaped.len() > max, "JSON would not fit: {}", escaped.len());

@@ -2,12 +2,26 @@
 //! lathe variable map, and tool-nose compensation started from the offset page.
 
 use cnc_interpreter_core::comp::Startup;
-use cnc_interpreter_core::{show, Aux, Fault, ProgramError};
+use cnc_interpreter_core::{show, Aux, CompRules, Fault, Plane, ProgramError};
 
 use super::block::{integer_word, Block};
 use super::codes::G;
 use super::expr::{EvalError, Value};
 use super::{Family, Fanuc};
+
+/// The lathe's working plane, Z-X.
+pub const LATHE_PLANE: Plane = Plane {
+    h: 'Z',
+    v: 'X',
+    normal: None,
+    missing: (Fault::AxisAddress, "this function needs the X and Z axes"),
+};
+
+/// Tool-nose compensation on a lathe whose G00 may not run under it.
+pub const LATHE_COMP: CompRules = CompRules {
+    refuse_rapid: true,
+    name: "tool-nose compensation",
+};
 
 /// Largest tool offset number (#4001–#4099: 99 offsets).
 pub const MAX_OFFSET: u32 = 99;

@@ -13,8 +13,8 @@ use cnc_interpreter_core::{
 use crate::fanuc::block::{code_x10, integer_word, Block};
 use crate::fanuc::codes::{GCode, Rules, G, M};
 use crate::fanuc::expr::{EvalError, Value};
+use crate::fanuc::lathe::LATHE_PLANE;
 use crate::fanuc::{Family, Fanuc};
-use crate::huaxing::LATHE_PLANE;
 
 pub use alarms::alarm;
 

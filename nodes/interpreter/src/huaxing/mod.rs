@@ -12,11 +12,12 @@ mod threads;
 mod tool;
 
 use cnc_interpreter_core::corner::Chamfer;
-use cnc_interpreter_core::{CompRules, Fault, Plane, ProgramError, Setup};
+use cnc_interpreter_core::{Fault, ProgramError, Setup};
 
 use crate::fanuc::block::Block;
 use crate::fanuc::codes::{GCode, Rules, G, M};
 use crate::fanuc::expr::{EvalError, Value};
+use crate::fanuc::lathe::{LATHE_COMP, LATHE_PLANE};
 use crate::fanuc::{Family, Fanuc, ThreadWords};
 
 pub use alarms::alarm;
@@ -87,20 +88,6 @@ pub struct Huaxing {
     /// The call depth of a running tool-change macro: T words inside it do not call it again.
     pub tool_macro_depth: Option<usize>,
 }
-
-/// The lathe's working plane, Z-X.
-pub const LATHE_PLANE: Plane = Plane {
-    h: 'Z',
-    v: 'X',
-    normal: None,
-    missing: (Fault::AxisAddress, "this function needs the X and Z axes"),
-};
-
-/// Tool-nose compensation on a lathe whose G00 may not run under it.
-pub const LATHE_COMP: CompRules = CompRules {
-    refuse_rapid: true,
-    name: "tool-nose compensation",
-};
 
 impl Family for Huaxing {
     type G = HuaxingG;

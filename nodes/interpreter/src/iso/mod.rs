@@ -8,8 +8,9 @@ use crate::fanuc::block::Block;
 use crate::fanuc::codes::{GCode, Nothing, Rules, G, M};
 use crate::fanuc::expr::{EvalError, Value};
 use crate::fanuc::lathe::MAX_OFFSET;
+use crate::fanuc::lathe::{LATHE_COMP, LATHE_PLANE};
 use crate::fanuc::{Family, Fanuc};
-use crate::huaxing::{self, ToolMacro, LATHE_COMP, LATHE_PLANE};
+use crate::huaxing::{self, ToolMacro};
 
 /// The ISO lathe has no state of its own.
 pub struct IsoLathe;

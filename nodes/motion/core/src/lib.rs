@@ -17,7 +17,7 @@ pub mod motion;
 pub mod path;
 pub mod planner;
 pub mod profile;
-pub mod thread;
+pub mod thread_cutting;
 
 pub use block::{Aux, Block, Command};
 pub use config::{AxisConfig, MotionConfig};

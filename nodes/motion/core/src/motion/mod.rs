@@ -19,7 +19,7 @@ use crate::encoder::Encoder;
 use crate::path::{self, Point, Segment, MAX_AXES};
 use crate::planner::{Done, Planner};
 use crate::profile::{Ahead, Limits, Mover, Shape};
-use crate::thread::{Piece, ThreadChain};
+use crate::thread_cutting::{Piece, ThreadChain};
 
 pub use crate::alarm;
 pub use panel::Panel;

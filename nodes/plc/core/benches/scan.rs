@@ -9,7 +9,7 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use cnc_msgs::signals::{f, x, FImage, SignalTable, XImage};
-use cnc_plc::{Plc, Program};
+use cnc_plc_core::{Plc, Program};
 
 const SCANS: usize = 100_000;
 
@@ -68,7 +68,7 @@ fn percentile(sorted: &[u64], p: f64) -> f64 {
 }
 
 fn main() {
-    let standard = Program::parse(cnc_plc::LATHE_STANDARD).expect("standard program");
+    let standard = Program::parse(cnc_plc_core::LATHE_STANDARD).expect("standard program");
     let empty = Program::parse("END1\nEND2\n").expect("empty program");
     let mut reference = measure(&empty);
     let mut scan = measure(&standard);

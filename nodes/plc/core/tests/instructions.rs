@@ -2,10 +2,10 @@
 
 use cnc_msgs::signals::FImage;
 use cnc_msgs::signals::{SignalTable, XImage};
-use cnc_plc::address::{self, Address};
-use cnc_plc::engine::{rotate, RotateMode};
-use cnc_plc::memory::Retained;
-use cnc_plc::{Plc, PlcEvent, Program, Value};
+use cnc_plc_core::address::{self, Address};
+use cnc_plc_core::engine::{rotate, RotateMode};
+use cnc_plc_core::memory::Retained;
+use cnc_plc_core::{Plc, PlcEvent, Program, Value};
 
 /// A PLC running `level1` (END1/END2 appended unless the text has them), no E-stop input.
 fn plc(level1: &str) -> Plc {
@@ -597,7 +597,7 @@ fn a_refused_program_leaves_the_running_one_in_charge() {
 
 #[test]
 fn the_standard_program_parses_and_shows_as_rungs() {
-    let p = Program::parse(cnc_plc::LATHE_STANDARD).unwrap_or_else(|e| panic!("{e}"));
+    let p = Program::parse(cnc_plc_core::LATHE_STANDARD).unwrap_or_else(|e| panic!("{e}"));
     assert!(p.steps.len() > 300, "{}", p.steps.len());
     let rungs = p.rungs();
     assert!(rungs.len() > 100);

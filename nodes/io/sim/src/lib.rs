@@ -5,7 +5,8 @@
 //! ramps to its commanded speed with a brake, an emergency-stop input, and the [`devices`] the
 //! PLC drives (turret, chuck, door, tailstock, coolant, air).
 //!
-//! Pure: [`SimLathe::step`] advances the machine by `dt` seconds.
+//! Pure: [`SimLathe::step`] advances the machine by `dt` seconds; the crate cannot reach a
+//! thread, a clock, DDS or iceoryx2 (`tests/boundaries.rs`). The io node (`cnc_io`) is its shell.
 
 pub mod devices;
 pub mod probe;
