@@ -4,7 +4,7 @@
 use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 
-use crate::canon::{Aux, Canon, Command};
+use crate::canon::{Aux, Canon, Command, Turn};
 use crate::chip_break::ChipBreak;
 use crate::comp::RadiusComp;
 use crate::corner::Corner;
@@ -134,8 +134,9 @@ pub struct Core {
     /// Under radius compensation outer corners meet at the offsets' intersection (below the
     /// limit of decision D103), not on an arc around the corner.
     pub outer_intersection: bool,
-    // The spindle.
-    pub spindle: SpindleDir,
+    // The spindle: its direction changes only with what the machine is told
+    // ([`Core::spindle_code`], [`Core::orient_spindle`], [`Core::spindle_left_by_code`]).
+    spindle: SpindleDir,
     /// Constant surface speed in force, with its rule.
     pub css: Option<CssRule>,
     /// The surface speed (or rpm at X0) constant surface speed keeps.
@@ -483,6 +484,37 @@ impl Core {
 
     pub fn aux(&mut self, a: Aux) {
         self.push(Command::Aux(a));
+    }
+
+    /// Which way the spindle turns, as the program has told the machine.
+    pub fn spindle(&self) -> SpindleDir {
+        self.spindle
+    }
+
+    /// A spindle code to the machine, M03 clockwise, M04 counter-clockwise, M05 stop, M19
+    /// orient (any other M code goes as it is), with the direction it leaves: the spindle's
+    /// modal state changes with the command that changes the machine, as rs274ngc's
+    /// START_SPINDLE_… and STOP_SPINDLE_TURNING do.
+    pub fn spindle_code(&mut self, m: i32) {
+        self.spindle = match m {
+            3 => SpindleDir::Cw,
+            4 => SpindleDir::Ccw,
+            5 | 19 => SpindleDir::Stopped,
+            _ => self.spindle,
+        };
+        self.aux(Aux::M(m));
+    }
+
+    /// The spindle stopped at an angle, reached by `way` (ORIENT_SPINDLE).
+    pub fn orient_spindle(&mut self, degrees: f64, way: Turn) {
+        self.spindle = SpindleDir::Stopped;
+        self.aux(Aux::Orient { degrees, way });
+    }
+
+    /// The direction a code of the dialect's own table leaves the spindle in (a program end
+    /// stops it); the code itself went to the machine through the dialect's M table.
+    pub fn spindle_left_by_code(&mut self, dir: SpindleDir) {
+        self.spindle = dir;
     }
 
     /// The commands queued from index `from` on (what a block produced, when `from` is

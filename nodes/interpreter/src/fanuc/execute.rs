@@ -134,12 +134,13 @@ impl<D: Family> Fanuc<D> {
 
     /// The spindle direction an M code leaves.
     pub fn track_spindle(&mut self, code: u32) {
-        self.core.spindle = match code {
+        let dir = match code {
             30 => SpindleDir::Cw,
             40 => SpindleDir::Ccw,
             50 | 200 | 300 => SpindleDir::Stopped,
-            _ => self.core.spindle,
+            _ => return,
         };
+        self.core.spindle_left_by_code(dir);
     }
 
     fn spindle_words(&mut self, b: &Block<D>) -> Result<(), ProgramError> {

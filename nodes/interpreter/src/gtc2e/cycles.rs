@@ -6,7 +6,7 @@
 //! G76 and G74, whose first move is a rapid or an infeed, and at the cycle's feed for G24,
 //! G75 and G83, where the manual gives feed (decision D24).
 
-use cnc_interpreter_core::{show, Aux, Command, Fault, MoveKind, ProgramError, Repeat, SpindleDir};
+use cnc_interpreter_core::{show, Command, Fault, MoveKind, ProgramError, Repeat, SpindleDir};
 
 use super::{Gtc2e, GtcCycle, GtcG, ReturnOrder};
 use crate::fanuc::block::{whole, Block};
@@ -169,7 +169,7 @@ impl Fanuc<Gtc2e> {
             }
             GtcG::Tapping => {
                 // Tap in synchronised, stop, reverse, back, stop (`002` §4.3.2-6).
-                let reverse = if self.core.spindle == SpindleDir::Ccw {
+                let reverse = if self.core.spindle() == SpindleDir::Ccw {
                     3
                 } else {
                     4
@@ -181,8 +181,8 @@ impl Fanuc<Gtc2e> {
                         angle: 0.0,
                     },
                 )?;
-                self.core.aux(Aux::M(5));
-                self.core.aux(Aux::M(reverse));
+                self.core.spindle_code(5);
+                self.core.spindle_code(reverse);
                 self.core.emit(
                     &at(x0, z0),
                     MoveKind::Thread {
@@ -190,8 +190,7 @@ impl Fanuc<Gtc2e> {
                         angle: 0.0,
                     },
                 )?;
-                self.core.aux(Aux::M(5));
-                self.core.spindle = SpindleDir::Stopped;
+                self.core.spindle_code(5);
             }
             _ => {
                 // G76: thread toward Z; W (G31) before the end X retracts U (G31) while Z runs

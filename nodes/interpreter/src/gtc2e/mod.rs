@@ -7,7 +7,7 @@ mod cycles;
 
 use cnc_interpreter_core::comp::Startup;
 use cnc_interpreter_core::{
-    show, Aux, CompRules, CssRule, Fault, Pos, ProgramError, Repeat, Setup, SpindleDir,
+    show, Aux, CompRules, CssRule, Fault, Pos, ProgramError, Repeat, Setup,
 };
 
 use crate::fanuc::block::{code_x10, integer_word, Block};
@@ -250,9 +250,8 @@ impl Family for Gtc2e {
         match m {
             GtcM::EndAndRestart => {
                 f.core.saw_end = true;
-                f.core.aux(Aux::M(5));
+                f.core.spindle_code(5);
                 f.core.aux(Aux::M(9));
-                f.core.spindle = SpindleDir::Stopped;
                 f.clear_shifts();
                 if f.core.setup.single_pass {
                     f.core.finish();

@@ -3,7 +3,7 @@
 //! G05 three-point arc (§5.5).
 
 use cnc_interpreter_core::geometry::{self, Pt};
-use cnc_interpreter_core::{show, Aux, Fault, MoveKind, ProgramError, SpindleDir};
+use cnc_interpreter_core::{show, Fault, MoveKind, ProgramError, SpindleDir};
 
 use super::{Huaxing, HuaxingG};
 use crate::fanuc::block::{whole, Block};
@@ -185,7 +185,7 @@ impl Fanuc<Huaxing> {
     pub(super) fn g33(&mut self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         // Z tapping cycle (`000` §5.23.3): feed in synchronised, M05, reverse, back, M05.
         let lead = self.lead(b, true)?;
-        let reverse = match self.core.spindle {
+        let reverse = match self.core.spindle() {
             SpindleDir::Cw => 4,
             SpindleDir::Ccw => 3,
             SpindleDir::Stopped => {
@@ -207,16 +207,15 @@ impl Fanuc<Huaxing> {
         };
         for n in 0..starts {
             if n > 0 {
-                self.core.aux(Aux::M(forward));
+                self.core.spindle_code(forward);
             }
             let angle = 360.0 * n as f64 / starts as f64;
             self.core.emit(&bottom, MoveKind::Thread { lead, angle })?;
-            self.core.aux(Aux::M(5));
-            self.core.aux(Aux::M(reverse));
+            self.core.spindle_code(5);
+            self.core.spindle_code(reverse);
             self.core.emit(&start, MoveKind::Thread { lead, angle })?;
-            self.core.aux(Aux::M(5));
+            self.core.spindle_code(5);
         }
-        self.core.spindle = SpindleDir::Stopped;
         Ok(())
     }
 

@@ -323,8 +323,8 @@ impl Fanuc<Mill> {
 
     /// M05, remembering which way the spindle turned for [`Self::spindle_on`].
     fn stop_spindle(&mut self) {
-        if self.core.spindle != SpindleDir::Stopped {
-            self.d.cycle_spindle = self.core.spindle;
+        if self.core.spindle() != SpindleDir::Stopped {
+            self.d.cycle_spindle = self.core.spindle();
         }
         self.spindle_code(5);
     }
@@ -354,11 +354,10 @@ impl Fanuc<Mill> {
     /// shift Q along +X (FANUC's default shift direction); otherwise it moves back.
     fn orient_and_shift(&mut self, q: f64, away: bool) -> Result<(), ProgramError> {
         if away {
-            if self.core.spindle != SpindleDir::Stopped {
-                self.d.cycle_spindle = self.core.spindle;
+            if self.core.spindle() != SpindleDir::Stopped {
+                self.d.cycle_spindle = self.core.spindle();
             }
-            self.core.aux(Aux::M(19));
-            self.core.spindle = SpindleDir::Stopped;
+            self.core.spindle_code(19);
         }
         if q == 0.0 {
             return Ok(());

@@ -6,7 +6,7 @@
 //! positions are in the work coordinates of the active frame. The milling cycles are not
 //! built yet (12140).
 
-use cnc_interpreter_core::{Aux, Command, Fault, MoveKind, ProgramError, SpindleDir, Turn};
+use cnc_interpreter_core::{Command, Fault, MoveKind, ProgramError, SpindleDir, Turn};
 
 use super::cutter_path::MAX_MOVES;
 use super::drilling::{self, CycleAlarm, DeepHole, Levels, Step};
@@ -396,7 +396,7 @@ impl Sinumerik {
             ));
         }
         let reverse = match c.or("SDR", 0.0).round() as i64 {
-            0 => match self.core.spindle {
+            0 => match self.core.spindle() {
                 SpindleDir::Cw => 4,
                 SpindleDir::Ccw => 3,
                 SpindleDir::Stopped => {
@@ -449,16 +449,10 @@ impl Sinumerik {
                 Ok(())
             }
             Step::M(m) => {
-                match m {
-                    3 => self.core.spindle = SpindleDir::Cw,
-                    4 => self.core.spindle = SpindleDir::Ccw,
-                    5 => self.core.spindle = SpindleDir::Stopped,
-                    _ => {}
-                }
                 if matches!(m, 3..=5) {
                     self.positioned = false;
                 }
-                self.core.aux(Aux::M(m as i32));
+                self.core.spindle_code(m as i32);
                 Ok(())
             }
             Step::Tap(level, lead, rpm) => {
@@ -467,11 +461,7 @@ impl Sinumerik {
             }
             Step::Orient(degrees) => {
                 self.positioned = true;
-                self.core.spindle = SpindleDir::Stopped;
-                self.core.aux(Aux::Orient {
-                    degrees,
-                    way: Turn::Shortest,
-                });
+                self.core.orient_spindle(degrees, Turn::Shortest);
                 Ok(())
             }
             Step::Speed(rpm) => {

@@ -791,11 +791,11 @@ impl Sinumerik {
         for &m in &w.m {
             match m {
                 0 | 1 | 2 | 17 | 30 | 6 => {}
-                3 => self.spindle(SpindleDir::Cw, 3),
-                4 => self.spindle(SpindleDir::Ccw, 4),
-                5 => self.spindle(SpindleDir::Stopped, 5),
+                3 => self.spindle(3),
+                4 => self.spindle(4),
+                5 => self.spindle(5),
                 19 => {
-                    self.spindle(SpindleDir::Stopped, 19);
+                    self.spindle(19);
                     self.positioned = true;
                 }
                 _ => self.core.aux(Aux::M(m as i32)),
@@ -830,16 +830,14 @@ impl Sinumerik {
                 ),
             ));
         }
-        self.core.spindle = SpindleDir::Stopped;
         self.positioned = true;
-        self.core.aux(Aux::Orient { degrees: v, way });
+        self.core.orient_spindle(v, way);
         Ok(())
     }
 
-    fn spindle(&mut self, dir: SpindleDir, code: i32) {
-        self.core.spindle = dir;
+    fn spindle(&mut self, code: i32) {
         self.positioned = false;
-        self.core.aux(Aux::M(code));
+        self.core.spindle_code(code);
     }
 
     /// M0, M1 after the motion; M2/M30 end the program (in a called program M2 returns, as
@@ -861,7 +859,7 @@ impl Sinumerik {
                     } else {
                         self.count_part();
                         self.core.saw_end = true;
-                        self.core.spindle = SpindleDir::Stopped;
+                        self.core.spindle_left_by_code(SpindleDir::Stopped);
                         self.positioned = false;
                         self.core.aux(Aux::M(m as i32));
                         self.core.finish();

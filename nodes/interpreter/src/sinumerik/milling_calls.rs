@@ -172,7 +172,7 @@ impl Sinumerik {
             },
             _ => return Err(wrong(61002, "VARI: tens 0/1 vertical, 2 helical insertion")),
         };
-        let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
+        let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle()) {
             (2, _) => false,
             (3, _) => true,
             // Climb: the tooth leaves the wall it finishes, the chip thick to thin (D87, issue
@@ -209,7 +209,7 @@ impl Sinumerik {
         // Climb round a spigot is clockwise under M3 (the spigot on the right of the travel),
         // counter-clockwise under M4; conventional the other way (D87, issue 46: §10.6.4's
         // table "M3→G3" is the pocket's, against the definition it gives).
-        let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle) {
+        let ccw = match (c.or("CDIR", 0.0).round() as i64, self.core.spindle()) {
             (2, _) => false,
             (3, _) => true,
             (0, SpindleDir::Cw | SpindleDir::Stopped) | (1, SpindleDir::Ccw) => false,
