@@ -84,8 +84,6 @@ fn tapping_reverses_the_spindle_at_the_bottom_and_back_at_r() {
             "RAPID X5.0000 Y5.0000 Z10.0000",
         ]
     );
-    // Rigid tapping (M29) is not built in this dialect.
-    assert_eq!(alarm("M29 S500\nM30\n").number, 10);
 }
 
 #[test]
@@ -511,4 +509,184 @@ fn m_and_s_between_compensated_blocks_keep_their_place() {
     assert!(last_of(6) < m8 && m8 < first_of(8), "{out:?}");
     // S800 in the X0 block (line 9) before its move, after Y0's.
     assert!(last_of(8) < s800 && s800 < first_of(9), "{out:?}");
+}
+
+/// G66/G67 (`003` Part 2 §8.4, D129): a drilling macro called after every positioning move of
+/// a hole pattern, as shops write them; the G66 block itself moves nothing (its Z and R are
+/// arguments), the macro's own moves do not call it again, and G67 ends the calls.
+#[test]
+fn g66_calls_its_macro_after_every_move_block_until_g67() {
+    let text = "%\nO1000\nG90 G0 X0. Y0. Z50.\n\
+                G66 P9110 Z-8. R2. F120.\n\
+                X10. Y10.\nX30.\nM8\nG91 Y20.\nG90 G67\nX0. Y0.\nM30\n\
+                O9110\n(DRILL ONE HOLE AT THE CURRENT XY)\n\
+                G90 G0 Z#18\nG1 Z#26 F#9\nG0 Z#18\nM99\n%\n";
+    let l = lines(text);
+    assert_eq!(
+        l[..15],
+        [
+            "RAPID X0.0000 Y0.0000 Z50.0000",
+            // G66 moved nothing; the first hole: the move, then the macro.
+            "RAPID X10.0000 Y10.0000 Z50.0000",
+            "RAPID X10.0000 Y10.0000 Z2.0000",
+            "LINEAR X10.0000 Y10.0000 Z-8.0000 F120.0000",
+            "RAPID X10.0000 Y10.0000 Z2.0000",
+            // X30.: the macro's moves left the tool at R; the next move starts there.
+            "RAPID X30.0000 Y10.0000 Z2.0000",
+            "RAPID X30.0000 Y10.0000 Z2.0000",
+            "LINEAR X30.0000 Y10.0000 Z-8.0000 F120.0000",
+            "RAPID X30.0000 Y10.0000 Z2.0000",
+            // M8 moves nothing and calls nothing.
+            "M8",
+            // G91 Y20.: an incremental move calls it too (the macro's G90 is modal: the
+            // caller is in G90 after it, as on the control).
+            "RAPID X30.0000 Y30.0000 Z2.0000",
+            "RAPID X30.0000 Y30.0000 Z2.0000",
+            "LINEAR X30.0000 Y30.0000 Z-8.0000 F120.0000",
+            "RAPID X30.0000 Y30.0000 Z2.0000",
+            // After G67 the move is only a move.
+            "RAPID X0.0000 Y0.0000 Z2.0000",
+        ],
+        "{l:#?}"
+    );
+    assert_eq!(l[15], "M30", "{l:#?}");
+}
+
+#[test]
+fn g66_counts_l_its_arguments_follow_the_table_and_its_errors_are_p_s_alarms() {
+    // L2: the macro runs twice after each move; its locals are set again for each call.
+    let text = "%\nO1000\nG66 P9120 L2 A1.\nG0 X5.\nG67\nM30\nO9120\n\
+                G1 Y#1 F100\n#1 = #1 + 1\nM99\n%\n";
+    let l = lines(text);
+    assert_eq!(
+        l[..4],
+        [
+            "RAPID X5.0000 Y0.0000 Z0.0000",
+            "LINEAR X5.0000 Y1.0000 Z0.0000 F100.0000",
+            "LINEAR X5.0000 Y2.0000 Z0.0000 F100.0000",
+            "M30",
+        ],
+        "{l:#?}"
+    );
+    // G04's X is a time, G92's a position set: neither calls the macro.
+    let l = lines("%\nO1000\nG66 P9130\nG4 X1.\nG92 X0.\nG67\nM30\nO9130\nM5\nM99\n%\n");
+    assert!(!l.iter().any(|c| c == "M5"), "{l:#?}");
+    // P missing: P/S 076; an address that is no argument (G, N, O, P, L excepted): P/S 129;
+    // a macro not in memory: P/S 078; a second G66 before G67: P/S 077.
+    assert_eq!(alarm("G66 Z1.\nM30\n").number, 76);
+    assert_eq!(
+        alarm("%\nO1\nG66 P9000 G1\nM30\nO9000\nM99\n%\n").number,
+        129
+    );
+    assert_eq!(alarm("G66 P9999\nM30\n").number, 78);
+    let twice = "%\nO1\nG66 P9000\nG66 P9000\nM30\nO9000\nM99\n%\n";
+    let e = alarm(twice);
+    assert_eq!((e.number, e.line), (77, 4), "{e}");
+    // G67 with no modal call is nothing to cancel.
+    assert_eq!(
+        lines("G67\nG0 X1.\nM30\n")[0],
+        "RAPID X1.0000 Y0.0000 Z0.0000"
+    );
+}
+
+/// M29 rigid tapping (`003` §6.4, inventory A.1 "rigid if M29 S_ precedes it, F = pitch × S";
+/// D130): the spindle holds its angle in position control, and each G84 hole is a tap in
+/// locked to the spindle at the pitch F/S, the dwell, and a tap out turning the other way —
+/// the canonical taps motion runs for the 802D's CYCLE84. G80 ends it: the next G84 is the
+/// floating one again.
+#[test]
+fn m29_makes_g84_and_g74_tap_rigidly_at_the_pitch_f_over_s_until_g80() {
+    let l = lines(
+        "G90 G0 X0. Y0. Z30.\nM29 S500\nG98 G84 X10. Y10. Z-12. R3. P200 F750.\n\
+         X20.\nG80\nM29 S400\nG99 G74 X30. Z-6. R2. F400.\nG80\nM30\n",
+    );
+    assert_eq!(
+        l[..16],
+        [
+            "RAPID X0.0000 Y0.0000 Z30.0000",
+            "S500.0",
+            // M29: position control where the spindle stands.
+            "SPINDLE_POSITION 0.000 Incremental",
+            "RAPID X10.0000 Y10.0000 Z30.0000",
+            "RAPID X10.0000 Y10.0000 Z3.0000",
+            // F750 / S500: a 1.5 mm pitch, in turning M03's way, out the other.
+            "TAP X10.0000 Y10.0000 Z-12.0000 LEAD1.5000 S500.0",
+            "DWELL 0.200",
+            "TAP X10.0000 Y10.0000 Z3.0000 LEAD-1.5000 S500.0",
+            "RAPID X10.0000 Y10.0000 Z30.0000",
+            // The second hole taps rigidly too.
+            "RAPID X20.0000 Y10.0000 Z30.0000",
+            "RAPID X20.0000 Y10.0000 Z3.0000",
+            "TAP X20.0000 Y10.0000 Z-12.0000 LEAD1.5000 S500.0",
+            "DWELL 0.200",
+            "TAP X20.0000 Y10.0000 Z3.0000 LEAD-1.5000 S500.0",
+            "RAPID X20.0000 Y10.0000 Z30.0000",
+            "S400.0",
+        ],
+        "{l:#?}"
+    );
+    // G74 (left hand) at F400/S400 = 1 mm: in turning M04's way; G99 ends at R.
+    assert_eq!(
+        l[16..22],
+        [
+            "SPINDLE_POSITION 0.000 Incremental",
+            "RAPID X30.0000 Y10.0000 Z30.0000",
+            "RAPID X30.0000 Y10.0000 Z2.0000",
+            "TAP X30.0000 Y10.0000 Z-6.0000 LEAD-1.0000 S400.0",
+            "TAP X30.0000 Y10.0000 Z2.0000 LEAD1.0000 S400.0",
+            "M30",
+        ],
+        "{l:#?}"
+    );
+    // G95: F is the pitch itself.
+    let l = lines("G0 X0. Y0. Z5.\nG95 M29 S300\nG84 Z-4. R1. F1.25\nG80\nM30\n");
+    assert!(
+        l.contains(&"TAP X0.0000 Y0.0000 Z-4.0000 LEAD1.2500 S300.0".to_string()),
+        "{l:#?}"
+    );
+    // After G80 a G84 is the floating tap: feed moves with the spindle reversed.
+    let l = lines("G0 X0. Y0. Z5.\nM29 S300\nG80\nM3\nG84 Z-4. R1. F300.\nG80\nM30\n");
+    assert!(!l.iter().any(|c| c.starts_with("TAP")), "{l:#?}");
+    assert!(l.contains(&"M4".to_string()), "{l:#?}");
+}
+
+#[test]
+fn rigid_tapping_refuses_what_it_cannot_tap() {
+    // No S for M29, no F for the pitch, and M03 after M29 (the spindle left position control).
+    let e = alarm("M29\nM30\n");
+    assert_eq!((e.number, e.line), (10, 1), "{e}");
+    let e = alarm("M29 S500\nG84 X1. Z-5. R2.\nM30\n");
+    assert_eq!((e.number, e.line), (10, 2), "{e}");
+    assert!(e.text.contains("F"), "{e}");
+    let e = alarm("M29 S500\nM3\nG84 X1. Z-5. R2. F500.\nM30\n");
+    assert_eq!((e.number, e.line), (10, 3), "{e}");
+    assert!(e.text.contains("M29 S again"), "{e}");
+}
+
+/// G63 tapping mode (`003` §3.4 "until G64 or G63"; D131): until G61 or G64 every linear move
+/// is a tap in a floating holder, cut as a thread of the pitch F/S so the overrides stay out
+/// and the feed holds to the spindle (as the 802D's G63, D93); rapids stay rapids.
+#[test]
+fn g63_cuts_linear_moves_as_taps_at_f_over_s_until_g64() {
+    let l = lines(
+        "G0 X5. Y5. Z5. S600 M3\nG63 G1 Z-10. F600.\nM4\nZ5.\nG0 X15.\nG64 G1 Z0. F100.\nM30\n",
+    );
+    assert_eq!(
+        l[3..9],
+        [
+            "THREAD X5.0000 Y5.0000 Z-10.0000 LEAD1.0000 Q0.000",
+            "M4",
+            // Out on the same lead, the spindle reversed.
+            "THREAD X5.0000 Y5.0000 Z5.0000 LEAD1.0000 Q0.000",
+            "RAPID X15.0000 Y5.0000 Z5.0000",
+            // G64 ends the tapping mode (and blends again).
+            "BLENDING",
+            "LINEAR X15.0000 Y5.0000 Z0.0000 F100.0000",
+        ],
+        "{l:#?}"
+    );
+    // Without S there is no pitch; an arc is no tap.
+    assert_eq!(alarm("G63 G1 Z-5. F100.\nM30\n").number, 10);
+    let e = alarm("S500 M3\nG63 G1 X1. F500.\nG2 X2. R1.\nM30\n");
+    assert_eq!((e.number, e.line), (10, 3), "{e}");
 }

@@ -129,7 +129,7 @@ impl<D: Family> Fanuc<D> {
                 D::block_ran(self, start);
             }
         }
-        Ok(())
+        D::after_block(self, &b)
     }
 
     /// The spindle direction an M code leaves.

@@ -157,6 +157,12 @@ pub trait Family: Sized + Send + 'static {
     /// A block that had axis words or produced commands has run; it started at `start` (work
     /// coordinates).
     fn block_ran(_f: &mut Fanuc<Self>, _start: Vec<f64>) {}
+
+    /// After a block has run entirely (its move, its M codes, its flow): the mill's modal
+    /// macro call (G66) calls its macro here.
+    fn after_block(_f: &mut Fanuc<Self>, _b: &Block<Self>) -> Result<(), ProgramError> {
+        Ok(())
+    }
     /// G41/G42 (`g`) and G40.
     fn start_comp(f: &mut Fanuc<Self>, b: &Block<Self>, g: G<Self::G>) -> Result<(), ProgramError>;
     fn cancel_comp(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError>;

@@ -259,6 +259,10 @@ impl Fanuc<Mill> {
                 self.cycle_move(d, r_level, MoveKind::Feed(feed))?;
                 self.rapid_to_level(d, clear)
             }
+            HoleKind::Tap | HoleKind::LeftTap if self.d.rigid_tapping => {
+                self.rigid_tap(h.kind, d, bottom, r_level, h.dwell_ms)?;
+                self.rapid_to_level(d, clear)
+            }
             HoleKind::Tap | HoleKind::LeftTap => {
                 // The spindle turns the way of the tap in, reverses at the bottom and turns
                 // back once the tap is out at R.
@@ -303,7 +307,12 @@ impl Fanuc<Mill> {
     }
 
     /// Moves the drilling axis alone to `level`.
-    fn cycle_move(&mut self, d: usize, level: f64, kind: MoveKind) -> Result<(), ProgramError> {
+    pub(super) fn cycle_move(
+        &mut self,
+        d: usize,
+        level: f64,
+        kind: MoveKind,
+    ) -> Result<(), ProgramError> {
         let mut end = self.core.work_position();
         end[d] = level;
         self.core.emit(&end, kind)
@@ -317,8 +326,7 @@ impl Fanuc<Mill> {
     }
 
     fn spindle_code(&mut self, m: i32) {
-        self.track_spindle((m * 10) as u32);
-        self.core.aux(Aux::M(m));
+        self.core.spindle_code(m);
     }
 
     /// M05, remembering which way the spindle turned for [`Self::spindle_on`].

@@ -1,5 +1,5 @@
 //! FANUC user macro B on the mill (`003` inventory Appendix A.3; decision D49): G65 calls
-//! with argument specification I, the #3000 alarm, and the mill's variable map (#1–#33 local,
+//! and G66/G67 modal calls (D129) with argument specification I, the #3000 alarm, and the mill's variable map (#1–#33 local,
 //! #100–#199 and #500–#999 common, #2001– offsets, #4001– modal information, #5001–
 //! positions, #5221– work offsets). WHILE … DO m … END m loops are the family's.
 
@@ -7,7 +7,7 @@ use cnc_interpreter_core::comp::Side;
 use cnc_interpreter_core::{Fault, ProgramError};
 
 use super::{Mill, MillG};
-use crate::fanuc::block::integer_word;
+use crate::fanuc::block::{integer_word, Block};
 use crate::fanuc::codes::G;
 use crate::fanuc::expr::{EvalError, Value};
 use crate::fanuc::syntax::Word;
@@ -41,36 +41,105 @@ fn argument_number(letter: char) -> Option<usize> {
     })
 }
 
+/// A modal macro call (G66, D129): the macro, how often it runs after each move block, the
+/// locals its G66 block set, and the call level it was given at (the macro's own moves, one
+/// level deeper, do not call it again).
+#[derive(Debug, Clone)]
+pub struct ModalCall {
+    program: u32,
+    count: u32,
+    locals: Vec<Value>,
+    level: usize,
+}
+
 impl Fanuc<Mill> {
     /// `G65 P<program> L<count> <arguments>`: calls the macro with its locals set from the
     /// argument table; P missing is P/S 076, an address that is no argument P/S 129.
     pub(super) fn macro_call(&mut self, words: &[Word]) -> Result<(), ProgramError> {
+        let (program, count, locals) = self.macro_arguments(words, 65)?;
+        self.core
+            .call_program(program, count, Some(locals), "G65: macro")
+    }
+
+    /// `G66 P<program> L<count> <arguments>`: the macro is called after every later block that
+    /// moves an axis, until G67 (D129). The block itself moves nothing: its X, Y, Z are
+    /// arguments. One modal call at a time: a G66 while one is active is P/S 077.
+    pub(super) fn modal_call(&mut self, words: &[Word]) -> Result<(), ProgramError> {
+        let (program, count, locals) = self.macro_arguments(words, 66)?;
+        if self.d.modal_call.is_some() {
+            return Err(self.fault(
+                Fault::CallDepth,
+                "G66: a modal macro call is already active (G67 first)",
+            ));
+        }
+        if self.core.library.get(program).is_none() {
+            return Err(self.fault(
+                Fault::UndefinedSubprogram,
+                format!("G66: macro O{program:04} not in the library"),
+            ));
+        }
+        self.d.modal_call = Some(ModalCall {
+            program,
+            count,
+            locals,
+            level: self.core.levels.len(),
+        });
+        Ok(())
+    }
+
+    /// After a block at G66's call level that moved an axis, the modal call's macro runs.
+    /// Blocks whose axis words are no move (G04's time, G10's data, G92's position) do not
+    /// call it, nor do blocks of the macro itself.
+    pub(super) fn modal_call_after(&mut self, b: &Block<Mill>) -> Result<(), ProgramError> {
+        let Some(call) = &self.d.modal_call else {
+            return Ok(());
+        };
+        let no_move =
+            b.has_g(G::Dwell) || b.has_g(G::SetCoordinate) || b.has_g(G::Own(MillG::SetOffsetData));
+        if call.level != self.core.levels.len() || no_move || !self.has_axis_words(b) {
+            return Ok(());
+        }
+        let (program, count, locals) = (call.program, call.count, call.locals.clone());
+        self.core
+            .call_program(program, count, Some(locals), "G66: macro")
+    }
+
+    /// A macro call's P, L and arguments (specification I) for G`code`; a number without a
+    /// decimal point in a length or angle argument counts least increments (D52).
+    fn macro_arguments(
+        &self,
+        words: &[Word],
+        code: u32,
+    ) -> Result<(u32, u32, Vec<Value>), ProgramError> {
         let mut locals = vec![None; Mill::LOCALS];
         let (mut program, mut count) = (None, 1);
         for w in words {
             let v = w.value.eval(self).map_err(|e| self.eval_err(e))?;
             match w.letter {
-                'G' if v == Some(65.0) => {}
+                'G' if v == Some(f64::from(code)) => {}
                 'P' => program = v,
                 'L' => {
                     count = v
                         .and_then(integer_word)
                         .filter(|c| (1..=9999).contains(c))
                         .ok_or_else(|| {
-                            self.fault(Fault::OutOfRange, "G65 L: a repeat count 1–9999")
+                            self.fault(
+                                Fault::OutOfRange,
+                                format!("G{code} L: a repeat count 1–9999"),
+                            )
                         })?;
                 }
                 letter => {
                     let n = argument_number(letter).ok_or_else(|| {
                         self.fault(
                             Fault::MacroCallFormat,
-                            format!("G65: address {letter} cannot be an argument"),
+                            format!("G{code}: address {letter} cannot be an argument"),
                         )
                     })?;
                     if locals[n].is_some() {
                         return Err(self.fault(
                             Fault::RepeatedWord,
-                            format!("G65: argument {letter} given twice"),
+                            format!("G{code}: argument {letter} given twice"),
                         ));
                     }
                     // A number without a decimal point counts least input increments for
@@ -88,9 +157,13 @@ impl Fanuc<Mill> {
         let number = program
             .and_then(integer_word)
             .filter(|&p| p <= 9999)
-            .ok_or_else(|| self.fault(Fault::Call, "G65 needs P (the macro's program number)"))?;
-        self.core
-            .call_program(number, count, Some(locals), "G65: macro")
+            .ok_or_else(|| {
+                self.fault(
+                    Fault::Call,
+                    format!("G{code} needs P (the macro's program number)"),
+                )
+            })?;
+        Ok((number, count, locals))
     }
 
     /// The least input increment in program units: 0.001 mm, or 0.0001 inch under G20.

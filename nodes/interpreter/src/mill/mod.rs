@@ -5,13 +5,14 @@
 mod alarms;
 mod hole_cycle;
 mod macro_b;
+mod tapping;
 mod words;
 
 use cnc_interpreter_core::comp::Startup;
 use cnc_interpreter_core::{CompRules, Fault, Plane, ProgramError, Setup, SpindleDir};
 
 use crate::fanuc::block::Block;
-use crate::fanuc::codes::{GCode, Nothing, Rules, WordUnit, G, M};
+use crate::fanuc::codes::{GCode, Rules, WordUnit, G, M};
 use crate::fanuc::expr::{EvalError, Value};
 use crate::fanuc::syntax::Word;
 use crate::fanuc::{Family, Fanuc};
@@ -38,6 +39,12 @@ pub enum MillG {
     MillLocal,
     /// G65 user macro call: run by the statement itself, never as a block.
     MacroCall,
+    /// G66 modal macro call: registered by the statement itself (its words are arguments).
+    ModalCall,
+    /// G67: the modal macro call cancelled.
+    ModalCallCancel,
+    /// G63 tapping mode (group 15, until G61 or G64; D131).
+    TappingMode,
     /// G27 reference position return check.
     ReferenceCheck,
     /// G29 return from the reference point through G28's intermediate point.
@@ -93,6 +100,19 @@ pub struct Mill {
     pub length_sign: i8,
     /// The H offset number of tool length compensation.
     pub length_offset: u32,
+    /// G66's macro, called after every move block until G67 (D129).
+    pub modal_call: Option<macro_b::ModalCall>,
+    /// G63: linear moves are taps in a floating holder (D131).
+    pub tapping_mode: bool,
+    /// M29: G84/G74 tap rigidly, the axis following the spindle (D130).
+    pub rigid_tapping: bool,
+}
+
+/// The mill's own M codes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MillM {
+    /// M29 S: rigid tapping, the spindle in position control (`003` §6.4; D130).
+    RigidTapping,
 }
 
 /// The working plane of G17, G18 or G19 (`003` §2.3, §4.4).
@@ -112,12 +132,12 @@ fn plane_of(g: G<MillG>) -> Plane {
 
 impl Family for Mill {
     type G = MillG;
-    type M = Nothing;
+    type M = MillM;
 
     fn g_code(x10: u32) -> Option<GCode<MillG>> {
         g_code(x10)
     }
-    fn m_code(x10: u32) -> Option<M<Nothing>> {
+    fn m_code(x10: u32) -> Option<M<MillM>> {
         m_code(x10)
     }
     fn alarm(f: Fault) -> u32 {
@@ -157,6 +177,9 @@ impl Family for Mill {
             cycle_spindle: SpindleDir::Cw,
             length_sign: 0,
             length_offset: 0,
+            modal_call: None,
+            tapping_mode: false,
+            rigid_tapping: false,
         }
     }
 
@@ -181,10 +204,18 @@ impl Family for Mill {
     }
     fn words_statement(f: &mut Fanuc<Self>, words: &[Word]) -> Option<Result<(), ProgramError>> {
         use crate::fanuc::expr::Expr;
-        let g65 = words.iter().any(|w| {
-            w.letter == 'G' && matches!(w.value, Expr::Num { value, .. } if value == 65.0)
-        });
-        g65.then(|| f.macro_call(words))
+        let code = |n: f64| {
+            words.iter().any(|w| {
+                w.letter == 'G' && matches!(w.value, Expr::Num { value, .. } if value == n)
+            })
+        };
+        if code(65.0) {
+            Some(f.macro_call(words))
+        } else if code(66.0) {
+            Some(f.modal_call(words))
+        } else {
+            None
+        }
     }
 
     fn read_var(f: &Fanuc<Self>, n: i64) -> Result<Value, EvalError> {
@@ -198,9 +229,25 @@ impl Family for Mill {
         match g {
             MillG::CycleReturn { r_level } => f.d.cycle_return_r = r_level,
             MillG::LengthComp(sign) => f.length_compensation(b, Some(sign))?,
+            MillG::ModalCallCancel => f.d.modal_call = None,
+            MillG::TappingMode => f.d.tapping_mode = true,
             _ => {}
         }
         Ok(())
+    }
+    fn after_block(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
+        f.modal_call_after(b)
+    }
+    /// The program's end cancels a modal macro call, as reset does (G67 is the power-on state).
+    fn on_program_end(f: &mut Fanuc<Self>) {
+        f.d.modal_call = None;
+        f.d.tapping_mode = false;
+        f.d.rigid_tapping = false;
+    }
+    fn own_m_before(f: &mut Fanuc<Self>, m: MillM, _b: &Block<Self>) -> Result<(), ProgramError> {
+        match m {
+            MillM::RigidTapping => f.rigid_tapping_on(),
+        }
     }
     fn plane(f: &mut Fanuc<Self>, g: G<MillG>) -> Result<(), ProgramError> {
         if f.core.comp.is_some() && g != f.d.plane {
@@ -214,6 +261,10 @@ impl Family for Mill {
         Ok(())
     }
     fn words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
+        // G61 and G64 end G63's tapping mode (group 15).
+        if matches!(b.group(15), Some(G::ExactStopMode | G::ContinuousMode)) {
+            f.d.tapping_mode = false;
+        }
         if b.group(8).is_none() && b.has('H') {
             f.length_compensation(b, None)?;
         }
@@ -283,16 +334,21 @@ impl Family for Mill {
         })
     }
     fn before_motion(f: &mut Fanuc<Self>, b: &Block<Self>) -> Option<Result<(), ProgramError>> {
-        // A group-01 code ends a canned cycle (§1.2); G80 too.
+        // A group-01 code ends a canned cycle (§1.2); G80 too, and rigid tapping with it
+        // (D130).
         if b.group(1).is_some() || b.group(9) == Some(G::Own(MillG::CycleCancel)) {
             f.d.hole = None;
+            f.d.rigid_tapping = false;
         }
         if let Some(G::Own(MillG::HoleCycle(kind))) = b.group(9) {
             if let Err(e) = f.select_hole_cycle(kind) {
                 return Some(Err(e));
             }
         }
-        f.d.hole.is_some().then(|| f.hole_block(b))
+        if f.d.hole.is_some() {
+            return Some(f.hole_block(b));
+        }
+        f.tapping_move(b)
     }
     fn motion(f: &mut Fanuc<Self>, g: MillG, _b: &Block<Self>) -> Result<(), ProgramError> {
         Err(f.fault(Fault::UndefinedCode, format!("{g:?} is not a motion")))
@@ -324,10 +380,7 @@ fn g_code(n: u32) -> Option<GCode<MillG>> {
         540..=590 if n.is_multiple_of(10) => (14, WorkSystem(((n - 540) / 10) as u8)),
         610 => (15, ExactStopMode),
         640 => (15, ContinuousMode),
-        630 => (
-            15,
-            Unsupported("G63 tapping mode: feed override suppression is not built"),
-        ),
+        630 => (15, G::Own(TappingMode)),
         900 => (3, Absolute),
         910 => (3, Incremental),
         920 => (0, SetCoordinate),
@@ -337,10 +390,8 @@ fn g_code(n: u32) -> Option<GCode<MillG>> {
         410 => (7, NoseLeft),
         420 => (7, NoseRight),
         650 => (0, G::Own(MacroCall)),
-        660 | 670 => (
-            12,
-            Unsupported("G66/G67 modal macro calls are not built: call with G65 per block"),
-        ),
+        660 => (12, G::Own(ModalCall)),
+        670 => (12, G::Own(ModalCallCancel)),
         430 => (8, G::Own(LengthComp(1))),
         440 => (8, G::Own(LengthComp(-1))),
         490 => (8, G::Own(LengthComp(0))),
@@ -364,7 +415,7 @@ fn g_code(n: u32) -> Option<GCode<MillG>> {
     };
     Some(GCode { group, meaning })
 }
-fn m_code(n: u32) -> Option<M<Nothing>> {
+fn m_code(n: u32) -> Option<M<MillM>> {
     use M::*;
     Some(match n {
         0 => Stop,
@@ -372,9 +423,7 @@ fn m_code(n: u32) -> Option<M<Nothing>> {
         20 | 300 => ProgramEnd,
         30 | 40 | 60 | 80 | 190 => AuxBefore,
         50 | 90 | 180 => AuxAfter,
-        290 => {
-            Unsupported("M29 rigid tapping is not built in this dialect (G84 taps with the feed)")
-        }
+        290 => Own(MillM::RigidTapping),
         980 => SubprogramCall,
         990 => SubprogramReturn,
         _ => return None,
