@@ -94,6 +94,10 @@ fn calls(listing: &str) -> Vec<Call> {
     // Where the last move ended (NaN before the first).
     let mut here = [f64::NAN; 6];
     let mut out: Vec<Call> = Vec::new();
+    // Where the last rigid tap started (its return is no call), and the pitch of the last
+    // speed-feed synchronisation, mm per revolution.
+    let mut tap_from: Option<Vec<f64>> = None;
+    let mut pitch = 0.0;
     let lines: Vec<(&str, &str)> = listing.lines().filter_map(split).collect();
     // rs274's M2/M30 reset: from its last SET_G5X_OFFSET before PROGRAM_END.
     let end = lines.iter().position(|(n, _)| *n == "PROGRAM_END");
@@ -185,6 +189,28 @@ fn calls(listing: &str) -> Vec<Call> {
                     feed,
                     tolerance,
                 })
+            }
+            // A rigid tap (G33.1 in rs274, our `Tap`): its end. rs274's tap retracts to where
+            // it started on its own; ours is a second tap back to that point, which is no call
+            // here. The tool ends where it started in both.
+            "START_SPEED_FEED_SYNC" if n.len() == 2 => pitch = n[0] * unit,
+            "RIGID_TAP" if n.len() == 3 => {
+                let end: Vec<f64> = (0..3).map(|k| mm(n[k], k) + offset(k)).collect();
+                let back = tap_from.as_ref().is_some_and(|s: &Vec<f64>| {
+                    s.iter().zip(&end).all(|(a, b)| (a - b).abs() <= TOLERANCE)
+                });
+                if back {
+                    tap_from = None;
+                } else {
+                    tap_from = Some(here[..3].to_vec());
+                    // The pitch stands in the feed's place.
+                    out.push(Call {
+                        name: name.to_string(),
+                        args: end,
+                        feed: pitch,
+                        tolerance,
+                    });
+                }
             }
             // A dwell of no time is none (rs274's G86 demands P, FANUC's has none).
             "DWELL" if n.len() == 1 && n[0] > 0.0 => out.push(aux(name, n)),

@@ -328,8 +328,10 @@ impl LinuxCnc {
                 self.six(out, "STRAIGHT_FEED(", end);
                 self.push(out, "STOP_SPEED_FEED_SYNCH()");
             }
-            // LinuxCNC's G33.1: the end point in the plane's three axes.
-            Command::Tap { end, .. } => {
+            // LinuxCNC's G33.1: the pitch synchronised, the end point in the plane's three
+            // axes (its retraction is part of the call; ours is a second tap).
+            Command::Tap { end, lead, .. } => {
+                self.push(out, &format!("START_SPEED_FEED_SYNC({:.6},0)", lead.abs()));
                 self.call(out, "RIGID_TAP(");
                 for k in 0..3 {
                     if k > 0 {
@@ -338,6 +340,7 @@ impl LinuxCnc {
                     write_num(out, self.value(end, k));
                 }
                 out.push_str(")\n");
+                self.push(out, "STOP_SPEED_FEED_SYNCH()");
             }
             // LinuxCNC's G38.2: a straight probe at the feed.
             Command::Probe { end, feed, .. } => {
