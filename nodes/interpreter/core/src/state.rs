@@ -126,8 +126,10 @@ pub struct Core {
     pub plane: Plane,
     // Modal motion state.
     pub feed: f64,
-    pub feed_per_rev: bool,
-    pub exact_stop_mode: bool,
+    // G95/G94 and G61/G64: changed only with the command that tells motion
+    // ([`Core::set_feed_mode`], [`Core::set_path_mode`]).
+    pub(crate) feed_per_rev: bool,
+    pub(crate) exact_stop_mode: bool,
     /// Under radius compensation the feed holds on the programmed contour, not at the
     /// cutter centre (decision D98).
     pub feed_on_contour: bool,
@@ -484,6 +486,28 @@ impl Core {
 
     pub fn aux(&mut self, a: Aux) {
         self.push(Command::Aux(a));
+    }
+
+    /// Feed per revolution (G95) rather than per minute.
+    pub fn feed_per_rev(&self) -> bool {
+        self.feed_per_rev
+    }
+
+    /// Exact stop at every block end (G61/G60) rather than blending (G64).
+    pub fn exact_stop_mode(&self) -> bool {
+        self.exact_stop_mode
+    }
+
+    /// Feed per revolution or per minute, and motion told (rs274ngc's SET_FEED_MODE).
+    pub fn set_feed_mode(&mut self, per_rev: bool) {
+        self.feed_per_rev = per_rev;
+        self.push(Command::FeedMode { per_rev });
+    }
+
+    /// Exact stop or blending from here on, and motion told (SET_MOTION_CONTROL_MODE).
+    pub fn set_path_mode(&mut self, exact_stop: bool) {
+        self.exact_stop_mode = exact_stop;
+        self.push(Command::PathMode { exact_stop });
     }
 
     /// Which way the spindle turns, as the program has told the machine.

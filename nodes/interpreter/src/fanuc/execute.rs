@@ -22,7 +22,7 @@
 //! 10. **Program flow**: M02/M30 end the program; M98/M99 call and return; GTC2E M20
 //!     restarts, M97 jumps. In a G70 block they wait for the cycle.
 
-use cnc_interpreter_core::{show, Aux, Command, Fault, ProgramError, SpindleDir};
+use cnc_interpreter_core::{show, Aux, Fault, ProgramError, SpindleDir};
 
 use super::block::Block;
 use super::codes::{G, M};
@@ -39,18 +39,15 @@ impl<D: Family> Fanuc<D> {
                 G::Absolute => self.incremental = false,
                 G::Incremental => self.incremental = true,
                 G::ExactStopMode => {
-                    self.core.exact_stop_mode = true;
-                    self.core.push(Command::PathMode { exact_stop: true });
+                    self.core.set_path_mode(true);
                 }
                 G::ContinuousMode => {
-                    self.core.exact_stop_mode = false;
-                    self.core.push(Command::PathMode { exact_stop: false });
+                    self.core.set_path_mode(false);
                 }
                 G::FeedPerMinute | G::FeedPerRevolution => {
                     let per_rev = g == G::FeedPerRevolution;
-                    if per_rev != self.core.feed_per_rev {
-                        self.core.feed_per_rev = per_rev;
-                        self.core.push(Command::FeedMode { per_rev });
+                    if per_rev != self.core.feed_per_rev() {
+                        self.core.set_feed_mode(per_rev);
                     }
                 }
                 // Keep the machine position; the work coordinates change.
@@ -116,7 +113,9 @@ impl<D: Family> Fanuc<D> {
             }
         }
         // 9. G09: this block ends at rest; the next blends again.
-        if b.has_g(G::ExactStopBlock) && self.core.queued() > produced && !self.core.exact_stop_mode
+        if b.has_g(G::ExactStopBlock)
+            && self.core.queued() > produced
+            && !self.core.exact_stop_mode()
         {
             self.core.exact_stop_block(produced);
         }

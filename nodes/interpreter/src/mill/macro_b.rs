@@ -249,7 +249,7 @@ impl Fanuc<Mill> {
             4002 => self.d.plane,
             4003 => pick(self.incremental, G::Incremental, G::Absolute),
             4005 => pick(
-                self.core.feed_per_rev,
+                self.core.feed_per_rev(),
                 G::FeedPerRevolution,
                 G::FeedPerMinute,
             ),
@@ -272,7 +272,7 @@ impl Fanuc<Mill> {
             }),
             4014 => G::WorkSystem(self.core.work_system),
             4015 => pick(
-                self.core.exact_stop_mode,
+                self.core.exact_stop_mode(),
                 G::ExactStopMode,
                 G::ContinuousMode,
             ),

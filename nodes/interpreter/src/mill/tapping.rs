@@ -26,7 +26,7 @@ impl Fanuc<Mill> {
                 format!("{what} needs F (S × pitch, or the pitch under G95)"),
             ));
         }
-        Ok(if self.core.feed_per_rev {
+        Ok(if self.core.feed_per_rev() {
             feed
         } else {
             feed / rpm

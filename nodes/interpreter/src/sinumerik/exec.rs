@@ -656,16 +656,14 @@ impl Sinumerik {
                 }
                 94 | 95 => {
                     let per_rev = g == 95;
-                    if self.core.feed_per_rev != per_rev {
-                        self.core.feed_per_rev = per_rev;
-                        self.core.push(Command::FeedMode { per_rev });
+                    if self.core.feed_per_rev() != per_rev {
+                        self.core.set_feed_mode(per_rev);
                     }
                 }
                 60 | 64 => {
                     let exact = g == 60;
-                    if self.core.exact_stop_mode != exact {
-                        self.core.exact_stop_mode = exact;
-                        self.core.push(Command::PathMode { exact_stop: exact });
+                    if self.core.exact_stop_mode() != exact {
+                        self.core.set_path_mode(exact);
                     }
                 }
                 // The corners of radius compensation (§9.6.5, D103).

@@ -222,8 +222,7 @@ impl Sinumerik {
         core.work_system = NO_WORK_OFFSET;
         core.program_start = core.work_position();
         // G60, exact stop, is the power-on path mode (§9.3.16).
-        core.exact_stop_mode = true;
-        core.push(cnc_interpreter_core::Command::PathMode { exact_stop: true });
+        core.set_path_mode(true);
         // CFC: F holds on the contour of a compensated arc (§9.1.6 `*`, §9.3.15, D98).
         core.feed_on_contour = true;
         // The tool the machine holds stays active, with its first edge (§9.6.2).

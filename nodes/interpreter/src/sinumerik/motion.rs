@@ -517,7 +517,7 @@ impl Sinumerik {
                     format!("{k}: G63 takes its pitch from F and S"),
                 ));
             }
-            if self.core.feed_per_rev {
+            if self.core.feed_per_rev() {
                 self.core.feed
             } else if self.core.rpm > 0.0 {
                 self.core.feed / self.core.rpm
