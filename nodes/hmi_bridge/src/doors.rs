@@ -268,18 +268,6 @@ fn machine_doors(
             |q| Ok(Operation::Mode { mode: q.mode }),
             said!(SetModeResponse),
         )?,
-        door::<Mdi>(
-            p,
-            ns,
-            qos,
-            "mdi",
-            |q| {
-                Ok(Operation::Mdi {
-                    text: q.text.clone(),
-                })
-            },
-            said!(MdiResponse),
-        )?,
         door::<Jog>(
             p,
             ns,
