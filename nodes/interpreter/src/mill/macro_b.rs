@@ -1,7 +1,8 @@
 //! FANUC user macro B on the mill (`003` inventory Appendix A.3; decision D49): G65 calls
-//! and G66/G67 modal calls (D129) with argument specification I, the #3000 alarm, and the mill's variable map (#1–#33 local,
-//! #100–#199 and #500–#999 common, #2001– offsets, #4001– modal information, #5001–
-//! positions, #5221– work offsets). WHILE … DO m … END m loops are the family's.
+//! and G66/G67 modal calls (D129) with argument specification I, the #3000 alarm, and the
+//! mill's variable map (#1–#33 local, #100–#199 and #500–#999 common, #2001– offsets, #4001–
+//! modal information, #5001– positions, #5221– work offsets). WHILE … DO m … END m loops are
+//! the family's.
 
 use cnc_interpreter_core::comp::Side;
 use cnc_interpreter_core::{Fault, ProgramError};
