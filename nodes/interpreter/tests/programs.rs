@@ -640,3 +640,90 @@ fn g83_g87_drilling() {
     .unwrap_err();
     assert_eq!((e.number, e.line), (42, 3), "{e}");
 }
+
+/// G99.1 (`000` §5.25, D132): feed per revolution whose next cut waits for the encoder's Z
+/// pulse: that one cut goes to motion locked to the encoder from the index (start angle 0), at
+/// F along the path; the rapid before it and the cuts after it are G99's own.
+#[test]
+fn g99_1_starts_its_next_cut_on_the_encoder_z_pulse_and_leaves_g99() {
+    let text = "G98 G00 X40 Z2\nM03 S500\nG99.1 F0.2\nG00 Z1\nG01 Z-30\nX60 Z-40\nG01 Z-50\nM30\n";
+    let c = check(
+        Dialect::HuaxingLathe,
+        text,
+        &AXES,
+        &DIAMETER,
+        &[100.0, 50.0],
+    )
+    .unwrap();
+    let kinds: Vec<&Command> = c.iter().map(|c| &c.command).collect();
+    // G99.1 selects feed per revolution once.
+    assert_eq!(
+        kinds
+            .iter()
+            .filter(|k| matches!(k, Command::FeedMode { per_rev: true }))
+            .count(),
+        1,
+        "{kinds:#?}"
+    );
+    let threads: Vec<(f64, f64, Vec<f64>)> = c
+        .iter()
+        .filter_map(|c| match &c.command {
+            Command::Thread {
+                end,
+                lead,
+                start_angle,
+            } => Some((*lead, *start_angle, end.to_vec())),
+            _ => None,
+        })
+        .collect();
+    // Only the first cut after G99.1, Z2 → Z-30: a straight cut, so the lead is F.
+    assert_eq!(threads.len(), 1, "{kinds:#?}");
+    let (lead, angle, end) = &threads[0];
+    assert!((lead - 0.2).abs() < 1e-12 && *angle == 0.0, "{threads:?}");
+    assert_close(end, &[40.0, -30.0]);
+    // The taper after it and the last cut are G99 cuts.
+    assert!(
+        c.iter()
+            .any(|c| matches!(&c.command, Command::Linear { .. })),
+        "{kinds:#?}"
+    );
+    // A taper as the indexed cut: F along the path, so its lead along Z (the longer slide
+    // travel: 10 mm of Z against 10 mm of X diameter, 5 mm of slide) is F × 10 / √125.
+    let c = check(
+        Dialect::HuaxingLathe,
+        "G00 X40 Z2\nM03 S500\nG99.1 F0.2\nG01 X50 Z-8\nM30\n",
+        &AXES,
+        &DIAMETER,
+        &[100.0, 50.0],
+    )
+    .unwrap();
+    let lead = c
+        .iter()
+        .find_map(|c| match &c.command {
+            Command::Thread { lead, .. } => Some(*lead),
+            _ => None,
+        })
+        .expect("the indexed cut");
+    assert!((lead - 0.2 * 10.0 / 125f64.sqrt()).abs() < 1e-12, "{lead}");
+    // An arc cannot start on the pulse; G98 before the cut cancels the wait.
+    let e = check(
+        Dialect::HuaxingLathe,
+        "G00 X40 Z2\nG99.1 F0.2\nG02 X50 Z-3 R5\nM30\n",
+        &AXES,
+        &DIAMETER,
+        &[100.0, 50.0],
+    )
+    .unwrap_err();
+    assert_eq!((e.number, e.line), (alarm::UNDEFINED_CODE, 3), "{e}");
+    let c = check(
+        Dialect::HuaxingLathe,
+        "G00 X40 Z2\nG99.1 F0.2\nG98 F100\nG01 Z-30\nM30\n",
+        &AXES,
+        &DIAMETER,
+        &[100.0, 50.0],
+    )
+    .unwrap();
+    assert!(!c
+        .iter()
+        .any(|c| matches!(c.command, Command::Thread { .. })));
+}

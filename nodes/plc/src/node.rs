@@ -249,17 +249,10 @@ impl Kept {
             self.held_parts = Some((msg, kept_version));
         }
         // A disk that refuses the write (logged as an error) does not hold the count back.
-        let durable =
-            self.keeper.as_ref().map_or(
-                u64::MAX,
-                |k| {
-                    if k.failing() {
-                        u64::MAX
-                    } else {
-                        k.durable()
-                    }
-                },
-            );
+        let durable = match &self.keeper {
+            Some(k) if !k.failing() => k.durable(),
+            _ => u64::MAX,
+        };
         if let Some((msg, _)) = self.held_parts.take_if(|(_, v)| *v <= durable) {
             let _ = parts_pub.publish(msg);
         }

@@ -64,6 +64,8 @@ pub enum HuaxingG {
     JumpRange,
     CallRange,
     LoopRange,
+    /// G99.1: feed per revolution whose next cut starts on the encoder's Z pulse (§5.25, D132).
+    FeedPerRevolutionOnIndex,
 }
 
 /// Retained words of a single cycle (G90/G92/G94, §5.21.3).
@@ -87,6 +89,8 @@ pub struct Huaxing {
     pub cycle_starts: u32,
     /// The call depth of a running tool-change macro: T words inside it do not call it again.
     pub tool_macro_depth: Option<usize>,
+    /// G99.1 given: the next cut starts on the spindle encoder's Z pulse (D132).
+    pub start_on_index: bool,
 }
 
 impl Family for Huaxing {
@@ -135,6 +139,7 @@ impl Family for Huaxing {
             drill: drilling::DrillWords::default(),
             cycle_starts: 1,
             tool_macro_depth: None,
+            start_on_index: false,
         }
     }
 
@@ -259,6 +264,18 @@ impl Family for Huaxing {
             f.drill_words(b)?;
         }
         Ok(())
+    }
+    fn modal(f: &mut Fanuc<Self>, g: HuaxingG, _b: &Block<Self>) -> Result<(), ProgramError> {
+        if g == HuaxingG::FeedPerRevolutionOnIndex {
+            if !f.core.feed_per_rev() {
+                f.core.set_feed_mode(true);
+            }
+            f.d.start_on_index = true;
+        }
+        Ok(())
+    }
+    fn before_motion(f: &mut Fanuc<Self>, b: &Block<Self>) -> Option<Result<(), ProgramError>> {
+        f.cut_on_index(b)
     }
     fn motion(f: &mut Fanuc<Self>, g: HuaxingG, b: &Block<Self>) -> Result<(), ProgramError> {
         use HuaxingG::*;
@@ -397,7 +414,7 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
         970 => (2, ConstantRpm),
         980 => (5, FeedPerMinute),
         990 => (5, FeedPerRevolution),
-        991 => (5, Unsupported("G99.1 needs the encoder Z pulse in motion")),
+        991 => (5, G::Own(FeedPerRevolutionOnIndex)),
         _ => return None,
     };
     Some(GCode { group, meaning })

@@ -1,12 +1,13 @@
 //! Threads and single cycles: G32 (constant lead, with run-out), G33 (tapping), G34 (variable
 //! lead), G90/G94 turning and facing cycles and the G92 thread cycle (§5.21, §5.23), and the
-//! G05 three-point arc (§5.5).
+//! G05 three-point arc (§5.5), and the cut G99.1 starts on the encoder's Z pulse (§5.25).
 
 use cnc_interpreter_core::geometry::{self, Pt};
 use cnc_interpreter_core::{show, Fault, MoveKind, ProgramError, SpindleDir};
 
 use super::{Huaxing, HuaxingG};
 use crate::fanuc::block::{whole, Block};
+use crate::fanuc::codes::G;
 use crate::fanuc::Fanuc;
 
 impl Fanuc<Huaxing> {
@@ -322,5 +323,61 @@ impl Fanuc<Huaxing> {
             }
         }
         Ok(())
+    }
+}
+
+impl Fanuc<Huaxing> {
+    /// The cut after G99.1 (§5.25, D132): it waits for the spindle encoder's Z pulse and then
+    /// runs at F mm per revolution, so it is cut as a thread from the index (start angle 0)
+    /// whose lead along its longer axis gives F along the path; the overrides do not act on
+    /// it, as on any cut locked to the encoder. Only that one cut; G99 stays. Rapids before it
+    /// wait; an arc cannot start on the pulse (alarm); G98 before the cut cancels it.
+    pub(super) fn cut_on_index(&mut self, b: &Block<Huaxing>) -> Option<Result<(), ProgramError>> {
+        if !self.d.start_on_index {
+            return None;
+        }
+        if !self.core.feed_per_rev() {
+            self.d.start_on_index = false;
+            return None;
+        }
+        if !self.has_axis_words(b) {
+            return None;
+        }
+        match b.group(1).unwrap_or(self.motion) {
+            G::Linear => {}
+            G::ArcCw | G::ArcCcw => {
+                self.d.start_on_index = false;
+                return Some(Err(self.fault(
+                    Fault::NotSupported,
+                    "G99.1: the cut that starts on the encoder's Z pulse is a line (G01)",
+                )));
+            }
+            _ => return None,
+        }
+        self.d.start_on_index = false;
+        if let Some(m) = b.group(1) {
+            self.motion = m;
+        }
+        Some(self.index_cut(b))
+    }
+
+    fn index_cut(&mut self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
+        let feed = self.core.feed;
+        if feed <= 0.0 {
+            return Err(self.fault(Fault::FeedRange, "G99.1 needs F (mm per revolution)"));
+        }
+        let start = self.core.work_position();
+        let end = self.end_point(b)?;
+        // Slide distances: a diameter axis moves half its programmed change.
+        let slide: Vec<f64> = start
+            .iter()
+            .zip(&end)
+            .zip(&self.core.setup.diameter)
+            .map(|((a, e), &d)| if d { (e - a) / 2.0 } else { e - a })
+            .collect();
+        let path = slide.iter().map(|d| d * d).sum::<f64>().sqrt();
+        let long = slide.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        let lead = if path > 0.0 { feed * long / path } else { feed };
+        self.core.emit(&end, MoveKind::Thread { lead, angle: 0.0 })
     }
 }
