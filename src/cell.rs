@@ -41,6 +41,9 @@ impl Cell {
             .filter(|n| **n != "recorder" || cfg.recorder.enabled)
             .map(|n| instance_lock::acquire(&inst, n))
             .collect::<Result<Vec<_>, _>>()?;
+        // The instance is ours now: what a killed run of it left in shared memory goes before
+        // any node opens a channel.
+        clean_dead_nodes();
         let shutdown = Shutdown::default();
         let mut cell = Cell {
             locks,
@@ -148,5 +151,19 @@ impl Cell {
         }
         drop(self.locks);
         (summary, errors)
+    }
+}
+
+/// Removes the iceoryx2 resources of dead processes (D65's instance lock is held, so none of
+/// them is this instance's live node); a failure is logged, not fatal: the nodes' own cleanup
+/// still runs.
+pub fn clean_dead_nodes() {
+    match cnc_runtime::shm::clean_dead_nodes() {
+        Ok((0, 0)) => {}
+        Ok((cleaned, 0)) => log::info!("shared memory: {cleaned} dead nodes' resources removed"),
+        Ok((cleaned, failed)) => log::warn!(
+            "shared memory: {cleaned} dead nodes' resources removed, {failed} could not be"
+        ),
+        Err(e) => log::warn!("shared memory: dead nodes not cleaned: {e}"),
     }
 }

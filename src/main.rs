@@ -564,6 +564,7 @@ fn run_node(node: NodeName, config: Option<&Path>) -> Result<(), String> {
         cnc_runtime::shm::instance(&cfg.machine.namespace, cfg.network.effective_domain_id()?);
     // Held until this process ends: a second copy of this node of this machine is refused.
     let _lock = cnc_runtime::instance_lock::acquire(&inst, node.lock_name())?;
+    cnc::cell::clean_dead_nodes();
     let shutdown = cnc_runtime::Shutdown::default();
     let s = shutdown.clone();
     let worker = std::thread::spawn(move || match node {

@@ -51,6 +51,21 @@ pub(crate) fn quiet_global_config() -> &'static iceoryx2::config::Config {
     })
 }
 
+/// Removes what the iceoryx2 nodes of dead processes left behind (a controller killed with
+/// SIGKILL leaves its publishers registered in its services), waiting for a cleanup another
+/// process is doing, before this controller's nodes open their channels. iceoryx2 also cleans
+/// when a node is created, but without waiting: the nodes of one cell start together, and one
+/// skipped a dead publisher another was still removing. Returns the nodes cleaned and those that
+/// could not be.
+pub fn clean_dead_nodes() -> Result<(u64, u64), String> {
+    let node = NodeBuilder::new()
+        .config(quiet_global_config())
+        .create::<ipc::Service>()
+        .map_err(|e| err("node", e))?;
+    let state = node.blocking_cleanup_dead_nodes(Duration::from_secs(2));
+    Ok((state.cleanups, state.failed_cleanups))
+}
+
 impl ShmNode {
     pub fn new(instance: &str, node_name: &str) -> Result<Self, String> {
         let name: NodeName = node_name.try_into().map_err(|e| err("node name", e))?;

@@ -232,6 +232,8 @@ struct Machine {
     /// The PLC's G image, for the block-skip switch (G44.0): its first arrival says the PLC
     /// has scanned (READY waits for it).
     g_in: cnc_runtime::shm::Receiver<GImage>,
+    /// A failing G image channel is logged once, not every turn of the loop.
+    g_failing: std::cell::Cell<bool>,
 }
 
 impl Machine {
@@ -253,10 +255,19 @@ impl Machine {
         while let Ok(Some(e)) = self.alarms.take() {
             core.alarm_event(&e);
         }
-        if let Ok(Some(g)) = self.g_in.latest() {
-            // The PLC writes its G image only after a scan: the machine can be ready.
-            core.plc_scanned();
-            core.block_skip_switch(g.get(g::BDT1));
+        match self.g_in.latest() {
+            Ok(Some(g)) => {
+                // The PLC writes its G image only after a scan: the machine can be ready.
+                core.plc_scanned();
+                core.block_skip_switch(g.get(g::BDT1));
+                self.g_failing.set(false);
+            }
+            Ok(None) => {}
+            // Until it reads, the machine stays WAIT; the log says why.
+            Err(e) if !self.g_failing.replace(true) => {
+                log::error!("interpreter: the PLC's G image cannot be read: {e}");
+            }
+            Err(_) => {}
         }
     }
 }
@@ -338,6 +349,7 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         axes: ros.subscription(&topics::AXES)?,
         alarms: ros.subscription(&topics::ALARM_EVENTS)?,
         g_in: shm.receiver::<GImage>(channel::G_IMAGE, false)?,
+        g_failing: std::cell::Cell::new(false),
     };
     let (memory, memory_error) = load_memory(&cfg);
     if let Some(e) = memory_error {
