@@ -4,6 +4,11 @@ use super::*;
 use cnc_interpreter::setup::ToolOffset;
 use cnc_msgs::msg::MotionCommand;
 
+#[path = "run_tests/commands.rs"]
+mod commands;
+#[path = "run_tests/restart.rs"]
+mod restart;
+
 const PART: &str = "G00 X100 Z20\nS500 M03\nG01 Z10 F3000\nG01 Z5\nM05\nM30\n";
 
 fn core() -> RunCore {
@@ -268,132 +273,6 @@ fn another_nodes_alarm_stops_the_run_with_a_cycle_stop_and_needs_its_source_to_c
     assert!(c.take_effects().is_empty());
 }
 
-#[test]
-fn mdi_runs_in_mdi_mode_only_and_programs_in_auto_only() {
-    let mut c = ready();
-    let r = command(
-        &mut c,
-        3,
-        TaskRequest::Mdi {
-            text: "G00 X80 Z20".into(),
-        },
-    );
-    assert!(!r.accepted && r.message.contains("not MDI"), "{r:?}");
-    assert!(command(&mut c, 4, TaskRequest::Mode(1)).accepted);
-    let r = command(&mut c, 5, start("part.nc", ""));
-    assert!(!r.accepted && r.message.contains("not AUTO"), "{r:?}");
-    assert!(!command(&mut c, 6, TaskRequest::Mdi { text: "  ".into() }).accepted);
-    assert!(
-        command(
-            &mut c,
-            7,
-            TaskRequest::Mdi {
-                text: "G00 X80 Z20".into()
-            }
-        )
-        .accepted
-    );
-    assert_eq!(c.state().program, MDI_PROGRAM);
-    // No mode change while it runs.
-    let r = command(&mut c, 8, TaskRequest::Mode(0));
-    assert!(!r.accepted && r.message.contains("running"), "{r:?}");
-    assert!(!command(&mut c, 9, TaskRequest::Mode(9)).accepted);
-}
-
-#[test]
-fn a_repeated_command_is_answered_again_not_done_twice() {
-    let mut c = ready();
-    let first = command(&mut c, 3, start("part.nc", ""));
-    let again = command(&mut c, 3, start("part.nc", ""));
-    assert_eq!(first, again);
-    assert!(first.accepted);
-    // A new id is a new start, refused while one runs.
-    assert!(!command(&mut c, 4, start("part.nc", "")).accepted);
-}
-
-#[test]
-fn program_memory_refuses_bad_names_and_keeps_a_running_program() {
-    let mut c = ready();
-    assert!(!command(&mut c, 3, load("../etc", "M30")).accepted);
-    assert!(!command(&mut c, 4, load(".hidden", "M30")).accepted);
-    let big = "G00 X1\n".repeat(MAX_PROGRAM_BYTES / 7 + 1);
-    assert!(!command(&mut c, 5, load("big.nc", &big)).accepted);
-    command(&mut c, 6, start("part.nc", ""));
-    assert!(!command(&mut c, 7, load("part.nc", "M30")).accepted);
-    assert!(
-        !command(
-            &mut c,
-            8,
-            TaskRequest::Delete {
-                name: "part.nc".into()
-            }
-        )
-        .accepted
-    );
-    let list = command(&mut c, 9, TaskRequest::List);
-    assert_eq!(
-        (list.programs, list.program_sizes),
-        (vec!["part.nc".to_string()], vec![PART.len() as u64])
-    );
-    let read = command(
-        &mut c,
-        10,
-        TaskRequest::Read {
-            name: "part.nc".into(),
-        },
-    );
-    assert_eq!(read.message, PART);
-    assert!(
-        !command(
-            &mut c,
-            11,
-            TaskRequest::Read {
-                name: "none.nc".into()
-            }
-        )
-        .accepted
-    );
-}
-
-#[test]
-fn what_a_run_leaves_in_memory_is_stored_and_offsets_wait_for_a_stop() {
-    let mut c = ready();
-    command(&mut c, 3, load("kept.nc", "#200=7\nG00 X100\nM30\n"));
-    command(&mut c, 4, start("kept.nc", ""));
-    let r = command(
-        &mut c,
-        5,
-        TaskRequest::SetToolOffset(cnc_msgs::msg::ToolOffset {
-            number: 1,
-            x: 0.5,
-            ..Default::default()
-        }),
-    );
-    assert!(
-        !r.accepted && r.message.contains("while a program runs"),
-        "{r:?}"
-    );
-    c.motion_status(status(0, 0, 16, MotionStatus::STATE_IDLE));
-    c.step();
-    // Stored as soon as the block that sets it is interpreted, not at the end of the run:
-    // a crash before the end keeps what the program wrote (issue 26).
-    let effects = c.take_effects();
-    assert!(effects.contains(&Effect::StoreMemory), "{effects:?}");
-    assert_eq!(c.memory().kept.get(&200), Some(&7.0));
-    let last = blocks(&effects).last().map(|b| b.seq).unwrap_or(0);
-    c.motion_status(status(1001, last, 16, MotionStatus::STATE_IDLE));
-    c.step();
-    assert_eq!(c.execution(), MachineState::PROGRAM_COMPLETED);
-    assert_eq!(c.memory().kept.get(&200), Some(&7.0));
-    // The next run starts from it.
-    command(&mut c, 6, load("use.nc", "G00 X[#200*10]\nM30\n"));
-    command(&mut c, 7, start("use.nc", ""));
-    c.motion_status(status(1001, last, 16, MotionStatus::STATE_IDLE));
-    c.step();
-    let b = c.take_effects();
-    assert_eq!(blocks(&b)[0].end.first(), Some(&70.0), "{b:?}");
-}
-
 /// Program memory in a folder as the core sees it: what it was asked to keep, or a disk
 /// that refuses.
 #[derive(Clone, Default)]
@@ -421,53 +300,6 @@ impl cnc_machine::programs::ProgramStorage for Disk {
         }
         Ok(())
     }
-}
-
-/// Issue 26: programs lived in RAM only, and 120 loads of 4 MiB were all taken. Program
-/// memory keeps what it stores, refuses what exceeds its capacity with alarm 70, and a
-/// program the disk did not take is not reported stored.
-#[test]
-fn program_memory_is_kept_bounded_by_its_capacity_and_a_failed_write_is_no_load() {
-    let disk = Disk::default();
-    let held: BTreeMap<String, String> = [("O0001".to_string(), "M30\n".to_string())].into();
-    let mut c = core().with_program_memory(held, Box::new(disk.clone()), 1000);
-    let r = command(&mut c, 1, TaskRequest::List);
-    assert!(r.programs.contains(&"O0001".to_string()), "{r:?}");
-    let r = command(&mut c, 2, load("shafts/O0010.nc", &"G0X1\n".repeat(100)));
-    assert!(r.accepted, "{r:?}");
-    assert!(disk.files.lock().unwrap().contains_key("shafts/O0010.nc"));
-    let r = command(&mut c, 3, load("big.nc", &"G0X1\n".repeat(100)));
-    assert!(!r.accepted && r.message.contains("alarm 70"), "{r:?}");
-    assert!(r.message.contains("of 1000 bytes free"), "{r:?}");
-    let r = command(&mut c, 4, load("../escape.nc", "M30\n"));
-    assert!(
-        !r.accepted && r.message.contains("invalid program name"),
-        "{r:?}"
-    );
-    let r = command(
-        &mut c,
-        5,
-        TaskRequest::Delete {
-            name: "shafts/O0010.nc".into(),
-        },
-    );
-    assert!(r.accepted, "{r:?}");
-    assert!(disk.files.lock().unwrap().is_empty());
-    // Deleting made room.
-    assert!(command(&mut c, 6, load("big.nc", &"G0X1\n".repeat(100))).accepted);
-
-    let broken = Disk {
-        broken: true,
-        ..Disk::default()
-    };
-    let mut c = core().with_program_memory(BTreeMap::new(), Box::new(broken), 1 << 20);
-    let r = command(&mut c, 1, load("part.nc", "M30\n"));
-    assert!(!r.accepted && r.message.contains("No space left"), "{r:?}");
-    let r = command(&mut c, 2, TaskRequest::List);
-    assert!(
-        !r.programs.contains(&"part.nc".to_string()),
-        "not in memory either: {r:?}"
-    );
 }
 
 #[test]
@@ -504,150 +336,6 @@ fn the_block_skip_switch_applies_to_the_blocks_read_after_it() {
     c.block_skip_switch(false);
     c.motion_status(status(c.run_counter, 2, 2, MotionStatus::STATE_RUNNING));
     assert_eq!(lines_sent(&mut c, 2), vec![4, 5]);
-}
-
-/// Motion's status for run `run_id` with `done_seq` blocks finished, at `line`.
-fn status_at(run_id: u64, done_seq: u64, line: u32, state: u8) -> MotionStatus {
-    MotionStatus {
-        line,
-        ..status(run_id, done_seq, 64, state)
-    }
-}
-
-/// Plays motion for the core's run `run_id` to its end, finishing whatever was sent; the
-/// blocks as (kind, end, line).
-fn run_to_end(c: &mut RunCore, run_id: u64) -> Vec<(u8, Vec<f64>, u32)> {
-    let mut out = Vec::new();
-    let mut done = 0;
-    c.motion_status(status_at(run_id, 0, 1, MotionStatus::STATE_RUNNING));
-    for _ in 0..100 {
-        c.step();
-        for b in blocks(&c.take_effects()) {
-            assert_eq!(b.run_id, run_id);
-            out.push((b.kind, b.end.clone(), b.line));
-            done = b.seq;
-        }
-        c.motion_status(status_at(run_id, done, 1, MotionStatus::STATE_RUNNING));
-        if c.execution() == MachineState::PROGRAM_COMPLETED {
-            return out;
-        }
-    }
-    panic!("the run did not end: {:?}", c.state());
-}
-
-/// The program counts its runs in kept #200 and moves by the count: a restart that read #200
-/// as the interrupted run left it would cut 1 mm further out.
-const COUNTED: &str =
-    "#200=#200+1\nG00 X[100+#200] Z20\nS500 M03\nG01 Z10 F3000\nG01 Z5\nG01 X120\nM05\nM30\n";
-
-fn counted_core() -> RunCore {
-    let mut c = core();
-    assert!(command(&mut c, 1, load("count.nc", COUNTED)).accepted);
-    c.plc_scanned();
-    c.axes(&[200.0, 100.0]);
-    c
-}
-
-#[test]
-fn a_program_starts_at_a_line_with_its_preamble_then_the_rest_of_it() {
-    let mut c = counted_core();
-    let r = command(&mut c, 2, start("count.nc", "line 5"));
-    assert!(r.accepted, "{}", r.message);
-    assert!(r.message.contains("at line 5"), "{}", r.message);
-    let sent = run_to_end(&mut c, 1001);
-    // S500 M03, then the approach: X stays out at 200, Z over to 10, X to 102 and onto 101.
-    let ends: Vec<&Vec<f64>> = sent
-        .iter()
-        .filter(|b| b.0 != MotionBlock::KIND_AUX && !b.1.is_empty())
-        .map(|b| &b.1)
-        .collect();
-    assert_eq!(
-        ends,
-        [
-            &vec![200.0, 10.0],
-            &vec![102.0, 10.0],
-            &vec![101.0, 10.0],
-            &vec![101.0, 5.0],
-            &vec![120.0, 5.0]
-        ]
-    );
-    assert!(sent.iter().all(|b| b.2 >= 5), "{sent:?}");
-    let refused = command(&mut c, 3, start("count.nc", "N999"));
-    assert!(!refused.accepted && refused.message.contains("not found"));
-    let refused = command(&mut c, 4, start("count.nc", "goto 3"));
-    assert!(!refused.accepted);
-}
-
-#[test]
-fn an_interrupted_run_restarts_at_its_block_with_the_variables_it_started_with() {
-    // The uninterrupted run, for comparison.
-    let mut whole = counted_core();
-    assert!(command(&mut whole, 2, start("count.nc", "")).accepted);
-    let full = run_to_end(&mut whole, 1001);
-    assert_eq!(whole.memory().kept.get(&200), Some(&1.0));
-
-    // The run that is interrupted: motion has finished 4 blocks, at line 4, when the power
-    // goes (an emergency stop here; a kill leaves the same kept position).
-    let mut first = counted_core();
-    assert!(command(&mut first, 2, start("count.nc", "")).accepted);
-    first.motion_status(status_at(1001, 0, 1, MotionStatus::STATE_RUNNING));
-    first.step();
-    assert!(blocks(&first.take_effects()).len() > 5);
-    first.motion_status(status_at(1001, 4, 4, MotionStatus::STATE_RUNNING));
-    first.step();
-    let kept = first.position().cloned().expect("a kept position");
-    assert_eq!(
-        (kept.program.as_str(), kept.line, kept.block),
-        ("count.nc", 4, 5)
-    );
-    assert!(kept.interrupted());
-    assert_eq!(kept.kept_at_start.get(&200), None, "#200 before the run");
-    let memory_after = first.memory().clone();
-    assert_eq!(memory_after.kept.get(&200), Some(&1.0));
-
-    // The cell restarts: memory and position as kept, the axes elsewhere.
-    let fresh = || {
-        let c = RunCore::new(
-            Dialect::HuaxingLathe,
-            Setup::lathe([200.0, 100.0]),
-            memory_after.clone(),
-            2000,
-        );
-        let mut c = c.with_kept_position(Some(kept.clone()));
-        assert!(command(&mut c, 1, load("count.nc", COUNTED)).accepted);
-        c.plc_scanned();
-        c.axes(&[250.0, 150.0]);
-        c
-    };
-    let mut again = fresh();
-    let r = command(&mut again, 2, start("", "interrupted"));
-    assert!(r.accepted, "{}", r.message);
-    assert!(r.message.contains("block 5"), "{}", r.message);
-    let rest = run_to_end(&mut again, 2001);
-    // After the preamble, exactly the uninterrupted run's blocks from block 5 on: X101, not
-    // X102 (the search ran with #200 as the interrupted run found it).
-    assert!(rest.len() > full.len() - 4);
-    assert_eq!(rest[rest.len() - (full.len() - 4)..], full[4..]);
-    assert_eq!(again.memory().kept.get(&200), Some(&1.0));
-    // Completed: nothing is left to restart.
-    let r = command(&mut again, 3, start("", "interrupted"));
-    assert!(
-        !r.accepted && r.message.contains("no interrupted program"),
-        "{}",
-        r.message
-    );
-
-    // Another program's name, or an edited program, is refused.
-    let mut other = fresh();
-    let r = command(&mut other, 2, start("part.nc", "interrupted"));
-    assert!(
-        !r.accepted && r.message.contains("not part.nc"),
-        "{}",
-        r.message
-    );
-    assert!(command(&mut other, 3, load("count.nc", PART)).accepted);
-    let r = command(&mut other, 4, start("count.nc", "interrupted"));
-    assert!(!r.accepted && r.message.contains("edited"), "{}", r.message);
 }
 
 #[test]
@@ -901,69 +589,6 @@ const MAIN_CALLING: &str = "G00 X100 Z20\nS500 M03\nM98 P2000\nG00 X150 Z50\nM05
 const SUB: &str = "O2000\nG01 X90 Z10 F3000\nG01 Z5\nG01 Z0\nG01 X95\nG01 Z-5\nM99\n";
 const SUB_EDITED: &str = "O2000\nG01 X80 Z10 F3000\nG01 Z5\nG01 Z0\nG01 X95\nG01 Z-5\nM99\n";
 
-fn calling_core() -> RunCore {
-    let mut c = core();
-    assert!(command(&mut c, 1, load("main.nc", MAIN_CALLING)).accepted);
-    assert!(command(&mut c, 2, load("O2000", SUB)).accepted);
-    c.plc_scanned();
-    c.axes(&[200.0, 100.0]);
-    c
-}
-
-/// An interruption inside a subprogram restarts at the subprogram's interrupted block (not at
-/// the main program's call line), and the rest is the uninterrupted run's; a restart after the
-/// subprogram was edited is refused.
-#[test]
-fn an_interrupted_subprogram_restarts_at_its_block_and_an_edit_of_it_is_refused() {
-    let mut whole = calling_core();
-    assert!(command(&mut whole, 3, start("main.nc", "")).accepted);
-    let full = run_to_end(&mut whole, 1001);
-
-    // Interrupted with 5 blocks done: inside O2000 (its third move).
-    let mut first = calling_core();
-    assert!(command(&mut first, 3, start("main.nc", "")).accepted);
-    first.motion_status(status_at(1001, 0, 1, MotionStatus::STATE_RUNNING));
-    first.step();
-    assert!(blocks(&first.take_effects()).len() > 6);
-    first.motion_status(status_at(1001, 5, 3, MotionStatus::STATE_RUNNING));
-    first.step();
-    let kept = first.position().cloned().expect("a kept position");
-    assert!(kept.interrupted() && kept.block == 6, "{kept:?}");
-
-    let fresh = |sub: &str| {
-        let c = RunCore::new(
-            Dialect::HuaxingLathe,
-            Setup::lathe([200.0, 100.0]),
-            first.memory().clone(),
-            2000,
-        );
-        let mut c = c.with_kept_position(Some(kept.clone()));
-        assert!(command(&mut c, 1, load("main.nc", MAIN_CALLING)).accepted);
-        assert!(command(&mut c, 2, load("O2000", sub)).accepted);
-        c.plc_scanned();
-        c.axes(&[250.0, 150.0]);
-        c
-    };
-    let mut again = fresh(SUB);
-    let r = command(&mut again, 3, start("", "interrupted"));
-    assert!(r.accepted, "{}", r.message);
-    assert!(r.message.contains("block 6"), "{}", r.message);
-    let rest = run_to_end(&mut again, 2001);
-    // After the preamble, the uninterrupted run's blocks from block 6 on: the subprogram is
-    // not run again from its top.
-    assert!(rest.len() >= full.len() - 5, "{rest:?}");
-    assert_eq!(rest[rest.len() - (full.len() - 5)..], full[5..], "{rest:?}");
-
-    // The subprogram edited since: refused, naming it.
-    let mut edited = fresh(SUB_EDITED);
-    let r = command(&mut edited, 3, start("", "interrupted"));
-    assert!(
-        !r.accepted && r.message.contains("O2000") && r.message.contains("edited"),
-        "{}",
-        r.message
-    );
-}
-
 /// Issue 46 item 4: the tool in the spindle is kept with the machine's memory: a run that
 /// changes the tool leaves it there, and the next run starts with it.
 #[test]
@@ -1005,114 +630,31 @@ fn the_tool_in_the_spindle_is_kept_from_run_to_run() {
     assert_eq!(last_z(&second), Some(12.0), "T3 D2 {second:?}");
 }
 
-fn to_motion(effects: &[Effect]) -> Vec<MotionCommand> {
-    effects
-        .iter()
-        .filter_map(|e| match e {
-            Effect::ToMotion(m) => Some(m.clone()),
-            _ => None,
-        })
-        .collect()
+/// Motion's status for run `run_id` with `done_seq` blocks finished, at `line`.
+fn status_at(run_id: u64, done_seq: u64, line: u32, state: u8) -> MotionStatus {
+    MotionStatus {
+        line,
+        ..status(run_id, done_seq, 64, state)
+    }
 }
 
-/// Issue 47: the task decides; what it passes on to motion is answered by motion, and a
-/// refusal there is the caller's answer, with motion's reason.
-#[test]
-fn a_jog_motion_refuses_is_refused_to_the_caller_with_motion_s_reason() {
-    let mut c = ready();
-    let jog =
-        |direction| TaskRequest::Jog(cnc_msgs::jog::Jog::new("z", direction, 600.0, 0.0).unwrap());
-    let r = command(&mut c, 3, jog(1));
-    assert!(!r.accepted && r.message.contains("not JOG"), "{r:?}");
-    assert!(command(&mut c, 4, TaskRequest::Mode(MachineState::MODE_JOG)).accepted);
-    c.take_effects();
-    assert_eq!(c.command(5, jog(1)), None, "waits for motion");
-    let sent = to_motion(&c.take_effects());
-    let [m] = &sent[..] else { panic!("{sent:?}") };
-    assert_eq!(
-        (m.kind, m.axis, m.direction, m.feed),
-        (MotionCommand::JOG, 1, 1, 600.0)
-    );
-    // The bridge repeats the command until answered: not sent twice.
-    assert_eq!(c.command(5, jog(1)), None);
-    assert!(c.take_effects().is_empty());
-    let why = "jog refused: Z is on its + overtravel switch: jog it the other way";
-    let refusal = CommandResult {
-        id: m.id,
-        accepted: false,
-        message: why.into(),
-        ..CommandResult::default()
-    };
-    let answer = c.motion_result(&refusal).expect("the caller's answer");
-    assert_eq!((answer.id, answer.accepted), (5, false));
-    assert_eq!(answer.message, why);
-    // Answered once: a repeat gets the same answer, a second answer of motion's is no one's.
-    assert_eq!(c.command(5, jog(1)), Some(answer));
-    assert_eq!(c.motion_result(&refusal), None);
-    // Accepted by motion: the task's words.
-    assert_eq!(c.command(6, jog(-1)), None);
-    let [m] = &to_motion(&c.take_effects())[..] else {
-        panic!()
-    };
-    let accepted = CommandResult {
-        id: m.id,
-        accepted: true,
-        message: "jog".into(),
-        ..CommandResult::default()
-    };
-    let answer = c.motion_result(&accepted).unwrap();
-    assert!(
-        answer.accepted && answer.message.starts_with("jog Z -"),
-        "{answer:?}"
-    );
-    // Refused by the task: nothing reaches motion.
-    let r = command(
-        &mut c,
-        7,
-        TaskRequest::Jog(cnc_msgs::jog::Jog::new("Y", 1, 0.0, 0.0).unwrap()),
-    );
-    assert!(!r.accepted && r.message.contains("no axis Y"), "{r:?}");
-    assert!(to_motion(&c.take_effects()).is_empty());
-    // Cycle start in HOME: the reference return is motion's to refuse too.
-    assert!(command(&mut c, 8, TaskRequest::Mode(MachineState::MODE_HOME)).accepted);
-    c.take_effects();
-    assert_eq!(c.command(9, start("", "")), None);
-    let [m] = &to_motion(&c.take_effects())[..] else {
-        panic!()
-    };
-    assert_eq!(m.kind, MotionCommand::REFERENCE_RETURN);
-    let refusal = CommandResult {
-        id: m.id,
-        accepted: false,
-        message: "reference return refused: a jog is moving an axis".into(),
-        ..CommandResult::default()
-    };
-    let answer = c.motion_result(&refusal).unwrap();
-    assert_eq!((answer.id, answer.accepted), (9, false));
-}
-
-/// Issue 47: one node judges a cycle start. A refused START reaches motion in no form; feed
-/// hold, and the start that resumes it, do.
-#[test]
-fn a_refused_start_sends_motion_nothing_and_a_resume_sends_it_on() {
-    let mut c = ready();
-    c.take_effects();
-    let r = command(&mut c, 3, start("none.nc", ""));
-    assert!(!r.accepted);
-    assert!(c.take_effects().is_empty());
-    assert!(command(&mut c, 4, start("part.nc", "")).accepted);
-    c.take_effects();
-    let r = command(&mut c, 5, start("part.nc", ""));
-    assert!(!r.accepted && r.message.contains("running"), "{r:?}");
-    assert!(to_motion(&c.take_effects()).is_empty());
-    assert!(command(&mut c, 6, TaskRequest::FeedHold).accepted);
-    let kinds = |c: &mut RunCore| -> Vec<u8> {
-        to_motion(&c.take_effects())
-            .iter()
-            .map(|m| m.kind)
-            .collect()
-    };
-    assert_eq!(kinds(&mut c), [MotionCommand::FEED_HOLD]);
-    assert!(command(&mut c, 7, start("", "")).accepted);
-    assert_eq!(kinds(&mut c), [MotionCommand::RESUME]);
+/// Plays motion for the core's run `run_id` to its end, finishing whatever was sent; the
+/// blocks as (kind, end, line).
+fn run_to_end(c: &mut RunCore, run_id: u64) -> Vec<(u8, Vec<f64>, u32)> {
+    let mut out = Vec::new();
+    let mut done = 0;
+    c.motion_status(status_at(run_id, 0, 1, MotionStatus::STATE_RUNNING));
+    for _ in 0..100 {
+        c.step();
+        for b in blocks(&c.take_effects()) {
+            assert_eq!(b.run_id, run_id);
+            out.push((b.kind, b.end.clone(), b.line));
+            done = b.seq;
+        }
+        c.motion_status(status_at(run_id, done, 1, MotionStatus::STATE_RUNNING));
+        if c.execution() == MachineState::PROGRAM_COMPLETED {
+            return out;
+        }
+    }
+    panic!("the run did not end: {:?}", c.state());
 }
