@@ -14,4 +14,6 @@ ip netns exec "$NS" ip link set lo up
 ip netns exec "$NS" ip link set lo multicast on
 ip netns exec "$NS" ip route add 224.0.0.0/4 dev lo
 cargo build --workspace --tests
+# A hung test binary fails the run with its stacks (scripts/test_runner.sh).
+export CARGO_TARGET_X86_64_UNKNOWN_LINUX_GNU_RUNNER="$PWD/scripts/test_runner.sh"
 ip netns exec "$NS" cargo test --workspace "$@"

@@ -211,12 +211,11 @@ fn count(s: &CellState, name: &str) -> u32 {
 fn read_cell_bag(bag: &Path) -> Vec<Vec<String>> {
     const ROOT: &str = env!("CARGO_MANIFEST_DIR");
     let python = PathBuf::from(format!("{ROOT}/target/venv/bin/python"));
-    let out = Command::new(&python)
-        .arg(format!("{ROOT}/tests/interop/read_cell_bag.py"))
+    let mut read = Command::new(&python);
+    read.arg(format!("{ROOT}/tests/interop/read_cell_bag.py"))
         .arg(bag)
-        .arg(format!("{ROOT}/msgs/msg"))
-        .output()
-        .expect("the venv's python (scripts/test.sh makes it)");
+        .arg(format!("{ROOT}/msgs/msg"));
+    let out = common::output_within(&mut read, Duration::from_secs(300));
     assert!(
         out.status.success(),
         "read_cell_bag.py: {}",

@@ -100,13 +100,13 @@ fn the_cell_launch_file_runs_two_lathes_robot_and_supervisor_shown_in_terminal_a
         assert!(t0.elapsed() < Duration::from_secs(60), "panels not served");
         std::thread::sleep(Duration::from_millis(100));
     }
-    let out = Command::new("node")
+    let mut browser = Command::new("node");
+    browser
         .arg(root.join("tests/hmi/cell.cjs"))
         .arg(format!("http://{}/", PANELS[0]))
         .arg(format!("http://{}/", PANELS[1]))
-        .env("PLAYWRIGHT_CORE", &playwright)
-        .output()
-        .expect("node runs");
+        .env("PLAYWRIGHT_CORE", &playwright);
+    let out = common::output_within(&mut browser, Duration::from_secs(300));
     println!("{}", String::from_utf8_lossy(&out.stdout));
     assert!(
         out.status.success(),

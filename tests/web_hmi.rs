@@ -51,13 +51,13 @@ fn the_operator_runs_a_program_from_the_web_hmi_in_chromium() {
     std::fs::create_dir_all(&shots).expect("target/hmi");
     let screenshot = shots.join("panel.png");
     let _ = std::fs::remove_file(&screenshot);
-    let out = std::process::Command::new("node")
+    let mut browser = std::process::Command::new("node");
+    browser
         .arg(root.join("tests/hmi/panel.cjs"))
         .arg(format!("http://{ADDRESS}/"))
         .arg(&screenshot)
-        .env("PLAYWRIGHT_CORE", &playwright)
-        .output()
-        .expect("node runs");
+        .env("PLAYWRIGHT_CORE", &playwright);
+    let out = common::output_within(&mut browser, std::time::Duration::from_secs(300));
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     println!("{stdout}");

@@ -230,12 +230,12 @@ fn the_panel_on_a_network_address_needs_a_login_and_keeps_the_operator_in() {
     // 4. The same in a real browser: a login form, then the panel under the operator's name.
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let playwright = root.join("target/npm/node_modules/playwright-core");
-    let out = std::process::Command::new("node")
+    let mut browser = std::process::Command::new("node");
+    browser
         .arg(root.join("tests/hmi/login.cjs"))
         .args([&format!("{ORIGIN}/"), "anna", PASSWORD])
-        .env("PLAYWRIGHT_CORE", &playwright)
-        .output()
-        .expect("node runs");
+        .env("PLAYWRIGHT_CORE", &playwright);
+    let out = common::output_within(&mut browser, std::time::Duration::from_secs(300));
     let stdout = String::from_utf8_lossy(&out.stdout);
     println!("{stdout}");
     assert!(

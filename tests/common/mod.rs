@@ -104,12 +104,65 @@ pub fn cyclone_peer(script: &str, domain: u16) -> std::process::Output {
         "{} missing: run scripts/test.sh, which creates the venv with cyclonedds",
         python.display()
     );
-    std::process::Command::new(&python)
-        .arg(root.join("tests/interop").join(script))
+    let mut peer = std::process::Command::new(&python);
+    peer.arg(root.join("tests/interop").join(script))
         .args(["--domain", &domain.to_string()])
         .env("CYCLONEDDS_URI", "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\" multicast=\"true\"/></Interfaces></General></Domain></CycloneDDS>")
-        .output()
-        .expect("python runs")
+        .env("PEER_LIMIT_S", PEER_LIMIT.as_secs().to_string());
+    output_within(&mut peer, PEER_LIMIT + std::time::Duration::from_secs(30))
+}
+
+/// How long a peer may run: it prints its threads' stacks and exits after this (its own
+/// watchdog), and is killed 30 s later if even that did not happen.
+const PEER_LIMIT: std::time::Duration = std::time::Duration::from_secs(300);
+
+/// The output of `cmd`, which must end within `limit`: a process nobody here wrote (a DDS
+/// peer, a browser, a protocol client) that hangs is killed, and the test fails with what it
+/// printed so far instead of waiting for CI's own timeout.
+pub fn output_within(cmd: &mut Command, limit: std::time::Duration) -> std::process::Output {
+    use std::io::Read;
+    let mut child = cmd
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap_or_else(|e| panic!("{cmd:?} does not start: {e}"));
+    let drain = |pipe: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            if let Some(mut p) = pipe {
+                let _ = p.read_to_end(&mut bytes);
+            }
+            bytes
+        })
+    };
+    let out = drain(child.stdout.take().map(|p| Box::new(p) as _));
+    let err = drain(child.stderr.take().map(|p| Box::new(p) as _));
+    let deadline = std::time::Instant::now() + limit;
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for a child") {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            let (out, err) = (
+                out.join().unwrap_or_default(),
+                err.join().unwrap_or_default(),
+            );
+            panic!(
+                "{cmd:?} still ran after {limit:?} and was killed; it printed:\n{}\n{}",
+                String::from_utf8_lossy(&out),
+                String::from_utf8_lossy(&err)
+            );
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    std::process::Output {
+        status,
+        stdout: out.join().unwrap_or_default(),
+        stderr: err.join().unwrap_or_default(),
+    }
 }
 
 /// Runs `tests/interop/<script>` as [`cyclone_peer`] does, prints what it printed and fails the

@@ -9,6 +9,7 @@ Exit 0 when every check holds; otherwise print what failed and exit 1.
 """
 
 import argparse
+import faulthandler
 import os
 import pathlib
 import sys
@@ -253,7 +254,10 @@ def main():
 def run(main):
     """Runs a peer's `main` and ends the process with its exit code at once, also after an
     exception: Cyclone's teardown at interpreter exit was seen to hang after a traceback, and
-    the calling test then waited for the peer instead of failing."""
+    the calling test then waited for the peer instead of failing. A peer that is still running
+    after PEER_LIMIT_S seconds (a hang inside Cyclone's C code, where no Python signal handler
+    runs) prints every thread's stack and exits, so the test fails with where it hung."""
+    faulthandler.dump_traceback_later(float(os.environ.get("PEER_LIMIT_S", "300")), exit=True)
     try:
         code = main()
     except SystemExit as e:

@@ -563,9 +563,12 @@ impl InnerPublisher {
     if let Some(sec_handle) = self.security_plugins_handle.as_ref() {
       // Security is enabled.
       // Check are we allowed to create the DataWriter from Access control
+      // The domain id first: `dp.domain_id()` locks the participant, and a thread that
+      // creates a topic holds the participant while it waits for the plugins (CNC_PATCH.md).
+      let domain_id = dp.domain_id();
       let check_res = sec_handle.get_plugins().check_create_datawriter(
         guid.prefix,
-        dp.domain_id(),
+        domain_id,
         topic.name(),
         &writer_qos,
       );
@@ -1178,9 +1181,12 @@ impl InnerSubscriber {
     if let Some(sec_handle) = self.security_plugins_handle.as_ref() {
       // Security is enabled.
       // Check are we allowed to create the DataReader from Access control
+      // The domain id first: `dp.domain_id()` locks the participant, and a thread that
+      // creates a topic holds the participant while it waits for the plugins (CNC_PATCH.md).
+      let domain_id = dp.domain_id();
       let check_res = sec_handle.get_plugins().check_create_datareader(
         reader_guid.prefix,
-        dp.domain_id(),
+        domain_id,
         topic.name(),
         &qos,
       );
