@@ -79,10 +79,7 @@ impl Cell {
         let (c, i, s) = (cfg.clone(), inst.clone(), shutdown.clone());
         cell.threads.push((
             "io",
-            spawn(
-                "io",
-                Box::new(move || cnc_io::node::run(c, i, s).map(|_| String::new())),
-            )?,
+            spawn("io", Box::new(move || cnc_io::node::run(c, i, s)))?,
         ));
         let (c, i, s) = (cfg.clone(), inst.clone(), shutdown.clone());
         cell.threads.push((

@@ -44,6 +44,10 @@ enum Verb {
         /// Cycles to run (with --program). 0 = until Ctrl-C.
         #[arg(long, default_value_t = 1)]
         cycles: u32,
+        /// Write the drive trace (every drive tick's setpoints, positions, following errors
+        /// and queue depth) to this CSV file; needs `servo.drive_queue_ms` in the config.
+        #[arg(long, value_name = "FILE")]
+        drive_trace: Option<PathBuf>,
     },
     /// Run one node of the cell in this process (the others run in their own processes or on
     /// other hosts), until Ctrl-C or SIGTERM.
@@ -56,6 +60,9 @@ enum Verb {
         /// The same as CONFIG.
         #[arg(long, conflicts_with = "config_file")]
         config: Option<PathBuf>,
+        /// The io node: write the drive trace to this CSV file (as `cnc run --drive-trace`).
+        #[arg(long, value_name = "FILE")]
+        drive_trace: Option<PathBuf>,
     },
     /// Interpret a program without running it; report every error with line and alarm number.
     Check {
@@ -276,11 +283,12 @@ fn main() -> ExitCode {
             config,
             program,
             cycles,
+            drive_trace,
         }) => program
             .as_deref()
             .map(read_named_program)
             .transpose()
-            .and_then(|p| run(config_file.or(config).as_deref(), p, cycles)),
+            .and_then(|p| run(config_file.or(config).as_deref(), p, cycles, drive_trace)),
         Some(Verb::Check {
             program,
             trace,
@@ -290,7 +298,8 @@ fn main() -> ExitCode {
             node,
             config_file,
             config,
-        }) => run_node(node, config_file.or(config).as_deref()),
+            drive_trace,
+        }) => run_node(node, config_file.or(config).as_deref(), drive_trace),
         Some(Verb::Simulate {
             program,
             svg,
@@ -352,7 +361,7 @@ fn main() -> ExitCode {
         ),
         None => {
             let (name, text) = machines::DEMO_PROGRAM;
-            run(None, Some((name.into(), text.into())), 0)
+            run(None, Some((name.into(), text.into())), 0, None)
         }
     };
     match result {
@@ -557,8 +566,13 @@ impl NodeName {
     }
 }
 
-fn run_node(node: NodeName, config: Option<&Path>) -> Result<(), String> {
-    let (cfg, _) = machines::load(config, None)?;
+fn run_node(
+    node: NodeName,
+    config: Option<&Path>,
+    drive_trace: Option<PathBuf>,
+) -> Result<(), String> {
+    let (mut cfg, _) = machines::load(config, None)?;
+    with_drive_trace(&mut cfg, drive_trace)?;
     install_signal_handlers();
     let inst =
         cnc_runtime::shm::instance(&cfg.machine.namespace, cfg.network.effective_domain_id()?);
@@ -568,7 +582,7 @@ fn run_node(node: NodeName, config: Option<&Path>) -> Result<(), String> {
     let shutdown = cnc_runtime::Shutdown::default();
     let s = shutdown.clone();
     let worker = std::thread::spawn(move || match node {
-        NodeName::Io => cnc_io::node::run(cfg, inst, s).map(|_| String::new()),
+        NodeName::Io => cnc_io::node::run(cfg, inst, s),
         NodeName::Plc => cnc_plc::node::run(cfg, inst, s).map(|_| String::new()),
         NodeName::Motion => cnc_motion::node::run(cfg, inst, s),
         NodeName::Interpreter => cnc_task::node::run(cfg, inst, s).map(|_| String::new()),
@@ -595,14 +609,34 @@ fn read_named_program(path: &Path) -> Result<NamedProgram, String> {
     Ok((program_name(path), read_program(path)?))
 }
 
-fn run(config: Option<&Path>, program: Option<NamedProgram>, cycles: u32) -> Result<(), String> {
+/// The drive trace named on the command line, which needs the drives' queue.
+fn with_drive_trace(cfg: &mut LaunchConfig, trace: Option<PathBuf>) -> Result<(), String> {
+    if let Some(path) = trace {
+        if cfg.servo.drive_queue_ms <= 0.0 {
+            return Err(
+                "--drive-trace: the drives run lock-step in this config; set servo.drive_queue_ms"
+                    .into(),
+            );
+        }
+        cfg.servo.drive_trace = Some(path);
+    }
+    Ok(())
+}
+
+fn run(
+    config: Option<&Path>,
+    program: Option<NamedProgram>,
+    cycles: u32,
+    drive_trace: Option<PathBuf>,
+) -> Result<(), String> {
     if let Some(path) = config.filter(|p| cnc_cell::launch::is_cell_file(p)) {
         if program.is_some() {
             return Err("a cell launch file runs its work order: no --program".into());
         }
         return run_cell(path);
     }
-    let (cfg, described) = machines::load(config, None)?;
+    let (mut cfg, described) = machines::load(config, None)?;
+    with_drive_trace(&mut cfg, drive_trace)?;
     install_signal_handlers();
     let domain = cfg.network.effective_domain_id()?;
     let ns = cfg.machine.namespace.clone();

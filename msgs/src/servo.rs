@@ -30,6 +30,13 @@ pub struct ServoSetpoint {
     /// Per axis, the drive's torque limit in percent of its maximum (100: none; lower while
     /// the axis travels to a fixed stop or presses against it).
     pub torque_limit_percent: [f64; MAX_AXES],
+    /// With the drives' setpoint queue (`servo.drive_queue_ms`): the drive tick this setpoint
+    /// is for (0 in lock-step, where every setpoint is for the drives' next tick).
+    pub tick: u64,
+    /// The queue's episode: how many times motion has seen the queue run dry. The drives
+    /// take only setpoints of their own episode, so nothing planned before a dry queue plays
+    /// after the brake tail.
+    pub episode: u32,
 }
 
 impl Default for ServoSetpoint {
@@ -42,6 +49,42 @@ impl Default for ServoSetpoint {
             enable: 0,
             spindle_acceleration_percent: 100.0,
             torque_limit_percent: [100.0; MAX_AXES],
+            tick: 0,
+            episode: 0,
+        }
+    }
+}
+
+/// Most ticks of a [`BrakeTail`]: 2 s at the 4 ms period.
+pub const TAIL_TICKS: usize = 500;
+
+/// What the drives play if their setpoint queue runs dry: the continuation that brings the
+/// path from the last queued setpoint (tick `first_tick` − 1) to a stop at the machine's
+/// limits, planned by motion with every batch (issue 48).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(
+    feature = "shm",
+    derive(ZeroCopySend),
+    type_name("cnc_msgs::BrakeTail")
+)]
+#[repr(C)]
+pub struct BrakeTail {
+    /// The queue episode it belongs to (as [`ServoSetpoint::episode`]).
+    pub episode: u32,
+    /// Positions used, at most [`TAIL_TICKS`]; the last is held once played.
+    pub len: u32,
+    /// The drive tick of `position[0]`.
+    pub first_tick: u64,
+    pub position: [[f64; MAX_AXES]; TAIL_TICKS],
+}
+
+impl Default for BrakeTail {
+    fn default() -> Self {
+        BrakeTail {
+            episode: 0,
+            len: 0,
+            first_tick: 0,
+            position: [[0.0; MAX_AXES]; TAIL_TICKS],
         }
     }
 }
@@ -91,6 +134,16 @@ pub struct ServoFeedback {
     pub probe_falling_position: [f64; MAX_AXES],
     /// Per axis, the torque the drive gives, percent of its maximum.
     pub torque_percent: [f64; MAX_AXES],
+    /// With the setpoint queue: the drive tick this reports (the drives' own clock).
+    pub tick: u64,
+    /// Ticks of setpoints queued after this one.
+    pub queue_depth: u32,
+    /// 1 when this tick had no setpoint of its own (the brake tail or a hold played).
+    pub underrun: u32,
+    /// The queue's episode: times it ran dry since the drives started.
+    pub episode: u32,
+    /// The drive tick at which the queue last ran dry (the brake tail's first tick).
+    pub dry_tick: u64,
 }
 
 impl Default for ServoFeedback {
@@ -115,6 +168,11 @@ impl Default for ServoFeedback {
             probe_rising_position: [0.0; MAX_AXES],
             probe_falling_position: [0.0; MAX_AXES],
             torque_percent: [0.0; MAX_AXES],
+            tick: 0,
+            queue_depth: 0,
+            underrun: 0,
+            episode: 0,
+            dry_tick: 0,
         }
     }
 }

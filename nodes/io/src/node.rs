@@ -9,6 +9,7 @@ use std::time::Duration;
 use cnc_msgs::msg::{Overrides, SimInput};
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint};
 use cnc_msgs::signals::{x, Bit, SignalTable, XImage, YImage};
+use cnc_runtime::bus::Subscription;
 use cnc_runtime::dds::RosNode;
 use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::topics;
@@ -155,7 +156,8 @@ pub fn is_robot_signal(input: u8) -> bool {
 }
 
 /// Runs the io node until shutdown (blocking).
-pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<(), String> {
+/// With the drives' queue it returns their loop's statistics.
+pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<String, String> {
     let mut ros = RosNode::new(&cfg.network, &cfg.machine.namespace, "io")?;
     let inputs = ros.subscription::<SimInput>(&topics::SIM_INPUT_CHECKED)?;
     let robot = ros.subscription::<SimInput>(&topics::ROBOT_SIGNALS)?;
@@ -180,34 +182,20 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         rt.servo_cpu,
         rt.lock_memory,
     );
+    if cfg.servo.drive_queue_ms > 0.0 {
+        let doors = Doors {
+            ros: &mut ros,
+            inputs: &inputs,
+            robot: &robot,
+            panel: &panel,
+            outputs: &outputs,
+            x_out: &x_out,
+        };
+        return crate::drive_clock::run(&cfg, &shm, doors, &mut sim, &shutdown);
+    }
     while !shutdown.requested() {
         ros.refresh();
-        while let Ok(Some(input)) = inputs.take() {
-            if apply_input(&mut sim, &input) {
-                log::info!("simulated input {} = {}", input.input, input.value);
-            } else {
-                log::warn!("unknown simulated input {} ignored", input.input);
-            }
-        }
-        // The panel's override switches set over the network (hmi_bridge checks the values).
-        while let Ok(Some(o)) = panel.take() {
-            // Only the switch positions reach the PLC, whoever sent the message.
-            match cnc_runtime::overrides::check(&o) {
-                Ok(o) => set_override_switches(&mut sim.devices.inputs, &o),
-                Err(why) => log::error!("io: panel overrides refused: {why}"),
-            }
-        }
-        // The robot interface block (X8) set over the network: robot signals only.
-        while let Ok(Some(input)) = robot.take() {
-            if is_robot_signal(input.input) {
-                apply_input(&mut sim, &input);
-            } else {
-                log::warn!(
-                    "robot signal {} is not a robot signal: ignored",
-                    input.input
-                );
-            }
-        }
+        take_network_inputs(&inputs, &robot, &panel, &mut sim);
         if let Some(latest) = outputs.latest()? {
             y = latest;
         }
@@ -227,7 +215,53 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<()
         }
         x_out.send(sim.x_image(&y))?;
     }
-    Ok(())
+    Ok(String::new())
+}
+
+/// What reaches the drives besides setpoints: the network's inputs and the PLC's images.
+pub struct Doors<'a> {
+    pub ros: &'a mut RosNode,
+    pub inputs: &'a Subscription<SimInput>,
+    pub robot: &'a Subscription<SimInput>,
+    pub panel: &'a Subscription<Overrides>,
+    pub outputs: &'a cnc_runtime::shm::Receiver<YImage>,
+    pub x_out: &'a cnc_runtime::shm::Sender<XImage>,
+}
+
+/// The simulated inputs, the panel's override switches and the robot's signals that came
+/// over the network since the last call.
+pub fn take_network_inputs(
+    inputs: &Subscription<SimInput>,
+    robot: &Subscription<SimInput>,
+    panel: &Subscription<Overrides>,
+    sim: &mut SimLathe,
+) {
+    while let Ok(Some(input)) = inputs.take() {
+        if apply_input(sim, &input) {
+            log::info!("simulated input {} = {}", input.input, input.value);
+        } else {
+            log::warn!("unknown simulated input {} ignored", input.input);
+        }
+    }
+    // The panel's override switches set over the network (hmi_bridge checks the values).
+    while let Ok(Some(o)) = panel.take() {
+        // Only the switch positions reach the PLC, whoever sent the message.
+        match cnc_runtime::overrides::check(&o) {
+            Ok(o) => set_override_switches(&mut sim.devices.inputs, &o),
+            Err(why) => log::error!("io: panel overrides refused: {why}"),
+        }
+    }
+    // The robot interface block (X8) set over the network: robot signals only.
+    while let Ok(Some(input)) = robot.take() {
+        if is_robot_signal(input.input) {
+            apply_input(sim, &input);
+        } else {
+            log::warn!(
+                "robot signal {} is not a robot signal: ignored",
+                input.input
+            );
+        }
+    }
 }
 
 #[cfg(test)]

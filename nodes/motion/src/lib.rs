@@ -4,6 +4,7 @@
 
 pub mod loop_stats;
 pub mod node;
+mod queued;
 
 pub use cnc_motion_core::*;
 
@@ -32,6 +33,7 @@ impl FromLaunch for MotionConfig {
             dry_run_feed: cfg.servo.dry_run_feed,
             reference_order: cfg.reference_order(),
             spindle_max_rpm: cfg.limits.spindle_max_rpm,
+            feedback_delay_ticks: cfg.servo.drive_queue_ticks().max(1) as u32,
         }
     }
 }

@@ -30,13 +30,13 @@ use crate::{Block, Motion, MotionConfig, MotionEvent, RunState};
 /// The PLC must answer within this time, else motion takes it as an emergency stop.
 const PLC_TIMEOUT_NS: u64 = 500_000_000;
 
-enum Input {
+pub(crate) enum Input {
     Block(Block),
     /// A command of the task's, with its id: answered by [`Report::Answer`].
     Command(u64, MotionRequest),
 }
 
-enum Report {
+pub(crate) enum Report {
     /// The status, and the result of the last block whose end the machine decided (its
     /// vectors are filled here, off the servo thread).
     Status(MotionStatus, Option<BlockResult>),
@@ -70,7 +70,13 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<St
     let timing = Timing::from_launch(&cfg);
     let servo = std::thread::Builder::new()
         .name("servo".into())
-        .spawn(move || servo_loop(mcfg, timing, instance, in_rx, out_tx, servo_shutdown))
+        .spawn(move || {
+            if timing.queue_ticks > 0 {
+                crate::queued::servo_loop(mcfg, timing, instance, in_rx, out_tx, servo_shutdown)
+            } else {
+                servo_loop(mcfg, timing, instance, in_rx, out_tx, servo_shutdown)
+            }
+        })
         .map_err(|e| format!("servo thread: {e}"))?;
     let dds_result = dds_loop(&cfg, in_tx, out_rx, &shutdown);
     shutdown.request();
@@ -82,11 +88,13 @@ pub fn run(cfg: LaunchConfig, instance: String, shutdown: Shutdown) -> Result<St
 }
 
 /// What the servo thread needs of the launch config for its timing.
-struct Timing {
-    realtime: cnc_runtime::config::RealtimeConfig,
+pub(crate) struct Timing {
+    pub(crate) realtime: cnc_runtime::config::RealtimeConfig,
     /// A tick this long after the last is a warning, ns.
     warning_ns: u64,
     alarm_ticks: usize,
+    /// Ticks motion keeps the drives' setpoint queue ahead (0: lock-step).
+    pub(crate) queue_ticks: u64,
 }
 
 impl Timing {
@@ -95,6 +103,7 @@ impl Timing {
             realtime: cfg.realtime.clone(),
             warning_ns: (cfg.servo.late_warning() * 1e6) as u64,
             alarm_ticks: cfg.servo.late_alarm_ticks as usize,
+            queue_ticks: cfg.servo.drive_queue_ticks(),
         }
     }
 }
@@ -243,7 +252,7 @@ fn dds_loop(
 /// Silence is counted in time and in servo ticks: a whole process or host that stood still (a
 /// busy host's stolen time, `kill -STOP`) wakes with the clock far ahead and the PLC not yet
 /// scanned; the PLC is silent only if it missed its chances (decisions D41).
-struct PlcLink {
+pub(crate) struct PlcLink {
     last_heard: Option<u64>,
     /// Servo ticks since the PLC last answered.
     ticks_since: u64,
@@ -253,7 +262,7 @@ struct PlcLink {
 }
 
 impl PlcLink {
-    fn new(period_ns: u64) -> PlcLink {
+    pub(crate) fn new(period_ns: u64) -> PlcLink {
         PlcLink {
             last_heard: None,
             ticks_since: 0,
@@ -330,8 +339,8 @@ fn publish<M: ros2_client::Message + std::fmt::Debug + Send + Sync + 'static>(
 }
 
 /// The drives' latest feedback as motion reads it each tick.
-struct Latest {
-    actual: [f64; MAX_AXES],
+pub(crate) struct Latest {
+    pub(crate) actual: [f64; MAX_AXES],
     spindle: (f64, f64),
     /// The dogs and index marks; a mark is passed on once.
     reference: ReferenceInputs,
@@ -343,7 +352,7 @@ struct Latest {
 }
 
 impl Latest {
-    fn first(fb: &ServoFeedback) -> Latest {
+    pub(crate) fn first(fb: &ServoFeedback) -> Latest {
         Latest {
             actual: fb.position,
             spindle: (fb.spindle_rpm, fb.spindle_angle_deg),
@@ -354,7 +363,7 @@ impl Latest {
         }
     }
 
-    fn read(&mut self, fb: &ServoFeedback, n: usize) {
+    pub(crate) fn read(&mut self, fb: &ServoFeedback, n: usize) {
         self.actual = fb.position;
         self.spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
         self.reference.dog = fb.reference_dog;
@@ -372,7 +381,7 @@ impl Latest {
     }
 
     /// Hands motion the inputs of this tick (the spindle's only when the drives answered).
-    fn give(&mut self, motion: &mut Motion, have_feedback: bool) {
+    pub(crate) fn give(&mut self, motion: &mut Motion, have_feedback: bool) {
         if have_feedback {
             motion.spindle_feedback(self.spindle.0, self.spindle.1);
         }
@@ -402,16 +411,22 @@ fn first_feedback(
 }
 
 /// The servo loop's own timing: its statistics and the lateness watch.
-struct Clockwork {
-    stats: ServoStatistics,
-    watch: LateWatch,
-    last_tick: Option<u64>,
+pub(crate) struct Clockwork {
+    pub(crate) stats: ServoStatistics,
+    pub(crate) watch: LateWatch,
+    pub(crate) last_tick: Option<u64>,
 }
 
 impl Clockwork {
     /// Counts the tick that woke at `now` (`late`: past half a period); a late warning or its
     /// clearing is reported, an overrun is motion's alarm.
-    fn tick(&mut self, now: u64, late: bool, motion: &mut Motion, reports: &Sender<Report>) {
+    pub(crate) fn tick(
+        &mut self,
+        now: u64,
+        late: bool,
+        motion: &mut Motion,
+        reports: &Sender<Report>,
+    ) {
         if let Some(prev) = self.last_tick {
             let interval = now - prev;
             self.stats.interval.record(interval as f64 / 1000.0);
@@ -442,7 +457,7 @@ impl Clockwork {
 }
 
 /// The DDS thread's blocks and the task's commands, carried out; each command answered.
-fn take_inputs(
+pub(crate) fn take_inputs(
     inputs: &Receiver<Input>,
     motion: &mut Motion,
     clock: &mut Clockwork,
@@ -472,7 +487,7 @@ fn take_inputs(
 
 /// The PLC's G image of this tick: its latest, or all zero (emergency stop) once it has been
 /// silent too long, reported once.
-fn plc_signals(
+pub(crate) fn plc_signals(
     latest: Option<GImage>,
     g: &mut GImage,
     plc: &mut PlcLink,
@@ -509,12 +524,12 @@ fn plc_signals(
 
 /// What the DDS thread publishes: motion's alarms; the status on a change and every 25 ticks;
 /// the axes every 10; the servo statistics every 250.
-struct Reporter {
-    last_status: Option<(u64, u64, u64, RunState, u32, Option<BlockResult>)>,
+pub(crate) struct Reporter {
+    pub(crate) last_status: Option<(u64, u64, u64, RunState, u32, Option<BlockResult>)>,
 }
 
 impl Reporter {
-    fn report(
+    pub(crate) fn report(
         &mut self,
         motion: &mut Motion,
         seq: u64,
@@ -571,14 +586,16 @@ impl Reporter {
     }
 }
 
-fn report_axes(motion: &Motion, limits: (u32, u32), reports: &Sender<Report>) {
+pub(crate) fn report_axes(motion: &Motion, limits: (u32, u32), reports: &Sender<Report>) {
     let n = motion.commanded().len();
     let mut commanded = [0.0; MAX_AXES];
     commanded[..n].copy_from_slice(motion.commanded());
     let mut machine = [0.0; MAX_AXES];
     machine[..n].copy_from_slice(motion.actual());
+    // The setpoint the actual position answers (with the drives' queue, the one sent a
+    // queue's length ago), so the following error is the drives'.
     let mut drive = [0.0; MAX_AXES];
-    drive[..n].copy_from_slice(motion.setpoint());
+    motion.answered_setpoint(&mut drive[..n]);
     let locked = motion.locked_axes();
     let referenced = motion
         .referenced()

@@ -233,6 +233,12 @@ pub const RULES: &[Rule] = &[
     cell("servo.profile", None, "the speed profile's shape"),
     builder("servo.period_ms", None, "the drives' cycle"),
     builder("servo.queue_capacity", None, "motion's memory"),
+    builder(
+        "servo.drive_queue_ms",
+        Some(Fixed(0.0, 1_000.0)),
+        "the drives' setpoint queue, ms",
+    ),
+    builder("servo.drive_trace", None, "a file the drives write"),
     builder("plc.*", None, "the PLC's program and timing"),
     builder("sim.*", None, "the simulated machine's switches"),
 ];

@@ -87,15 +87,17 @@ impl ShmNode {
             .map_err(|e| err("service name", e))
     }
 
-    /// The publish-subscribe service of `channel`: newest value kept for late subscribers.
+    /// The publish-subscribe service of `channel`: `depth` values buffered for a subscriber
+    /// (4 for a channel read as its newest value), the newest kept for late subscribers.
     fn service<T: Debug + ZeroCopySend + Copy + 'static>(
         &self,
         channel: &str,
+        depth: usize,
     ) -> Result<PortFactory<ipc::Service, T, ()>, String> {
         self.node
             .service_builder(&self.service_name(channel)?)
             .publish_subscribe::<T>()
-            .subscriber_max_buffer_size(4)
+            .subscriber_max_buffer_size(depth)
             .history_size(1)
             .open_or_create()
             .map_err(|e| err(channel, e))
@@ -116,8 +118,19 @@ impl ShmNode {
         channel: &str,
         wake: bool,
     ) -> Result<Sender<T>, String> {
+        self.stream_sender(channel, wake, LATEST_DEPTH)
+    }
+
+    /// Sender on a stream `channel` whose receiver takes every value in order (up to
+    /// `depth` unread): the drives' setpoint queue and their per-tick feedback.
+    pub fn stream_sender<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        channel: &str,
+        wake: bool,
+        depth: usize,
+    ) -> Result<Sender<T>, String> {
         let publisher = self
-            .service::<T>(channel)?
+            .service::<T>(channel, depth)?
             .publisher_builder()
             .create()
             .map_err(|e| err(channel, e))?;
@@ -141,8 +154,19 @@ impl ShmNode {
         channel: &str,
         wake: bool,
     ) -> Result<Receiver<T>, String> {
+        self.stream_receiver(channel, wake, LATEST_DEPTH)
+    }
+
+    /// Receiver of a stream `channel` (see [`ShmNode::stream_sender`]), read with
+    /// [`Receiver::take_all`].
+    pub fn stream_receiver<T: Debug + ZeroCopySend + Copy + 'static>(
+        &self,
+        channel: &str,
+        wake: bool,
+        depth: usize,
+    ) -> Result<Receiver<T>, String> {
         let subscriber = self
-            .service::<T>(channel)?
+            .service::<T>(channel, depth)?
             .subscriber_builder()
             .create()
             .map_err(|e| err(channel, e))?;
@@ -184,6 +208,34 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Receiver<T> {
         Ok(last)
     }
 
+    /// Every value received since the last call, oldest first, appended to `out`.
+    pub fn take_all(&self, out: &mut Vec<T>) -> Result<(), String> {
+        while let Some(sample) = self.subscriber.receive().map_err(|e| err("receive", e))? {
+            out.push(*sample);
+        }
+        Ok(())
+    }
+
+    /// Waits up to `timeout` until a value is there to take (needs `wake`); false if none
+    /// came. The value stays for [`Receiver::take_all`].
+    pub fn wait_for_any(&self, timeout: Duration) -> Result<bool, String> {
+        if self
+            .subscriber
+            .has_samples()
+            .map_err(|e| err("receive", e))?
+        {
+            return Ok(true);
+        }
+        match &self.listener {
+            Some(l) if !timeout.is_zero() => match l.timed_wait(|_| {}, timeout) {
+                Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
+                Err(e) => return Err(err("wait", e)),
+            },
+            _ => {}
+        }
+        self.subscriber.has_samples().map_err(|e| err("receive", e))
+    }
+
     /// Waits up to `timeout` for a value (needs `wake`) and returns the newest. A wake-up whose
     /// value was already taken by [`Receiver::latest`] does not end the wait.
     pub fn wait(&self, timeout: Duration) -> Result<Option<T>, String> {
@@ -205,6 +257,9 @@ impl<T: Debug + ZeroCopySend + Copy + 'static> Receiver<T> {
     }
 }
 
+/// The buffer of a channel read as its newest value.
+const LATEST_DEPTH: usize = 4;
+
 /// Channel names.
 pub mod channel {
     pub const SETPOINT: &str = "servo/setpoint";
@@ -213,6 +268,11 @@ pub mod channel {
     pub const G_IMAGE: &str = "signals/g";
     pub const X_IMAGE: &str = "signals/x";
     pub const Y_IMAGE: &str = "signals/y";
+    /// With the drives' setpoint queue (issue 48): setpoints stamped with their drive tick,
+    /// the brake tail, and the drives' feedback of every tick.
+    pub const SETPOINT_QUEUE: &str = "servo/queue";
+    pub const BRAKE_TAIL: &str = "servo/brake_tail";
+    pub const FEEDBACK_STREAM: &str = "servo/feedback_stream";
 }
 
 /// Instance name of a cell: namespace plus domain, so cells and tests never share channels.

@@ -9,6 +9,7 @@
 //! thread, a clock, DDS or iceoryx2 (`tests/boundaries.rs`). The io node (`cnc_io`) is its shell.
 
 pub mod devices;
+pub mod drive_queue;
 pub mod probe;
 pub mod spindle_position;
 

@@ -29,6 +29,10 @@ pub struct MotionConfig {
     pub reference_order: Vec<usize>,
     /// The spindle's rating (`limits.spindle_max_rpm`): no tap turns it faster.
     pub spindle_max_rpm: f64,
+    /// How many ticks old the drives' feedback is when a tick is computed: 1 in lock-step
+    /// (it answers the last setpoint), the queue's length with the drives' setpoint queue
+    /// (issue 48), where motion computes a tick that far ahead of the drives.
+    pub feedback_delay_ticks: u32,
 }
 
 impl MotionConfig {

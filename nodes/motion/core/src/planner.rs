@@ -73,6 +73,7 @@ struct Planned {
 /// The sequence number of a finished block, reported by [`Planner::step`].
 pub type Done = u64;
 
+#[derive(Clone)]
 pub struct Planner {
     cfg: PlannerConfig,
     segs: VecDeque<Planned>,

@@ -69,6 +69,7 @@ fn ramp_phase(u: f64) -> f64 {
 }
 
 /// The pieces of one chain and where the spindle must be to cut them.
+#[derive(Clone)]
 pub struct ThreadChain {
     pieces: VecDeque<Link>,
     limits: AxisLimits,

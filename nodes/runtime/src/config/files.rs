@@ -68,6 +68,7 @@ impl LaunchConfig {
             &mut self.plc.program,
             &mut self.plc.memory_file,
             &mut self.hmi.operators_file,
+            &mut self.servo.drive_trace,
         ];
         for file in files.into_iter().flatten() {
             if file.is_relative() {
@@ -110,6 +111,9 @@ impl LaunchConfig {
         }
         if let Some(f) = &self.plc.memory_file {
             out.push(("PLC memory", f.as_path()));
+        }
+        if let Some(f) = &self.servo.drive_trace {
+            out.push(("drive trace", f.as_path()));
         }
         if self.recorder.enabled {
             out.push(("recordings", self.recorder.directory.as_path()));

@@ -287,6 +287,17 @@ pub struct ServoConfig {
     /// of a second.
     #[serde(default = "default_late_alarm_ticks")]
     pub late_alarm_ticks: u32,
+    /// How far ahead of the drives motion keeps their setpoint queue, ms (issue 48): the
+    /// drives then run on their own clock and a host that wakes late costs nothing while the
+    /// queue lasts. 0 (the default for now, D133): lock-step, the drives step once per
+    /// setpoint.
+    #[serde(default)]
+    pub drive_queue_ms: f64,
+    /// The drive trace: every drive tick's setpoints, actual positions, following errors,
+    /// queue depth and underruns written to this CSV file (with the queue only). The machine
+    /// builder's, like every path (issue 45).
+    #[serde(default)]
+    pub drive_trace: Option<std::path::PathBuf>,
 }
 
 fn default_late_alarm_ticks() -> u32 {
@@ -327,6 +338,8 @@ impl Default for ServoConfig {
             dry_run_feed: default_dry_run_feed(),
             late_warning_ms: None,
             late_alarm_ticks: default_late_alarm_ticks(),
+            drive_queue_ms: 0.0,
+            drive_trace: None,
         }
     }
 }
@@ -558,6 +571,11 @@ impl RealtimeConfig {
 }
 
 impl ServoConfig {
+    /// The drives' queue in ticks (0: lock-step).
+    pub fn drive_queue_ticks(&self) -> u64 {
+        (self.drive_queue_ms / self.period_ms).ceil() as u64
+    }
+
     /// The servo tick lateness that is a warning, ms: `late_warning_ms`, else three periods.
     pub fn late_warning(&self) -> f64 {
         self.late_warning_ms.unwrap_or(3.0 * self.period_ms)
@@ -589,6 +607,12 @@ impl ServoConfig {
         }
         if !(self.tolerance > 0.0 && self.tolerance <= 10.0) {
             return Err("servo.tolerance must be in (0, 10] mm".into());
+        }
+        let q = self.drive_queue_ms;
+        if !(q == 0.0 || (q >= 2.0 * self.period_ms && q <= 1000.0)) {
+            return Err(format!(
+                "servo.drive_queue_ms {q}: 0 (lock-step) or two periods to 1000 ms"
+            ));
         }
         Ok(())
     }

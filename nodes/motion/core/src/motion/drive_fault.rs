@@ -29,7 +29,7 @@ impl Motion {
             if self.lag_allowed(i) {
                 return None;
             }
-            let lag = (self.drive[i] - self.actual[i]).abs();
+            let lag = (self.answered_drive(i) - self.actual[i]).abs();
             let limit = a.following_error_limit();
             (lag > limit).then(|| {
                 format!(

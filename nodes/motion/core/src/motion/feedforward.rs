@@ -36,6 +36,31 @@ impl Motion {
             self.encoder_setpoint[i] = self.drive[i] + lead + self.press(i) - self.shift[i];
             self.last_drive[i] = self.drive[i];
         }
+        let mut sent = [0.0; MAX_AXES];
+        let n = self.drive.len().min(MAX_AXES);
+        sent[..n].copy_from_slice(&self.drive[..n]);
+        self.sent_drive.push_back(sent);
+        while self.sent_drive.len() > self.cfg.feedback_delay_ticks.max(1) as usize {
+            self.sent_drive.pop_front();
+        }
+    }
+
+    /// The drive setpoints the latest feedback answers, per axis into `out`.
+    pub fn answered_setpoint(&self, out: &mut [f64]) {
+        for (i, o) in out.iter_mut().enumerate().take(self.drive.len()) {
+            *o = self.answered_drive(i);
+        }
+    }
+
+    /// The drive setpoint the latest feedback answers: the one sent `feedback_delay_ticks`
+    /// ago (the current one before that many were sent).
+    pub(super) fn answered_drive(&self, i: usize) -> f64 {
+        match self.sent_drive.front() {
+            Some(s) if self.sent_drive.len() >= self.cfg.feedback_delay_ticks.max(1) as usize => {
+                s[i]
+            }
+            _ => self.drive[i],
+        }
     }
 
     /// ACC: an axis at `share` of its rated acceleration from the next block on; the

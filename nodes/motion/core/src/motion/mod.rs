@@ -25,6 +25,7 @@ pub use crate::alarm;
 pub use panel::Panel;
 
 mod activate;
+mod brake_tail;
 mod compressor;
 mod drive_fault;
 mod feedforward;
@@ -40,6 +41,7 @@ mod tapping;
 mod timers;
 mod window;
 
+pub use brake_tail::PlannedStop;
 pub use probe::ProbeInput;
 pub use reference::ReferenceInputs;
 pub use timers::RunTimers;
@@ -79,6 +81,7 @@ pub enum RunState {
 // The rapid's per-axis state is inline on purpose: boxing it would allocate on the servo
 // thread for every rapid.
 #[allow(clippy::large_enum_variant)]
+#[derive(Clone)]
 enum Active {
     /// Lines and arcs through the look-ahead planner; further path blocks join it as they
     /// arrive.
@@ -119,6 +122,7 @@ struct RapidAxis {
 /// Servo ticks the reset signal RST stays on: 100 ms, ten PLC scans.
 const RESET_SIGNAL_TICKS: u32 = 25;
 
+#[derive(Clone)]
 pub struct Motion {
     cfg: MotionConfig,
     queue: VecDeque<Block>,
@@ -134,6 +138,9 @@ pub struct Motion {
     drive: Vec<f64>,
     /// Last tick's `drive`, for the feedforward's velocity.
     last_drive: Vec<f64>,
+    /// The drive setpoints of the last `feedback_delay_ticks` ticks, oldest first: the
+    /// feedback answers the oldest, so the following error is measured against it.
+    sent_drive: VecDeque<[f64; MAX_AXES]>,
     /// FFWON: the drives get the feedforward lead (D106).
     feedforward: bool,
     /// The spindle drive's acceleration, a share of its rated (`ACC[S]`, D108).
@@ -237,9 +244,12 @@ impl Motion {
         let planner = Planner::new(cfg.planner(), path::point_from(&commanded));
         let mut thread_lead_time = [0.0; MAX_AXES];
         for (l, a) in thread_lead_time.iter_mut().zip(&cfg.axes) {
-            *l = cfg.period + a.drive_lag.max(0.0);
+            // The setpoint is reached `feedback_delay_ticks` periods after the reading (one
+            // in lock-step, the queue's length with the drives' queue), then lags the drive.
+            *l = f64::from(cfg.feedback_delay_ticks.max(1)) * cfg.period + a.drive_lag.max(0.0);
         }
         let thread = ThreadChain::new(cfg.lookahead.max(1), cfg.planner().limits);
+        let delay = cfg.feedback_delay_ticks.max(1) as usize;
         let referenced = cfg.axes.iter().map(|a| a.reference.is_none()).collect();
         let signal_axis = cfg
             .axes
@@ -286,6 +296,7 @@ impl Motion {
             actual: commanded.clone(),
             drive: commanded.clone(),
             last_drive: commanded.clone(),
+            sent_drive: VecDeque::with_capacity(delay + 1),
             feedforward: false,
             spindle_acceleration: 1.0,
             locked: 0,

@@ -40,6 +40,7 @@ pub fn lathe() -> MotionConfig {
         dry_run_feed: 1000.0,
         reference_order: vec![0, 1],
         spindle_max_rpm: 6000.0,
+        feedback_delay_ticks: 1,
     }
 }
 

@@ -1,0 +1,267 @@
+//! The drives' setpoint queue (issue 48): what a drive in cyclic synchronous position mode
+//! plays at each tick of its own clock.
+//!
+//! Motion sends setpoints ahead, each stamped with the drive tick it is for, and with every
+//! batch a brake tail: the path from the batch's last setpoint to a stop. The drives play the
+//! setpoint of each tick; a tick without one is an underrun. The first underrun of an episode
+//! starts the brake tail (the machine stops on the programmed path) and closes the episode:
+//! setpoints planned before it are refused, so nothing planned for a machine that kept moving
+//! plays after the stop. Motion learns of it from the feedback, takes the state it planned the
+//! tail with, and sends the next episode from where the tail ends (D133). Pure: the io node calls
+//! [`SetpointQueue::play`] once per tick of its clock.
+
+use std::collections::VecDeque;
+
+use cnc_msgs::servo::{BrakeTail, ServoSetpoint, TAIL_TICKS};
+
+/// What the drives do in one tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Played {
+    pub setpoint: ServoSetpoint,
+    /// No setpoint was queued for the tick: the brake tail (or a hold where it ended) played.
+    pub underrun: bool,
+}
+
+#[derive(Debug, Clone)]
+pub struct SetpointQueue {
+    /// Queued setpoints in tick order; the front is the next to play.
+    queue: VecDeque<ServoSetpoint>,
+    tail: Option<Box<BrakeTail>>,
+    episode: u32,
+    /// What the last tick played, held while nothing else is there.
+    last: ServoSetpoint,
+    /// A setpoint has played: from now on a tick without one is an underrun.
+    armed: bool,
+    /// The tick the queue ran dry at, while the tail (or the hold after it) plays.
+    dry_since: Option<u64>,
+    /// The tick the current episode last ran dry at (0: never).
+    dry_tick: u64,
+    /// Ticks played without a setpoint of their own, since start.
+    pub underrun_ticks: u64,
+    /// Dry ticks at which no brake tail continued the queue: the drives held the last
+    /// setpoint, a step in velocity (motion was stopped between a batch and its tail).
+    pub tailless_stops: u64,
+}
+
+impl Default for SetpointQueue {
+    fn default() -> Self {
+        SetpointQueue::new()
+    }
+}
+
+impl SetpointQueue {
+    pub fn new() -> SetpointQueue {
+        SetpointQueue {
+            queue: VecDeque::with_capacity(1024),
+            tail: None,
+            episode: 0,
+            last: ServoSetpoint::default(),
+            armed: false,
+            dry_since: None,
+            dry_tick: 0,
+            underrun_ticks: 0,
+            tailless_stops: 0,
+        }
+    }
+
+    /// Queues a setpoint from motion; false (refused) when it belongs to an episode that has
+    /// ended, or is not later than what is queued or `now` (the tick being played).
+    pub fn push(&mut self, sp: ServoSetpoint, now: u64) -> bool {
+        let after = self.queue.back().map_or(now, |b| b.tick.max(now));
+        if sp.episode != self.episode || sp.tick <= after {
+            return false;
+        }
+        self.queue.push_back(sp);
+        true
+    }
+
+    /// The brake tail of the latest batch (of this episode; another is ignored).
+    pub fn set_tail(&mut self, tail: &BrakeTail) {
+        if tail.episode == self.episode && self.dry_since.is_none() {
+            match &mut self.tail {
+                Some(t) => **t = *tail,
+                None => self.tail = Some(Box::new(*tail)),
+            }
+        }
+    }
+
+    /// What the drives play at `tick` (called once per tick, in order).
+    pub fn play(&mut self, tick: u64) -> Played {
+        while self.queue.front().is_some_and(|s| s.tick < tick) {
+            self.queue.pop_front();
+        }
+        if let Some(sp) = self.queue.front().filter(|s| s.tick == tick).copied() {
+            self.queue.pop_front();
+            self.armed = true;
+            self.dry_since = None;
+            self.last = sp;
+            return Played {
+                setpoint: sp,
+                underrun: false,
+            };
+        }
+        if !self.armed {
+            return Played {
+                setpoint: self.last,
+                underrun: false,
+            };
+        }
+        self.underrun_ticks += 1;
+        let since = match self.dry_since {
+            Some(t) => t,
+            None => {
+                // The queue ran dry: this episode is over.
+                self.dry_since = Some(tick);
+                self.dry_tick = tick;
+                self.episode = self.episode.wrapping_add(1);
+                self.queue.clear();
+                if self.tail.as_ref().is_none_or(|t| t.first_tick != tick) {
+                    self.tail = None;
+                    self.tailless_stops += 1;
+                }
+                tick
+            }
+        };
+        if let Some(t) = self.tail.as_ref().filter(|t| t.len > 0) {
+            let len = (t.len as usize).min(TAIL_TICKS);
+            let i = ((tick - since) as usize).min(len - 1);
+            let n = self.last.axis_count as usize;
+            self.last.position[..n].copy_from_slice(&t.position[i][..n]);
+        }
+        self.last.tick = tick;
+        Played {
+            setpoint: self.last,
+            underrun: true,
+        }
+    }
+
+    /// Ticks of setpoints queued after `tick`.
+    pub fn depth(&self, tick: u64) -> u32 {
+        self.queue
+            .back()
+            .map_or(0, |b| b.tick.saturating_sub(tick) as u32)
+    }
+
+    /// The episode whose setpoints are taken.
+    pub fn episode(&self) -> u32 {
+        self.episode
+    }
+
+    /// The tick the queue last ran dry at (0: never).
+    pub fn dry_tick(&self) -> u64 {
+        self.dry_tick
+    }
+}
+
+/// The drive trace's header: tick, queue depth, underrun, then per axis its setpoint, actual
+/// position and following error (the oscilloscope a commissioning engineer reads).
+pub fn trace_header(axes: &[String]) -> String {
+    let mut h = String::from("tick,queue_depth,underrun");
+    for a in axes {
+        h.push_str(&format!(",{a}_setpoint,{a}_actual,{a}_following_error"));
+    }
+    h
+}
+
+/// One tick of the drive trace. Positions are written exactly (Rust's shortest round-trip
+/// form), so two traces compare to the last bit.
+pub fn trace_line(tick: u64, played: &Played, actual: &[f64], depth: u32) -> String {
+    use std::fmt::Write;
+    let sp = &played.setpoint;
+    let mut line = format!("{tick},{depth},{}", u8::from(played.underrun));
+    for (i, a) in actual.iter().enumerate() {
+        let c = sp.position[i];
+        let _ = write!(line, ",{c:?},{a:?},{:?}", c - a);
+    }
+    line
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sp(tick: u64, x: f64, episode: u32) -> ServoSetpoint {
+        let mut s = ServoSetpoint {
+            tick,
+            episode,
+            axis_count: 1,
+            enable: 1,
+            ..ServoSetpoint::default()
+        };
+        s.position[0] = x;
+        s
+    }
+
+    fn tail(first_tick: u64, xs: &[f64]) -> BrakeTail {
+        let mut t = BrakeTail {
+            first_tick,
+            len: xs.len() as u32,
+            ..BrakeTail::default()
+        };
+        for (p, x) in t.position.iter_mut().zip(xs) {
+            p[0] = *x;
+        }
+        t
+    }
+
+    /// Setpoints play at their ticks; before the first one the drives hold (no underrun);
+    /// what is late or of another episode is refused.
+    #[test]
+    fn setpoints_play_at_their_ticks() {
+        let mut q = SetpointQueue::new();
+        assert!(!q.play(1).underrun, "not armed yet");
+        for t in 3..=6 {
+            assert!(q.push(sp(t, t as f64, 0), 1));
+        }
+        assert!(!q.push(sp(6, 0.0, 0), 1), "not later than the queue");
+        assert!(!q.push(sp(7, 0.0, 1), 1), "another episode");
+        assert_eq!(q.depth(2), 4);
+        assert!(!q.play(2).underrun, "still not armed");
+        for t in 3..=6 {
+            let p = q.play(t);
+            assert!(!p.underrun);
+            assert_eq!(p.setpoint.position[0], t as f64);
+        }
+        assert_eq!(q.underrun_ticks, 0);
+    }
+
+    /// A dry queue plays the brake tail of the batch it ended with, then holds its last
+    /// point; the episode ends, so setpoints planned before are refused and the next
+    /// episode's are played.
+    #[test]
+    fn a_dry_queue_plays_the_brake_tail_and_ends_the_episode() {
+        let mut q = SetpointQueue::new();
+        for t in 1..=3 {
+            q.push(sp(t, t as f64, 0), 0);
+            q.play(t);
+        }
+        q.set_tail(&tail(4, &[3.8, 4.4, 4.7, 4.8]));
+        let played: Vec<f64> = (4..=9).map(|t| q.play(t).setpoint.position[0]).collect();
+        assert_eq!(played, [3.8, 4.4, 4.7, 4.8, 4.8, 4.8]);
+        assert_eq!((q.episode(), q.dry_tick(), q.underrun_ticks), (1, 4, 6));
+        assert_eq!(q.tailless_stops, 0);
+        assert!(!q.push(sp(12, 9.0, 0), 9), "planned before the stop");
+        assert!(q.push(sp(11, 4.8, 1), 9));
+        assert!(
+            q.play(10).underrun,
+            "held until the new episode's first tick"
+        );
+        let p = q.play(11);
+        assert!(!p.underrun);
+        assert_eq!(p.setpoint.position[0], 4.8);
+        assert_eq!(q.underrun_ticks, 7);
+    }
+
+    /// A tail that does not start where the queue ran dry is not played: the drives hold.
+    #[test]
+    fn a_tail_of_another_batch_is_not_played() {
+        let mut q = SetpointQueue::new();
+        q.set_tail(&tail(2, &[9.0]));
+        for t in 1..=3 {
+            q.push(sp(t, t as f64, 0), 0);
+            q.play(t);
+        }
+        assert_eq!(q.play(4).setpoint.position[0], 3.0);
+        assert_eq!(q.tailless_stops, 1);
+    }
+}
