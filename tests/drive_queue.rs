@@ -20,7 +20,10 @@ use cnc_msgs::msg::MachineState;
 use cnc_runtime::config::NetworkConfig;
 use ros2_client::ServiceMapping;
 
-const DOMAIN: u16 = 167;
+/// Each test its own domain (and so its own shared-memory instance): they run in parallel.
+const STALLS: u16 = 167;
+const DRY: u16 = 168;
+const ESTOP: u16 = 169;
 const NODES: [&str; 5] = ["io", "plc", "motion", "interpreter", "hmi-bridge"];
 
 /// Lines, arcs both ways and a thread at a speed whose revolution is a whole number of ticks
@@ -44,6 +47,15 @@ Z5
 M05
 M30
 ";
+
+/// The test's network: loopback, its own domain.
+fn net(domain: u16) -> NetworkConfig {
+    NetworkConfig {
+        domain_id: Some(domain),
+        interfaces: vec![[127, 0, 0, 1].into()],
+        security: None,
+    }
+}
 
 /// The machine's nodes, each its own process; stopped with SIGTERM so the drives flush their
 /// trace.
@@ -95,10 +107,12 @@ impl Drop for Nodes {
     }
 }
 
-/// One row of the drive trace: tick, depth, underrun, then per axis setpoint, actual, error.
+/// One row of the drive trace: tick, depth, underrun, emergency stop, then per axis setpoint,
+/// actual, following error.
 pub struct Row {
     pub depth: u32,
     pub underrun: bool,
+    pub emergency_stop: bool,
     pub setpoint: Vec<f64>,
     pub actual: Vec<f64>,
 }
@@ -110,12 +124,13 @@ pub fn read_trace(path: &Path) -> Vec<Row> {
         .map(|l| {
             let v: Vec<&str> = l.split(',').collect();
             let num = |s: &str| s.parse::<f64>().expect("number");
-            let axes = (v.len() - 3) / 3;
+            let axes = (v.len() - 4) / 3;
             Row {
                 depth: v[1].parse().expect("depth"),
                 underrun: v[2] == "1",
-                setpoint: (0..axes).map(|i| num(v[3 + 3 * i])).collect(),
-                actual: (0..axes).map(|i| num(v[4 + 3 * i])).collect(),
+                emergency_stop: v[3] == "1",
+                setpoint: (0..axes).map(|i| num(v[4 + 3 * i])).collect(),
+                actual: (0..axes).map(|i| num(v[5 + 3 * i])).collect(),
             }
         })
         .collect()
@@ -142,11 +157,16 @@ pub struct Cut {
 }
 
 impl Cut {
-    /// Starts the nodes and the part.
-    pub fn start(dir: &Path, name: &str) -> Cut {
+    /// Starts the nodes on `domain` and the part.
+    pub fn start(dir: &Path, name: &str, domain: u16) -> Cut {
+        Cut::start_program(dir, name, PART, domain)
+    }
+
+    /// Starts the nodes on `domain` and `program`.
+    pub fn start_program(dir: &Path, name: &str, program: &str, domain: u16) -> Cut {
         let trace: PathBuf = dir.join(format!("{name}.csv"));
         let trace_s = trace.to_string_lossy().to_string();
-        let config = common::sim_lathe_file(dir, &format!("{name}.yaml"), DOMAIN, |v| {
+        let config = common::sim_lathe_file(dir, &format!("{name}.yaml"), domain, |v| {
             v["servo"]["drive_queue_ms"] = 100.0.into();
             v["servo"]["drive_trace"] = trace_s.clone().into();
             v["machine"]["position_file"] = serde_yaml::Value::Null;
@@ -154,18 +174,13 @@ impl Cut {
             v["plc"]["memory_file"] = serde_yaml::Value::Null;
         });
         let nodes = Nodes::start(&config, dir);
-        let net = NetworkConfig {
-            domain_id: Some(DOMAIN),
-            interfaces: vec![[127, 0, 0, 1].into()],
-            security: None,
-        };
-        let mut client = CellClient::new(&net, "lathe1", name, ServiceMapping::Enhanced)
+        let mut client = CellClient::new(&net(domain), "lathe1", name, ServiceMapping::Enhanced)
             .expect("client")
             .with_timeout(Duration::from_secs(10));
         client
             .wait_ready(Duration::from_secs(90))
             .expect("the machine is ready");
-        let r = client.load_program("o0480.nc", PART).expect("load");
+        let r = client.load_program("o0480.nc", program).expect("load");
         assert!(r.accepted, "{}", r.message);
         let r = client.start_program("o0480.nc").expect("start");
         assert!(r.accepted, "{}", r.message);
@@ -203,6 +218,11 @@ impl Cut {
         );
         // The drives play the queue's last 100 ms after motion finished.
         std::thread::sleep(Duration::from_millis(500));
+        self.stop()
+    }
+
+    /// Stops the nodes and returns the drive trace.
+    pub fn stop(self) -> Vec<Row> {
         let Cut {
             nodes,
             client,
@@ -216,8 +236,8 @@ impl Cut {
 }
 
 /// Runs `PART` once, stopping the motion process for each `(after_ms, for_ms)` of `stalls`.
-pub fn cut(dir: &Path, name: &str, stalls: &[(u64, u64)]) -> Vec<Row> {
-    let run = Cut::start(dir, name);
+pub fn cut(dir: &Path, name: &str, domain: u16, stalls: &[(u64, u64)]) -> Vec<Row> {
+    let run = Cut::start(dir, name, domain);
     for &(after, stall) in stalls {
         run.stall(after, stall);
     }
@@ -227,7 +247,7 @@ pub fn cut(dir: &Path, name: &str, stalls: &[(u64, u64)]) -> Vec<Row> {
 #[test]
 fn stalls_shorter_than_the_queue_cost_nothing() {
     let dir = common::fresh_dir("drive_queue");
-    let calm = cut(&dir, "calm", &[]);
+    let calm = cut(&dir, "calm", STALLS, &[]);
     // Stalls of 5 to 80 ms from 1 s after cycle start, 700 ms apart: through the approach, the
     // contour and both thread passes.
     let stalls: Vec<(u64, u64)> = [5, 10, 20, 40, 80, 60, 30, 15]
@@ -235,7 +255,7 @@ fn stalls_shorter_than_the_queue_cost_nothing() {
         .enumerate()
         .map(|(i, ms)| (1000 + 700 * i as u64, *ms))
         .collect();
-    let stalled = cut(&dir, "stalled", &stalls);
+    let stalled = cut(&dir, "stalled", STALLS, &stalls);
     let underruns = stalled.iter().filter(|r| r.underrun).count();
     assert_eq!(underruns, 0, "ticks without a setpoint");
     // From motion's first setpoint on: the stalls drew on the queue (80 ms is 20 of its 25
@@ -304,8 +324,8 @@ fn from_segment(p: &[f64], a: &[f64], b: &[f64]) -> f64 {
 #[test]
 fn a_stall_beyond_the_queue_stops_on_the_path_and_cycle_start_goes_on() {
     let dir = common::fresh_dir("drive_queue_dry");
-    let calm = cut(&dir, "calm", &[]);
-    let mut run = Cut::start(&dir, "dry");
+    let calm = cut(&dir, "calm", DRY, &[]);
+    let mut run = Cut::start(&dir, "dry", DRY);
     run.stall(1700, 300);
     let (held, _) = run.client.wait_until(Duration::from_secs(30), |c| {
         c.state
@@ -354,5 +374,82 @@ fn a_stall_beyond_the_queue_stops_on_the_path_and_cycle_start_goes_on() {
     }
     let (a, b) = (path.last(), dry.last().map(|r| &r.setpoint));
     assert_eq!(a, b, "the same finished part");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 48, must-show 3 (emergency stop): with the motion process stopped (SIGSTOP), the
+/// emergency-stop input reaches the drives directly; they ramp Z from 50 mm/s to a stop at its
+/// rated 1500 mm/s², starting with the tick the input reached them, then remove power; the
+/// PLC sees it too. The queue is not what stops them: no tick is an underrun.
+#[test]
+fn emergency_stop_ramps_at_the_drives_with_motion_stopped() {
+    use cnc_msgs::msg::SimInput;
+    let dir = common::fresh_dir("drive_queue_estop");
+    let program = "G00 X60 Z140\nG01 Z-300 F3000\nM30\n";
+    let run = Cut::start_program(&dir, "estop", program, ESTOP);
+    let mut panel = cnc_runtime::dds::RosNode::new(&net(ESTOP), "lathe1", "estop_panel").unwrap();
+    let input = panel
+        .dds_publisher::<SimInput>(&cnc_runtime::topics::SIM_INPUT)
+        .unwrap();
+    let motion = run.nodes.pid("motion");
+    // Z runs at 50 mm/s from about 1.5 s on; it has 8.8 s to go.
+    std::thread::sleep(Duration::from_millis(3500));
+    // SAFETY: kill(2) on our own child's pid.
+    unsafe { libc::kill(motion, libc::SIGSTOP) };
+    let press = |value| {
+        input
+            .publish(SimInput {
+                input: SimInput::EMERGENCY_STOP,
+                value,
+            })
+            .unwrap()
+    };
+    press(true);
+    std::thread::sleep(Duration::from_millis(1000));
+    unsafe { libc::kill(motion, libc::SIGCONT) };
+    let mut run = run;
+    let (seen, _) = run.client.wait_until(Duration::from_secs(10), |c| {
+        c.state.as_ref().is_some_and(|s| s.emergency_stop)
+    });
+    assert!(seen, "the PLC saw the emergency stop");
+    press(false);
+    std::thread::sleep(Duration::from_millis(500));
+    drop(panel);
+    let rows = run.stop();
+    let k0 = rows
+        .iter()
+        .position(|r| r.emergency_stop)
+        .expect("the emergency stop reached the drives");
+    let z = |k: usize| rows[k].setpoint[1];
+    let v0 = z(k0 - 1) - z(k0 - 2);
+    assert!(
+        (v0 + 0.2).abs() < 1e-6,
+        "Z ran at 50 mm/s before: {v0} mm/tick"
+    );
+    let step = 1500.0 * 0.004 * 0.004;
+    let mut v = v0;
+    let mut k = k0;
+    while v != 0.0 {
+        let now = z(k) - z(k - 1);
+        assert!(
+            (now - (v + step).min(0.0)).abs() < 1e-9,
+            "tick {}: Z's step {now} after {v}: the ramp at 1500 mm/s²",
+            k - k0
+        );
+        assert!(
+            !rows[k].underrun,
+            "no underrun: the drives stop on their own"
+        );
+        v = now;
+        k += 1;
+    }
+    assert!(k - k0 <= 10, "stopped in {} ticks", k - k0);
+    assert!(
+        rows[k..]
+            .iter()
+            .take(100)
+            .all(|r| r.setpoint[1] == z(k - 1)),
+        "and stand"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -144,6 +144,18 @@ pub struct ServoFeedback {
     pub episode: u32,
     /// The drive tick at which the queue last ran dry (the brake tail's first tick).
     pub dry_tick: u64,
+    /// Why the last episode ended: [`ServoFeedback::ENDED_DRY`] or
+    /// [`ServoFeedback::ENDED_EMERGENCY_STOP`].
+    pub episode_ended: u32,
+    /// 1 while the emergency-stop input is pressed at the drives.
+    pub emergency_stop: u32,
+}
+
+impl ServoFeedback {
+    /// The queue ran dry: the drives played the brake tail.
+    pub const ENDED_DRY: u32 = 0;
+    /// Emergency stop: the drives ramped to a stop on their own and removed power.
+    pub const ENDED_EMERGENCY_STOP: u32 = 1;
 }
 
 impl Default for ServoFeedback {
@@ -173,6 +185,8 @@ impl Default for ServoFeedback {
             underrun: 0,
             episode: 0,
             dry_tick: 0,
+            episode_ended: 0,
+            emergency_stop: 0,
         }
     }
 }

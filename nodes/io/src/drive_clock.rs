@@ -126,6 +126,14 @@ pub fn run(
     let mut min_depth: Option<u32> = None;
     let mut y = YImage::default();
     let mut arrived = Vec::with_capacity(STREAM_DEPTH);
+    // The drives' quick stop: each axis at its rated acceleration.
+    let decel: Vec<f64> = cfg
+        .machine
+        .axes
+        .iter()
+        .map(|a| a.max_acceleration)
+        .collect();
+    let mut estop = false;
     let t0 = monotonic_ns();
     let mut tick = 0u64;
     while !shutdown.requested() {
@@ -137,6 +145,18 @@ pub fn run(
         if let Some(latest) = doors.outputs.latest()? {
             y = latest;
         }
+        // Emergency stop reaches the drives here, not through motion: they ramp to a stop on
+        // their own and then remove power (D134).
+        let pressed = sim.emergency_stop_pressed();
+        if pressed != estop {
+            estop = pressed;
+            queue.emergency_stop(pressed, &decel, period);
+            log::warn!(
+                "emergency stop {} at drive tick {tick}",
+                if pressed { "pressed" } else { "released" }
+            );
+        }
+        sim.power_drives(!(estop && queue.stopped_by_emergency_stop()));
         arrived.clear();
         setpoints.take_all(&mut arrived)?;
         for sp in &arrived {
@@ -161,12 +181,14 @@ pub fn run(
             fb.underrun = u32::from(played.underrun);
             fb.episode = queue.episode();
             fb.dry_tick = queue.dry_tick();
+            fb.episode_ended = queue.episode_ended();
+            fb.emergency_stop = u32::from(estop);
             if played.setpoint.tick == tick && !played.underrun {
                 min_depth = Some(min_depth.map_or(depth, |d| d.min(depth)));
             }
             feedback.send(fb)?;
             if let Some(t) = &mut trace {
-                let line = trace_line(tick, &played, &fb.position[..n], depth);
+                let line = trace_line(tick, &played, &fb.position[..n], depth, estop);
                 t.write(&line, ticks_per_second);
             }
         }

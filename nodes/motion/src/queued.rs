@@ -154,6 +154,14 @@ pub(crate) fn servo_loop(
         let Some(newest) = received.back().copied() else {
             continue;
         };
+        if newest.episode != episode && newest.episode_ended == ServoFeedback::ENDED_EMERGENCY_STOP
+        {
+            // The drives stopped on their own (emergency stop, D134); the PLC tells the core,
+            // which holds where the slides are. The next episode starts from there.
+            episode = newest.episode;
+            tails.kept.clear();
+            next_tick = newest.tick + ahead;
+        }
         if newest.episode != episode {
             // The queue ran dry: the drives play the tail of the batch they ran out at.
             episode = newest.episode;

@@ -12,7 +12,7 @@
 
 use std::collections::VecDeque;
 
-use cnc_msgs::servo::{BrakeTail, ServoSetpoint, TAIL_TICKS};
+use cnc_msgs::servo::{BrakeTail, ServoFeedback, ServoSetpoint, MAX_AXES, TAIL_TICKS};
 
 /// What the drives do in one tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,6 +41,21 @@ pub struct SetpointQueue {
     /// Dry ticks at which no brake tail continued the queue: the drives held the last
     /// setpoint, a step in velocity (motion was stopped between a batch and its tail).
     pub tailless_stops: u64,
+    /// The setpoint played before `last`, for the axes' velocity.
+    before_last: [f64; MAX_AXES],
+    /// The emergency-stop input is pressed: no setpoint is taken.
+    emergency_stop: bool,
+    /// The drives' own stop after an emergency stop: per axis its velocity (per tick) and
+    /// how much it may lose a tick.
+    quick_stop: Option<QuickStop>,
+    /// Why the last episode ended (`ServoFeedback::ENDED_*`).
+    ended: u32,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct QuickStop {
+    velocity: [f64; MAX_AXES],
+    step: [f64; MAX_AXES],
 }
 
 impl Default for SetpointQueue {
@@ -61,14 +76,57 @@ impl SetpointQueue {
             dry_tick: 0,
             underrun_ticks: 0,
             tailless_stops: 0,
+            before_last: [0.0; MAX_AXES],
+            emergency_stop: false,
+            quick_stop: None,
+            ended: ServoFeedback::ENDED_DRY,
         }
+    }
+
+    /// The emergency-stop input reached the drives. Pressed: the episode ends and each axis
+    /// ramps from its velocity to a stop, losing at most `decel[i]` (mm/s²) × period² of
+    /// step a tick (the drives' quick stop; the path is not kept, each axis stops on its
+    /// own); no setpoint is taken while it is pressed. Released: the drives take the next
+    /// episode's setpoints.
+    pub fn emergency_stop(&mut self, pressed: bool, decel: &[f64], period: f64) {
+        if pressed && !self.emergency_stop {
+            let mut qs = QuickStop {
+                velocity: [0.0; MAX_AXES],
+                step: [0.0; MAX_AXES],
+            };
+            if self.armed {
+                for (i, d) in decel.iter().enumerate().take(MAX_AXES) {
+                    qs.velocity[i] = self.last.position[i] - self.before_last[i];
+                    qs.step[i] = d.abs() * period * period;
+                }
+            }
+            self.quick_stop = Some(qs);
+            self.episode = self.episode.wrapping_add(1);
+            self.ended = ServoFeedback::ENDED_EMERGENCY_STOP;
+            self.queue.clear();
+            self.tail = None;
+            self.dry_since = None;
+            self.armed = false;
+        }
+        self.emergency_stop = pressed;
+    }
+
+    /// The drives stand after an emergency stop's ramp (their power may go).
+    pub fn stopped_by_emergency_stop(&self) -> bool {
+        self.quick_stop
+            .is_some_and(|q| q.velocity.iter().all(|v| *v == 0.0))
+    }
+
+    /// Why the last episode ended (`ServoFeedback::ENDED_*`).
+    pub fn episode_ended(&self) -> u32 {
+        self.ended
     }
 
     /// Queues a setpoint from motion; false (refused) when it belongs to an episode that has
     /// ended, or is not later than what is queued or `now` (the tick being played).
     pub fn push(&mut self, sp: ServoSetpoint, now: u64) -> bool {
         let after = self.queue.back().map_or(now, |b| b.tick.max(now));
-        if sp.episode != self.episode || sp.tick <= after {
+        if self.emergency_stop || sp.episode != self.episode || sp.tick <= after {
             return false;
         }
         self.queue.push_back(sp);
@@ -94,9 +152,24 @@ impl SetpointQueue {
             self.queue.pop_front();
             self.armed = true;
             self.dry_since = None;
+            self.quick_stop = None;
+            self.before_last = self.last.position;
             self.last = sp;
             return Played {
                 setpoint: sp,
+                underrun: false,
+            };
+        }
+        if let Some(q) = self.quick_stop.as_mut() {
+            self.before_last = self.last.position;
+            for i in 0..MAX_AXES {
+                let v = q.velocity[i];
+                q.velocity[i] = v - v.signum() * v.abs().min(q.step[i]);
+                self.last.position[i] += q.velocity[i];
+            }
+            self.last.tick = tick;
+            return Played {
+                setpoint: self.last,
                 underrun: false,
             };
         }
@@ -114,6 +187,7 @@ impl SetpointQueue {
                 self.dry_since = Some(tick);
                 self.dry_tick = tick;
                 self.episode = self.episode.wrapping_add(1);
+                self.ended = ServoFeedback::ENDED_DRY;
                 self.queue.clear();
                 if self.tail.as_ref().is_none_or(|t| t.first_tick != tick) {
                     self.tail = None;
@@ -126,6 +200,7 @@ impl SetpointQueue {
             let len = (t.len as usize).min(TAIL_TICKS);
             let i = ((tick - since) as usize).min(len - 1);
             let n = self.last.axis_count as usize;
+            self.before_last = self.last.position;
             self.last.position[..n].copy_from_slice(&t.position[i][..n]);
         }
         self.last.tick = tick;
@@ -153,10 +228,10 @@ impl SetpointQueue {
     }
 }
 
-/// The drive trace's header: tick, queue depth, underrun, then per axis its setpoint, actual
+/// The drive trace's header: tick, queue depth, underrun, emergency stop, then per axis its setpoint, actual
 /// position and following error (the oscilloscope a commissioning engineer reads).
 pub fn trace_header(axes: &[String]) -> String {
-    let mut h = String::from("tick,queue_depth,underrun");
+    let mut h = String::from("tick,queue_depth,underrun,emergency_stop");
     for a in axes {
         h.push_str(&format!(",{a}_setpoint,{a}_actual,{a}_following_error"));
     }
@@ -165,10 +240,20 @@ pub fn trace_header(axes: &[String]) -> String {
 
 /// One tick of the drive trace. Positions are written exactly (Rust's shortest round-trip
 /// form), so two traces compare to the last bit.
-pub fn trace_line(tick: u64, played: &Played, actual: &[f64], depth: u32) -> String {
+pub fn trace_line(
+    tick: u64,
+    played: &Played,
+    actual: &[f64],
+    depth: u32,
+    emergency_stop: bool,
+) -> String {
     use std::fmt::Write;
     let sp = &played.setpoint;
-    let mut line = format!("{tick},{depth},{}", u8::from(played.underrun));
+    let mut line = format!(
+        "{tick},{depth},{},{}",
+        u8::from(played.underrun),
+        u8::from(emergency_stop)
+    );
     for (i, a) in actual.iter().enumerate() {
         let c = sp.position[i];
         let _ = write!(line, ",{c:?},{a:?},{:?}", c - a);
@@ -263,5 +348,34 @@ mod tests {
         }
         assert_eq!(q.play(4).setpoint.position[0], 3.0);
         assert_eq!(q.tailless_stops, 1);
+    }
+
+    /// Emergency stop: the episode ends, each axis ramps from its velocity to a stop by at
+    /// most its step a tick, no setpoint is taken while pressed; after release the next
+    /// episode's are.
+    #[test]
+    fn an_emergency_stop_ramps_each_axis_to_a_stop() {
+        let mut q = SetpointQueue::new();
+        for t in 1..=3 {
+            q.push(sp(t, t as f64, 0), 0);
+            q.play(t);
+        }
+        q.push(sp(4, 4.0, 0), 3);
+        // 1 mm a tick, losing at most 0.3 mm a tick: 1 s period, 0.3 mm/s².
+        q.emergency_stop(true, &[0.3], 1.0);
+        assert_eq!(q.episode(), 1);
+        assert_eq!(q.episode_ended(), ServoFeedback::ENDED_EMERGENCY_STOP);
+        assert!(!q.push(sp(9, 9.0, 1), 3), "nothing is taken while pressed");
+        let xs: Vec<f64> = (4..=9).map(|t| q.play(t).setpoint.position[0]).collect();
+        let expected = [3.7, 4.1, 4.2, 4.2, 4.2, 4.2];
+        for (x, e) in xs.iter().zip(expected) {
+            assert!((x - e).abs() < 1e-9, "{xs:?}");
+        }
+        assert!(q.stopped_by_emergency_stop());
+        assert_eq!(q.underrun_ticks, 0, "a stop, not an underrun");
+        q.emergency_stop(false, &[0.3], 1.0);
+        assert!(q.push(sp(12, 4.2, 1), 9));
+        assert!(!q.play(10).underrun);
+        assert_eq!(q.play(12).setpoint.position[0], 4.2);
     }
 }

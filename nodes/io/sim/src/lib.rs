@@ -102,7 +102,10 @@ pub struct SimLathe {
     /// The drive in position control: its stop position and goal.
     positioning: Option<Positioning>,
     pub devices: Devices,
+    /// The emergency-stop input (the PLC's X image, the spindle's stop).
     emergency_stop: bool,
+    /// The axes' drives without power (they hold nothing, follow no setpoint).
+    powered_off: bool,
     x_seq: u64,
     /// Overtravel switches pressed at the last step (bits per axis), for the PLC's inputs.
     overtravel: (u32, u32),
@@ -144,6 +147,7 @@ impl SimLathe {
             spindle_turned: 0.0,
             positioning: None,
             emergency_stop: false,
+            powered_off: false,
             x_seq: 0,
             overtravel: (0, 0),
             handwheel_count: 0,
@@ -156,8 +160,26 @@ impl SimLathe {
         self.handwheel_count = self.handwheel_count.wrapping_add(detents.wrapping_mul(4));
     }
 
+    /// Emergency stop that removes the drives' power at once (the lock-step machine).
     pub fn set_emergency_stop(&mut self, pressed: bool) {
         self.emergency_stop = pressed;
+        self.powered_off = pressed;
+    }
+
+    /// The emergency-stop input alone: the PLC sees it and the spindle stops; the axes' drives
+    /// keep power until [`SimLathe::power_drives`] removes it, so they can ramp to a stop
+    /// first (a stop of category 1, with the drives' setpoint queue).
+    pub fn set_emergency_stop_input(&mut self, pressed: bool) {
+        self.emergency_stop = pressed;
+    }
+
+    /// Whether the emergency-stop input is pressed.
+    pub fn emergency_stop_pressed(&self) -> bool {
+        self.emergency_stop
+    }
+
+    pub fn power_drives(&mut self, on: bool) {
+        self.powered_off = !on;
     }
 
     /// Slide positions in machine coordinates (what an absolute encoder would report).
@@ -178,7 +200,7 @@ impl SimLathe {
     pub fn step(&mut self, setpoint: &ServoSetpoint, y: &YImage, dt: f64) -> ServoFeedback {
         let n = self.cfg.drive_lag.len().min(MAX_AXES);
         let before = self.position;
-        if setpoint.enable != 0 && !self.emergency_stop {
+        if setpoint.enable != 0 && !self.powered_off {
             for i in 0..n {
                 let target = setpoint.position[i] + self.encoder_offset[i];
                 if !target.is_finite() {
@@ -198,7 +220,7 @@ impl SimLathe {
         }
         let torque = self.fixed_stops(setpoint, &before, n);
         // A disabled drive starts interpolating from where its slide stands.
-        let enabled = setpoint.enable != 0 && !self.emergency_stop;
+        let enabled = setpoint.enable != 0 && !self.powered_off;
         for i in 0..n {
             self.last_setpoint[i] = if enabled && setpoint.position[i].is_finite() {
                 setpoint.position[i] + self.encoder_offset[i]
@@ -348,7 +370,7 @@ impl SimLathe {
             }
             let target = setpoint.position[i] + self.encoder_offset[i];
             let pressing = self.position[i] == at && (target - at) * side < 0.0;
-            if pressing && setpoint.enable != 0 && !self.emergency_stop {
+            if pressing && setpoint.enable != 0 && !self.powered_off {
                 let limit = setpoint.torque_limit_percent[i];
                 torque[i] = if limit.is_finite() {
                     limit.clamp(0.0, 100.0)
