@@ -131,7 +131,12 @@ impl Cell {
         let mut errors = Vec::new();
         for (name, h) in self.threads {
             match h.join() {
-                Ok(Ok(s)) if !s.is_empty() => summary = s,
+                Ok(Ok(s)) if !s.is_empty() => {
+                    if !summary.is_empty() {
+                        summary.push('\n');
+                    }
+                    summary.push_str(&s);
+                }
                 Ok(Ok(_)) => {}
                 Ok(Err(e)) => errors.push(format!("{name}: {e}")),
                 Err(_) => errors.push(format!("{name}: panicked")),

@@ -148,6 +148,43 @@ pub fn moves(rows: &[Row]) -> Vec<Vec<u64>> {
     out
 }
 
+/// A machine to cut on: its built-in launch config and namespace.
+pub struct Machine {
+    pub config: &'static str,
+    pub namespace: &'static str,
+    pub program: &'static str,
+}
+
+pub const LATHE: Machine = Machine {
+    config: "sim_lathe.yaml",
+    namespace: "lathe1",
+    program: PART,
+};
+
+/// The mill's part: lines and arcs both ways in X-Y, plunges in Z.
+pub const MILL: Machine = Machine {
+    config: "sim_mill.yaml",
+    namespace: "mill1",
+    program: "O0481
+G90 G17 G00 X0 Y0 Z50
+M03 S1000
+G00 Z5
+G01 Z-2 F300
+G01 X40 F1200
+G02 X60 Y20 R20
+G03 X40 Y40 R20
+G01 X0 Y40
+G01 Y0
+G00 Z5
+X80 Y80
+G01 Z-1 F300
+G03 X80 Y80 I-20 J0 F900
+G00 Z50
+M05
+M30
+",
+};
+
 /// A run of `PART` on a lathe with a 100 ms queue, the machine's nodes in their own processes.
 pub struct Cut {
     nodes: Nodes,
@@ -162,19 +199,35 @@ impl Cut {
         Cut::start_program(dir, name, PART, domain)
     }
 
-    /// Starts the nodes on `domain` and `program`.
+    /// Starts the nodes of the lathe on `domain` and `program`.
     pub fn start_program(dir: &Path, name: &str, program: &str, domain: u16) -> Cut {
+        Cut::start_on(&LATHE, dir, name, program, domain)
+    }
+
+    /// Starts the nodes of `machine` on `domain` and `program`.
+    pub fn start_on(machine: &Machine, dir: &Path, name: &str, program: &str, domain: u16) -> Cut {
         let trace: PathBuf = dir.join(format!("{name}.csv"));
-        let trace_s = trace.to_string_lossy().to_string();
-        let config = common::sim_lathe_file(dir, &format!("{name}.yaml"), domain, |v| {
-            v["servo"]["drive_queue_ms"] = 100.0.into();
-            v["servo"]["drive_trace"] = trace_s.clone().into();
-            v["machine"]["position_file"] = serde_yaml::Value::Null;
-            v["machine"]["memory_file"] = serde_yaml::Value::Null;
-            v["plc"]["memory_file"] = serde_yaml::Value::Null;
-        });
+        let base = format!(
+            "{}/launch_configs/{}",
+            env!("CARGO_MANIFEST_DIR"),
+            machine.config
+        );
+        let text = std::fs::read_to_string(&base).expect("launch config");
+        let mut v: serde_yaml::Value = serde_yaml::from_str(&text).expect("yaml");
+        v["network"]["domain_id"] = domain.into();
+        v["recorder"]["enabled"] = false.into();
+        v["hmi"]["web_address"] = "".into();
+        v["servo"]["drive_queue_ms"] = 100.0.into();
+        v["servo"]["drive_trace"] = trace.to_string_lossy().to_string().into();
+        for file in ["position_file", "memory_file", "parameter_file"] {
+            v["machine"][file] = serde_yaml::Value::Null;
+        }
+        v["plc"]["memory_file"] = serde_yaml::Value::Null;
+        let config = dir.join(format!("{name}.yaml"));
+        std::fs::write(&config, serde_yaml::to_string(&v).expect("yaml")).expect("config");
         let nodes = Nodes::start(&config, dir);
-        let mut client = CellClient::new(&net(domain), "lathe1", name, ServiceMapping::Enhanced)
+        let ns = machine.namespace;
+        let mut client = CellClient::new(&net(domain), ns, name, ServiceMapping::Enhanced)
             .expect("client")
             .with_timeout(Duration::from_secs(10));
         client
@@ -451,5 +504,89 @@ fn emergency_stop_ramps_at_the_drives_with_motion_stopped() {
             .all(|r| r.setpoint[1] == z(k - 1)),
         "and stand"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 48, must-show 1, the full table (`scripts/drive_queue_stalls.sh` runs it under a
+/// concurrent `cargo build` and prints it; about 15 minutes): on the lathe and on the mill,
+/// for stalls of 5, 10, 20, 40 and 80 ms, the motion process is stopped at `CNC_STALLS` (50)
+/// random moments of the part; each run's drive trace must be the undisturbed run's path to
+/// the last bit, with no underrun.
+#[test]
+#[ignore = "the full stall table, about 15 minutes: scripts/drive_queue_stalls.sh"]
+fn stall_table() {
+    let per: usize = std::env::var("CNC_STALLS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(50);
+    let dir = common::fresh_dir("drive_queue_table");
+    let mut failures = Vec::new();
+    println!("machine  stall ms  stalls  underruns  least depth ms  path");
+    for (m, machine) in [&LATHE, &MILL].into_iter().enumerate() {
+        // The mill's contour four times over, so fifty stalls fit into one part.
+        let program = if m == 0 {
+            machine.program.to_string()
+        } else {
+            let body: Vec<&str> = machine.program.lines().collect();
+            let (head, rest) = body.split_at(4);
+            let (contour, tail) = rest.split_at(rest.len() - 3);
+            let mut p = head.join("\n") + "\n";
+            for _ in 0..4 {
+                p += &(contour.join("\n") + "\n");
+            }
+            p + &tail.join("\n") + "\n"
+        };
+        let calm_run = Cut::start_on(machine, &dir, "calm", &program, STALLS);
+        let t0 = calm_run.t0;
+        let calm = calm_run.finish();
+        let run_ms = t0.elapsed().as_millis() as u64;
+        let reference = moves(&calm);
+        for (k, stall) in [5u64, 10, 20, 40, 80].into_iter().enumerate() {
+            // Moments spread over the run, at least the stall and 120 ms apart.
+            let mut seed = 0x9e37_79b9_7f4a_7c15u64 ^ (stall * 7919 + m as u64);
+            let mut moments: Vec<u64> = (0..per)
+                .map(|_| {
+                    seed = seed
+                        .wrapping_mul(6_364_136_223_846_793_005)
+                        .wrapping_add(1_442_695_040_888_963_407);
+                    800 + (seed >> 33) % run_ms.saturating_sub(2000).max(1)
+                })
+                .collect();
+            moments.sort_unstable();
+            let mut stalls: Vec<(u64, u64)> = Vec::new();
+            let mut next = 0;
+            for at in moments {
+                let at = at.max(next);
+                stalls.push((at, stall));
+                next = at + stall + 120;
+            }
+            let name = format!("{}_{stall}", machine.namespace);
+            let domain = DRY + 10 + (m * 5 + k) as u16;
+            let run = Cut::start_on(machine, &dir, &name, &program, domain);
+            for &(at, ms) in &stalls {
+                run.stall(at, ms);
+            }
+            let rows = run.finish();
+            let underruns = rows.iter().filter(|r| r.underrun).count();
+            let least = rows
+                .iter()
+                .skip_while(|r| r.depth == 0)
+                .map(|r| r.depth)
+                .min()
+                .unwrap_or(0);
+            let same = moves(&rows) == reference;
+            println!(
+                "{:<8} {stall:>8} {:>7} {underruns:>10} {:>15} {}",
+                machine.namespace,
+                stalls.len(),
+                least * 4,
+                if same { "identical" } else { "DIFFERENT" }
+            );
+            if !same || underruns > 0 {
+                failures.push(name);
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
