@@ -188,7 +188,8 @@ pub fn run(
             }
             feedback.send(fb)?;
             if let Some(t) = &mut trace {
-                let line = trace_line(tick, &played, &fb.position[..n], depth, estop);
+                let spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
+                let line = trace_line(tick, &played, &fb.position[..n], depth, estop, spindle);
                 t.write(&line, ticks_per_second);
             }
         }

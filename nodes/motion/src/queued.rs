@@ -76,6 +76,139 @@ impl Tails {
     }
 }
 
+/// Motion's side of the queue: its core, the drives' feedback by tick, where the queue ends.
+struct Planner {
+    motion: Motion,
+    latest: Latest,
+    received: VecDeque<ServoFeedback>,
+    /// The drive tick of the next setpoint to compute.
+    next_tick: u64,
+    episode: u32,
+    ahead: u64,
+    n: usize,
+    g: GImage,
+    plc: PlcLink,
+    clock: Clockwork,
+    reporter: Reporter,
+    tails: Tails,
+    /// Alarm 54 of a dry queue is shown (cleared once the machine runs again).
+    dry_shown: bool,
+    missing_feedback: u64,
+    last_wake: u64,
+}
+
+impl Planner {
+    /// The queue's episode ended at the drives: a dry queue (the drives played a brake tail:
+    /// go on from the state it ends in) or an emergency stop (the core holds where the slides
+    /// are; the next episode starts from there).
+    fn episode_ended(&mut self, newest: &ServoFeedback, now: u64, reports: &Sender<Report>) {
+        self.episode = newest.episode;
+        if newest.episode_ended == ServoFeedback::ENDED_EMERGENCY_STOP {
+            self.tails.kept.clear();
+            self.next_tick = newest.tick + self.ahead;
+            return;
+        }
+        let text = format!(
+            "the drives' setpoint queue ran dry at drive tick {} (motion was not scheduled \
+             for {:.0} ms): the machine stopped on its path, cycle start goes on",
+            newest.dry_tick,
+            now.saturating_sub(self.last_wake) as f64 / 1e6
+        );
+        match self.tails.take(newest.dry_tick) {
+            Some((stopped, after)) => {
+                self.motion = *stopped;
+                self.next_tick = after.max(newest.tick + self.ahead);
+            }
+            None => {
+                // The drives held without a tail: a step in velocity, the servo alarm.
+                self.motion
+                    .servo_overrun(format!("{text}; no brake tail reached the drives"));
+                self.next_tick = newest.tick + self.ahead;
+            }
+        }
+        log::warn!("{text}");
+        let _ = reports.send(Report::Warning(alarm::SERVO_OVERRUN, Some(text)));
+        self.dry_shown = true;
+    }
+
+    /// Computes the setpoints up to `newest.tick` + the queue's length, each with the
+    /// feedback of the tick a queue's length before it, and sends them.
+    fn plan_batch(
+        &mut self,
+        newest: &ServoFeedback,
+        period: f64,
+        out: &Channels,
+        reports: &Sender<Report>,
+    ) -> Result<(), String> {
+        let n = self.n;
+        while self.next_tick <= newest.tick + self.ahead {
+            let answered = self.next_tick - self.ahead;
+            while self.received.front().is_some_and(|f| f.tick < answered) {
+                self.received.pop_front();
+            }
+            match self.received.front().filter(|f| f.tick == answered) {
+                Some(fb) => self.latest.read(fb, n),
+                None => self.missing_feedback += 1,
+            }
+            self.motion.plc_signals(&self.g);
+            self.latest.give(&mut self.motion, true);
+            let mut sp = ServoSetpoint {
+                seq: self.next_tick,
+                sent_ns: monotonic_ns(),
+                tick: self.next_tick,
+                episode: self.episode,
+                axis_count: n as u32,
+                ..ServoSetpoint::default()
+            };
+            let position = self.motion.tick(Some(&self.latest.actual[..n]), &self.g);
+            sp.position[..n].copy_from_slice(position);
+            self.motion.fill_setpoint(&mut sp);
+            out.setpoints.send(sp)?;
+            let mut fi = *self.motion.f_image();
+            fi.seq = self.next_tick;
+            out.f_image.send(fi)?;
+            let (tick, clock) = (self.next_tick, &self.clock);
+            self.reporter
+                .report(&mut self.motion, tick, &self.latest, clock, period, reports);
+            self.next_tick += 1;
+        }
+        let (next, episode) = (self.next_tick, self.episode);
+        self.tails
+            .plan(&self.motion, &self.g, next, episode, &out.tails)?;
+        if self.dry_shown && self.motion.state() == RunState::Running {
+            self.dry_shown = false;
+            let _ = reports.send(Report::Warning(alarm::SERVO_OVERRUN, None));
+        }
+        Ok(())
+    }
+}
+
+/// What motion sends the drives and the PLC.
+struct Channels {
+    setpoints: cnc_runtime::shm::Sender<ServoSetpoint>,
+    tails: cnc_runtime::shm::Sender<BrakeTail>,
+    f_image: cnc_runtime::shm::Sender<FImage>,
+}
+
+/// Waits for the drives' first feedback (not past shutdown or 30 s); everything that came.
+fn first_feedback(
+    feedback: &cnc_runtime::shm::Receiver<ServoFeedback>,
+    shutdown: &Shutdown,
+) -> Result<Option<Vec<ServoFeedback>>, String> {
+    let mut arrived = Vec::with_capacity(STREAM_DEPTH);
+    for _ in 0..300 {
+        if shutdown.requested() {
+            return Ok(None);
+        }
+        feedback.wait_for_any(Duration::from_millis(100))?;
+        feedback.take_all(&mut arrived)?;
+        if !arrived.is_empty() {
+            return Ok(Some(arrived));
+        }
+    }
+    Err("no feedback from the drives within 30 s (is io running?)".into())
+}
+
 pub(crate) fn servo_loop(
     mcfg: MotionConfig,
     timing: Timing,
@@ -85,13 +218,14 @@ pub(crate) fn servo_loop(
     shutdown: Shutdown,
 ) -> Result<String, String> {
     let shm = ShmNode::new(&instance, "motion")?;
-    let setpoints =
-        shm.stream_sender::<ServoSetpoint>(channel::SETPOINT_QUEUE, false, STREAM_DEPTH)?;
-    let tail_out = shm.sender::<BrakeTail>(channel::BRAKE_TAIL, false)?;
+    let out = Channels {
+        setpoints: shm.stream_sender(channel::SETPOINT_QUEUE, false, STREAM_DEPTH)?,
+        tails: shm.sender(channel::BRAKE_TAIL, false)?,
+        f_image: shm.sender(channel::F_IMAGE, false)?,
+    };
     let feedback =
         shm.stream_receiver::<ServoFeedback>(channel::FEEDBACK_STREAM, true, STREAM_DEPTH)?;
     let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
-    let f_out = shm.sender::<FImage>(channel::F_IMAGE, false)?;
     let rt = &timing.realtime;
     let granted = cnc_runtime::realtime::enter(
         "motion planning loop",
@@ -102,156 +236,76 @@ pub(crate) fn servo_loop(
     let n = mcfg.axes.len();
     let ahead = timing.queue_ticks.max(1);
     let period_ns = (mcfg.period * 1e9) as u64;
-    let mut arrived: Vec<ServoFeedback> = Vec::with_capacity(STREAM_DEPTH);
     // Start from where the drives are, at the tick they report.
-    let mut waited = 0;
-    let first = loop {
-        if shutdown.requested() {
-            return Ok("stopped before the drives reported".into());
-        }
-        feedback.wait_for_any(Duration::from_millis(100))?;
-        feedback.take_all(&mut arrived)?;
-        if let Some(fb) = arrived.last() {
-            break *fb;
-        }
-        waited += 1;
-        if waited > 300 {
-            return Err("no feedback from the drives within 30 s (is io running?)".into());
-        }
+    let Some(arrived) = first_feedback(&feedback, &shutdown)? else {
+        return Ok("stopped before the drives reported".into());
     };
-    let mut latest = Latest::first(&first);
-    let mut motion = Motion::new(mcfg.clone(), &latest.actual[..n]);
-    let mut received: VecDeque<ServoFeedback> = VecDeque::with_capacity(STREAM_DEPTH);
-    received.extend(arrived.drain(..));
-    let mut next_tick = first.tick + ahead;
-    let mut episode = first.episode;
-    let mut g = GImage::default();
-    let mut plc = PlcLink::new(period_ns);
+    let first = arrived[arrived.len() - 1];
+    let latest = Latest::first(&first);
     let ticks_per_second = (1.0 / mcfg.period).round().max(1.0) as u64;
-    // Motion's lateness is no alarm here (the queue absorbs it); its statistics stay.
-    let mut clock = Clockwork {
-        stats: ServoStatistics {
-            realtime: granted.is_realtime(),
-            ..Default::default()
+    let mut p = Planner {
+        motion: Motion::new(mcfg.clone(), &latest.actual[..n]),
+        latest,
+        received: arrived.into_iter().collect(),
+        next_tick: first.tick + ahead,
+        episode: first.episode,
+        ahead,
+        n,
+        g: GImage::default(),
+        plc: PlcLink::new(period_ns),
+        // Motion's lateness is no alarm here (the queue absorbs it); its statistics stay.
+        clock: Clockwork {
+            stats: ServoStatistics {
+                realtime: granted.is_realtime(),
+                ..Default::default()
+            },
+            watch: LateWatch::new(u64::MAX, usize::MAX, ticks_per_second, ticks_per_second),
+            last_tick: None,
         },
-        watch: LateWatch::new(u64::MAX, usize::MAX, ticks_per_second, ticks_per_second),
-        last_tick: None,
+        reporter: Reporter { last_status: None },
+        tails: Tails {
+            kept: VecDeque::with_capacity(TAILS_KEPT + 1),
+            buffer: vec![[0.0; MAX_AXES]; TAIL_TICKS],
+            msg: Box::default(),
+        },
+        dry_shown: false,
+        missing_feedback: 0,
+        last_wake: monotonic_ns(),
     };
-    let mut reporter = Reporter { last_status: None };
-    let mut tails = Tails {
-        kept: VecDeque::with_capacity(TAILS_KEPT + 1),
-        buffer: vec![[0.0; MAX_AXES]; TAIL_TICKS],
-        msg: Box::default(),
-    };
-    let mut dry_shown = false;
-    let mut missing_feedback = 0u64;
-    let mut last_wake = monotonic_ns();
+    let mut arrived = Vec::with_capacity(STREAM_DEPTH);
     while !shutdown.requested() {
         feedback.wait_for_any(Duration::from_nanos(period_ns))?;
         let now = monotonic_ns();
         feedback.take_all(&mut arrived)?;
-        received.extend(arrived.drain(..));
-        let Some(newest) = received.back().copied() else {
+        p.received.extend(arrived.drain(..));
+        let Some(newest) = p.received.back().copied() else {
             continue;
         };
-        if newest.episode != episode && newest.episode_ended == ServoFeedback::ENDED_EMERGENCY_STOP
-        {
-            // The drives stopped on their own (emergency stop, D134); the PLC tells the core,
-            // which holds where the slides are. The next episode starts from there.
-            episode = newest.episode;
-            tails.kept.clear();
-            next_tick = newest.tick + ahead;
+        if newest.episode != p.episode {
+            p.episode_ended(&newest, now, &reports);
         }
-        if newest.episode != episode {
-            // The queue ran dry: the drives play the tail of the batch they ran out at.
-            episode = newest.episode;
-            let text = format!(
-                "the drives' setpoint queue ran dry at drive tick {} (motion was not scheduled \
-                 for {:.0} ms): the machine stopped on its path, cycle start goes on",
-                newest.dry_tick,
-                now.saturating_sub(last_wake) as f64 / 1e6
-            );
-            match tails.take(newest.dry_tick) {
-                Some((stopped, after)) => {
-                    motion = *stopped;
-                    next_tick = after.max(newest.tick + ahead);
-                }
-                None => {
-                    // The drives held without a tail: a step in velocity, the servo alarm.
-                    motion.servo_overrun(format!("{text}; no brake tail reached the drives"));
-                    next_tick = newest.tick + ahead;
-                }
-            }
-            log::warn!("{text}");
-            let _ = reports.send(Report::Warning(alarm::SERVO_OVERRUN, Some(text)));
-            dry_shown = true;
-        }
-        last_wake = now;
-        if newest.tick + ahead < next_tick + BATCH_TICKS - 1 {
+        p.last_wake = now;
+        if newest.tick + ahead < p.next_tick + BATCH_TICKS - 1 {
             continue;
         }
-        clock.tick(now, false, &mut motion, &reports);
-        take_inputs(&inputs, &mut motion, &mut clock, &mut plc, &reports);
-        plc_signals(
-            g_in.latest()?,
-            &mut g,
-            &mut plc,
-            now,
-            motion.line(),
-            &reports,
-        );
+        p.clock.tick(now, false, &mut p.motion, &reports);
+        take_inputs(&inputs, &mut p.motion, &mut p.clock, &mut p.plc, &reports);
+        let line = p.motion.line();
+        plc_signals(g_in.latest()?, &mut p.g, &mut p.plc, now, line, &reports);
         let computing = monotonic_ns();
-        while next_tick <= newest.tick + ahead {
-            let answered = next_tick - ahead;
-            while received.front().is_some_and(|f| f.tick < answered) {
-                received.pop_front();
-            }
-            match received.front().filter(|f| f.tick == answered) {
-                Some(fb) => latest.read(fb, n),
-                None => missing_feedback += 1,
-            }
-            motion.plc_signals(&g);
-            latest.give(&mut motion, true);
-            let mut out = ServoSetpoint {
-                seq: next_tick,
-                sent_ns: monotonic_ns(),
-                tick: next_tick,
-                episode,
-                axis_count: n as u32,
-                ..ServoSetpoint::default()
-            };
-            out.position[..n].copy_from_slice(motion.tick(Some(&latest.actual[..n]), &g));
-            motion.fill_setpoint(&mut out);
-            setpoints.send(out)?;
-            let mut fi = *motion.f_image();
-            fi.seq = next_tick;
-            f_out.send(fi)?;
-            reporter.report(
-                &mut motion,
-                next_tick,
-                &latest,
-                &clock,
-                mcfg.period,
-                &reports,
-            );
-            next_tick += 1;
-        }
-        tails.plan(&motion, &g, next_tick, episode, &tail_out)?;
-        if dry_shown && motion.state() == RunState::Running {
-            dry_shown = false;
-            let _ = reports.send(Report::Warning(alarm::SERVO_OVERRUN, None));
-        }
+        p.plan_batch(&newest, mcfg.period, &out, &reports)?;
         let done = monotonic_ns();
-        clock
+        p.clock
             .stats
             .phases(0.0, done.saturating_sub(computing) as f64 / 1000.0, 0.0);
     }
-    let stats = &clock.stats;
+    let stats = &p.clock.stats;
     let _ = reports.send(Report::Stats(stats.message(mcfg.period)));
     let period_us = mcfg.period * 1e6;
     Ok(format!(
-        "{}\nfeedback missing for {missing_feedback} planned ticks\n{}",
+        "{}\nfeedback missing for {} planned ticks\n{}",
         stats.summary(period_us),
+        p.missing_feedback,
         stats.interval_histogram(period_us).trim_end()
     ))
 }

@@ -228,13 +228,15 @@ impl SetpointQueue {
     }
 }
 
-/// The drive trace's header: tick, queue depth, underrun, emergency stop, then per axis its setpoint, actual
-/// position and following error (the oscilloscope a commissioning engineer reads).
+/// The drive trace's header: tick, queue depth, underrun, emergency stop, per axis its
+/// setpoint, actual position and following error, then the spindle encoder's speed (rpm) and
+/// angle (degrees): the oscilloscope a commissioning engineer reads.
 pub fn trace_header(axes: &[String]) -> String {
     let mut h = String::from("tick,queue_depth,underrun,emergency_stop");
     for a in axes {
         h.push_str(&format!(",{a}_setpoint,{a}_actual,{a}_following_error"));
     }
+    h.push_str(",spindle_rpm,spindle_angle");
     h
 }
 
@@ -246,6 +248,7 @@ pub fn trace_line(
     actual: &[f64],
     depth: u32,
     emergency_stop: bool,
+    spindle: (f64, f64),
 ) -> String {
     use std::fmt::Write;
     let sp = &played.setpoint;
@@ -258,6 +261,7 @@ pub fn trace_line(
         let c = sp.position[i];
         let _ = write!(line, ",{c:?},{a:?},{:?}", c - a);
     }
+    let _ = write!(line, ",{:?},{:?}", spindle.0, spindle.1);
     line
 }
 

@@ -170,6 +170,11 @@ pub struct Motion {
     feed_per_rev: bool,
     /// G09/G61 in force: path blocks end at rest.
     exact_stop: bool,
+    /// Ticks since the last strobe that may change the spindle's speed (S, M03/M04/M05, M19),
+    /// and readings in a row at the same speed: with the drives' queue a thread starts only
+    /// once the (older) encoder reading shows the spindle settled after the last command.
+    spindle_quiet: u32,
+    spindle_steady: u32,
     /// The look-ahead window: built once, so the servo thread allocates nothing per block.
     planner: Planner,
     /// Consecutive ticks without drive feedback.
@@ -297,6 +302,8 @@ impl Motion {
             drive: commanded.clone(),
             last_drive: commanded.clone(),
             sent_drive: VecDeque::with_capacity(delay + 1),
+            spindle_quiet: u32::MAX,
+            spindle_steady: 0,
             feedforward: false,
             spindle_acceleration: 1.0,
             locked: 0,
@@ -419,7 +426,14 @@ impl Motion {
     /// The spindle encoder's reading this tick: speed (negative counter-clockwise) and
     /// angle after the index pulse in degrees.
     pub fn spindle_feedback(&mut self, rpm: f64, angle_deg: f64) {
+        let before = self.encoder.rpm;
         self.encoder.read(rpm, angle_deg);
+        let settled = (self.encoder.rpm - before).abs() <= 0.002 * before.abs();
+        self.spindle_steady = if settled {
+            self.spindle_steady.saturating_add(1)
+        } else {
+            0
+        };
     }
 
     /// Feed hold: decelerate on the path and wait for [`Motion::cycle_start`].
@@ -589,6 +603,7 @@ impl Motion {
     fn tick_machine(&mut self, actual: Option<&[f64]>, plc: &GImage) {
         // Detents turned while the machine cannot take them (servo off, emergency stop) are
         // dropped with this period.
+        self.spindle_quiet = self.spindle_quiet.saturating_add(1);
         let detents = self.take_detents();
         self.trial_run(plc, detents, self.cfg.period);
         self.count_power_on(self.cfg.period);
@@ -959,6 +974,9 @@ impl Motion {
                     }
                     Aux::M(19) => tapping::strobe_stop_position(fi, 0.0, Turn::Shortest, 0.0),
                     Aux::M(m) => {
+                        if matches!(m, 3..=5 | 19) {
+                            self.spindle_quiet = 0;
+                        }
                         fi.write_i32(f::ORIENT_ANGLE, 0);
                         fi.bytes[f::ORIENT_WAY] = 0;
                         fi.write_i32(f::ORIENT_SPEED, 0);
@@ -971,6 +989,7 @@ impl Motion {
                     }
                     Aux::S(s) => {
                         self.spindle_rpm = s;
+                        self.spindle_quiet = 0;
                         fi.write_i32(f::S_CODE, s.round().clamp(0.0, i32::MAX as f64) as i32);
                         fi.set(f::SF, true);
                     }

@@ -181,6 +181,13 @@ impl Motion {
         if self.thread.synchronised() || self.feed_hold {
             return Ok(());
         }
+        // With the drives' queue the encoder reading is a queue's length old and the thread's
+        // start is extrapolated over it: the reading must show the spindle settled since the
+        // last command that changed it (D133).
+        let delay = self.cfg.feedback_delay_ticks;
+        if delay > 1 && (self.spindle_quiet < delay + 2 || self.spindle_steady < 5) {
+            return Ok(());
+        }
         // `000` §5.23: the thread starts only with the spindle turning (alarm 36).
         let omega = self.encoder.omega();
         if omega * 60.0 < 1.0 {
