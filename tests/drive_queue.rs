@@ -1,7 +1,7 @@
 //! Issue 48, must-show 1 (the suite's short version; `scripts/drive_queue_stalls.sh` runs the
 //! full table): with the drives' setpoint queue (`servo.drive_queue_ms: 100`) and the machine's
 //! nodes as separate processes, a lathe part with lines, arcs and a thread is cut twice: once
-//! undisturbed, once with the motion process stopped (SIGSTOP … SIGCONT) for 5 to 80 ms at
+//! undisturbed, once with the motion process stopped (SIGSTOP … SIGCONT) for 5 to 60 ms at
 //! moments spread over the run. The drives' trace of the two runs is the same path, setpoint for
 //! setpoint to the last bit, and the stalled run had no underrun.
 //!
@@ -308,9 +308,10 @@ pub fn cut(dir: &Path, name: &str, domain: u16, stalls: &[(u64, u64)]) -> Vec<Ro
 fn stalls_shorter_than_the_queue_cost_nothing() {
     let dir = common::fresh_dir("drive_queue");
     let calm = cut(&dir, "calm", STALLS, &[]);
-    // Stalls of 5 to 80 ms from 1 s after cycle start, 700 ms apart: through the approach, the
-    // contour and both thread passes.
-    let stalls: Vec<(u64, u64)> = [5, 10, 20, 40, 80, 60, 30, 15]
+    // Stalls of 5 to 60 ms from 1 s after cycle start, 700 ms apart: through the approach, the
+    // contour and both thread passes (80 ms, the queue less a batch and a wake-up, is the full
+    // table's: scripts/drive_queue_stalls.sh).
+    let stalls: Vec<(u64, u64)> = [5, 10, 20, 40, 60, 50, 30, 15]
         .iter()
         .enumerate()
         .map(|(i, ms)| (1000 + 700 * i as u64, *ms))
@@ -318,7 +319,7 @@ fn stalls_shorter_than_the_queue_cost_nothing() {
     let stalled = cut(&dir, "stalled", STALLS, &stalls);
     let underruns = stalled.iter().filter(|r| r.underrun).count();
     assert_eq!(underruns, 0, "ticks without a setpoint");
-    // From motion's first setpoint on: the stalls drew on the queue (80 ms is 20 of its 25
+    // From motion's first setpoint on: the stalls drew on the queue (60 ms is 15 of its 25
     // ticks), and it never ran out.
     let least = stalled
         .iter()
@@ -327,7 +328,7 @@ fn stalls_shorter_than_the_queue_cost_nothing() {
         .min()
         .unwrap_or(0);
     assert!(
-        (1..15).contains(&least),
+        (1..20).contains(&least),
         "least queue depth {least} ticks: the stalls did not reach the drives' queue"
     );
     println!(

@@ -157,12 +157,15 @@ pub fn run(
             );
         }
         sim.power_drives(!(estop && queue.stopped_by_emergency_stop()));
+        // The tail first: motion sends a batch's setpoints before its tail, so every setpoint
+        // of the batch whose tail is read here is there to read after it.
+        let tail = tails.latest()?;
         arrived.clear();
         setpoints.take_all(&mut arrived)?;
         for sp in &arrived {
             queue.push(*sp, tick);
         }
-        if let Some(t) = tails.latest()? {
+        if let Some(t) = tail {
             queue.set_tail(&t);
         }
         // Every tick that is due by now, by index: a late wake-up catches up.

@@ -31,7 +31,7 @@ use crate::{Motion, MotionConfig, RunState};
 const STREAM_DEPTH: usize = 1024;
 /// Motion computes when at least this many ticks are missing from the queue: one wake-up
 /// then plans a batch of them and one brake tail.
-const BATCH_TICKS: u64 = 5;
+const BATCH_TICKS: u64 = 2;
 /// Brake tails kept with the state they end in: the drives may run dry on one sent before
 /// the latest.
 const TAILS_KEPT: usize = 4;
@@ -76,8 +76,9 @@ impl Tails {
     }
 }
 
-/// Motion's side of the queue: its core, the drives' feedback by tick, where the queue ends.
-struct Planner {
+/// What keeps the drives' queue fed: motion's core, the drives' feedback by tick, where the
+/// queue ends.
+struct Feeder {
     motion: Motion,
     latest: Latest,
     received: VecDeque<ServoFeedback>,
@@ -97,7 +98,7 @@ struct Planner {
     last_wake: u64,
 }
 
-impl Planner {
+impl Feeder {
     /// The queue's episode ended at the drives: a dry queue (the drives played a brake tail:
     /// go on from the state it ends in) or an emergency stop (the core holds where the slides
     /// are; the next episode starts from there).
@@ -109,8 +110,8 @@ impl Planner {
             return;
         }
         let text = format!(
-            "the drives' setpoint queue ran dry at drive tick {} (motion was not scheduled \
-             for {:.0} ms): the machine stopped on its path, cycle start goes on",
+            "the drives' setpoint queue ran dry at drive tick {} (motion's last wake-up {:.0} ms \
+             before this one): the machine stopped on its path, cycle start goes on",
             newest.dry_tick,
             now.saturating_sub(self.last_wake) as f64 / 1e6
         );
@@ -243,7 +244,7 @@ pub(crate) fn servo_loop(
     let first = arrived[arrived.len() - 1];
     let latest = Latest::first(&first);
     let ticks_per_second = (1.0 / mcfg.period).round().max(1.0) as u64;
-    let mut p = Planner {
+    let mut p = Feeder {
         motion: Motion::new(mcfg.clone(), &latest.actual[..n]),
         latest,
         received: arrived.into_iter().collect(),

@@ -26,7 +26,13 @@ pub struct Played {
 pub struct SetpointQueue {
     /// Queued setpoints in tick order; the front is the next to play.
     queue: VecDeque<ServoSetpoint>,
+    /// Setpoints whose batch's brake tail has not come yet: they join the queue with it, so
+    /// the queue always ends where a tail starts (motion stopped between a batch and its tail
+    /// leaves the batch out, not the tail).
+    pending: VecDeque<ServoSetpoint>,
+    /// The latest batch's brake tail, and the one being played since the queue ran dry.
     tail: Option<Box<BrakeTail>>,
+    braking: Option<Box<BrakeTail>>,
     episode: u32,
     /// What the last tick played, held while nothing else is there.
     last: ServoSetpoint,
@@ -68,7 +74,9 @@ impl SetpointQueue {
     pub fn new() -> SetpointQueue {
         SetpointQueue {
             queue: VecDeque::with_capacity(1024),
+            pending: VecDeque::with_capacity(1024),
             tail: None,
+            braking: None,
             episode: 0,
             last: ServoSetpoint::default(),
             armed: false,
@@ -104,7 +112,9 @@ impl SetpointQueue {
             self.episode = self.episode.wrapping_add(1);
             self.ended = ServoFeedback::ENDED_EMERGENCY_STOP;
             self.queue.clear();
+            self.pending.clear();
             self.tail = None;
+            self.braking = None;
             self.dry_since = None;
             self.armed = false;
         }
@@ -122,24 +132,32 @@ impl SetpointQueue {
         self.ended
     }
 
-    /// Queues a setpoint from motion; false (refused) when it belongs to an episode that has
+    /// Takes a setpoint from motion (it plays once its batch's tail has come, see
+    /// [`SetpointQueue::set_tail`]); false (refused) when it belongs to an episode that has
     /// ended, or is not later than what is queued or `now` (the tick being played).
     pub fn push(&mut self, sp: ServoSetpoint, now: u64) -> bool {
-        let after = self.queue.back().map_or(now, |b| b.tick.max(now));
+        let last = self.pending.back().or(self.queue.back());
+        let after = last.map_or(now, |b| b.tick.max(now));
         if self.emergency_stop || sp.episode != self.episode || sp.tick <= after {
             return false;
         }
-        self.queue.push_back(sp);
+        self.pending.push_back(sp);
         true
     }
 
-    /// The brake tail of the latest batch (of this episode; another is ignored).
+    /// The brake tail of the latest batch (of this episode; another is ignored): the batch's
+    /// setpoints before the tail's first tick join the queue.
     pub fn set_tail(&mut self, tail: &BrakeTail) {
-        if tail.episode == self.episode && self.dry_since.is_none() {
-            match &mut self.tail {
-                Some(t) => **t = *tail,
-                None => self.tail = Some(Box::new(*tail)),
-            }
+        if tail.episode != self.episode {
+            return;
+        }
+        while let Some(sp) = self.pending.front().filter(|s| s.tick < tail.first_tick) {
+            self.queue.push_back(*sp);
+            self.pending.pop_front();
+        }
+        match &mut self.tail {
+            Some(t) => **t = *tail,
+            None => self.tail = Some(Box::new(*tail)),
         }
     }
 
@@ -189,14 +207,15 @@ impl SetpointQueue {
                 self.episode = self.episode.wrapping_add(1);
                 self.ended = ServoFeedback::ENDED_DRY;
                 self.queue.clear();
-                if self.tail.as_ref().is_none_or(|t| t.first_tick != tick) {
-                    self.tail = None;
+                self.pending.clear();
+                self.braking = self.tail.take().filter(|t| t.first_tick == tick);
+                if self.braking.is_none() {
                     self.tailless_stops += 1;
                 }
                 tick
             }
         };
-        if let Some(t) = self.tail.as_ref().filter(|t| t.len > 0) {
+        if let Some(t) = self.braking.as_ref().filter(|t| t.len > 0) {
             let len = (t.len as usize).min(TAIL_TICKS);
             let i = ((tick - since) as usize).min(len - 1);
             let n = self.last.axis_count as usize;
@@ -293,8 +312,19 @@ mod tests {
         t
     }
 
-    /// Setpoints play at their ticks; before the first one the drives hold (no underrun);
-    /// what is late or of another episode is refused.
+    /// Motion's batch: setpoints `ticks` of `episode` and the tail after them.
+    fn batch(q: &mut SetpointQueue, ticks: std::ops::RangeInclusive<u64>, now: u64, episode: u32) {
+        let end = *ticks.end();
+        for t in ticks {
+            assert!(q.push(sp(t, t as f64, episode), now));
+        }
+        let mut t = tail(end + 1, &[end as f64]);
+        t.episode = episode;
+        q.set_tail(&t);
+    }
+
+    /// Setpoints play at their ticks once their batch's tail has come; before the first one
+    /// the drives hold (no underrun); what is late or of another episode is refused.
     #[test]
     fn setpoints_play_at_their_ticks() {
         let mut q = SetpointQueue::new();
@@ -302,8 +332,10 @@ mod tests {
         for t in 3..=6 {
             assert!(q.push(sp(t, t as f64, 0), 1));
         }
+        assert_eq!(q.depth(2), 0, "the batch waits for its tail");
         assert!(!q.push(sp(6, 0.0, 0), 1), "not later than the queue");
         assert!(!q.push(sp(7, 0.0, 1), 1), "another episode");
+        q.set_tail(&tail(7, &[6.0]));
         assert_eq!(q.depth(2), 4);
         assert!(!q.play(2).underrun, "still not armed");
         for t in 3..=6 {
@@ -322,32 +354,52 @@ mod tests {
         let mut q = SetpointQueue::new();
         for t in 1..=3 {
             q.push(sp(t, t as f64, 0), 0);
-            q.play(t);
         }
         q.set_tail(&tail(4, &[3.8, 4.4, 4.7, 4.8]));
+        for t in 1..=3 {
+            q.play(t);
+        }
         let played: Vec<f64> = (4..=9).map(|t| q.play(t).setpoint.position[0]).collect();
         assert_eq!(played, [3.8, 4.4, 4.7, 4.8, 4.8, 4.8]);
         assert_eq!((q.episode(), q.dry_tick(), q.underrun_ticks), (1, 4, 6));
         assert_eq!(q.tailless_stops, 0);
         assert!(!q.push(sp(12, 9.0, 0), 9), "planned before the stop");
-        assert!(q.push(sp(11, 4.8, 1), 9));
+        batch(&mut q, 11..=11, 9, 1);
         assert!(
             q.play(10).underrun,
             "held until the new episode's first tick"
         );
         let p = q.play(11);
         assert!(!p.underrun);
-        assert_eq!(p.setpoint.position[0], 4.8);
+        assert_eq!(p.setpoint.position[0], 11.0);
         assert_eq!(q.underrun_ticks, 7);
+    }
+
+    /// Motion stopped between a batch and its tail: the batch is left out and the queue runs
+    /// dry where the last tail starts, which plays.
+    #[test]
+    fn a_batch_without_its_tail_does_not_play() {
+        let mut q = SetpointQueue::new();
+        batch(&mut q, 1..=3, 0, 0);
+        for t in 4..=5 {
+            assert!(q.push(sp(t, 9.0, 0), 0));
+        }
+        for t in 1..=3 {
+            q.play(t);
+        }
+        let p = q.play(4);
+        assert!(p.underrun);
+        assert_eq!(p.setpoint.position[0], 3.0, "the tail of the batch 1–3");
+        assert_eq!(q.tailless_stops, 0);
     }
 
     /// A tail that does not start where the queue ran dry is not played: the drives hold.
     #[test]
     fn a_tail_of_another_batch_is_not_played() {
         let mut q = SetpointQueue::new();
-        q.set_tail(&tail(2, &[9.0]));
+        batch(&mut q, 1..=3, 0, 0);
+        q.set_tail(&tail(9, &[9.0]));
         for t in 1..=3 {
-            q.push(sp(t, t as f64, 0), 0);
             q.play(t);
         }
         assert_eq!(q.play(4).setpoint.position[0], 3.0);
@@ -360,11 +412,10 @@ mod tests {
     #[test]
     fn an_emergency_stop_ramps_each_axis_to_a_stop() {
         let mut q = SetpointQueue::new();
+        batch(&mut q, 1..=4, 0, 0);
         for t in 1..=3 {
-            q.push(sp(t, t as f64, 0), 0);
             q.play(t);
         }
-        q.push(sp(4, 4.0, 0), 3);
         // 1 mm a tick, losing at most 0.3 mm a tick: 1 s period, 0.3 mm/s².
         q.emergency_stop(true, &[0.3], 1.0);
         assert_eq!(q.episode(), 1);
@@ -378,8 +429,8 @@ mod tests {
         assert!(q.stopped_by_emergency_stop());
         assert_eq!(q.underrun_ticks, 0, "a stop, not an underrun");
         q.emergency_stop(false, &[0.3], 1.0);
-        assert!(q.push(sp(12, 4.2, 1), 9));
+        batch(&mut q, 12..=12, 9, 1);
         assert!(!q.play(10).underrun);
-        assert_eq!(q.play(12).setpoint.position[0], 4.2);
+        assert_eq!(q.play(12).setpoint.position[0], 12.0);
     }
 }

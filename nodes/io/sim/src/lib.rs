@@ -166,18 +166,13 @@ impl SimLathe {
         self.powered_off = pressed;
     }
 
-    /// The emergency-stop input alone: the PLC sees it and the spindle stops; the axes' drives
-    /// keep power until [`SimLathe::power_drives`] removes it, so they can ramp to a stop
-    /// first (a stop of category 1, with the drives' setpoint queue).
-    pub fn set_emergency_stop_input(&mut self, pressed: bool) {
-        self.emergency_stop = pressed;
-    }
-
     /// Whether the emergency-stop input is pressed.
     pub fn emergency_stop_pressed(&self) -> bool {
         self.emergency_stop
     }
 
+    /// Power to the axes' drives. With the setpoint queue the io node gives it back after an
+    /// emergency stop until the drives have ramped to a stop (a stop of category 1, D134).
     pub fn power_drives(&mut self, on: bool) {
         self.powered_off = !on;
     }
