@@ -218,7 +218,7 @@ impl SetpointQueue {
         if let Some(t) = self.braking.as_ref().filter(|t| t.len > 0) {
             let len = (t.len as usize).min(TAIL_TICKS);
             let i = ((tick - since) as usize).min(len - 1);
-            let n = self.last.axis_count as usize;
+            let n = (self.last.axis_count as usize).min(MAX_AXES);
             self.before_last = self.last.position;
             self.last.position[..n].copy_from_slice(&t.position[i][..n]);
         }
