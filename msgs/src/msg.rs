@@ -380,7 +380,8 @@ ros_message! {
             HANDWHEEL_X100: u8 = 20,
             Z_AXIS_LOCK_KEY: u8 = 21,
             HANDWHEEL_DETENT: u8 = 22,
-            HANDWHEEL_TRIAL_KEY: u8 = 23
+            HANDWHEEL_TRIAL_KEY: u8 = 23,
+            FEED_HOLD_KEY: u8 = 24
         }
         input: u8,
         value: bool,

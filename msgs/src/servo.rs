@@ -37,6 +37,25 @@ pub struct ServoSetpoint {
     /// take only setpoints of their own episode, so nothing planned before a dry queue plays
     /// after the brake tail.
     pub episode: u32,
+    /// With the setpoint queue: how the drives may time-scale this setpoint (one of
+    /// `ServoSetpoint::SCALE_*`): feed hold and the overrides act at the drives, by playing the
+    /// queued path slower (issue 48).
+    pub scaling: u32,
+    /// The feed override the setpoint was planned at (a `SCALE_FEED` setpoint): the drives
+    /// play it at the operator's override over this one, at most 1.
+    pub planned_override: f64,
+}
+
+impl ServoSetpoint {
+    /// Played as queued, one a tick: spindle-locked moves (threads, taps), manual moves, an
+    /// idle machine. Feed hold and overrides do not act on it at the drives.
+    pub const SCALE_FIXED: u32 = 0;
+    /// A program's wait (dwell, an M/S/T answer): feed hold stops it, no override slows it.
+    pub const SCALE_WAIT: u32 = 1;
+    /// A feed move: feed hold and the feed override act.
+    pub const SCALE_FEED: u32 = 2;
+    /// A rapid: feed hold and the rapid override act.
+    pub const SCALE_RAPID: u32 = 3;
 }
 
 impl Default for ServoSetpoint {
@@ -51,6 +70,8 @@ impl Default for ServoSetpoint {
             torque_limit_percent: [100.0; MAX_AXES],
             tick: 0,
             episode: 0,
+            scaling: ServoSetpoint::SCALE_FIXED,
+            planned_override: 1.0,
         }
     }
 }
@@ -149,6 +170,15 @@ pub struct ServoFeedback {
     pub episode_ended: u32,
     /// 1 while the emergency-stop input is pressed at the drives.
     pub emergency_stop: u32,
+    /// 1 while the drives hold the queued path (feed hold reached them).
+    pub held: u32,
+    /// The rate the drives advance along the queued path, 0–1 (1: a setpoint a tick).
+    pub scale: f64,
+    /// With the setpoint queue: the setpoint the drives played this tick (interpolated on
+    /// the queued path while it is time-scaled).
+    pub setpoint: [f64; MAX_AXES],
+    /// The resets the drives have stopped for ([`DriveControl::resets`] once done).
+    pub resets_done: u32,
 }
 
 impl ServoFeedback {
@@ -156,6 +186,8 @@ impl ServoFeedback {
     pub const ENDED_DRY: u32 = 0;
     /// Emergency stop: the drives ramped to a stop on their own and removed power.
     pub const ENDED_EMERGENCY_STOP: u32 = 1;
+    /// Reset: the drives stopped on the queued path and dropped the rest of it.
+    pub const ENDED_RESET: u32 = 2;
 }
 
 impl Default for ServoFeedback {
@@ -187,6 +219,31 @@ impl Default for ServoFeedback {
             dry_tick: 0,
             episode_ended: 0,
             emergency_stop: 0,
+            held: 0,
+            scale: 1.0,
+            setpoint: [0.0; MAX_AXES],
+            resets_done: 0,
         }
     }
+}
+
+/// What motion tells the drives beside the queue, at once (issue 48): its feed hold, and
+/// counters of the cycle starts and resets it took, so the drives release a hold they took
+/// from the PLC's feed-hold signal, and stop for a reset until their
+/// [`ServoFeedback::resets_done`] is the same count (counters, so a value read late or
+/// missed loses nothing).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(
+    feature = "shm",
+    derive(ZeroCopySend),
+    type_name("cnc_msgs::DriveControl")
+)]
+#[repr(C)]
+pub struct DriveControl {
+    /// 1 while motion is in feed hold.
+    pub hold: u32,
+    /// Cycle starts motion took (wrapping).
+    pub starts: u32,
+    /// Resets motion took (wrapping).
+    pub resets: u32,
 }

@@ -355,6 +355,7 @@ pub mod x {
     pub const ROBOT_CYCLE_START: Bit = bit(8, 5);
     /// Panel keys (X10–X15 of the manual).
     pub const KEY_CYCLE_START: Bit = bit(13, 1);
+    pub const KEY_FEED_HOLD: Bit = bit(15, 3);
     pub const KEY_RESET: Bit = bit(15, 6);
     pub const KEY_SINGLE_BLOCK: Bit = bit(10, 3);
     /// Feed override switch, percent in binary (a coded rotary switch on the panel).

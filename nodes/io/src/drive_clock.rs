@@ -3,18 +3,21 @@
 //! stepping the simulated machine once per tick it missed, so the host's lateness never becomes
 //! the machine's (a real drive's clock is not late). Each tick plays the setpoint motion queued
 //! for it ([`SetpointQueue`]), or the brake tail when the queue ran dry, and reports feedback
-//! stamped with the tick. The drive trace, when the config names a file, gets one line a tick.
+//! stamped with the tick. Feed hold and the overrides reach the drives here, from the PLC's G
+//! image and motion's control, and time-scale the queued path (D135). The drive trace, when the
+//! config names a file, gets one line a tick.
 
 use std::io::Write;
 
-use cnc_msgs::servo::{BrakeTail, ServoFeedback, ServoSetpoint};
-use cnc_msgs::signals::YImage;
+use cnc_msgs::servo::{BrakeTail, DriveControl, ServoFeedback, ServoSetpoint};
+use cnc_msgs::signals::{GImage, YImage};
 use cnc_runtime::clock::{monotonic_ns, sleep_until_ns};
 use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::node::{take_network_inputs, Doors};
 use crate::sim::drive_queue::{trace_header, trace_line, SetpointQueue};
+use crate::sim::time_scale::HoldLatch;
 use crate::SimLathe;
 
 /// Setpoints and feedback a stream channel buffers: 4 s at the 4 ms period, more than any
@@ -116,6 +119,10 @@ pub fn run(
     let tails = shm.receiver::<BrakeTail>(channel::BRAKE_TAIL, false)?;
     let feedback =
         shm.stream_sender::<ServoFeedback>(channel::FEEDBACK_STREAM, true, STREAM_DEPTH)?;
+    let g_in = shm.receiver::<GImage>(channel::G_IMAGE, false)?;
+    let control = shm.receiver::<DriveControl>(channel::DRIVE_CONTROL, false)?;
+    let mut g = GImage::released();
+    let mut latch = HoldLatch::default();
     let period = cfg.servo.period_ms / 1000.0;
     let period_ns = (cfg.servo.period_ms * 1e6) as u64;
     let ticks_per_second = (1.0 / period).round().max(1.0) as u64;
@@ -133,6 +140,7 @@ pub fn run(
         .iter()
         .map(|a| a.max_acceleration)
         .collect();
+    queue.set_limits(&decel, period);
     let mut estop = false;
     let t0 = monotonic_ns();
     let mut tick = 0u64;
@@ -163,11 +171,16 @@ pub fn run(
         arrived.clear();
         setpoints.take_all(&mut arrived)?;
         for sp in &arrived {
-            queue.push(*sp, tick);
+            queue.push(*sp);
         }
         if let Some(t) = tail {
             queue.set_tail(&t);
         }
+        if let Some(latest) = g_in.latest()? {
+            g = latest;
+        }
+        let scaling = latch.update(&g, control.latest()?);
+        queue.reset(latch.resets());
         // Every tick that is due by now, by index: a late wake-up catches up.
         let due_ticks = (now.saturating_sub(t0) / period_ns).max(tick + 1);
         lateness.record(
@@ -176,23 +189,28 @@ pub fn run(
         );
         while tick < due_ticks {
             tick += 1;
-            let played = queue.play(tick);
+            let played = queue.play(&scaling);
             let mut fb = sim.step(&played.setpoint, &y, period);
-            let depth = queue.depth(tick);
-            fb.tick = tick;
+            let depth = queue.depth();
+            fb.tick = queue.position();
             fb.queue_depth = depth;
             fb.underrun = u32::from(played.underrun);
             fb.episode = queue.episode();
             fb.dry_tick = queue.dry_tick();
             fb.episode_ended = queue.episode_ended();
             fb.emergency_stop = u32::from(estop);
-            if played.setpoint.tick == tick && !played.underrun {
+            fb.held = u32::from(scaling.hold);
+            fb.scale = played.scale;
+            fb.setpoint = played.setpoint.position;
+            fb.resets_done = queue.resets_done();
+            if !played.underrun && queue.armed() {
                 min_depth = Some(min_depth.map_or(depth, |d| d.min(depth)));
             }
             feedback.send(fb)?;
             if let Some(t) = &mut trace {
                 let spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
-                let line = trace_line(tick, &played, &fb.position[..n], depth, estop, spindle);
+                let flags = (estop, scaling.hold);
+                let line = trace_line(tick, &played, &fb.position[..n], depth, flags, spindle);
                 t.write(&line, ticks_per_second);
             }
         }

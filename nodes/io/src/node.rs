@@ -109,6 +109,7 @@ fn input_bit(input: u8) -> Option<Bit> {
         SimInput::HANDWHEEL_X100 => x::HANDWHEEL_X100,
         SimInput::Z_AXIS_LOCK_KEY => x::KEY_Z_AXIS_LOCK,
         SimInput::HANDWHEEL_TRIAL_KEY => x::KEY_HANDWHEEL_TRIAL,
+        SimInput::FEED_HOLD_KEY => x::KEY_FEED_HOLD,
         _ => return None,
     })
 }
@@ -283,6 +284,7 @@ mod tests {
             (SimInput::HANDWHEEL_X100, x::HANDWHEEL_X100),
             (SimInput::Z_AXIS_LOCK_KEY, x::KEY_Z_AXIS_LOCK),
             (SimInput::HANDWHEEL_TRIAL_KEY, x::KEY_HANDWHEEL_TRIAL),
+            (SimInput::FEED_HOLD_KEY, x::KEY_FEED_HOLD),
         ] {
             assert!(apply_input(&mut sim, &input(key, true)));
             let y = YImage::default();

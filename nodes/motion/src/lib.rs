@@ -34,6 +34,7 @@ impl FromLaunch for MotionConfig {
             reference_order: cfg.reference_order(),
             spindle_max_rpm: cfg.limits.spindle_max_rpm,
             feedback_delay_ticks: cfg.servo.drive_queue_ticks().max(1) as u32,
+            time_scaling_at_drives: cfg.servo.drive_queue_ticks() > 0,
         }
     }
 }

@@ -14,7 +14,9 @@ use std::collections::VecDeque;
 use std::sync::mpsc::{Receiver, Sender};
 use std::time::Duration;
 
-use cnc_msgs::servo::{BrakeTail, ServoFeedback, ServoSetpoint, MAX_AXES, TAIL_TICKS};
+use cnc_msgs::servo::{
+    BrakeTail, DriveControl, ServoFeedback, ServoSetpoint, MAX_AXES, TAIL_TICKS,
+};
 use cnc_msgs::signals::{FImage, GImage};
 use cnc_runtime::clock::monotonic_ns;
 use cnc_runtime::shm::{channel, ShmNode};
@@ -96,6 +98,10 @@ struct Feeder {
     dry_shown: bool,
     missing_feedback: u64,
     last_wake: u64,
+    /// What the drives were last told beside the queue.
+    control: DriveControl,
+    /// Wake-ups without planning (the periodic status counts them).
+    idle_wakes: u64,
 }
 
 impl Feeder {
@@ -104,6 +110,17 @@ impl Feeder {
     /// are; the next episode starts from there).
     fn episode_ended(&mut self, newest: &ServoFeedback, now: u64, reports: &Sender<Report>) {
         self.episode = newest.episode;
+        if newest.episode_ended == ServoFeedback::ENDED_RESET {
+            // The drives stopped on the queued path for motion's reset: go on from there.
+            self.tails.kept.clear();
+            self.motion.stand_at(&newest.setpoint[..self.n]);
+            self.next_tick = newest.tick + self.ahead;
+            return;
+        }
+        if self.control.resets != newest.resets_done {
+            // A dry queue on the way to the reset's stop is part of it.
+            return;
+        }
         if newest.episode_ended == ServoFeedback::ENDED_EMERGENCY_STOP {
             self.tails.kept.clear();
             self.next_tick = newest.tick + self.ahead;
@@ -130,6 +147,16 @@ impl Feeder {
         log::warn!("{text}");
         let _ = reports.send(Report::Warning(alarm::SERVO_OVERRUN, Some(text)));
         self.dry_shown = true;
+    }
+
+    /// Tells the drives motion's feed hold, cycle starts and resets when they change.
+    fn tell_drives(&mut self, out: &Channels) -> Result<(), String> {
+        let control = self.motion.drive_control();
+        if control == self.control {
+            return Ok(());
+        }
+        self.control = control;
+        out.control.send(control)
     }
 
     /// Computes the setpoints up to `newest.tick` + the queue's length, each with the
@@ -189,6 +216,7 @@ struct Channels {
     setpoints: cnc_runtime::shm::Sender<ServoSetpoint>,
     tails: cnc_runtime::shm::Sender<BrakeTail>,
     f_image: cnc_runtime::shm::Sender<FImage>,
+    control: cnc_runtime::shm::Sender<DriveControl>,
 }
 
 /// Waits for the drives' first feedback (not past shutdown or 30 s); everything that came.
@@ -223,6 +251,7 @@ pub(crate) fn servo_loop(
         setpoints: shm.stream_sender(channel::SETPOINT_QUEUE, false, STREAM_DEPTH)?,
         tails: shm.sender(channel::BRAKE_TAIL, false)?,
         f_image: shm.sender(channel::F_IMAGE, false)?,
+        control: shm.sender(channel::DRIVE_CONTROL, false)?,
     };
     let feedback =
         shm.stream_receiver::<ServoFeedback>(channel::FEEDBACK_STREAM, true, STREAM_DEPTH)?;
@@ -272,7 +301,10 @@ pub(crate) fn servo_loop(
         dry_shown: false,
         missing_feedback: 0,
         last_wake: monotonic_ns(),
+        control: DriveControl::default(),
+        idle_wakes: 0,
     };
+    out.control.send(p.control)?;
     let mut arrived = Vec::with_capacity(STREAM_DEPTH);
     while !shutdown.requested() {
         feedback.wait_for_any(Duration::from_nanos(period_ns))?;
@@ -286,13 +318,32 @@ pub(crate) fn servo_loop(
             p.episode_ended(&newest, now, &reports);
         }
         p.last_wake = now;
-        if newest.tick + ahead < p.next_tick + BATCH_TICKS - 1 {
-            continue;
-        }
-        p.clock.tick(now, false, &mut p.motion, &reports);
+        // Requests and the operator's signals at every wake, planned or not: a hold at the
+        // drives keeps the queue full, and only a cycle start or reset taken here ends it.
         take_inputs(&inputs, &mut p.motion, &mut p.clock, &mut p.plc, &reports);
         let line = p.motion.line();
         plc_signals(g_in.latest()?, &mut p.g, &mut p.plc, now, line, &reports);
+        p.motion.plc_signals(&p.g);
+        p.tell_drives(&out)?;
+        // After a reset nothing is sent until the drives have stopped for it on the queued
+        // path and ended the episode: motion goes on from where they stand.
+        let resetting = p.control.resets != newest.resets_done;
+        if resetting || newest.tick + ahead < p.next_tick + BATCH_TICKS - 1 {
+            // Nothing to plan (the queue is full: held at the drives, or a reset on its way):
+            // the state and alarms are reported all the same, at the wakes' rate.
+            p.idle_wakes += 1;
+            let (wakes, clock) = (p.idle_wakes, &p.clock);
+            p.reporter.report(
+                &mut p.motion,
+                wakes,
+                &p.latest,
+                clock,
+                mcfg.period,
+                &reports,
+            );
+            continue;
+        }
+        p.clock.tick(now, false, &mut p.motion, &reports);
         let computing = monotonic_ns();
         p.plan_batch(&newest, mcfg.period, &out, &reports)?;
         let done = monotonic_ns();

@@ -273,6 +273,8 @@ pub mod channel {
     pub const SETPOINT_QUEUE: &str = "servo/queue";
     pub const BRAKE_TAIL: &str = "servo/brake_tail";
     pub const FEEDBACK_STREAM: &str = "servo/feedback_stream";
+    /// Motion's feed hold, cycle starts and resets, to the drives (issue 48).
+    pub const DRIVE_CONTROL: &str = "servo/drive_control";
 }
 
 /// Instance name of a cell: namespace plus domain, so cells and tests never share channels.

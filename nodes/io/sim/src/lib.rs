@@ -12,6 +12,7 @@ pub mod devices;
 pub mod drive_queue;
 pub mod probe;
 pub mod spindle_position;
+pub mod time_scale;
 
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{x, y, SignalTable, XImage, YImage};

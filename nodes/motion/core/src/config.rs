@@ -33,6 +33,9 @@ pub struct MotionConfig {
     /// (it answers the last setpoint), the queue's length with the drives' setpoint queue
     /// (issue 48), where motion computes a tick that far ahead of the drives.
     pub feedback_delay_ticks: u32,
+    /// With the drives' setpoint queue: feed hold and the overrides act at the drives, which
+    /// time-scale the queued path (D135); the core plans as if they were off.
+    pub time_scaling_at_drives: bool,
 }
 
 impl MotionConfig {

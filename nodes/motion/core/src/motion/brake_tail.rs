@@ -28,6 +28,8 @@ impl Motion {
             hold.set(g::jog_minus(k), false);
         }
         m.events.clear();
+        // The tail is the core's own stop: the drives play it as it is planned.
+        m.at_drives.on = false;
         m.feed_hold();
         m.jog_stop();
         m.handwheel.stop();
@@ -51,6 +53,7 @@ impl Motion {
             }
         }
         m.events.clear();
+        m.at_drives = self.at_drives;
         PlannedStop { len, stopped: m }
     }
 

@@ -28,6 +28,7 @@ mod activate;
 mod brake_tail;
 mod compressor;
 mod drive_fault;
+mod drive_scaling;
 mod feedforward;
 mod fixed_stop;
 pub mod handwheel;
@@ -152,6 +153,8 @@ pub struct Motion {
     actual: Vec<f64>,
     feed_hold: bool,
     cycle_stop: bool,
+    /// With the drives' queue: what the drives' time-scaling takes over (D135).
+    at_drives: drive_scaling::AtDrives,
     /// Emergency stop from the PLC (`*ESP` low): servo hold, the run dropped. Releasing it
     /// returns the NC to the reset state, as on a FANUC control, but blocks of the dropped run
     /// stay refused (`dead_run`).
@@ -255,6 +258,7 @@ impl Motion {
         }
         let thread = ThreadChain::new(cfg.lookahead.max(1), cfg.planner().limits);
         let delay = cfg.feedback_delay_ticks.max(1) as usize;
+        let cfg_scaling = cfg.time_scaling_at_drives;
         let referenced = cfg.axes.iter().map(|a| a.reference.is_none()).collect();
         let signal_axis = cfg
             .axes
@@ -310,6 +314,10 @@ impl Motion {
             commanded,
             feed_hold: false,
             cycle_stop: false,
+            at_drives: drive_scaling::AtDrives {
+                on: cfg_scaling,
+                ..Default::default()
+            },
             emergency_stop: false,
             dead_run: 0,
             plc_start: false,
@@ -443,6 +451,7 @@ impl Motion {
 
     /// Cycle start: resumes after feed hold, and after a single-block, M00 or M01 stop.
     pub fn cycle_start(&mut self) {
+        self.at_drives.starts = self.at_drives.starts.wrapping_add(1);
         self.feed_hold = false;
         self.block_stop = false;
     }
@@ -456,6 +465,7 @@ impl Motion {
     /// Reset: clears the alarm state and the queue; the axes stop where they are. The run
     /// is dropped: its blocks still on their way are let go.
     pub fn reset(&mut self) {
+        self.at_drives.resets = self.at_drives.resets.wrapping_add(1);
         self.dead_run = self.run_id;
         self.program_running = false;
         self.reset_ticks = RESET_SIGNAL_TICKS;
@@ -737,6 +747,7 @@ impl Motion {
                 self.queue.clear();
                 break;
             }
+            self.count_locked_wait();
             if self.advance(dt, plc) {
                 let moved = matches!(
                     self.active,
@@ -835,7 +846,11 @@ impl Motion {
 
     /// Advances the active block by one tick; true when it is finished.
     fn advance(&mut self, dt: f64, plc: &GImage) -> bool {
-        let hold = self.feed_hold;
+        let hold = self.planning_hold();
+        let (feed_scale, rapid_scale) = (
+            self.planning_feed_override(),
+            self.planning_rapid_override(),
+        );
         let in_pos = self.in_position();
         let n = self.commanded.len().min(MAX_AXES);
         // A rapid runs in the program's profile too (BRISK/SOFT act on every path move).
@@ -880,7 +895,7 @@ impl Motion {
                 let braking = self.probe_braking() || self.fixed_stop_braking();
                 let end = self.planner.step(
                     hold || braking,
-                    self.panel.feed_override,
+                    feed_scale,
                     self.trial.speed_cap(),
                     &mut self.finished,
                     &mut out,
@@ -907,8 +922,7 @@ impl Motion {
                 for (i, ax) in axes.iter_mut().enumerate().take(n) {
                     if ax.travelled < ax.length {
                         let limits = Limits {
-                            velocity: (lim.velocity[i] * self.panel.rapid_override)
-                                .min(self.trial.speed_cap()),
+                            velocity: (lim.velocity[i] * rapid_scale).min(self.trial.speed_cap()),
                             acceleration: lim.acceleration[i],
                             jerk: lim.jerk[i],
                         };
@@ -952,7 +966,7 @@ impl Motion {
                     self.clear_strobe();
                     return true;
                 }
-                if !in_pos || hold || plc.get(g::FIN) {
+                if !in_pos || self.feed_hold || plc.get(g::FIN) {
                     return false;
                 }
                 // Auxiliary function lock: done without the PLC; the program stops stay. The

@@ -103,7 +103,7 @@ impl Motion {
     pub(super) fn tap_tick(&mut self, tap: &mut Tap, plc: &GImage, in_pos: bool) -> bool {
         let e = self.encoder;
         let Some(from) = tap.from else {
-            if in_pos && !plc.get(g::FIN) {
+            if in_pos && !plc.get(g::FIN) && self.locked_move_may_start() {
                 tap.from = Some(e.turned);
                 strobe_stop_position(&mut self.f, tap.degrees, Turn::Incremental, tap.rpm);
             }

@@ -178,7 +178,7 @@ impl Motion {
             self.queue.pop_front();
         }
         // Under feed hold the thread does not start; once started, it is cut to its end.
-        if self.thread.synchronised() || self.feed_hold {
+        if self.thread.synchronised() || self.feed_hold || !self.locked_move_may_start() {
             return Ok(());
         }
         // With the drives' queue the encoder reading is a queue's length old and the thread's

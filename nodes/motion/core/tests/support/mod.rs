@@ -41,6 +41,7 @@ pub fn lathe() -> MotionConfig {
         reference_order: vec![0, 1],
         spindle_max_rpm: 6000.0,
         feedback_delay_ticks: 1,
+        time_scaling_at_drives: false,
     }
 }
 
