@@ -28,6 +28,7 @@ const ESTOP: u16 = 169;
 const THREADS: u16 = 170;
 const KILLED: u16 = 171;
 const HOLD: u16 = 172;
+const ESTOP_KILLED: u16 = 173;
 const NODES: [&str; 5] = ["io", "plc", "motion", "interpreter", "hmi-bridge"];
 
 /// Lines, arcs both ways and a thread at a speed whose revolution is a whole number of ticks
@@ -511,19 +512,27 @@ fn a_stall_beyond_the_queue_stops_on_the_path_and_cycle_start_goes_on() {
 /// PLC sees it too. The queue is not what stops them: no tick is an underrun.
 #[test]
 fn emergency_stop_ramps_at_the_drives_with_motion_stopped() {
+    emergency_stop_with_motion(libc::SIGSTOP, ESTOP);
+}
+
+/// The same with the motion process killed (SIGKILL) as the input is pressed.
+#[test]
+fn emergency_stop_ramps_at_the_drives_with_motion_killed() {
+    emergency_stop_with_motion(libc::SIGKILL, ESTOP_KILLED);
+}
+
+fn emergency_stop_with_motion(signal: i32, domain: u16) {
     use cnc_msgs::msg::SimInput;
-    let dir = common::fresh_dir("drive_queue_estop");
+    let dir = common::fresh_dir(&format!("drive_queue_estop_{signal}"));
     let program = "G00 X60 Z140\nG01 Z-300 F3000\nM30\n";
-    let run = Cut::start_program(&dir, "estop", program, ESTOP);
-    let mut panel = cnc_runtime::dds::RosNode::new(&net(ESTOP), "lathe1", "estop_panel").unwrap();
+    let run = Cut::start_program(&dir, "estop", program, domain);
+    let mut panel = cnc_runtime::dds::RosNode::new(&net(domain), "lathe1", "estop_panel").unwrap();
     let input = panel
         .dds_publisher::<SimInput>(&cnc_runtime::topics::SIM_INPUT)
         .unwrap();
     let motion = run.nodes.pid("motion");
     // Z runs at 50 mm/s from about 1.5 s on; it has 8.8 s to go.
     std::thread::sleep(Duration::from_millis(3500));
-    // SAFETY: kill(2) on our own child's pid.
-    unsafe { libc::kill(motion, libc::SIGSTOP) };
     let press = |value| {
         input
             .publish(SimInput {
@@ -532,6 +541,13 @@ fn emergency_stop_ramps_at_the_drives_with_motion_stopped() {
             })
             .unwrap()
     };
+    // Killed: the input is on its way before motion dies, so it is the emergency stop, not a
+    // dry queue, that stops the drives.
+    if signal == libc::SIGKILL {
+        press(true);
+    }
+    // SAFETY: kill(2) on our own child's pid.
+    unsafe { libc::kill(motion, signal) };
     press(true);
     std::thread::sleep(Duration::from_millis(1000));
     unsafe { libc::kill(motion, libc::SIGCONT) };
