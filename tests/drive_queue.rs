@@ -29,6 +29,7 @@ const THREADS: u16 = 170;
 const KILLED: u16 = 171;
 const HOLD: u16 = 172;
 const ESTOP_KILLED: u16 = 173;
+const TAPS: u16 = 174;
 const NODES: [&str; 5] = ["io", "plc", "motion", "interpreter", "hmi-bridge"];
 
 /// Lines, arcs both ways and a thread at a speed whose revolution is a whole number of ticks
@@ -723,6 +724,77 @@ fn feed_hold_and_override_act_at_the_drives_with_motion_stopped() {
         rows.last().map(|r| &r.setpoint),
         "the same part"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The SINUMERIK 802D mill (rigid tapping, G331/G332).
+const MILL_802D: Machine = Machine {
+    config: "sim_mill_802d.yaml",
+    namespace: "mill2",
+    program: "",
+};
+
+/// Issue 48, must-show 4 (rigid tapping under stalls): G331 down 30 mm and G332 back at
+/// 0.8 mm a turn, with the drives' queue and the motion process stopped for 20 ms every
+/// 150 ms through both taps. The drives gear the slide to the spindle's encoder (D135), so at
+/// every tick the slide keeps to the spindle's helix within the 0.1 mm the lock-step tap
+/// meets (`plc_cell_mill.rs`), and each tap ends at its depth.
+#[test]
+fn rigid_taps_stay_locked_to_the_spindle_under_stalls() {
+    let dir = common::fresh_dir("drive_queue_taps");
+    let program =
+        "G0 X10 Y10 Z5\nSPOS=0\nG331 Z-25 K0.8 S600\nG4 F0.5\nG332 Z5 K0.8\nG0 Z50\nM30\n";
+    let run = Cut::start_on(&MILL_802D, &dir, "taps", program, TAPS);
+    for i in 0..40 {
+        run.stall(1500 + 150 * i, 20);
+    }
+    let rows = run.finish();
+    assert_eq!(rows.iter().filter(|r| r.underrun).count(), 0, "no underrun");
+    // Z's column; the spindle's angle unwrapped.
+    let z = 2;
+    let mut turned = Vec::with_capacity(rows.len());
+    let mut t = 0.0;
+    for (k, r) in rows.iter().enumerate() {
+        if k > 0 {
+            t += (r.spindle_angle - rows[k - 1].spindle_angle + 180.0).rem_euclid(360.0) - 180.0;
+        }
+        turned.push(t);
+    }
+    // The spindle's turning spans; the taps are those in which Z travels.
+    let mut taps = Vec::new();
+    let mut k = 1;
+    while k < rows.len() {
+        if rows[k].spindle_rpm == 0.0 {
+            k += 1;
+            continue;
+        }
+        let begin = k;
+        while k < rows.len() && rows[k].spindle_rpm != 0.0 {
+            k += 1;
+        }
+        let travel = rows[k - 1].actual[z] - rows[begin - 1].actual[z];
+        if travel.abs() > 1.0 {
+            taps.push((begin, k));
+        }
+    }
+    assert_eq!(taps.len(), 2, "down and back: {taps:?}");
+    let mut worst = 0.0f64;
+    for &(begin, end) in &taps {
+        let (z0, t0) = (rows[begin - 1].setpoint[z], turned[begin - 1]);
+        let down = if z0 > 0.0 { -1.0 } else { 1.0 };
+        for k in begin..end {
+            let want = z0 + down * (turned[k] - t0).abs() / 360.0 * 0.8;
+            worst = worst.max((rows[k].actual[z] - want).abs());
+        }
+        // Where the spindle stands (its positioning's own tolerance, as in lock-step).
+        let stop = rows[end].setpoint[z];
+        assert!(
+            (stop - (z0 + down * 30.0)).abs() < 1e-3,
+            "ends at its depth: {stop}"
+        );
+    }
+    println!("taps {taps:?}: slide off the spindle's helix by at most {worst:.4} mm");
+    assert!(worst < 0.1, "{worst} mm");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

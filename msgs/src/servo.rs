@@ -44,6 +44,13 @@ pub struct ServoSetpoint {
     /// The feed override the setpoint was planned at (a `SCALE_FEED` setpoint): the drives
     /// play it at the operator's override over this one, at most 1.
     pub planned_override: f64,
+    /// A `SCALE_GEARED` setpoint (rigid tapping): the drives set each axis from the
+    /// spindle's encoder, from `gear_start` to `gear_end` (setpoint units) while the spindle
+    /// turns `gear_degrees` (signed) from where it last stood: electronic gearing, whatever
+    /// the queue (issue 48).
+    pub gear_start: [f64; MAX_AXES],
+    pub gear_end: [f64; MAX_AXES],
+    pub gear_degrees: f64,
 }
 
 impl ServoSetpoint {
@@ -56,6 +63,9 @@ impl ServoSetpoint {
     pub const SCALE_FEED: u32 = 2;
     /// A rapid: feed hold and the rapid override act.
     pub const SCALE_RAPID: u32 = 3;
+    /// Locked to the spindle at the drives (rigid tapping): played one a tick as a fixed
+    /// setpoint, its position computed from the encoder (`gear_*`).
+    pub const SCALE_GEARED: u32 = 4;
 }
 
 impl Default for ServoSetpoint {
@@ -72,6 +82,9 @@ impl Default for ServoSetpoint {
             episode: 0,
             scaling: ServoSetpoint::SCALE_FIXED,
             planned_override: 1.0,
+            gear_start: [0.0; MAX_AXES],
+            gear_end: [0.0; MAX_AXES],
+            gear_degrees: 0.0,
         }
     }
 }

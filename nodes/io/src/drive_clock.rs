@@ -141,6 +141,15 @@ pub fn run(
         .map(|a| a.max_acceleration)
         .collect();
     queue.set_limits(&decel, period);
+    // A geared tap's setpoint is reached at the end of the tick, the slide trailing it by its
+    // drive's lag: computed that far ahead of the encoder.
+    let lead: Vec<f64> = cfg
+        .machine
+        .axes
+        .iter()
+        .map(|a| period + a.drive_lag.max(0.0))
+        .collect();
+    queue.set_gear_lead(&lead);
     let mut estop = false;
     let t0 = monotonic_ns();
     let mut tick = 0u64;
@@ -191,6 +200,7 @@ pub fn run(
             tick += 1;
             let played = queue.play(&scaling);
             let mut fb = sim.step(&played.setpoint, &y, period);
+            queue.read_spindle(fb.spindle_rpm, fb.spindle_angle_deg);
             let depth = queue.depth();
             fb.tick = queue.position();
             fb.queue_depth = depth;

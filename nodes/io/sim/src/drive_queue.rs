@@ -83,6 +83,32 @@ pub struct SetpointQueue {
     resetting: bool,
     resets: u32,
     resets_done: u32,
+    /// The spindle's encoder as the drives read it, and the tap they gear to it.
+    spindle: SpindleReading,
+    gear: Option<Gear>,
+    /// Per axis, how far ahead of the encoder reading a geared setpoint is computed, s (the
+    /// period and the drive's lag, as motion's lock-step tap).
+    gear_lead: [f64; MAX_AXES],
+}
+
+/// The spindle encoder at the drives: degrees turned (signed, unwrapped), speed (rpm), and
+/// where it last stood (a tap's origin).
+#[derive(Debug, Clone, Copy, Default)]
+struct SpindleReading {
+    raw: Option<f64>,
+    turned: f64,
+    rpm: f64,
+    standing: f64,
+}
+
+/// Electronic gearing of a tap: each axis from `start` to `end` while the spindle turns
+/// `degrees` from `origin` (degrees turned).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Gear {
+    start: [f64; MAX_AXES],
+    end: [f64; MAX_AXES],
+    degrees: f64,
+    origin: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -124,6 +150,9 @@ impl SetpointQueue {
             resetting: false,
             resets: 0,
             resets_done: 0,
+            spindle: SpindleReading::default(),
+            gear: None,
+            gear_lead: [0.0; MAX_AXES],
         }
     }
 
@@ -132,6 +161,29 @@ impl SetpointQueue {
     pub fn set_limits(&mut self, acceleration: &[f64], period: f64) {
         for (l, a) in self.limit.iter_mut().zip(acceleration) {
             *l = a.abs() * period * period;
+        }
+    }
+
+    /// Per axis, how far ahead of the encoder a geared setpoint is computed (s).
+    pub fn set_gear_lead(&mut self, lead: &[f64]) {
+        for (l, v) in self.gear_lead.iter_mut().zip(lead) {
+            *l = *v;
+        }
+    }
+
+    /// The spindle encoder's reading after a tick: speed (rpm, signed) and angle (degrees).
+    pub fn read_spindle(&mut self, rpm: f64, angle_deg: f64) {
+        if !rpm.is_finite() || !angle_deg.is_finite() {
+            return;
+        }
+        let s = &mut self.spindle;
+        if let Some(prev) = s.raw {
+            s.turned += (angle_deg - prev + 180.0).rem_euclid(360.0) - 180.0;
+        }
+        s.raw = Some(angle_deg);
+        s.rpm = rpm;
+        if rpm == 0.0 {
+            s.standing = s.turned;
         }
     }
 
@@ -270,6 +322,7 @@ impl SetpointQueue {
             self.last = sp;
             self.last.position = keep;
         }
+        let position = self.geared(position);
         let underrun = self.dry_since.is_some();
         if underrun {
             self.underrun_ticks += 1;
@@ -297,7 +350,8 @@ impl SetpointQueue {
             let held = self.last.position;
             self.last = sp;
             self.last.position = held;
-            return self.played(sp.position, false);
+            let position = self.geared(sp.position);
+            return self.played(position, false);
         }
         if let Some(q) = self.quick_stop.as_mut() {
             let mut p = self.last.position;
@@ -310,13 +364,50 @@ impl SetpointQueue {
         self.played(self.last.position, false)
     }
 
+    /// A tap's position: while the setpoints reached are geared (or a tail continues them),
+    /// each axis is set from the spindle's encoder, not from what was queued, so the tap stays
+    /// in its thread whatever the queue did.
+    fn geared(&mut self, queued: [f64; MAX_AXES]) -> [f64; MAX_AXES] {
+        if self.last_kind.0 != ServoSetpoint::SCALE_GEARED {
+            self.gear = None;
+            return queued;
+        }
+        let sp = &self.last;
+        let origin = match self.gear {
+            Some(g) if g.start == sp.gear_start && g.end == sp.gear_end => g.origin,
+            _ => self.spindle.standing,
+        };
+        let gear = Gear {
+            start: sp.gear_start,
+            end: sp.gear_end,
+            degrees: sp.gear_degrees,
+            origin,
+        };
+        self.gear = Some(gear);
+        let s = self.spindle;
+        let mut out = queued;
+        for (i, o) in out.iter_mut().enumerate() {
+            let ahead = s.turned + s.rpm / 60.0 * 360.0 * self.gear_lead[i];
+            let share = match gear.degrees != 0.0 {
+                true => ((ahead - gear.origin) / gear.degrees).clamp(0.0, 1.0),
+                false => 1.0,
+            };
+            *o = gear.start[i] + (gear.end[i] - gear.start[i]) * share;
+        }
+        out
+    }
+
     /// Moves the drives' position along the queued path by this tick's rate.
     fn advance(&mut self, scaling: &Scaling) {
         let k = self.position();
         let (kind, planned) = self
             .sample(k + 1)
             .map_or(self.last_kind, |s| (s.scaling, s.planned_override));
-        if kind == ServoSetpoint::SCALE_FIXED && !scaling.reset {
+        let fixed = matches!(
+            kind,
+            ServoSetpoint::SCALE_FIXED | ServoSetpoint::SCALE_GEARED
+        );
+        if fixed && !scaling.reset {
             // Spindle-locked and manual moves play one a tick, from a whole index: motion
             // starts them from rest, so the snap moves nothing (D135).
             self.scale = 1.0;
@@ -748,6 +839,39 @@ mod tests {
             run(&mut q, &hold, 15, &mut xs);
             run(&mut q, &Scaling::default(), 150, &mut xs);
             assert_eq!(xs[xs.len() - 1], path[path.len() - 1], "the path's end");
+        }
+    }
+
+    /// A geared tap follows the spindle's encoder from where it stood, not the queued
+    /// positions, and goes on following it when the queue runs dry.
+    #[test]
+    fn a_geared_tap_follows_the_spindle_whatever_the_queue() {
+        let mut q = SetpointQueue::new();
+        q.set_limits(&[1500.0], 0.004);
+        for t in 1..=20 {
+            let mut s = sp(t, 99.0, 0);
+            s.scaling = ServoSetpoint::SCALE_GEARED;
+            s.gear_start[0] = 5.0;
+            s.gear_end[0] = -25.0;
+            s.gear_degrees = 13_500.0;
+            q.push(s);
+        }
+        q.set_tail(&tail(21, &[99.0]));
+        q.read_spindle(0.0, 350.0);
+        // 600 rpm: 14.4° a tick, from 350° through the index mark.
+        let mut angle = 350.0;
+        for k in 0..40 {
+            let p = play(&mut q);
+            let turned = 14.4 * k as f64;
+            let want = 5.0 - 30.0 * turned / 13_500.0;
+            assert!(
+                (p.setpoint.position[0] - want).abs() < 1e-9,
+                "tick {k}: {} not {want}",
+                p.setpoint.position[0]
+            );
+            assert_eq!(p.underrun, k >= 20, "the queue runs dry at 20");
+            angle = (angle + 14.4f64).rem_euclid(360.0);
+            q.read_spindle(600.0, angle);
         }
     }
 

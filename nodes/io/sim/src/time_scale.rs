@@ -47,7 +47,7 @@ impl Scaling {
             }
         };
         match scaling {
-            ServoSetpoint::SCALE_FIXED => 1.0,
+            ServoSetpoint::SCALE_FIXED | ServoSetpoint::SCALE_GEARED => 1.0,
             _ if self.hold => 0.0,
             ServoSetpoint::SCALE_FEED if planned > 0.0 => clean(self.feed_override / planned),
             ServoSetpoint::SCALE_RAPID => clean(self.rapid_override),

@@ -2,7 +2,9 @@
 //! drives, which time-scale the queued path within a tick; the core plans as if they were off
 //! and tells the drives, with every setpoint, how it may be scaled. Spindle-locked moves
 //! cannot be scaled: a thread or tap starts only after a queue's length of unscaled waiting,
-//! so the encoder reading its start is computed from was taken at the rate it plays at.
+//! so the encoder reading its start is computed from was taken at the rate it plays at; a
+//! rigid tap is geared to the spindle's encoder at the drives (its start, end and degrees go
+//! with each setpoint).
 
 use cnc_msgs::servo::{DriveControl, ServoSetpoint};
 
@@ -60,6 +62,21 @@ impl Motion {
     /// setpoint a tick (always, without the drives' scaling).
     pub(super) fn locked_move_may_start(&self) -> bool {
         !self.at_drives.on || self.at_drives.locked_wait > self.cfg.feedback_delay_ticks
+    }
+
+    /// How the drives may scale this tick's setpoint, the feed override it was planned at,
+    /// and for a tap what they gear to the spindle.
+    pub fn fill_scaling(&self, sp: &mut ServoSetpoint) {
+        (sp.scaling, sp.planned_override) = self.setpoint_scaling();
+        if !self.at_drives.on {
+            return;
+        }
+        if let Some((start, end, degrees)) = self.tap_gear() {
+            sp.scaling = ServoSetpoint::SCALE_GEARED;
+            sp.gear_start = start;
+            sp.gear_end = end;
+            sp.gear_degrees = degrees;
+        }
     }
 
     /// How the drives may scale this tick's setpoint, and the feed override it was planned at.

@@ -85,7 +85,7 @@ impl Motion {
         sp.enable = u32::from(self.servo_enabled());
         sp.spindle_acceleration_percent = self.spindle_acceleration_percent();
         sp.torque_limit_percent = self.torque_limits();
-        (sp.scaling, sp.planned_override) = self.setpoint_scaling();
+        self.fill_scaling(sp);
     }
 
     pub fn spindle_acceleration_percent(&self) -> f64 {

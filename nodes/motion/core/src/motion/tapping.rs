@@ -97,6 +97,23 @@ impl Motion {
         })
     }
 
+    /// The active tap as the drives gear it (issue 48): start and end in setpoint units and
+    /// the spindle's degrees; none without a tap, or with an axis under machine lock.
+    pub(super) fn tap_gear(&self) -> Option<([f64; MAX_AXES], [f64; MAX_AXES], f64)> {
+        let Some((_, Active::Tap(tap))) = &self.active else {
+            return None;
+        };
+        if self.locked != 0 {
+            return None;
+        }
+        let (mut start, mut end) = ([0.0; MAX_AXES], [0.0; MAX_AXES]);
+        for i in 0..self.commanded.len().min(MAX_AXES) {
+            start[i] = tap.start[i] - self.shift[i];
+            end[i] = tap.end[i] - self.shift[i];
+        }
+        Some((start, end, tap.degrees))
+    }
+
     /// One tick of a tap: sends the positioning once the axes stand, then sets each axis by
     /// the spindle's angle read ahead by its lead time; true when the PLC's FIN says the
     /// spindle stands at the end, the axes then exactly on it. Feed hold does not stop it.
