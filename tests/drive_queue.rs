@@ -30,6 +30,7 @@ const KILLED: u16 = 171;
 const HOLD: u16 = 172;
 const ESTOP_KILLED: u16 = 173;
 const TAPS: u16 = 174;
+const JOG: u16 = 175;
 const NODES: [&str; 5] = ["io", "plc", "motion", "interpreter", "hmi-bridge"];
 
 /// Lines, arcs both ways and a thread at a speed whose revolution is a whole number of ticks
@@ -723,6 +724,92 @@ fn feed_hold_and_override_act_at_the_drives_with_motion_stopped() {
         path.last(),
         rows.last().map(|r| &r.setpoint),
         "the same part"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 48, must-show 3 (jog release at the drives, D135): the panel's −Z jog key held in JOG
+/// mode, then released with the motion process stopped: the drives stop the jog from the tick
+/// the release reaches them, within the axis's acceleration, and drop the rest of the queue;
+/// after motion comes back the machine stays where it stopped (motion goes on from there), and
+/// a new jog starts from that point without a step.
+#[test]
+fn a_jog_key_released_stops_the_drives_with_motion_stopped() {
+    use cnc_msgs::msg::SimInput;
+    let dir = common::fresh_dir("drive_queue_jog");
+    let mut run = Cut::start_program(&dir, "jog", "G04 X0.1\nM30\n", JOG);
+    common::wait(
+        &mut run.client,
+        Duration::from_secs(30),
+        "the program",
+        |c| {
+            c.state
+                .as_ref()
+                .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+        },
+    );
+    common::set_mode(&mut run.client, MachineState::MODE_JOG);
+    let mut panel = cnc_runtime::dds::RosNode::new(&net(JOG), "lathe1", "jog_panel").unwrap();
+    let input = panel
+        .dds_publisher::<SimInput>(&cnc_runtime::topics::SIM_INPUT)
+        .unwrap();
+    let key = |input_key, value| {
+        input
+            .publish(SimInput {
+                input: input_key,
+                value,
+            })
+            .unwrap()
+    };
+    let motion = run.nodes.pid("motion");
+    // The new publisher must be discovered before its first key counts.
+    std::thread::sleep(Duration::from_millis(2000));
+    key(SimInput::JOG_MINUS_Z_KEY, true);
+    std::thread::sleep(Duration::from_millis(1500));
+    // SAFETY: kill(2) on our own child's pid.
+    unsafe { libc::kill(motion, libc::SIGSTOP) };
+    key(SimInput::JOG_MINUS_Z_KEY, false);
+    std::thread::sleep(Duration::from_millis(300));
+    unsafe { libc::kill(motion, libc::SIGCONT) };
+    std::thread::sleep(Duration::from_millis(500));
+    key(SimInput::JOG_PLUS_Z_KEY, true);
+    std::thread::sleep(Duration::from_millis(500));
+    key(SimInput::JOG_PLUS_Z_KEY, false);
+    std::thread::sleep(Duration::from_millis(500));
+    drop(panel);
+    let rows = run.stop();
+    let z = |k: usize| rows[k].setpoint[1];
+    // The jog at 1000 mm/min: 0.0667 mm a tick; the release: the first tick heading for 0.
+    let k0 = (1..rows.len())
+        .find(|&k| rows[k].target == 0.0 && z(k - 1) - z(k - 2) < -0.06)
+        .expect("the release reached the drives while jogging");
+    assert!(rows[k0].scale < 1.0, "slower in the tick the release came");
+    assert!(
+        z(k0) - z(k0 - 1) > z(k0 - 1) - z(k0 - 2),
+        "decelerating at once"
+    );
+    let stood = (k0..rows.len())
+        .find(|&k| z(k) == z(k - 1))
+        .expect("stands");
+    assert!(
+        stood - k0 <= 10,
+        "stood {} ticks after the release",
+        stood - k0
+    );
+    assert_eq!(rows.iter().filter(|r| r.underrun).count(), 0, "no underrun");
+    // It stays there until the +Z jog, which starts from there without a step.
+    let moved = (stood..rows.len())
+        .find(|&k| z(k) != z(stood))
+        .expect("the +Z jog moved");
+    assert!(moved - stood > 100, "stood through the stall");
+    let limit = 1500.0 * 0.004 * 0.004 * 1.01;
+    for k in stood..rows.len() - 1 {
+        let dv = (z(k + 1) - z(k)) - (z(k) - z(k - 1));
+        assert!(dv.abs() <= limit, "tick {k}: a step in velocity {dv}");
+    }
+    assert!(
+        z(rows.len() - 1) > z(stood) + 5.0,
+        "the +Z jog went on from there"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

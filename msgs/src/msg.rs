@@ -381,7 +381,11 @@ ros_message! {
             Z_AXIS_LOCK_KEY: u8 = 21,
             HANDWHEEL_DETENT: u8 = 22,
             HANDWHEEL_TRIAL_KEY: u8 = 23,
-            FEED_HOLD_KEY: u8 = 24
+            FEED_HOLD_KEY: u8 = 24,
+            JOG_PLUS_X_KEY: u8 = 25,
+            JOG_MINUS_X_KEY: u8 = 26,
+            JOG_PLUS_Z_KEY: u8 = 27,
+            JOG_MINUS_Z_KEY: u8 = 28
         }
         input: u8,
         value: bool,

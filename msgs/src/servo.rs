@@ -51,6 +51,9 @@ pub struct ServoSetpoint {
     pub gear_start: [f64; MAX_AXES],
     pub gear_end: [f64; MAX_AXES],
     pub gear_degrees: f64,
+    /// A `SCALE_JOG` setpoint: the jog key that holds it, +(k + 1) for +J of the PLC's axis
+    /// signal k (G100.k), −(k + 1) for −J (G102.k); its release stops the drives at once.
+    pub jog_key: i32,
 }
 
 impl ServoSetpoint {
@@ -66,6 +69,9 @@ impl ServoSetpoint {
     /// Locked to the spindle at the drives (rigid tapping): played one a tick as a fixed
     /// setpoint, its position computed from the encoder (`gear_*`).
     pub const SCALE_GEARED: u32 = 4;
+    /// A jog held by the operator's key (`jog_key`): played one a tick while the key is held;
+    /// its release stops the drives on the jog's path and drops the rest of the queue.
+    pub const SCALE_JOG: u32 = 5;
 }
 
 impl Default for ServoSetpoint {
@@ -85,6 +91,7 @@ impl Default for ServoSetpoint {
             gear_start: [0.0; MAX_AXES],
             gear_end: [0.0; MAX_AXES],
             gear_degrees: 0.0,
+            jog_key: 0,
         }
     }
 }
@@ -201,6 +208,8 @@ impl ServoFeedback {
     pub const ENDED_EMERGENCY_STOP: u32 = 1;
     /// Reset: the drives stopped on the queued path and dropped the rest of it.
     pub const ENDED_RESET: u32 = 2;
+    /// A jog key released: the drives stopped the jog and dropped the rest of the queue.
+    pub const ENDED_JOG_RELEASE: u32 = 3;
 }
 
 impl Default for ServoFeedback {

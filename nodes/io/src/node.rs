@@ -110,6 +110,10 @@ fn input_bit(input: u8) -> Option<Bit> {
         SimInput::Z_AXIS_LOCK_KEY => x::KEY_Z_AXIS_LOCK,
         SimInput::HANDWHEEL_TRIAL_KEY => x::KEY_HANDWHEEL_TRIAL,
         SimInput::FEED_HOLD_KEY => x::KEY_FEED_HOLD,
+        SimInput::JOG_PLUS_X_KEY => x::KEY_JOG_PLUS_X,
+        SimInput::JOG_MINUS_X_KEY => x::KEY_JOG_MINUS_X,
+        SimInput::JOG_PLUS_Z_KEY => x::KEY_JOG_PLUS_Z,
+        SimInput::JOG_MINUS_Z_KEY => x::KEY_JOG_MINUS_Z,
         _ => return None,
     })
 }
@@ -285,6 +289,8 @@ mod tests {
             (SimInput::Z_AXIS_LOCK_KEY, x::KEY_Z_AXIS_LOCK),
             (SimInput::HANDWHEEL_TRIAL_KEY, x::KEY_HANDWHEEL_TRIAL),
             (SimInput::FEED_HOLD_KEY, x::KEY_FEED_HOLD),
+            (SimInput::JOG_PLUS_X_KEY, x::KEY_JOG_PLUS_X),
+            (SimInput::JOG_MINUS_Z_KEY, x::KEY_JOG_MINUS_Z),
         ] {
             assert!(apply_input(&mut sim, &input(key, true)));
             let y = YImage::default();

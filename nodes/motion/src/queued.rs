@@ -110,8 +110,12 @@ impl Feeder {
     /// are; the next episode starts from there).
     fn episode_ended(&mut self, newest: &ServoFeedback, now: u64, reports: &Sender<Report>) {
         self.episode = newest.episode;
-        if newest.episode_ended == ServoFeedback::ENDED_RESET {
-            // The drives stopped on the queued path for motion's reset: go on from there.
+        if matches!(
+            newest.episode_ended,
+            ServoFeedback::ENDED_RESET | ServoFeedback::ENDED_JOG_RELEASE
+        ) {
+            // The drives stopped on the queued path for motion's reset or a jog key's
+            // release: go on from there.
             self.tails.kept.clear();
             self.motion.stand_at(&newest.setpoint[..self.n]);
             self.next_tick = newest.tick + self.ahead;

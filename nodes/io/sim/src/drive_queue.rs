@@ -83,6 +83,8 @@ pub struct SetpointQueue {
     resetting: bool,
     resets: u32,
     resets_done: u32,
+    /// The key of the jog being played was released: the drives stop, then the episode ends.
+    jog_released: bool,
     /// The spindle's encoder as the drives read it, and the tap they gear to it.
     spindle: SpindleReading,
     gear: Option<Gear>,
@@ -150,6 +152,7 @@ impl SetpointQueue {
             resetting: false,
             resets: 0,
             resets_done: 0,
+            jog_released: false,
             spindle: SpindleReading::default(),
             gear: None,
             gear_lead: [0.0; MAX_AXES],
@@ -238,6 +241,7 @@ impl SetpointQueue {
         self.dry_since = None;
         self.armed = false;
         self.resetting = false;
+        self.jog_released = false;
     }
 
     /// The drives stand after an emergency stop's ramp (their power may go).
@@ -296,8 +300,11 @@ impl SetpointQueue {
             return self.play_unarmed(&scaling);
         }
         self.advance(&scaling);
-        if scaling.reset && self.scale == 0.0 {
-            self.end_episode(ServoFeedback::ENDED_RESET);
+        if (scaling.reset || self.jog_released) && self.scale == 0.0 {
+            self.end_episode(match scaling.reset {
+                true => ServoFeedback::ENDED_RESET,
+                false => ServoFeedback::ENDED_JOG_RELEASE,
+            });
             return self.played(self.last.position, false);
         }
         let k = self.position();
@@ -400,12 +407,21 @@ impl SetpointQueue {
     /// Moves the drives' position along the queued path by this tick's rate.
     fn advance(&mut self, scaling: &Scaling) {
         let k = self.position();
+        let next = self.sample(k + 1).unwrap_or(&self.last);
         let (kind, planned) = self
             .sample(k + 1)
             .map_or(self.last_kind, |s| (s.scaling, s.planned_override));
+        if kind == ServoSetpoint::SCALE_JOG && !scaling.jog_key_held(next.jog_key) {
+            // The jog's key is released: stop on the jog's path now, not a queue later.
+            self.jog_released = true;
+        }
+        let scaling = &Scaling {
+            reset: scaling.reset || self.jog_released,
+            ..*scaling
+        };
         let fixed = matches!(
             kind,
-            ServoSetpoint::SCALE_FIXED | ServoSetpoint::SCALE_GEARED
+            ServoSetpoint::SCALE_FIXED | ServoSetpoint::SCALE_GEARED | ServoSetpoint::SCALE_JOG
         );
         if fixed && !scaling.reset {
             // Spindle-locked and manual moves play one a tick, from a whole index: motion
@@ -457,9 +473,9 @@ impl SetpointQueue {
         let before = missing.checked_sub(1).and_then(|b| self.point(b));
         self.before_dry = before.unwrap_or(self.last.position);
         let tail = self.tail.take().filter(|t| t.first_tick == missing);
-        let resetting = self.resetting;
+        let (resetting, released) = (self.resetting, self.jog_released);
         self.end_episode(ServoFeedback::ENDED_DRY);
-        self.resetting = resetting;
+        (self.resetting, self.jog_released) = (resetting, released);
         self.armed = true;
         self.dry_since = Some(missing);
         self.dry_tick = missing;
@@ -873,6 +889,34 @@ mod tests {
             angle = (angle + 14.4f64).rem_euclid(360.0);
             q.read_spindle(600.0, angle);
         }
+    }
+
+    /// A key jog plays while its key is held; the key's release stops the drives on the
+    /// jog's path within the acceleration, drops the rest of the queue and ends the episode.
+    #[test]
+    fn a_released_jog_key_stops_the_drives_at_once() {
+        let mut q = moving(ServoSetpoint::SCALE_JOG, 0.4, 400);
+        for s in q.queue.iter_mut().chain(q.pending.iter_mut()) {
+            s.jog_key = -2;
+        }
+        q.last.jog_key = -2;
+        let held = Scaling {
+            jog_keys: (0, 0b10),
+            ..Scaling::default()
+        };
+        let mut xs = vec![0.0];
+        run(&mut q, &held, 10, &mut xs);
+        assert!((xs[10] - xs[9] - 0.4).abs() < 1e-9, "jogging");
+        assert_eq!(q.episode(), 0);
+        let released = Scaling::default();
+        let before = xs.len();
+        run(&mut q, &released, 30, &mut xs);
+        assert!(xs[before] - xs[before - 1] < 0.4 - 0.02, "slower at once");
+        assert_eq!(q.episode(), 1);
+        assert_eq!(q.episode_ended(), ServoFeedback::ENDED_JOG_RELEASE);
+        assert_eq!(q.depth(), 0, "the rest of the queue is dropped");
+        let stood = xs[xs.len() - 1] - xs[before - 1];
+        assert!(stood < 3.3, "stopped within its braking distance: {stood}");
     }
 
     /// Setpoints that must play one a tick (spindle-locked, manual) are not held.

@@ -17,6 +17,23 @@ pub struct Scaling {
     pub rapid_override: f64,
     /// A reset: stop on the path whatever the setpoints are, then drop the queue.
     pub reset: bool,
+    /// The PLC's jog keys, a bit per axis signal: +J (G100), −J (G102).
+    pub jog_keys: (u32, u32),
+}
+
+impl Scaling {
+    /// Whether the jog key a `SCALE_JOG` setpoint names (`ServoSetpoint::jog_key`) is held.
+    pub fn jog_key_held(&self, key: i32) -> bool {
+        let bit = |k: i32| {
+            1u32.checked_shl((k.unsigned_abs()).saturating_sub(1))
+                .unwrap_or(0)
+        };
+        match key {
+            k if k > 0 => self.jog_keys.0 & bit(k) != 0,
+            k if k < 0 => self.jog_keys.1 & bit(k) != 0,
+            _ => false,
+        }
+    }
 }
 
 impl Default for Scaling {
@@ -26,6 +43,7 @@ impl Default for Scaling {
             feed_override: 1.0,
             rapid_override: 1.0,
             reset: false,
+            jog_keys: (0, 0),
         }
     }
 }
@@ -48,6 +66,7 @@ impl Scaling {
         };
         match scaling {
             ServoSetpoint::SCALE_FIXED | ServoSetpoint::SCALE_GEARED => 1.0,
+            ServoSetpoint::SCALE_JOG => 1.0,
             _ if self.hold => 0.0,
             ServoSetpoint::SCALE_FEED if planned > 0.0 => clean(self.feed_override / planned),
             ServoSetpoint::SCALE_RAPID => clean(self.rapid_override),
@@ -85,11 +104,17 @@ impl HoldLatch {
             self.plc_hold = false;
         }
         let motion_hold = self.control.is_some_and(|c| c.hold != 0);
+        let mut jog_keys = (0, 0);
+        for k in 0..8 {
+            jog_keys.0 |= u32::from(plc.get(g::jog_plus(k))) << k;
+            jog_keys.1 |= u32::from(plc.get(g::jog_minus(k))) << k;
+        }
         Scaling {
             hold: self.plc_hold || motion_hold,
             feed_override: plc.feed_override(),
             rapid_override: plc.rapid_override(),
             reset: false,
+            jog_keys,
         }
     }
 

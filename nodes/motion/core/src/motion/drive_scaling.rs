@@ -71,6 +71,10 @@ impl Motion {
         if !self.at_drives.on {
             return;
         }
+        if let Some(key) = self.held_jog_key() {
+            sp.scaling = ServoSetpoint::SCALE_JOG;
+            sp.jog_key = key;
+        }
         if let Some((start, end, degrees)) = self.tap_gear() {
             sp.scaling = ServoSetpoint::SCALE_GEARED;
             sp.gear_start = start;
@@ -100,9 +104,12 @@ impl Motion {
         }
     }
 
-    /// After a reset the drives stopped on the queued path at `setpoint` (encoder counts):
-    /// the core stands there, its sent setpoints forgotten.
+    /// After a reset or a jog key's release the drives stopped on the queued path at
+    /// `setpoint` (encoder counts): the core stands there, its jog ended and its sent
+    /// setpoints forgotten.
     pub fn stand_at(&mut self, setpoint: &[f64]) {
+        self.jog = None;
+        self.key_jog = false;
         for (i, s) in setpoint.iter().enumerate().take(self.commanded.len()) {
             if s.is_finite() {
                 self.commanded[i] = s + self.shift[i];

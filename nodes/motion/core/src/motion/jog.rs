@@ -111,6 +111,17 @@ impl Motion {
         }
     }
 
+    /// The key holding a continuous key jog, as the drives are told it (`jog_key`: +(k + 1)
+    /// for +J of axis signal k, −(k + 1) for −J); none for other moves.
+    pub(super) fn held_jog_key(&self) -> Option<i32> {
+        let j = self
+            .jog
+            .as_ref()
+            .filter(|j| self.key_jog && j.end.is_none() && j.held > 0)?;
+        let k = (*self.signal_axis.get(j.axis)?)? as i32 + 1;
+        Some(if j.direction > 0.0 { k } else { -k })
+    }
+
     /// A manual move in progress.
     pub fn jogging(&self) -> bool {
         self.jog.is_some()
