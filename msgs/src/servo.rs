@@ -30,8 +30,9 @@ pub struct ServoSetpoint {
     /// Per axis, the drive's torque limit in percent of its maximum (100: none; lower while
     /// the axis travels to a fixed stop or presses against it).
     pub torque_limit_percent: [f64; MAX_AXES],
-    /// With the drives' setpoint queue (`servo.drive_queue_ms`): the drive tick this setpoint
-    /// is for (0 in lock-step, where every setpoint is for the drives' next tick).
+    /// With the drives' setpoint queue (`servo.drive_queue_ms`): its index on the queued path,
+    /// the drive tick it is for while nothing time-scales the path (0 in lock-step, where
+    /// every setpoint is for the drives' next tick).
     pub tick: u64,
     /// The queue's episode: how many times motion has seen the queue run dry. The drives
     /// take only setpoints of their own episode, so nothing planned before a dry queue plays
@@ -175,7 +176,9 @@ pub struct ServoFeedback {
     pub probe_falling_position: [f64; MAX_AXES],
     /// Per axis, the torque the drive gives, percent of its maximum.
     pub torque_percent: [f64; MAX_AXES],
-    /// With the setpoint queue: the drive tick this reports (the drives' own clock).
+    /// With the setpoint queue: the index of the queued setpoint the drives are at (their
+    /// own clock's tick while nothing time-scales the path, slower under feed hold or an
+    /// override).
     pub tick: u64,
     /// Ticks of setpoints queued after this one.
     pub queue_depth: u32,
@@ -183,10 +186,9 @@ pub struct ServoFeedback {
     pub underrun: u32,
     /// The queue's episode: times it ran dry since the drives started.
     pub episode: u32,
-    /// The drive tick at which the queue last ran dry (the brake tail's first tick).
+    /// The index at which the queue last ran dry (the brake tail's first).
     pub dry_tick: u64,
-    /// Why the last episode ended: [`ServoFeedback::ENDED_DRY`] or
-    /// [`ServoFeedback::ENDED_EMERGENCY_STOP`].
+    /// Why the last episode ended: one of `ServoFeedback::ENDED_*`.
     pub episode_ended: u32,
     /// 1 while the emergency-stop input is pressed at the drives.
     pub emergency_stop: u32,
