@@ -658,8 +658,12 @@ fn feed_hold_and_override_act_at_the_drives_with_motion_stopped() {
         (run.t0 + Duration::from_millis(2000)).saturating_duration_since(Instant::now()),
     );
     stop(true);
-    key(true);
-    std::thread::sleep(Duration::from_millis(400));
+    // Pressed again every 50 ms: a new publisher's first samples are lost until discovery
+    // has matched it.
+    for _ in 0..8 {
+        key(true);
+        std::thread::sleep(Duration::from_millis(50));
+    }
     stop(false);
     let (held, _) = run.client.wait_until(Duration::from_secs(10), |c| {
         c.state
@@ -762,10 +766,27 @@ fn a_jog_key_released_stops_the_drives_with_motion_stopped() {
             .unwrap()
     };
     let motion = run.nodes.pid("motion");
-    // The new publisher must be discovered before its first key counts.
-    std::thread::sleep(Duration::from_millis(2000));
-    key(SimInput::JOG_MINUS_Z_KEY, true);
-    std::thread::sleep(Duration::from_millis(1500));
+    // Held: pressed again until Z moves (a new publisher's first samples are lost until
+    // discovery has matched it), then for a second.
+    let z_now = |c: &CellClient| {
+        c.axes
+            .as_ref()
+            .map_or(f64::NAN, |a| a.axes[1].actual_position)
+    };
+    common::wait(&mut run.client, Duration::from_secs(10), "axes", |c| {
+        z_now(c).is_finite()
+    });
+    let z0 = z_now(&run.client);
+    let mut polls = 0;
+    let (moving, _) = run.client.wait_until(Duration::from_secs(20), |c| {
+        if polls % 40 == 0 {
+            key(SimInput::JOG_MINUS_Z_KEY, true);
+        }
+        polls += 1;
+        z_now(c) < z0 - 1.0
+    });
+    assert!(moving, "the −Z key jogs Z: {z0} → {}", z_now(&run.client));
+    std::thread::sleep(Duration::from_millis(1000));
     // SAFETY: kill(2) on our own child's pid.
     unsafe { libc::kill(motion, libc::SIGSTOP) };
     key(SimInput::JOG_MINUS_Z_KEY, false);
