@@ -580,24 +580,7 @@ impl Motion {
         let detents = self.take_detents();
         self.trial_run(plc, detents, self.cfg.period);
         self.count_power_on(self.cfg.period);
-        if let Some(a) = actual {
-            for ((dst, src), s) in self.actual.iter_mut().zip(a).zip(&self.shift) {
-                *dst = *src + *s;
-            }
-            self.missed_feedback = 0;
-            self.check_following_error();
-        } else {
-            self.missed_feedback += 1;
-            if self.missed_feedback >= self.cfg.feedback_lost_ticks && !self.servo_off {
-                self.drive_fault(
-                    alarm::FEEDBACK_LOST,
-                    format!(
-                        "no feedback from the drives for {} servo ticks",
-                        self.missed_feedback
-                    ),
-                );
-            }
-        }
+        self.read_feedback(actual);
         if self.servo_off {
             // Setpoints stay where they were; the drives are disabled (see `servo_enabled`).
             self.reference = None;
@@ -655,11 +638,50 @@ impl Motion {
         self.count_run_time(dt);
         self.watch_probe();
         self.watch_fixed_stops();
+        self.run_blocks(dt, plc);
+        self.finish_probing();
+        self.finish_fixed_stops();
+        // Cycle stop: once the axes stand on the path, the rest of the run is dropped.
+        if self.cycle_stop && self.stopped_on_path() {
+            self.drop_run();
+            self.cycle_stop = false;
+            self.feed_hold = false;
+        }
+        self.update_f();
+        self.drive_setpoint();
+    }
+
+    /// The drives' feedback of this tick (encoder counts, the reference shift added), checked
+    /// against its setpoint; none for too long is the lost-feedback alarm.
+    fn read_feedback(&mut self, actual: Option<&[f64]>) {
+        if let Some(a) = actual {
+            for ((dst, src), s) in self.actual.iter_mut().zip(a).zip(&self.shift) {
+                *dst = *src + *s;
+            }
+            self.missed_feedback = 0;
+            self.check_following_error();
+        } else {
+            self.missed_feedback += 1;
+            if self.missed_feedback >= self.cfg.feedback_lost_ticks && !self.servo_off {
+                self.drive_fault(
+                    alarm::FEEDBACK_LOST,
+                    format!(
+                        "no feedback from the drives for {} servo ticks",
+                        self.missed_feedback
+                    ),
+                );
+            }
+        }
+    }
+
+    /// The run's blocks this tick: the next one activated when none is, the active one
+    /// advanced; blocks that finish without moving (aux, dwell, settings) chain on within it.
+    fn run_blocks(&mut self, dt: f64, plc: &GImage) {
         let mut budget = 8; // blocks that can finish within one tick (zero-length moves, aux)
         while budget > 0 && !self.alarm {
             budget -= 1;
             if self.active.is_none() {
-                // A cycle stop starts nothing new; it ends below once the axes stand.
+                // A cycle stop starts nothing new; `tick_machine` ends it once the axes stand.
                 if self.cycle_stop || self.block_stop {
                     break;
                 }
@@ -740,16 +762,6 @@ impl Motion {
             }
             break;
         }
-        self.finish_probing();
-        self.finish_fixed_stops();
-        // Cycle stop: once the axes stand on the path, the rest of the run is dropped.
-        if self.cycle_stop && self.stopped_on_path() {
-            self.drop_run();
-            self.cycle_stop = false;
-            self.feed_hold = false;
-        }
-        self.update_f();
-        self.drive_setpoint();
     }
 
     /// Whether a STOPFIFO section may run: the queue is full, or the section's end or the
