@@ -182,7 +182,6 @@ impl Feeder {
                 Some(fb) => self.latest.read(fb, n),
                 None => self.missing_feedback += 1,
             }
-            self.motion.plc_signals(&self.g);
             self.latest.give(&mut self.motion, true);
             let mut sp = ServoSetpoint {
                 seq: self.next_tick,

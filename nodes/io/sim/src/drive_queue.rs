@@ -45,7 +45,8 @@ pub struct SetpointQueue {
     tail: Option<Box<BrakeTail>>,
     braking: Option<Box<BrakeTail>>,
     episode: u32,
-    /// What the last tick played, held while nothing else is there.
+    /// What the last tick played, held while nothing else is there, with the kind of the last
+    /// setpoint reached (a brake tail is scaled and geared as the setpoints it continues).
     last: ServoSetpoint,
     /// A setpoint has played: from now on a missing one is an underrun.
     armed: bool,
@@ -73,9 +74,6 @@ pub struct SetpointQueue {
     index: f64,
     scale: f64,
     target: f64,
-    /// The scaling and planned override of the last setpoint reached: a brake tail is
-    /// scaled as the setpoints it continues.
-    last_kind: (u32, f64),
     /// Each axis's acceleration × period², mm a tick²: how fast the rate may change.
     limit: [f64; MAX_AXES],
     /// A reset: the drives stop on the path, then the episode ends; the resets motion has
@@ -147,7 +145,6 @@ impl SetpointQueue {
             index: 0.0,
             scale: 1.0,
             target: 1.0,
-            last_kind: (ServoSetpoint::SCALE_FIXED, 1.0),
             limit: [0.0; MAX_AXES],
             resetting: false,
             resets: 0,
@@ -324,7 +321,6 @@ impl SetpointQueue {
             self.braking = None;
         }
         if let Some(sp) = self.sample(k).copied() {
-            self.last_kind = (sp.scaling, sp.planned_override);
             let keep = self.last.position;
             self.last = sp;
             self.last.position = keep;
@@ -353,7 +349,6 @@ impl SetpointQueue {
         if let Some(sp) = self.queue.front().filter(|s| s.tick == k).copied() {
             self.armed = true;
             self.quick_stop = None;
-            self.last_kind = (sp.scaling, sp.planned_override);
             let held = self.last.position;
             self.last = sp;
             self.last.position = held;
@@ -375,7 +370,7 @@ impl SetpointQueue {
     /// each axis is set from the spindle's encoder, not from what was queued, so the tap stays
     /// in its thread whatever the queue did.
     fn geared(&mut self, queued: [f64; MAX_AXES]) -> [f64; MAX_AXES] {
-        if self.last_kind.0 != ServoSetpoint::SCALE_GEARED {
+        if self.last.scaling != ServoSetpoint::SCALE_GEARED {
             self.gear = None;
             return queued;
         }
@@ -407,11 +402,10 @@ impl SetpointQueue {
     /// Moves the drives' position along the queued path by this tick's rate.
     fn advance(&mut self, scaling: &Scaling) {
         let k = self.position();
+        // The next setpoint's kind; past the queue's end (a brake tail) the last one reached.
         let next = self.sample(k + 1).unwrap_or(&self.last);
-        let (kind, planned) = self
-            .sample(k + 1)
-            .map_or(self.last_kind, |s| (s.scaling, s.planned_override));
-        if kind == ServoSetpoint::SCALE_JOG && !scaling.jog_key_held(next.jog_key) {
+        let (kind, planned, key) = (next.scaling, next.planned_override, next.jog_key);
+        if kind == ServoSetpoint::SCALE_JOG && !scaling.jog_key_held(key) {
             // The jog's key is released: stop on the jog's path now, not a queue later.
             self.jog_released = true;
         }

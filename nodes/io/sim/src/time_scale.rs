@@ -21,21 +21,6 @@ pub struct Scaling {
     pub jog_keys: (u32, u32),
 }
 
-impl Scaling {
-    /// Whether the jog key a `SCALE_JOG` setpoint names (`ServoSetpoint::jog_key`) is held.
-    pub fn jog_key_held(&self, key: i32) -> bool {
-        let bit = |k: i32| {
-            1u32.checked_shl((k.unsigned_abs()).saturating_sub(1))
-                .unwrap_or(0)
-        };
-        match key {
-            k if k > 0 => self.jog_keys.0 & bit(k) != 0,
-            k if k < 0 => self.jog_keys.1 & bit(k) != 0,
-            _ => false,
-        }
-    }
-}
-
 impl Default for Scaling {
     fn default() -> Self {
         Scaling {
@@ -49,6 +34,19 @@ impl Default for Scaling {
 }
 
 impl Scaling {
+    /// Whether the jog key a `SCALE_JOG` setpoint names (`ServoSetpoint::jog_key`) is held.
+    pub fn jog_key_held(&self, key: i32) -> bool {
+        let bit = |k: i32| {
+            1u32.checked_shl((k.unsigned_abs()).saturating_sub(1))
+                .unwrap_or(0)
+        };
+        match key {
+            k if k > 0 => self.jog_keys.0 & bit(k) != 0,
+            k if k < 0 => self.jog_keys.1 & bit(k) != 0,
+            _ => false,
+        }
+    }
+
     /// The rate a setpoint of `scaling` (`ServoSetpoint::SCALE_*`) planned at feed override
     /// `planned` is to be played at. Rates above 1 would outrun the queue and the
     /// accelerations the path was planned with: an override above 100 % acts through
