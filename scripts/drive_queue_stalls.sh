@@ -5,7 +5,7 @@
 # workspace; prints per machine and stall length the stalls made, the underruns, the least
 # queue depth and whether the drive trace's path is the undisturbed run's: "identical" (every
 # bit), "same" (a thread's setpoints differ in their last bits, as between any two runs:
-# `tests/drive_queue.rs::Comparison`) or DIFFERENT (`tests/drive_queue.rs::stall_table`).
+# `tests/common/queued_cell.rs::Comparison`) or DIFFERENT (`tests/drive_queue.rs::stall_table`).
 # DDS stays in a network namespace with only loopback.
 #   scripts/drive_queue_stalls.sh [STALLS]
 # CNC_TABLE_MACHINE=lathe1|mill1 and CNC_STALL_LENGTHS=5,80 run a part of the table.

@@ -55,6 +55,11 @@ pub struct ServoSetpoint {
     /// A `SCALE_JOG` setpoint: the jog key that holds it, +(k + 1) for +J of the PLC's axis
     /// signal k (G100.k), −(k + 1) for −J (G102.k); its release stops the drives at once.
     pub jog_key: i32,
+    /// A `SCALE_THREAD` setpoint: the spindle encoder's angle its position is for (degrees,
+    /// as the feedback reports it) and the speed its axes' lead was computed at (rpm, signed):
+    /// the drives play a thread by their own encoder, not by the clock (issue 48).
+    pub thread_angle: f64,
+    pub thread_rpm: f64,
 }
 
 impl ServoSetpoint {
@@ -73,6 +78,11 @@ impl ServoSetpoint {
     /// A jog held by the operator's key (`jog_key`): played one a tick while the key is held;
     /// its release stops the drives on the jog's path and drops the rest of the queue.
     pub const SCALE_JOG: u32 = 5;
+    /// A thread's setpoint, locked to the spindle at the drives: the thread's setpoints are a
+    /// table of positions by spindle angle (`thread_angle`), which the drives look up with
+    /// their own encoder every tick (electronic cam), whatever the spindle's speed did since
+    /// motion computed them.
+    pub const SCALE_THREAD: u32 = 6;
 }
 
 impl Default for ServoSetpoint {
@@ -93,6 +103,8 @@ impl Default for ServoSetpoint {
             gear_end: [0.0; MAX_AXES],
             gear_degrees: 0.0,
             jog_key: 0,
+            thread_angle: 0.0,
+            thread_rpm: 0.0,
         }
     }
 }

@@ -16,6 +16,7 @@ use std::collections::VecDeque;
 
 use cnc_msgs::servo::{BrakeTail, ServoFeedback, ServoSetpoint, MAX_AXES, TAIL_TICKS};
 
+use crate::gearing::{SpindleReading, TapGear, ThreadCam};
 use crate::time_scale::{next_rate, within, Scaling};
 
 /// What the drives do in one tick.
@@ -83,32 +84,16 @@ pub struct SetpointQueue {
     resets_done: u32,
     /// The key of the jog being played was released: the drives stop, then the episode ends.
     jog_released: bool,
-    /// The spindle's encoder as the drives read it, and the tap they gear to it.
+    /// The spindle's encoder as the drives read it, the tap they gear to it and the thread
+    /// they play by it ([`crate::gearing`]).
     spindle: SpindleReading,
-    gear: Option<Gear>,
-    /// Per axis, how far ahead of the encoder reading a geared setpoint is computed, s (the
-    /// period and the drive's lag, as motion's lock-step tap).
+    gear: Option<TapGear>,
+    cam: ThreadCam,
+    /// Where the thread's cam put the axes this tick.
+    cam_position: Option<[f64; MAX_AXES]>,
+    /// Per axis, how far ahead of the encoder reading a geared or cammed setpoint is computed,
+    /// s (the period and the drive's lag, as motion's lock-step tap and thread).
     gear_lead: [f64; MAX_AXES],
-}
-
-/// The spindle encoder at the drives: degrees turned (signed, unwrapped), speed (rpm), and
-/// where it last stood (a tap's origin).
-#[derive(Debug, Clone, Copy, Default)]
-struct SpindleReading {
-    raw: Option<f64>,
-    turned: f64,
-    rpm: f64,
-    standing: f64,
-}
-
-/// Electronic gearing of a tap: each axis from `start` to `end` while the spindle turns
-/// `degrees` from `origin` (degrees turned).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Gear {
-    start: [f64; MAX_AXES],
-    end: [f64; MAX_AXES],
-    degrees: f64,
-    origin: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -152,6 +137,8 @@ impl SetpointQueue {
             jog_released: false,
             spindle: SpindleReading::default(),
             gear: None,
+            cam: ThreadCam::default(),
+            cam_position: None,
             gear_lead: [0.0; MAX_AXES],
         }
     }
@@ -173,18 +160,7 @@ impl SetpointQueue {
 
     /// The spindle encoder's reading after a tick: speed (rpm, signed) and angle (degrees).
     pub fn read_spindle(&mut self, rpm: f64, angle_deg: f64) {
-        if !rpm.is_finite() || !angle_deg.is_finite() {
-            return;
-        }
-        let s = &mut self.spindle;
-        if let Some(prev) = s.raw {
-            s.turned += (angle_deg - prev + 180.0).rem_euclid(360.0) - 180.0;
-        }
-        s.raw = Some(angle_deg);
-        s.rpm = rpm;
-        if rpm == 0.0 {
-            s.standing = s.turned;
-        }
+        self.spindle.read(rpm, angle_deg);
     }
 
     /// The emergency-stop input reached the drives. Pressed: the episode ends and each axis
@@ -308,7 +284,7 @@ impl SetpointQueue {
         while self.queue.get(1).is_some_and(|s| s.tick < k) {
             self.queue.pop_front();
         }
-        let position = match self.at(self.index) {
+        let position = match self.cam_position.take().or_else(|| self.at(self.index)) {
             Some(p) => p,
             None => {
                 let missing = if self.point(k).is_none() { k } else { k + 1 };
@@ -374,34 +350,25 @@ impl SetpointQueue {
             self.gear = None;
             return queued;
         }
-        let sp = &self.last;
-        let origin = match self.gear {
-            Some(g) if g.start == sp.gear_start && g.end == sp.gear_end => g.origin,
-            _ => self.spindle.standing,
-        };
-        let gear = Gear {
-            start: sp.gear_start,
-            end: sp.gear_end,
-            degrees: sp.gear_degrees,
-            origin,
-        };
+        let gear = TapGear::of(&self.last, self.gear, &self.spindle);
         self.gear = Some(gear);
-        let s = self.spindle;
-        let mut out = queued;
-        for (i, o) in out.iter_mut().enumerate() {
-            let ahead = s.turned + s.rpm / 60.0 * 360.0 * self.gear_lead[i];
-            let share = match gear.degrees != 0.0 {
-                true => ((ahead - gear.origin) / gear.degrees).clamp(0.0, 1.0),
-                false => 1.0,
-            };
-            *o = gear.start[i] + (gear.end[i] - gear.start[i]) * share;
-        }
-        out
+        gear.position(&self.spindle, &self.gear_lead)
     }
 
     /// Moves the drives' position along the queued path by this tick's rate.
     fn advance(&mut self, scaling: &Scaling) {
         let k = self.position();
+        if !scaling.reset {
+            // A thread goes by the spindle's encoder, not by the clock.
+            let queue = &self.queue;
+            let sample = |m| sample_in(queue, m);
+            if let Some(c) = self.cam.follow(k, sample, &self.spindle, &self.gear_lead) {
+                (self.scale, self.target) = (1.0, 1.0);
+                self.index = c.index;
+                self.cam_position = Some(c.position);
+                return;
+            }
+        }
         // The next setpoint's kind; past the queue's end (a brake tail) the last one reached.
         let next = self.sample(k + 1).unwrap_or(&self.last);
         let (kind, planned, key) = (next.scaling, next.planned_override, next.jog_key);
@@ -415,7 +382,10 @@ impl SetpointQueue {
         };
         let fixed = matches!(
             kind,
-            ServoSetpoint::SCALE_FIXED | ServoSetpoint::SCALE_GEARED | ServoSetpoint::SCALE_JOG
+            ServoSetpoint::SCALE_FIXED
+                | ServoSetpoint::SCALE_GEARED
+                | ServoSetpoint::SCALE_JOG
+                | ServoSetpoint::SCALE_THREAD
         );
         if fixed && !scaling.reset {
             // Spindle-locked and manual moves play one a tick, from a whole index: motion
@@ -480,8 +450,7 @@ impl SetpointQueue {
     }
 
     fn sample(&self, index: u64) -> Option<&ServoSetpoint> {
-        let i = self.queue.binary_search_by_key(&index, |s| s.tick).ok()?;
-        self.queue.get(i)
+        sample_in(&self.queue, index)
     }
 
     /// The queued path's point at `index`: a queued setpoint, or while the queue is dry the
@@ -541,6 +510,12 @@ impl SetpointQueue {
     pub fn dry_tick(&self) -> u64 {
         self.dry_tick
     }
+}
+
+/// The queued setpoint for `index`.
+fn sample_in(queue: &VecDeque<ServoSetpoint>, index: u64) -> Option<&ServoSetpoint> {
+    let i = queue.binary_search_by_key(&index, |s| s.tick).ok()?;
+    queue.get(i)
 }
 
 /// The drive trace's header: tick (the drives' clock), queue depth, underrun, emergency

@@ -10,6 +10,7 @@
 
 pub mod devices;
 pub mod drive_queue;
+mod gearing;
 pub mod probe;
 pub mod spindle_position;
 pub mod time_scale;

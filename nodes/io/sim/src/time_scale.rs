@@ -63,8 +63,10 @@ impl Scaling {
             }
         };
         match scaling {
-            ServoSetpoint::SCALE_FIXED | ServoSetpoint::SCALE_GEARED => 1.0,
-            ServoSetpoint::SCALE_JOG => 1.0,
+            ServoSetpoint::SCALE_FIXED
+            | ServoSetpoint::SCALE_GEARED
+            | ServoSetpoint::SCALE_THREAD
+            | ServoSetpoint::SCALE_JOG => 1.0,
             _ if self.hold => 0.0,
             ServoSetpoint::SCALE_FEED if planned > 0.0 => clean(self.feed_override / planned),
             ServoSetpoint::SCALE_RAPID => clean(self.rapid_override),

@@ -39,6 +39,12 @@ impl Encoder {
         self.angle = (raw_angle * self.direction).rem_euclid(360.0);
     }
 
+    /// The angle the encoder will report `seconds` after its last reading at the speed now
+    /// (degrees, 0–360, as the drive reports it).
+    pub(crate) fn raw_ahead(&self, seconds: f64) -> f64 {
+        (self.raw.unwrap_or(0.0) + self.rpm * 6.0 * seconds).rem_euclid(360.0)
+    }
+
     /// Revolutions per second, whatever the direction.
     pub(crate) fn omega(&self) -> f64 {
         self.rpm.abs() / 60.0

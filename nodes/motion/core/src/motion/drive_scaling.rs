@@ -4,7 +4,8 @@
 //! cannot be scaled: a thread or tap starts only after a queue's length of unscaled waiting,
 //! so the encoder reading its start is computed from was taken at the rate it plays at; a
 //! rigid tap is geared to the spindle's encoder at the drives (its start, end and degrees go
-//! with each setpoint).
+//! with each setpoint), a thread is played by it (each setpoint says the encoder angle it is
+//! for, D136).
 
 use cnc_msgs::servo::{DriveControl, ServoSetpoint};
 
@@ -75,12 +76,31 @@ impl Motion {
             sp.scaling = ServoSetpoint::SCALE_JOG;
             sp.jog_key = key;
         }
+        if let Some((angle, rpm)) = self.thread_cam() {
+            sp.scaling = ServoSetpoint::SCALE_THREAD;
+            sp.thread_angle = angle;
+            sp.thread_rpm = rpm;
+        }
         if let Some((start, end, degrees)) = self.tap_gear() {
             sp.scaling = ServoSetpoint::SCALE_GEARED;
             sp.gear_start = start;
             sp.gear_end = end;
             sp.gear_degrees = degrees;
         }
+    }
+
+    /// The active thread as the drives play it by their encoder (D136): the angle the encoder
+    /// is to show when this tick's setpoint plays (its reading a queue's length ago, at the
+    /// speed then) and the speed its lead was computed at; none without a thread, or with an
+    /// axis under machine lock.
+    fn thread_cam(&self) -> Option<(f64, f64)> {
+        if !matches!(self.active, Some((_, Active::Thread { .. }))) || self.locked != 0 {
+            return None;
+        }
+        // The drives play tick j with the reading of tick j − 1; this one is of j − delay.
+        let ticks = self.cfg.feedback_delay_ticks.max(1) - 1;
+        let e = &self.encoder;
+        Some((e.raw_ahead(f64::from(ticks) * self.cfg.period), e.rpm))
     }
 
     /// How the drives may scale this tick's setpoint, and the feed override it was planned at.
