@@ -21,7 +21,7 @@ use cnc_msgs::msg::MachineState;
 use queued_cell::*;
 
 /// Each test its own domain (and so its own shared-memory instance): they run in parallel
-/// (`tests/drive_queue_spindle.rs` has 170, 174 and 176).
+/// (`tests/drive_queue_spindle.rs` has 170, 174 and 176; the stall table 178–187).
 const STALLS: u16 = 167;
 const DRY: u16 = 168;
 const ESTOP: u16 = 169;
@@ -29,6 +29,7 @@ const KILLED: u16 = 171;
 const HOLD: u16 = 172;
 const ESTOP_KILLED: u16 = 173;
 const JOG: u16 = 175;
+const SINGLE_BLOCK: u16 = 177;
 
 /// The mill's contour, from and back to X0 Y0 Z5 (repeated to make the part long enough).
 const MILL_CONTOUR: &str = "G00 X0 Y0 Z5
@@ -638,5 +639,114 @@ fn motion_killed_stops_the_machine_on_its_path() {
     );
     let moved = rows[dry].setpoint != *last;
     println!("dry at row {dry}; the tail moved: {moved}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Twenty blocks of 3 mm along Z at 50 mm/s, each about 60 ms: the 100 ms queue holds more
+/// than one block's end.
+const SHORT_BLOCKS: &str = "O0484
+G00 X60 Z5
+G01 X50 Z0 F3000
+Z-3\nZ-6\nZ-9\nZ-12\nZ-15\nZ-18\nZ-21\nZ-24\nZ-27\nZ-30
+Z-33\nZ-36\nZ-39\nZ-42\nZ-45\nZ-48\nZ-51\nZ-54\nZ-57\nZ-60
+G00 X80
+Z5
+M30
+";
+
+/// Issue 48, must-show 3 (single block at the drives, D137): with the motion process stopped
+/// for 400 ms (four queues' length), the panel's single-block key reaches the drives through
+/// the PLC's SBK and they stop, at rest and within the acceleration, exactly at the end of a
+/// block (Z on a multiple of 3 mm), not at the queue's end: no tick runs dry. The machine
+/// shows feed hold; a cycle start runs the next block and stops at its end; single block off
+/// and cycle start finish the part along the undisturbed path.
+#[test]
+fn single_block_stops_the_drives_at_a_blocks_end_with_motion_stopped() {
+    use cnc_msgs::msg::SimInput;
+    let dir = common::fresh_dir("drive_queue_single_block");
+    let calm = Cut::start_program(&dir, "calm", SHORT_BLOCKS, SINGLE_BLOCK).finish();
+    let mut run = Cut::start_program(&dir, "single", SHORT_BLOCKS, SINGLE_BLOCK);
+    let mut panel =
+        cnc_runtime::dds::RosNode::new(&net(SINGLE_BLOCK), "lathe1", "sbk_panel").unwrap();
+    let input = panel
+        .dds_publisher::<SimInput>(&cnc_runtime::topics::SIM_INPUT)
+        .unwrap();
+    // The key toggles single block: pressed once, so the publisher must be matched first.
+    let toggle = || {
+        for value in [true, false] {
+            let input_sample = SimInput {
+                input: SimInput::SINGLE_BLOCK_KEY,
+                value,
+            };
+            input.publish(input_sample).unwrap();
+            std::thread::sleep(Duration::from_millis(60));
+        }
+    };
+    let motion = run.nodes.pid("motion");
+    let below = |z: f64| {
+        move |c: &CellClient| {
+            c.axes
+                .as_ref()
+                .is_some_and(|a| a.axes.len() > 1 && a.axes[1].actual_position < z)
+        }
+    };
+    common::wait(
+        &mut run.client,
+        Duration::from_secs(60),
+        "Z−20",
+        below(-20.0),
+    );
+    // SAFETY: kill(2) on our own child's pid.
+    unsafe { libc::kill(motion, libc::SIGSTOP) };
+    toggle();
+    std::thread::sleep(Duration::from_millis(280));
+    unsafe { libc::kill(motion, libc::SIGCONT) };
+    let in_hold = |c: &CellClient| {
+        c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::FEED_HOLD)
+    };
+    common::wait(&mut run.client, Duration::from_secs(10), "stopped", in_hold);
+    let r = run.client.start_program("").expect("cycle start");
+    assert!(r.accepted, "{}", r.message);
+    common::wait(&mut run.client, Duration::from_secs(10), "going", |c| {
+        !in_hold(c)
+    });
+    common::wait(&mut run.client, Duration::from_secs(10), "stopped", in_hold);
+    toggle();
+    let r = run.client.start_program("").expect("cycle start");
+    assert!(r.accepted, "{}", r.message);
+    drop(panel);
+    let rows = run.finish();
+    assert_eq!(
+        rows.iter().filter(|r| r.underrun).count(),
+        0,
+        "no tick ran dry"
+    );
+    // Where the drives stood for single block: two block ends, one after the other.
+    let mut stops: Vec<f64> = Vec::new();
+    for w in rows.windows(2) {
+        if w[1].block_stop && !w[0].block_stop {
+            stops.push(w[1].setpoint[1]);
+        }
+    }
+    println!("stood at the block ends Z {stops:?}");
+    assert_eq!(stops.len(), 2, "{stops:?}");
+    for z in &stops {
+        assert!(
+            (z / 3.0 - (z / 3.0).round()).abs() < 1e-9 && *z < -20.0,
+            "Z {z} is a block's end"
+        );
+    }
+    assert!(
+        (stops[1] - (stops[0] - 3.0)).abs() < 1e-9,
+        "the next block's end"
+    );
+    let path = on_the_path_without_a_step(&calm, &rows);
+    assert_eq!(
+        path.last(),
+        rows.last().map(|r| &r.setpoint),
+        "the same part"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -385,7 +385,8 @@ ros_message! {
             JOG_PLUS_X_KEY: u8 = 25,
             JOG_MINUS_X_KEY: u8 = 26,
             JOG_PLUS_Z_KEY: u8 = 27,
-            JOG_MINUS_Z_KEY: u8 = 28
+            JOG_MINUS_Z_KEY: u8 = 28,
+            SINGLE_BLOCK_KEY: u8 = 29
         }
         input: u8,
         value: bool,

@@ -60,6 +60,12 @@ pub struct ServoSetpoint {
     /// the drives play a thread by their own encoder, not by the clock (issue 48).
     pub thread_angle: f64,
     pub thread_rpm: f64,
+    /// The program line (block) the setpoint belongs to, 0 outside a program: where it
+    /// changes a block ends, and single block stops the drives there (issue 48).
+    pub line: u32,
+    /// Where between the previous setpoint and this one its block began, as a share of the
+    /// way (1: at this setpoint): the drives stop a single block exactly there.
+    pub block_start: f64,
 }
 
 impl ServoSetpoint {
@@ -105,6 +111,8 @@ impl Default for ServoSetpoint {
             jog_key: 0,
             thread_angle: 0.0,
             thread_rpm: 0.0,
+            line: 0,
+            block_start: 1.0,
         }
     }
 }
@@ -213,6 +221,8 @@ pub struct ServoFeedback {
     pub setpoint: [f64; MAX_AXES],
     /// The resets the drives have stopped for ([`DriveControl::resets`] once done).
     pub resets_done: u32,
+    /// 1 while the drives stand at a block's end for single block, until a cycle start.
+    pub block_stop: u32,
 }
 
 impl ServoFeedback {
@@ -259,6 +269,7 @@ impl Default for ServoFeedback {
             scale: 1.0,
             setpoint: [0.0; MAX_AXES],
             resets_done: 0,
+            block_stop: 0,
         }
     }
 }

@@ -104,6 +104,8 @@ pub struct Row {
     pub underrun: bool,
     pub emergency_stop: bool,
     pub hold: bool,
+    /// Standing at a block's end for single block (`hold` 2 in the trace).
+    pub block_stop: bool,
     pub scale: f64,
     pub target: f64,
     pub setpoint: Vec<f64>,
@@ -129,6 +131,7 @@ pub fn read_trace(path: &Path) -> Vec<Row> {
                 underrun: v[2] == "1",
                 emergency_stop: v[3] == "1",
                 hold: v[4] == "1",
+                block_stop: v[4] == "2",
                 scale: num(v[6]),
                 target: num(v[7]),
                 setpoint: (0..axes).map(|i| num(v[FIRST_AXIS + 3 * i])).collect(),

@@ -16,8 +16,9 @@ use cnc_runtime::shm::{channel, ShmNode};
 use cnc_runtime::{LaunchConfig, Shutdown};
 
 use crate::node::{take_network_inputs, Doors};
-use crate::sim::drive_queue::{trace_header, trace_line, SetpointQueue};
+use crate::sim::drive_queue::SetpointQueue;
 use crate::sim::time_scale::HoldLatch;
+use crate::sim::trace::{trace_header, trace_line};
 use crate::SimLathe;
 
 /// Setpoints and feedback a stream channel buffers: 4 s at the 4 ms period, more than any
@@ -213,13 +214,19 @@ pub fn run(
             fb.scale = played.scale;
             fb.setpoint = played.setpoint.position;
             fb.resets_done = queue.resets_done();
+            let block_stop = queue.standing_at_block_end();
+            fb.block_stop = u32::from(block_stop);
             if !played.underrun && queue.armed() {
                 min_depth = Some(min_depth.map_or(depth, |d| d.min(depth)));
             }
             feedback.send(fb)?;
             if let Some(t) = &mut trace {
                 let spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
-                let flags = (estop, scaling.hold);
+                let hold = match (block_stop, scaling.hold) {
+                    (true, _) => 2,
+                    (false, held) => u8::from(held),
+                };
+                let flags = (estop, hold);
                 let line = trace_line(tick, &played, &fb.position[..n], depth, flags, spindle);
                 t.write(&line, ticks_per_second);
             }

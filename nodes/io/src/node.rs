@@ -114,6 +114,7 @@ fn input_bit(input: u8) -> Option<Bit> {
         SimInput::JOG_MINUS_X_KEY => x::KEY_JOG_MINUS_X,
         SimInput::JOG_PLUS_Z_KEY => x::KEY_JOG_PLUS_Z,
         SimInput::JOG_MINUS_Z_KEY => x::KEY_JOG_MINUS_Z,
+        SimInput::SINGLE_BLOCK_KEY => x::KEY_SINGLE_BLOCK,
         _ => return None,
     })
 }
@@ -291,6 +292,7 @@ mod tests {
             (SimInput::FEED_HOLD_KEY, x::KEY_FEED_HOLD),
             (SimInput::JOG_PLUS_X_KEY, x::KEY_JOG_PLUS_X),
             (SimInput::JOG_MINUS_Z_KEY, x::KEY_JOG_MINUS_Z),
+            (SimInput::SINGLE_BLOCK_KEY, x::KEY_SINGLE_BLOCK),
         ] {
             assert!(apply_input(&mut sim, &input(key, true)));
             let y = YImage::default();

@@ -327,6 +327,7 @@ pub(crate) fn servo_loop(
         let line = p.motion.line();
         plc_signals(g_in.latest()?, &mut p.g, &mut p.plc, now, line, &reports);
         p.motion.plc_signals(&p.g);
+        p.motion.drives_at_block_end(newest.block_stop != 0);
         p.tell_drives(&out)?;
         // After a reset nothing is sent until the drives have stopped for it on the queued
         // path and ended the episode: motion goes on from where they stand.

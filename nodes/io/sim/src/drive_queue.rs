@@ -17,6 +17,7 @@ use std::collections::VecDeque;
 use cnc_msgs::servo::{BrakeTail, ServoFeedback, ServoSetpoint, MAX_AXES, TAIL_TICKS};
 
 use crate::gearing::{SpindleReading, TapGear, ThreadCam};
+use crate::single_block::BlockStop;
 use crate::time_scale::{next_rate, within, Scaling};
 
 /// What the drives do in one tick.
@@ -91,6 +92,8 @@ pub struct SetpointQueue {
     cam: ThreadCam,
     /// Where the thread's cam put the axes this tick.
     cam_position: Option<[f64; MAX_AXES]>,
+    /// Single block at the drives: the block end they stop at ([`crate::single_block`]).
+    block_stop: BlockStop,
     /// Per axis, how far ahead of the encoder reading a geared or cammed setpoint is computed,
     /// s (the period and the drive's lag, as motion's lock-step tap and thread).
     gear_lead: [f64; MAX_AXES],
@@ -139,6 +142,7 @@ impl SetpointQueue {
             gear: None,
             cam: ThreadCam::default(),
             cam_position: None,
+            block_stop: BlockStop::default(),
             gear_lead: [0.0; MAX_AXES],
         }
     }
@@ -215,6 +219,7 @@ impl SetpointQueue {
         self.armed = false;
         self.resetting = false;
         self.jog_released = false;
+        self.block_stop.clear();
     }
 
     /// The drives stand after an emergency stop's ramp (their power may go).
@@ -272,6 +277,13 @@ impl SetpointQueue {
         if !self.armed {
             return self.play_unarmed(&scaling);
         }
+        self.block_stop.update(
+            scaling.single_block && !scaling.reset,
+            scaling.starts,
+            (self.index, self.scale),
+            &self.queue,
+            &self.limit,
+        );
         self.advance(&scaling);
         if (scaling.reset || self.jog_released) && self.scale == 0.0 {
             self.end_episode(match scaling.reset {
@@ -355,8 +367,29 @@ impl SetpointQueue {
         gear.position(&self.spindle, &self.gear_lead)
     }
 
-    /// Moves the drives' position along the queued path by this tick's rate.
+    /// Moves the drives' position along the queued path by this tick's rate; under single
+    /// block not past the block end they stop at.
     fn advance(&mut self, scaling: &Scaling) {
+        if self.block_stop.standing() && !scaling.reset {
+            (self.scale, self.target) = (0.0, 0.0);
+            return;
+        }
+        let unscaled = self.step_index(scaling);
+        if let Some(end) = self.block_stop.end() {
+            if unscaled && self.index > end {
+                // A move by whole setpoints (spindle-locked, manual) stops on the end: the
+                // path stands there (`single_block.rs` chose only such an end for it).
+                self.index = end;
+                self.cam_position = None;
+            }
+        }
+        self.block_stop
+            .arrive(&mut self.index, &mut self.scale, scaling.starts);
+    }
+
+    /// Moves the drives' position along the queued path by this tick's rate; true when the
+    /// setpoints are not time-scaled (played by the clock one a tick, or by the encoder).
+    fn step_index(&mut self, scaling: &Scaling) -> bool {
         let k = self.position();
         if !scaling.reset {
             // A thread goes by the spindle's encoder, not by the clock.
@@ -366,7 +399,7 @@ impl SetpointQueue {
                 (self.scale, self.target) = (1.0, 1.0);
                 self.index = c.index;
                 self.cam_position = Some(c.position);
-                return;
+                return true;
             }
         }
         // The next setpoint's kind; past the queue's end (a brake tail) the last one reached.
@@ -393,7 +426,7 @@ impl SetpointQueue {
             self.scale = 1.0;
             self.target = 1.0;
             self.index = (k + 1) as f64;
-            return;
+            return true;
         }
         let target = scaling.target(kind, planned);
         self.target = target;
@@ -409,12 +442,15 @@ impl SetpointQueue {
                     self.at(self.index + r)
                         .is_some_and(|to| within(&self.limit, &here, &step, &keeping, &to))
                 };
-                self.scale = next_rate(keep, target, fits);
+                let proposed = next_rate(keep, target, fits);
+                let most = || next_rate(keep, 0.0, fits);
+                self.scale = self.block_stop.rate(self.index, proposed, most);
             }
             // Nothing queued to measure by: the drives come to the end of what was queued.
             None => self.scale = self.scale.min(target),
         }
         self.index += self.scale;
+        false
     }
 
     /// The queued path's position at `index`, interpolated between setpoints.
@@ -496,6 +532,11 @@ impl SetpointQueue {
             .map_or(0, |b| b.tick.saturating_sub(at) as u32)
     }
 
+    /// The drives stand at a block's end for single block, until a cycle start.
+    pub fn standing_at_block_end(&self) -> bool {
+        self.block_stop.standing()
+    }
+
     /// A setpoint of this episode has been reached.
     pub fn armed(&self) -> bool {
         self.armed && self.dry_since.is_none()
@@ -516,49 +557,6 @@ impl SetpointQueue {
 fn sample_in(queue: &VecDeque<ServoSetpoint>, index: u64) -> Option<&ServoSetpoint> {
     let i = queue.binary_search_by_key(&index, |s| s.tick).ok()?;
     queue.get(i)
-}
-
-/// The drive trace's header: tick (the drives' clock), queue depth, underrun, emergency
-/// stop, feed hold, where on the queued path the drives are, their rate along it and the rate
-/// they head for (feed hold, overrides), per axis
-/// its setpoint, actual position and following error, then the spindle encoder's speed (rpm)
-/// and angle (degrees): the oscilloscope a commissioning engineer reads.
-pub fn trace_header(axes: &[String]) -> String {
-    let mut h = String::from("tick,queue_depth,underrun,emergency_stop,hold,index,scale,target");
-    for a in axes {
-        h.push_str(&format!(",{a}_setpoint,{a}_actual,{a}_following_error"));
-    }
-    h.push_str(",spindle_rpm,spindle_angle");
-    h
-}
-
-/// One tick of the drive trace. Positions are written exactly (Rust's shortest round-trip
-/// form), so two traces compare to the last bit. `flags`: emergency stop, feed hold.
-pub fn trace_line(
-    tick: u64,
-    played: &Played,
-    actual: &[f64],
-    depth: u32,
-    flags: (bool, bool),
-    spindle: (f64, f64),
-) -> String {
-    use std::fmt::Write;
-    let sp = &played.setpoint;
-    let mut line = format!(
-        "{tick},{depth},{},{},{},{:?},{:?},{:?}",
-        u8::from(played.underrun),
-        u8::from(flags.0),
-        u8::from(flags.1),
-        played.index,
-        played.scale,
-        played.target
-    );
-    for (i, a) in actual.iter().enumerate() {
-        let c = sp.position[i];
-        let _ = write!(line, ",{c:?},{a:?},{:?}", c - a);
-    }
-    let _ = write!(line, ",{:?},{:?}", spindle.0, spindle.1);
-    line
 }
 
 #[cfg(test)]

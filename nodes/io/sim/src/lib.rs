@@ -12,8 +12,10 @@ pub mod devices;
 pub mod drive_queue;
 mod gearing;
 pub mod probe;
+mod single_block;
 pub mod spindle_position;
 pub mod time_scale;
+pub mod trace;
 
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{x, y, SignalTable, XImage, YImage};

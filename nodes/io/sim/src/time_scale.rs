@@ -19,6 +19,10 @@ pub struct Scaling {
     pub reset: bool,
     /// The PLC's jog keys, a bit per axis signal: +J (G100), −J (G102).
     pub jog_keys: (u32, u32),
+    /// Single block (the PLC's SBK): the drives stop at the end of the block they play.
+    pub single_block: bool,
+    /// The cycle starts motion has taken: one releases the drives from a block's end.
+    pub starts: u32,
 }
 
 impl Default for Scaling {
@@ -29,6 +33,8 @@ impl Default for Scaling {
             rapid_override: 1.0,
             reset: false,
             jog_keys: (0, 0),
+            single_block: false,
+            starts: 0,
         }
     }
 }
@@ -115,6 +121,8 @@ impl HoldLatch {
             rapid_override: plc.rapid_override(),
             reset: false,
             jog_keys,
+            single_block: plc.get(g::SBK),
+            starts: self.control.map_or(0, |c| c.starts),
         }
     }
 

@@ -158,6 +158,11 @@ impl Planner {
         self.segs.front().map(|p| p.line)
     }
 
+    /// The segment being cut: its block number, line and end.
+    pub fn front(&self) -> Option<(u64, u32, Point)> {
+        self.segs.front().map(|p| (p.seq, p.line, p.seg.end()))
+    }
+
     /// Where the tool is now.
     pub fn position(&self) -> Point {
         self.segs.front().map_or(self.end, |p| p.seg.point(self.s))

@@ -103,3 +103,56 @@ fn feed_hold_is_told_to_the_drives_and_a_cycle_stop_is_planned() {
         "the core brakes for a cycle stop"
     );
 }
+
+/// Ten lines of 3 mm along Z at F3000, merged into one chord by the planner: with the drives'
+/// scaling every setpoint still names the programmed line being cut, and where the line
+/// changes it says where between the two setpoints the block ended (D137): interpolated
+/// there, the point is the programmed end. With single block on, the core does not stop
+/// between the blocks itself (the drives do), but gives each its own setpoint.
+#[test]
+fn setpoints_say_where_each_block_ends_also_in_merged_lines() {
+    for single_block in [false, true] {
+        let mut m = Motion::new(scaling_lathe(), &[25.0, 0.0]);
+        m.set_panel(Panel {
+            single_block,
+            ..Panel::default()
+        });
+        for k in 1..=10u32 {
+            m.push(block(
+                u64::from(k),
+                10 * k,
+                Command::Linear {
+                    end: vec![50.0, -3.0 * f64::from(k)],
+                    feed: 3000.0,
+                },
+            ));
+        }
+        m.push(block(11, 110, Command::ProgramEnd));
+        let g = GImage::released();
+        let mut setpoints: Vec<(f64, u32, f64)> = Vec::new();
+        for _ in 0..600 {
+            let actual = m.commanded().to_vec();
+            let z = m.tick(Some(&actual), &g)[1];
+            let mut sp = ServoSetpoint::default();
+            m.fill_setpoint(&mut sp);
+            setpoints.push((z, sp.line, sp.block_start));
+            assert_ne!(m.state(), RunState::Hold, "the core does not stop");
+        }
+        let mut ends = Vec::new();
+        for w in setpoints.windows(2) {
+            let ((z0, l0, _), (z1, l1, began)) = (w[0], w[1]);
+            if l0 != l1 && l0 != 0 && l1 != 0 {
+                ends.push((l0, z0 + (z1 - z0) * began));
+            }
+        }
+        assert_eq!(ends.len(), 9, "single block {single_block}: {ends:?}");
+        for (k, (line, z)) in ends.iter().enumerate() {
+            let want = -3.0 * (k + 1) as f64;
+            assert_eq!(*line, 10 * (k as u32 + 1));
+            assert!(
+                (z - want).abs() < 1e-9,
+                "line {line} ends at Z {z}, not {want}"
+            );
+        }
+    }
+}

@@ -106,8 +106,9 @@ impl Motion {
                 for &seq in &self.finished {
                     self.done_seq = self.done_seq.max(seq);
                 }
-                if let Some(line) = self.planner.line() {
+                if let Some((line, end)) = self.line_cut() {
                     self.line = line;
+                    self.block_end = Some(end);
                 }
                 // A measuring block that braked at its edge ends at rest: the rest of its
                 // line is dropped (delete distance to go).

@@ -18,6 +18,10 @@ pub(super) struct AtDrives {
     pub on: bool,
     /// Ticks the active thread or tap has waited, its setpoints unscaled.
     pub locked_wait: u32,
+    /// The drives stand at a block's end for single block (their feedback says so).
+    pub block_stop: bool,
+    /// The block the last setpoint was cut in, and where this one's began (D137).
+    pub cut: block_ends::CutBlock,
     /// Cycle starts and resets taken (wrapping): they release the drives' hold.
     pub starts: u32,
     pub resets: u32,
@@ -47,6 +51,19 @@ impl Motion {
         }
     }
 
+    /// Single block as the core takes it: with the drives time-scaling, the drives stop at a
+    /// block's end (D137); the core only gives every block a tick of its own, so each ends
+    /// where the setpoints' line changes.
+    pub(super) fn planning_block_stop(&self) -> bool {
+        !self.at_drives.on
+    }
+
+    /// The drives' feedback: they stand at a block's end for single block, until a cycle
+    /// start (D137).
+    pub fn drives_at_block_end(&mut self, standing: bool) {
+        self.at_drives.block_stop = standing;
+    }
+
     /// Counts the ticks a thread or tap has been active (its setpoints unscaled).
     pub(super) fn count_locked_wait(&mut self) {
         let locked = matches!(
@@ -72,6 +89,8 @@ impl Motion {
         if !self.at_drives.on {
             return;
         }
+        sp.line = self.at_drives.cut.line();
+        sp.block_start = self.at_drives.cut.began;
         if let Some(key) = self.held_jog_key() {
             sp.scaling = ServoSetpoint::SCALE_JOG;
             sp.jog_key = key;

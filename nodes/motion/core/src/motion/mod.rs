@@ -29,6 +29,7 @@ use active::{Active, RapidAxis};
 
 mod activate;
 mod active;
+mod block_ends;
 mod brake_tail;
 mod compressor;
 mod drive_fault;
@@ -159,6 +160,9 @@ pub struct Motion {
     last_line: Option<u32>,
     /// End points of lines being merged into one chord (built once).
     merge_points: Vec<Point>,
+    /// Chords of merged lines still in the planner, and the end of the line being cut.
+    merged: VecDeque<block_ends::MergedLines>,
+    block_end: Option<Point>,
     /// Per axis, how far ahead of the encoder reading a thread's setpoint is computed, s:
     /// one servo period (the setpoint is reached at the end of the coming period) plus the
     /// drive lag (the slide trails a moving setpoint by it).
@@ -254,6 +258,8 @@ impl Motion {
             encoder: Encoder::default(),
             panel: Panel::default(),
             merge_points: Vec::with_capacity(window::MAX_MERGE),
+            merged: VecDeque::with_capacity(64),
+            block_end: None,
             block_stop: false,
             last_line: None,
             thread_lead_time,
@@ -342,6 +348,7 @@ impl Motion {
             }
             self.run_id = block.run_id;
             self.queue.clear();
+            self.merged.clear();
             self.active = None;
             let here = self.commanded_point();
             self.planner.reset(here);
@@ -436,6 +443,7 @@ impl Motion {
         self.servo_off = false;
         self.missed_feedback = 0;
         self.queue.clear();
+        self.merged.clear();
         self.active = None;
         self.feed_hold = false;
         self.cycle_stop = false;
@@ -501,6 +509,7 @@ impl Motion {
         if self.alarm || self.emergency_stop {
             RunState::Alarm
         } else if self.block_stop
+            || self.at_drives.block_stop
             || self.feed_hold && (self.active.is_some() || !self.queue.is_empty())
         {
             RunState::Hold
@@ -561,6 +570,9 @@ impl Motion {
     /// lock holds them.
     pub fn tick(&mut self, actual: Option<&[f64]>, plc: &GImage) -> &[f64] {
         self.tick_machine(actual, plc);
+        if self.at_drives.on {
+            self.mark_block_start();
+        }
         self.drive_output();
         &self.encoder_setpoint
     }
@@ -692,9 +704,10 @@ impl Motion {
                 let Some(next_line) = self.queue.front().map(|b| b.line) else {
                     break;
                 };
-                // Single block: the next line waits for cycle start (`000` §7.4).
+                // Single block: the next line waits for cycle start (`000` §7.4); with the
+                // drives time-scaling they stop at its end, and it starts a tick later (D137).
                 if self.panel.single_block && self.last_line.is_some_and(|l| l != next_line) {
-                    self.block_stop = true;
+                    self.block_stop = self.planning_block_stop();
                     self.last_line = None;
                     break;
                 }

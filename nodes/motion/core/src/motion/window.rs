@@ -69,6 +69,7 @@ impl Motion {
                         start,
                         end: merged.end,
                     };
+                    self.record_merge(&start, &merged.end, merged.seq, merged.blocks);
                     self.planner
                         .push(seg, feed, merged.seq, line, true, merged.deviation);
                     for _ in 0..merged.blocks {
