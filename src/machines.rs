@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use cnc_runtime::LaunchConfig;
 
 /// The built-in machines by name: the launch configs of the repository, as they were built.
-pub const BUILT_IN: [(&str, &str); 3] = [
+pub const BUILT_IN: [(&str, &str); 4] = [
     (
         "sim_lathe",
         include_str!("../launch_configs/sim_lathe.yaml"),
@@ -22,6 +22,10 @@ pub const BUILT_IN: [(&str, &str); 3] = [
     (
         "sim_mill_802d",
         include_str!("../launch_configs/sim_mill_802d.yaml"),
+    ),
+    (
+        "sim_turnmill",
+        include_str!("../launch_configs/sim_turnmill.yaml"),
     ),
 ];
 

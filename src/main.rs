@@ -30,7 +30,7 @@ struct Cli {
 enum Verb {
     /// Start every node of the cell in this process.
     Run {
-        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d); default:
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d, sim_turnmill); default:
         /// the built-in sim_lathe. A cell launch file (`launch_configs/cell_two_lathes.yaml`)
         /// runs all its machines, the robot and the cell supervisor until its order is done.
         #[arg(value_name = "CONFIG")]
@@ -53,7 +53,7 @@ enum Verb {
     /// other hosts), until Ctrl-C or SIGTERM.
     Node {
         node: NodeName,
-        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d); default:
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d, sim_turnmill); default:
         /// the built-in sim_lathe.
         #[arg(value_name = "CONFIG")]
         config_file: Option<PathBuf>,
@@ -108,7 +108,7 @@ enum Verb {
     Operator {
         #[command(subcommand)]
         action: OperatorVerb,
-        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d); default:
+        /// The launch config: a file, or a built-in machine (sim_lathe, sim_mill, sim_mill_802d, sim_turnmill); default:
         /// the built-in sim_lathe.
         #[arg(long, global = true)]
         config: Option<PathBuf>,

@@ -47,6 +47,16 @@ pub enum Command {
         lead: f64,
         rpm: f64,
     },
+    /// The turn-mill's C axis (the main spindle in position control, D138): the spindle turns
+    /// at `rpm` to `degrees`, an angle 0–360 reached the way `way` says or, with
+    /// [`Turn::Incremental`], a signed travel; the axes follow its angle to `end` (the Huaxing
+    /// G08). The block ends with the spindle standing there.
+    Rotary {
+        end: Vec<f64>,
+        degrees: f64,
+        way: Turn,
+        rpm: f64,
+    },
     /// A measuring move (touch probe, measuring input 1): a straight line at `feed` during
     /// which the probe's rising (`rising`) or falling edge latches every axis's position. With
     /// `stop` (delete distance to go) the axes brake at the edge and the rest of the line is
@@ -130,6 +140,7 @@ impl Command {
             | Command::Arc { end, .. }
             | Command::Thread { end, .. }
             | Command::Tap { end, .. }
+            | Command::Rotary { end, .. }
             | Command::Probe { end, .. } => Some(end),
             _ => None,
         }
@@ -252,6 +263,18 @@ pub fn to_motion_block(
             m.end.clone_from(end);
             m.lead = *lead;
             m.aux_value = *rpm;
+        }
+        Command::Rotary {
+            end,
+            degrees,
+            way,
+            rpm,
+        } => {
+            m.kind = MotionBlock::KIND_ROTARY;
+            m.end.clone_from(end);
+            m.aux_code = *way as i32;
+            m.aux_value = *degrees;
+            m.feed = *rpm;
         }
         Command::Probe {
             end,
@@ -388,6 +411,22 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
                 end: m.end.clone(),
                 lead: m.lead,
                 rpm: m.aux_value,
+            }
+        }
+        MotionBlock::KIND_ROTARY => {
+            let way = Turn::from_code(m.aux_code)
+                .filter(|w| w.accepts(m.aux_value))
+                .ok_or_else(|| {
+                    format!(
+                        "rotary move to {} the way {} is not valid",
+                        m.aux_value, m.aux_code
+                    )
+                })?;
+            Command::Rotary {
+                end: m.end.clone(),
+                degrees: m.aux_value,
+                way,
+                rpm: feed()?,
             }
         }
         MotionBlock::KIND_PROBE => Command::Probe {
@@ -542,6 +581,18 @@ mod tests {
                 lead: -0.8,
                 rpm: 600.0,
             },
+            Command::Rotary {
+                end: vec![190.0, 120.0],
+                degrees: 330.0,
+                way: Turn::Minus,
+                rpm: 1000.0,
+            },
+            Command::Rotary {
+                end: vec![190.0, 120.0],
+                degrees: -750.0,
+                way: Turn::Incremental,
+                rpm: 800.0,
+            },
             Command::FeedMode { per_rev: true },
             Command::PathMode { exact_stop: true },
             Command::Profile { jerk_limited: true },
@@ -600,6 +651,18 @@ mod tests {
         m.feed = 100.0;
         m.end = vec![f64::NAN];
         assert!(from_motion_block(&m).is_err());
+        // A rotary move's angle outside 0–360 for an absolute way, its way unknown, no speed.
+        let rotary = Command::Rotary {
+            end: vec![1.0],
+            degrees: 100.0,
+            way: Turn::Plus,
+            rpm: 1000.0,
+        };
+        for (degrees, way, rpm) in [(360.0, 1, 1000.0), (10.0, 7, 1000.0), (10.0, 1, 0.0)] {
+            let mut r = to_motion_block(1, 1, "", 1, &rotary);
+            (r.aux_value, r.aux_code, r.feed) = (degrees, way, rpm);
+            assert!(from_motion_block(&r).is_err(), "{degrees} {way} {rpm}");
+        }
         let mut d = to_motion_block(1, 1, "", 1, &Command::Dwell { seconds: 1.0 });
         d.dwell_seconds = f64::NAN;
         assert!(from_motion_block(&d).is_err());

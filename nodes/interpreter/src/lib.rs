@@ -25,7 +25,7 @@ pub mod sinumerik;
 pub mod trace;
 
 pub use cnc_interpreter_core::{
-    canon, geometry, rough, Aux, Canon, Command, Library, MachineTimers, Measurement,
+    canon, geometry, rough, Aux, Canon, Command, Library, MachineTimers, Measurement, Turn,
 };
 pub use dialect::Dialect;
 pub use error::ProgramError;

@@ -74,6 +74,7 @@ pub fn of_machine(machine: &MachineConfig, start: &[f64]) -> Setup {
     setup.front_tool_post = machine.tool_post == cnc_machine::ToolPost::Front;
     setup.tool_change_macro = machine.tool_change_macro;
     setup.tool_change_with_m6 = machine.tool_change_with_m6;
+    setup.spindle_c_axis = machine.spindle_c_axis;
     setup.active_tool = machine.tool_in_spindle;
     setup.contour_tolerance = machine.contour_tolerance;
     setup.calculator_decimal_point = machine

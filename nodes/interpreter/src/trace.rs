@@ -69,6 +69,16 @@ pub fn line(letters: &[char], c: &Canon) -> String {
             axes(&mut s, letters, end, "");
             let _ = write!(s, " LEAD{lead:.4} S{rpm:.1}");
         }
+        Command::Rotary {
+            end,
+            degrees,
+            way,
+            rpm,
+        } => {
+            s.push_str("ROTARY");
+            axes(&mut s, letters, end, "");
+            let _ = write!(s, " C{degrees:.3} {way:?} S{rpm:.1}");
+        }
         Command::Probe {
             end,
             feed,
@@ -342,6 +352,9 @@ impl LinuxCnc {
                 out.push_str(")\n");
                 self.push(out, "STOP_SPEED_FEED_SYNCH()");
             }
+            // rs274 has no spindle-positioned move: the axes' end as a feed at the rotary
+            // speed's share is no honest equivalent, so nothing is written (D138).
+            Command::Rotary { .. } => {}
             // LinuxCNC's G38.2: a straight probe at the feed.
             Command::Probe { end, feed, .. } => {
                 self.set_feed(out, *feed);

@@ -579,9 +579,10 @@ fn fixtures_with_the_alarm_the_manual_predicts() {
     let text = fixture("041_g98_feed_vector_example.nc");
     let e = run(&text, HOME).unwrap_err();
     assert_eq!((e.number, line_of(&text, "W-10;")), (11, e.line));
-    // 057 writes `C01` (for G01): this lathe has no C axis, alarm 7 on that line.
+    // 057 writes `C01` (for G01): this lathe has no C axis, alarm 74 ("rotary axis not
+    // defined", D138) on that line.
     let e = run(&fixture("057_ch20_ex3_aluminium_shaft.nc"), HOME).unwrap_err();
-    assert_eq!(e.number, 7);
+    assert_eq!(e.number, 74);
     assert!(e.text.contains('C'), "{e}");
 }
 
@@ -690,25 +691,26 @@ fn fixture_003_g96_surface_speed_is_kept_through_g97() {
 
 #[test]
 fn fixtures_004_014_to_017_need_the_c_axis_or_live_tool_this_lathe_lacks() {
-    // `000` §3.1: an unlicensed optional code is alarm 7. The simulated lathe has X and Z
-    // only: no C axis (M14, G08, G12.1, C words), no live tool (G14.n), and no oscillation
-    // in motion (G07.1). Every line of 004 is an independent example; each is refused.
+    // The plain lathe (`sim_lathe`) has X and Z only: its spindle is no C axis (M14.6, G08,
+    // C words: alarm 74 "rotary axis not defined", D138; `sim_turnmill` runs them, see
+    // `turn_mill.rs`). No live tool (G14.n) and no oscillation in motion (G07.1): alarm 7,
+    // `000` §3.1's unlicensed option. Every line of 004 is an independent example.
     let text = fixture("004_spindle_c_axis_position_m14_g08.nc");
     for l in lines(&text) {
         let e = run(&l, HOME).unwrap_err();
-        assert_eq!((e.number, e.line), (7, 1), "{l}: {e}");
+        assert_eq!((e.number, e.line), (74, 1), "{l}: {e}");
     }
-    for (name, first_bad) in [
-        ("014_g07_1_thread_chip_break.nc", "N0020"),
-        ("015_g08_rotary_axis_examples.nc", "M14.6"),
-        ("016_g12_1_polar_interpolation.nc", "G00 C0"),
-        ("017_g14_4_flying_cutter_tapping.nc", "N0020"),
+    for (name, first_bad, number) in [
+        ("014_g07_1_thread_chip_break.nc", "N0020", 7),
+        ("015_g08_rotary_axis_examples.nc", "M14.6", 74),
+        ("016_g12_1_polar_interpolation.nc", "G00 C0", 74),
+        ("017_g14_4_flying_cutter_tapping.nc", "N0020", 7),
     ] {
         let text = fixture(name);
         let e = run(&text, HOME).unwrap_err();
         assert_eq!(
             (e.number, e.line),
-            (7, line_of(&text, first_bad)),
+            (number, line_of(&text, first_bad)),
             "{name}: {e}"
         );
     }

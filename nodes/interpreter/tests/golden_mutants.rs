@@ -91,7 +91,7 @@ const LATHE_TOKENS: &[&str] = &[
     "G54 ", "G96 ", "G97 ", "G99 ", "G99.1 ", "G02 ", "G03 ", "G05 ", "G07 ", "G09 ", "G41 ",
     "G42 ", "G40 ", "M98 ", "M99 ", "M97 ", "M30 ", "M03 ", "M05 ", "P", "Q", "R", "U", "W", "X",
     "Z", "I", "K", "L", "E", "F", "S", "T0101", "T0202", "#1=", "#200=[", "]", "[", "GOTO", "IF",
-    "EQ", "/", ";", ",L1 ", ",R2 ", "C1 ", "D2 ",
+    "EQ", "/", ";", ",L1 ", ",R2 ", "C1 ", "D2 ", "G08 ", "G08.6 ", "M14.6 ", "M15 ", "C", "H",
 ];
 
 /// A set of seed programs and how they are read.
@@ -159,6 +159,19 @@ fn lathe_setup() -> Setup {
     setup
 }
 
+/// The machine a dialect's programs run on: the Huaxing lathe as the turn-mill
+/// (`sim_turnmill`), so its C axis is mutated too.
+fn setup_for(dialect: Dialect) -> Setup {
+    match dialect {
+        Dialect::FanucMill => mill_setup(),
+        Dialect::HuaxingLathe => Setup {
+            spindle_c_axis: true,
+            ..lathe_setup()
+        },
+        _ => lathe_setup(),
+    }
+}
+
 fn fnv1a(h: u64, bytes: &[u8]) -> u64 {
     bytes
         .iter()
@@ -167,11 +180,7 @@ fn fnv1a(h: u64, bytes: &[u8]) -> u64 {
 
 /// One mutant's outcome as a line: commands produced, the hash of everything, how it ended.
 fn outcome(dialect: Dialect, text: &str) -> String {
-    let setup = if dialect == Dialect::FanucMill {
-        mill_setup()
-    } else {
-        lathe_setup()
-    };
+    let setup = setup_for(dialect);
     let letters = setup.axes.clone();
     let mut h = 0xcbf2_9ce4_8422_2325;
     let result = check_limited(dialect, text, setup, Library::new(), LIMIT);
@@ -226,11 +235,7 @@ fn show(id: &str, dialect: Dialect, text: &str) {
     if std::env::var("GOLDEN_SHOW").ok().as_deref() != Some(id) {
         return;
     }
-    let setup = if dialect == Dialect::FanucMill {
-        mill_setup()
-    } else {
-        lathe_setup()
-    };
+    let setup = setup_for(dialect);
     let letters = setup.axes.clone();
     println!("--- {id}\n{text}---");
     match check_limited(dialect, text, setup, Library::new(), LIMIT) {

@@ -66,6 +66,10 @@ pub struct MachineConfig {
     /// with a magazine); false: T changes the tool at once (D94).
     #[serde(default)]
     pub tool_change_with_m6: bool,
+    /// A turn-mill lathe: the main spindle is also the C axis, positioned by its drive
+    /// (M14.6, G08 on the Huaxing control, `000` §4.2.6–4.2.7, D138).
+    #[serde(default)]
+    pub spindle_c_axis: bool,
     /// The tool in the spindle when the kept memory says none (the machine's first power-up,
     /// and `cnc check`/`simulate`, which read no kept memory; `--tool-in-spindle` overrides):
     /// a program that selects its edge before M6 finds the tool it expects (issue 46).

@@ -176,6 +176,7 @@ impl Core {
                 MoveKind::Rapid
                 | MoveKind::Thread { .. }
                 | MoveKind::Tap { .. }
+                | MoveKind::Rotary { .. }
                 | MoveKind::Probe { .. },
             ) => plain(self),
             (chamfer, MoveKind::Feed(_)) => {

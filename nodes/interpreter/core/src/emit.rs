@@ -62,6 +62,13 @@ pub enum MoveKind {
         lead: f64,
         rpm: f64,
     },
+    /// The turn-mill's C axis: the positioned spindle turns to `degrees` the way `way` says
+    /// at `rpm`, and the axes follow its angle (D138).
+    Rotary {
+        degrees: f64,
+        way: crate::canon::Turn,
+        rpm: f64,
+    },
     /// A measuring line at the feed: the probe's edge latches the axes, `stop` brakes there
     /// ([`crate::measure`]).
     Probe {
@@ -160,6 +167,15 @@ impl Core {
                 }
                 0.0
             }
+            MoveKind::Rotary { degrees, way, rpm } => {
+                if !(way.accepts(degrees) && rpm > 0.0 && rpm.is_finite()) {
+                    return Err(self.fault(
+                        Fault::OutOfRange,
+                        format!("C axis to {degrees}° at {rpm} rpm"),
+                    ));
+                }
+                0.0
+            }
         };
         if matches!(kind, MoveKind::Arc { .. }) {
             self.arc_under_frame()?;
@@ -204,6 +220,12 @@ impl Core {
                 start_angle: angle,
             },
             MoveKind::Tap { lead, rpm } => Command::Tap { end: m, lead, rpm },
+            MoveKind::Rotary { degrees, way, rpm } => Command::Rotary {
+                end: m,
+                degrees,
+                way,
+                rpm,
+            },
             MoveKind::Probe { rising, stop, .. } => Command::Probe {
                 end: m,
                 feed,
@@ -391,10 +413,11 @@ impl Core {
                 },
                 comp::Kind::Feed(feed),
             ),
-            MoveKind::Thread { .. } | MoveKind::Tap { .. } => {
+            MoveKind::Thread { .. } | MoveKind::Tap { .. } | MoveKind::Rotary { .. } => {
                 return Err(self.fault(
                     Fault::CompInCycle,
-                    "thread cutting or tapping while tool-nose compensation is active",
+                    "thread cutting, tapping or a C-axis move while tool-nose compensation is \
+                     active",
                 ))
             }
             // `Core::measure` refuses it before it comes here.

@@ -137,6 +137,10 @@ pub enum Fault {
     /// Unknown axis for reference return.
     NoSuchAxis,
     /// Three-point arc points collinear.
+    /// A rotary-axis move (G08) without its rotary axis's word.
+    RotaryWord,
+    /// A rotary axis the machine does not have (no C axis, not that axis's spindle).
+    RotaryAxis,
     ThreePointArc,
     /// Too few blocks between compensation start and cancel.
     CompBlocks,

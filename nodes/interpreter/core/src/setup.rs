@@ -84,6 +84,8 @@ pub struct Setup {
     /// A T word only preselects the tool and M6 changes it (a machine datum); else T
     /// changes the tool at once.
     pub tool_change_with_m6: bool,
+    /// The main spindle is also the C axis (a turn-mill lathe, D138).
+    pub spindle_c_axis: bool,
     /// The tool in the spindle when the program starts, as the last program or the operator
     /// left it (0: none); a control that keeps it across power-off starts with it.
     pub active_tool: u32,
@@ -123,6 +125,7 @@ impl Setup {
             calculator_decimal_point: None,
             contour_tolerance: 0.05,
             tool_change_with_m6: false,
+            spindle_c_axis: false,
             active_tool: 0,
         }
     }

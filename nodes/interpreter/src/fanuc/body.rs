@@ -52,7 +52,7 @@ impl<D: Family> Fanuc<D> {
         if !self.has_axis_words(b) {
             // A block of only modal words; arcs may still be full circles by I/K.
             let arc_ik = matches!(self.motion, G::ArcCw | G::ArcCcw) && (b.has('I') || b.has('K'));
-            if !arc_ik {
+            if !arc_ik && !D::moves_without_axes(self, b) {
                 return Ok(());
             }
         }

@@ -112,6 +112,10 @@ pub trait Family: Sized + Send + 'static {
     fn words(_f: &mut Fanuc<Self>, _b: &Block<Self>) -> Result<(), ProgramError> {
         Ok(())
     }
+    /// A block that moves without axis words (the Huaxing's C axis, turned by G08 C or H).
+    fn moves_without_axes(_f: &Fanuc<Self>, _b: &Block<Self>) -> bool {
+        false
+    }
     /// In this block F is a thread lead, not a feed.
     fn f_is_lead(_f: &Fanuc<Self>, _b: &Block<Self>) -> bool {
         false

@@ -43,7 +43,9 @@ pub fn alarm(f: Fault) -> u32 {
         PatternReliefZero => 59,
         WorkOffset => 62,
         NoSuchAxis => 75,
-        ThreePointArc => 80,
+        // "G05/G08 programmed without a rotary axis" and "rotary axis not defined".
+        ThreePointArc | RotaryWord => 80,
+        RotaryAxis => 74,
         CompBlocks => 82,
         CompStartNotLine => 85,
         CompNoIntersection | CompInterference => 88,

@@ -4,6 +4,7 @@
 //! macro.
 
 mod alarms;
+mod c_axis;
 mod compound;
 mod drilling;
 mod flow;
@@ -66,6 +67,11 @@ pub enum HuaxingG {
     LoopRange,
     /// G99.1: feed per revolution whose next cut starts on the encoder's Z pulse (§5.25, D132).
     FeedPerRevolutionOnIndex,
+    /// G08 (`orient` none) / G08.n (M14.n first): the C axis turned, X and Z along (§5.7,
+    /// D138).
+    Rotary {
+        orient: Option<u8>,
+    },
 }
 
 /// Retained words of a single cycle (G90/G92/G94, §5.21.3).
@@ -91,6 +97,8 @@ pub struct Huaxing {
     pub tool_macro_depth: Option<usize>,
     /// G99.1 given: the next cut starts on the spindle encoder's Z pulse (D132).
     pub start_on_index: bool,
+    /// The C axis's speed of the last G08, r/min (its F, modal apart from the feed).
+    pub rotary_rpm: Option<f64>,
 }
 
 impl Family for Huaxing {
@@ -140,6 +148,7 @@ impl Family for Huaxing {
             cycle_starts: 1,
             tool_macro_depth: None,
             start_on_index: false,
+            rotary_rpm: None,
         }
     }
 
@@ -147,7 +156,8 @@ impl Family for Huaxing {
     const INCREMENTAL_ADDRESSES: bool = true;
 
     fn extra_address(c: char) -> bool {
-        c == 'U' || c == 'W'
+        // C and H: the C axis of a turn-mill, checked in `words`.
+        matches!(c, 'U' | 'W' | 'C' | 'H')
     }
 
     fn read_var(f: &Fanuc<Self>, n: i64) -> Result<Value, EvalError> {
@@ -166,6 +176,7 @@ impl Family for Huaxing {
                     | HuaxingG::VariableLeadThread
                     | HuaxingG::ThreadCycle
                     | HuaxingG::TappingCycle
+                    | HuaxingG::Rotary { .. }
             )
         ) || b.has_g(G::Own(HuaxingG::MultiThreadCycle))
     }
@@ -245,6 +256,7 @@ impl Family for Huaxing {
                 | FacingCycle
                 | ThreadCycle
                 | Drilling { .. }
+                | Rotary { .. }
         )
     }
     fn motion_selected(
@@ -258,6 +270,12 @@ impl Family for Huaxing {
             f.d.cycle = CycleWords::default();
         }
         None
+    }
+    fn words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
+        f.c_words(b)
+    }
+    fn moves_without_axes(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
+        matches!(f.motion, G::Own(HuaxingG::Rotary { .. })) && (b.has('C') || b.has('H'))
     }
     fn motion_words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
         if let G::Own(HuaxingG::Drilling { .. }) = f.motion {
@@ -286,6 +304,7 @@ impl Family for Huaxing {
             VariableLeadThread => f.g34(b),
             TappingCycle => f.g33(b),
             TurningCycle | FacingCycle | ThreadCycle => f.single_cycle(b, g),
+            Rotary { orient } => f.rotary(b, orient),
             other => Err(f.fault(Fault::UndefinedCode, format!("{other:?} is not a motion"))),
         }
     }
@@ -337,9 +356,11 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
             0,
             Unsupported("G07.1 thread chip breaking needs an oscillation superimposed in motion"),
         ),
-        80..=86 => (
+        80 => (1, G::Own(Rotary { orient: None })),
+        86 => (1, G::Own(Rotary { orient: Some(6) })),
+        81..=85 => (
             1,
-            Unsupported("G08 rotary-axis interpolation needs a rotary axis"),
+            Unsupported("G08.1–G08.5 make X…B a rotary axis: the turn-mill's is the spindle, C"),
         ),
         90 => (15, ExactStopBlock),
         121 => (16, Unsupported("G12.1 polar interpolation needs a C axis")),
@@ -435,7 +456,8 @@ pub fn m_code(n: u32) -> Option<M<ToolMacro>> {
         480 => AuxAfter,
         980 => SubprogramCall,
         990 => SubprogramReturn,
-        141..=146 => Unsupported("M14.n assigns the spindle angle to a rotary axis"),
+        146 => Own(ToolMacro::PositionMode(6)),
+        141..=145 => Unsupported("M14.1–M14.5 give X…B the spindle's angle: the turn-mill's is C"),
         290 => Unsupported("M29 rigid tapping needs a position spindle"),
         500 => Unsupported("M50 bar feed drives outputs directly, not through the PLC"),
         510 => Unsupported("M51 sets the start block in MDI"),

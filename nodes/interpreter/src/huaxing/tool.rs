@@ -23,6 +23,8 @@ pub enum ToolMacro {
     ToolToPlc,
     /// M58 Kn: raise alarm number n.
     RaiseAlarm,
+    /// M14.n: the spindle into position control, its angle axis n's coordinate (§4.2.7, D138).
+    PositionMode(u8),
 }
 
 impl Fanuc<Huaxing> {
@@ -111,6 +113,7 @@ impl<D: Family<M = ToolMacro>> Fanuc<D> {
                 self.tool = n;
                 Ok(())
             }
+            ToolMacro::PositionMode(n) => self.position_mode(n),
             ToolMacro::RaiseAlarm => {
                 let n = need_k(self)?;
                 let mut e = self.fault(

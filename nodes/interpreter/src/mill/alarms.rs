@@ -16,7 +16,7 @@ pub fn alarm(f: Fault) -> u32 {
         IllegalMinus => 6,
         DecimalPoint => 7,
         DataFormat | IllegalWord | AbsAndInc | TooManyM | RepeatedWord | AxisAddress
-        | NoSuchAxis | ArcRAndIk | NoSuchAddress => 9,
+        | NoSuchAxis | ArcRAndIk | NoSuchAddress | RotaryWord | RotaryAxis => 9,
         UndefinedCode | NotSupported | SameGroup | Group00With01 | MissingWord | ThreadLead
         | TaperTooLarge | CssWithoutS | Chamfer | ChamferTooShort | RangeError
         | LoopWithoutStart | NoProgramEnd | CompInCycle | CycleZero | CycleFormat

@@ -103,6 +103,7 @@ impl Motion {
                 })
             }
             Command::Tap { .. } => Ok(Active::Tap(self.tap_for(block, &start)?)),
+            Command::Rotary { .. } => Ok(Active::Tap(self.rotary_for(block, &start)?)),
             Command::Dwell { seconds } => Ok(Active::Dwell {
                 remaining: *seconds,
             }),

@@ -44,31 +44,97 @@ impl Motion {
             return Err((alarm::BAD_BLOCK, "not a tap block".into()));
         };
         self.check_limits(end)?;
-        if self.panel.aux_lock {
-            return Err((
-                alarm::SPINDLE_NOT_TURNING,
-                "rigid tapping needs the spindle: auxiliary function lock is on".into(),
-            ));
-        }
-        if *rpm > self.cfg.spindle_max_rpm {
-            return Err((
-                alarm::BAD_BLOCK,
-                format!(
-                    "tapping at {rpm} rpm: the spindle is rated {} rpm",
-                    self.cfg.spindle_max_rpm
-                ),
-            ));
-        }
         let n = self.cfg.axes.len().min(MAX_AXES);
         let end = self.to_slide(end);
         let long = (0..n)
             .map(|i| (end[i] - start[i]).abs())
             .fold(0.0, f64::max);
         let degrees = 360.0 * long / lead;
+        self.geared_move(start, end, degrees, *rpm)
+    }
+
+    /// A rotary block (the turn-mill's C axis, D138) as a geared move: the spindle, standing
+    /// in position control, turns from its angle now to the block's the way it says, and the
+    /// axes follow its angle.
+    pub(super) fn rotary_for(&self, block: &Block, start: &Point) -> Result<Tap, (u32, String)> {
+        self.check_block(&block.kind)?;
+        let Command::Rotary {
+            end,
+            degrees,
+            way,
+            rpm,
+        } = &block.kind
+        else {
+            return Err((alarm::BAD_BLOCK, "not a rotary block".into()));
+        };
+        self.check_limits(end)?;
+        if self.encoder.rpm != 0.0 {
+            return Err((
+                alarm::SPINDLE_NOT_TURNING,
+                format!(
+                    "the C axis needs the spindle in position mode (M14.6), it turns at {} rpm",
+                    self.encoder.rpm
+                ),
+            ));
+        }
+        let now = self.encoder.raw_ahead(0.0);
+        let travel = match way {
+            Turn::Plus => (degrees - now).rem_euclid(360.0),
+            Turn::Minus => -(now - degrees).rem_euclid(360.0),
+            Turn::Shortest => (degrees - now + 180.0).rem_euclid(360.0) - 180.0,
+            Turn::Incremental => *degrees,
+        };
+        let end = self.to_slide(end);
+        let moves = (0..self.cfg.axes.len().min(MAX_AXES)).any(|i| end[i] != start[i]);
+        if moves && travel == 0.0 {
+            return Err((
+                alarm::BAD_BLOCK,
+                format!("the axes cannot follow C: it is at {degrees}° already"),
+            ));
+        }
+        // The rotary axis leads (§5.7): it turns slower where an axis could not follow, as a
+        // feed is clamped to an axis's rapid rate (D138).
+        let revs = travel.abs() / 360.0;
+        let mut rpm = *rpm;
+        for (i, a) in self.cfg.axes.iter().enumerate().take(MAX_AXES) {
+            let per_rev = (end[i] - start[i]).abs() / revs.max(f64::MIN_POSITIVE);
+            if per_rev > 0.0 {
+                rpm = rpm.min(a.max_velocity / per_rev);
+            }
+        }
+        self.geared_move(start, end, travel, rpm)
+    }
+
+    /// The axes from `start` to `end` (slide units) geared to the spindle turning `degrees`
+    /// at `rpm`: refused when the spindle could not turn it (auxiliary function lock, above
+    /// its rating) or an axis could not follow (faster than it may move).
+    fn geared_move(
+        &self,
+        start: &Point,
+        end: Point,
+        degrees: f64,
+        rpm: f64,
+    ) -> Result<Tap, (u32, String)> {
+        if self.panel.aux_lock {
+            return Err((
+                alarm::SPINDLE_NOT_TURNING,
+                "a tap or C-axis move needs the spindle: auxiliary function lock is on".into(),
+            ));
+        }
+        if rpm > self.cfg.spindle_max_rpm {
+            return Err((
+                alarm::BAD_BLOCK,
+                format!(
+                    "turning the spindle at {rpm} rpm: it is rated {} rpm",
+                    self.cfg.spindle_max_rpm
+                ),
+            ));
+        }
+        let n = self.cfg.axes.len().min(MAX_AXES);
         if !(degrees.is_finite() && degrees.abs() <= MAX_TAP_DEGREES) {
             return Err((
                 alarm::BAD_BLOCK,
-                format!("tap of lead {lead} mm over {long:.4} mm: {degrees:e}° of the spindle"),
+                format!("{degrees:e}° of the spindle in one block"),
             ));
         }
         let revs = degrees.abs() / 360.0;
@@ -92,7 +158,7 @@ impl Motion {
             start: *start,
             end,
             degrees,
-            rpm: *rpm,
+            rpm,
             from: None,
         })
     }

@@ -1,0 +1,112 @@
+//! The turn-mill's C axis on the Huaxing (`000` §4.2.6–4.2.7, §5.7; decision D138): the main
+//! spindle, switched into position control by M14.6 (or G08.6), is the C axis, its angle
+//! counted from the encoder's Z pulse. G08 turns it at F r/min: C an angle reached within one
+//! revolution the way its sign says, H a travel of any number of turns; X and Z in the same
+//! block move along, geared to its angle (motion's rigid-tap gearing, D101).
+
+use cnc_interpreter_core::{Aux, Fault, MoveKind, ProgramError, Turn};
+
+use super::Huaxing;
+use crate::fanuc::block::Block;
+use crate::fanuc::{Family, Fanuc};
+
+/// The spindle's axis number on these machines: 6, C (M14.1–M14.5 would name X … B).
+const C_AXIS: u8 = 6;
+
+/// The fastest a G08 may turn the C axis, r/min (§5.7).
+const MAX_RPM: f64 = 3000.0;
+
+impl<D: Family> Fanuc<D> {
+    /// M14.n: the spindle into position control where it stands; its angle is axis n's
+    /// coordinate. Only C (n = 6) is the spindle's axis, and only on a turn-mill.
+    pub fn position_mode(&mut self, n: u8) -> Result<(), ProgramError> {
+        if !self.core.setup.spindle_c_axis || n != C_AXIS {
+            let axis = ['X', 'Y', 'Z', 'A', 'B', 'C']
+                .get(usize::from(n.saturating_sub(1)))
+                .copied()
+                .unwrap_or('?');
+            return Err(self.fault(
+                Fault::RotaryAxis,
+                format!("M14.{n}/G08.{n}: the spindle is not axis {axis} of this machine"),
+            ));
+        }
+        self.core.aux(Aux::Orient {
+            degrees: 0.0,
+            way: Turn::Incremental,
+        });
+        Ok(())
+    }
+}
+
+impl Fanuc<Huaxing> {
+    /// G08 (`orient` none) or G08.n (M14.n first): the C axis to C (or by H) at F r/min, X and
+    /// Z along with it.
+    pub(super) fn rotary(
+        &mut self,
+        b: &Block<Huaxing>,
+        orient: Option<u8>,
+    ) -> Result<(), ProgramError> {
+        match orient {
+            Some(n) => self.position_mode(n)?,
+            None if !self.core.setup.spindle_c_axis => {
+                return Err(self.fault(Fault::RotaryAxis, "G08: this lathe has no C axis"));
+            }
+            None => {}
+        }
+        let rpm = match b.get('F') {
+            Some(f) => f,
+            None => self.d.rotary_rpm.ok_or_else(|| {
+                self.fault(
+                    Fault::MissingWord,
+                    "G08 needs F, the C axis's speed in r/min",
+                )
+            })?,
+        };
+        if !(rpm > 0.0 && rpm <= MAX_RPM) {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!("G08 F{rpm}: the C axis turns at 1–{MAX_RPM} r/min"),
+            ));
+        }
+        self.d.rotary_rpm = Some(rpm);
+        let (degrees, way) = match (b.get('C'), b.get('H')) {
+            (Some(_), Some(_)) => {
+                return Err(self.fault(Fault::AbsAndInc, "C and H in one G08 block"));
+            }
+            // An absolute C within one revolution, its sign the way: C−750 turns the negative
+            // way to −30°, that is 330° (D138: the manual's "320°" is a slip).
+            (Some(c), None) => {
+                let way = if c < 0.0 { Turn::Minus } else { Turn::Plus };
+                let angle = c.rem_euclid(360.0);
+                (if angle >= 360.0 { 0.0 } else { angle }, way)
+            }
+            (None, Some(h)) => (h, Turn::Incremental),
+            (None, None) => {
+                return Err(self.fault(
+                    Fault::RotaryWord,
+                    "G08 without C or H: no rotary axis programmed",
+                ));
+            }
+        };
+        let end = self.end_point(b)?;
+        self.core.emit(&end, MoveKind::Rotary { degrees, way, rpm })
+    }
+
+    /// C and H program the C axis, in G08 blocks only.
+    pub(super) fn c_words(&self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
+        let g08 = matches!(
+            b.group(1).unwrap_or(self.motion),
+            crate::fanuc::codes::G::Own(super::HuaxingG::Rotary { .. })
+        );
+        for c in ['C', 'H'] {
+            if b.get(c).is_some() && !g08 {
+                let why = match self.core.setup.spindle_c_axis {
+                    true => format!("address {c}: the C axis is programmed with G08"),
+                    false => format!("address {c}: no C axis on this machine"),
+                };
+                return Err(self.fault(Fault::RotaryAxis, why));
+            }
+        }
+        Ok(())
+    }
+}

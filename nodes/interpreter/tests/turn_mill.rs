@@ -1,0 +1,129 @@
+//! The Huaxing turn-mill's C axis (`000` §4.2.6–4.2.7, §5.7; decision D138) on the canonical
+//! stream: the manual's fixtures 004 and 015 block by block, and the section's alarms.
+
+use cnc_interpreter::{Aux, Canon, Command, Dialect, ProgramError, Setup, Turn};
+
+/// A turn-mill lathe at X200 Z100 (diameter), its spindle the C axis.
+fn turn_mill() -> Setup {
+    let mut s = Setup::lathe([200.0, 100.0]);
+    s.spindle_c_axis = true;
+    s
+}
+
+fn run(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
+    cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
+}
+
+fn fixture(name: &str) -> String {
+    let path = format!(
+        "{}/../../../shared/fixtures/000/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    text.split("(--- listing as printed ---)")
+        .nth(1)
+        .expect("listing marker")
+        .to_string()
+}
+
+/// A rotary move as (X, Z, degrees, way, rpm).
+fn rotary(c: &Command) -> Option<(f64, f64, f64, Turn, f64)> {
+    match c {
+        Command::Rotary {
+            end,
+            degrees,
+            way,
+            rpm,
+        } => Some((end[0], end[1], *degrees, *way, *rpm)),
+        _ => None,
+    }
+}
+
+fn position_mode(c: &Command) -> bool {
+    matches!(
+        c,
+        Command::Aux(Aux::Orient {
+            degrees,
+            way: Turn::Incremental
+        }) if *degrees == 0.0
+    )
+}
+
+/// Fixture 004 as printed, run as one program: M14.6 puts the spindle in position mode where
+/// it stands; G08 C100 turns it the positive way to 100° at 1000 r/min; C−750 the negative
+/// way to −30°, 330° (the manual prints 320°: D138); H−750 750° back, turns included; the
+/// three-axis G08 moves X by U−10 (diameter) and Z to 120 while C turns 100° at 800 r/min;
+/// G08.6 is M14.6 and G08 in one.
+#[test]
+fn fixture_004_positions_c_and_turns_it_with_x_and_z() {
+    let text = fixture("004_spindle_c_axis_position_m14_g08.nc");
+    let cmds = run(&text, turn_mill()).unwrap();
+    let c: Vec<&Command> = cmds.iter().map(|c| &c.command).collect();
+    assert!(position_mode(c[0]), "{:?}", c[0]);
+    let want = [
+        (200.0, 100.0, 100.0, Turn::Plus, 1000.0),
+        (200.0, 100.0, 330.0, Turn::Minus, 1000.0),
+        (200.0, 100.0, -750.0, Turn::Incremental, 1000.0),
+        (190.0, 120.0, 100.0, Turn::Incremental, 800.0),
+    ];
+    for (k, w) in want.iter().enumerate() {
+        assert_eq!(rotary(c[1 + k]), Some(*w), "block {}", k + 2);
+    }
+    assert!(position_mode(c[5]), "G08.6 positions first: {:?}", c[5]);
+    assert_eq!(
+        rotary(c[6]),
+        Some((190.0, 120.0, 120.0, Turn::Plus, 1000.0))
+    );
+    assert_eq!(c.len(), 8, "{c:?}");
+}
+
+/// Fixture 015's first two listings: to C0, the infeed U−1.5 at the feed, then three turns
+/// of C with Z 4.5 mm along (a 1.5 mm thread's three turns at 800 r/min); the G08.6 form
+/// gives the same stream. Its third listing names Y as the rotary axis (G08.2 Y100): this
+/// machine has no Y, alarm 7 for the word (and M14.2 alone is 7 too: its spindle is C).
+#[test]
+fn fixture_015_three_turns_of_c_with_z_along() {
+    let text = fixture("015_g08_rotary_axis_examples.nc");
+    let parts: Vec<&str> = text.split(".....").collect();
+    let first = run(parts[0], turn_mill()).unwrap();
+    let second = run(parts[1].split("(例:)").next().unwrap(), turn_mill()).unwrap();
+    for cmds in [&first, &second] {
+        let c: Vec<&Command> = cmds.iter().map(|c| &c.command).collect();
+        assert!(position_mode(c[0]));
+        assert_eq!(rotary(c[1]), Some((200.0, 100.0, 0.0, Turn::Plus, 1000.0)));
+        assert!(
+            matches!(c[2], Command::Linear { end, feed } if end[0] == 198.5 && *feed == 50.0),
+            "{:?}",
+            c[2]
+        );
+        assert_eq!(
+            rotary(c[3]),
+            Some((198.5, 4.5, 1080.0, Turn::Incremental, 800.0))
+        );
+    }
+    let e = run("G08.2 Y100 F1000\n", turn_mill()).unwrap_err();
+    assert_eq!(e.number, 7, "{e}");
+    assert!(e.text.contains("address Y"), "{e}");
+    assert_eq!(run("M14.2\n", turn_mill()).unwrap_err().number, 7);
+}
+
+/// The section's alarms: G08 without C or H is 80; C and H together 9; the first G08
+/// without F 23; F above 3000 r/min 13; a C word outside G08 74; on a lathe whose spindle
+/// is no C axis G08 and M14.6 are 74; M14.3 (Z as the spindle's axis) 7: only C is built.
+#[test]
+fn the_c_axis_alarms() {
+    let cases = [
+        ("M14.6\nG08 Z10 F100\n", turn_mill(), 80, 2),
+        ("M14.6\nG08 C10 H10 F100\n", turn_mill(), 9, 2),
+        ("M14.6\nG08 C10\n", turn_mill(), 23, 2),
+        ("M14.6\nG08 C10 F4000\n", turn_mill(), 13, 2),
+        ("G01 Z10 C10 F100\n", turn_mill(), 74, 1),
+        ("G08 C10 F100\n", Setup::lathe([200.0, 100.0]), 74, 1),
+        ("M14.6\n", Setup::lathe([200.0, 100.0]), 74, 1),
+        ("M14.3\n", turn_mill(), 7, 1),
+    ];
+    for (text, setup, number, line) in cases {
+        let e = run(text, setup).unwrap_err();
+        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
+    }
+}

@@ -1,0 +1,163 @@
+//! The turn-mill lathe (`sim_turnmill`, decision D138) through the whole chain on the PLC rig
+//! (`rig/mod.rs`): the Huaxing front end, motion's positioned spindle and its gearing, the
+//! ladder's M19 handshake and the simulated spindle drive. The manual's fixture 004 as one
+//! program: at every positioning's FIN the spindle stands at the angle the block asks for,
+//! having turned only the way the block says, and in the three-axis G08 the slides follow
+//! its angle.
+
+#[path = "rig/mod.rs"]
+mod rig;
+
+use cnc_msgs::signals::{f, g, SignalTable};
+use rig::*;
+
+/// The text of the Huaxing manual's fixture `number` (`../shared/fixtures/000`).
+fn fixture(number: &str) -> String {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/fixtures/000");
+    let path = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(number))
+        .unwrap();
+    let text = std::fs::read_to_string(path).unwrap();
+    text.split("(--- listing as printed ---)")
+        .nth(1)
+        .unwrap()
+        .to_string()
+}
+
+/// The spindle's degrees turned, signed, from the encoder's 0–360° readings.
+struct Turned {
+    degrees: f64,
+    last: f64,
+}
+
+impl Turned {
+    fn read(&mut self, angle: f64) -> f64 {
+        self.degrees += (angle - self.last + 180.0).rem_euclid(360.0) - 180.0;
+        self.last = angle;
+        self.degrees
+    }
+}
+
+/// Fixture 004 on the turn-mill, the spindle standing at 0° at power-on: M14.6 holds it there
+/// (C0); G08 C100 turns +100° to 100°; C−750 turns −130° to 330°; H−750 −750° to 300°; the
+/// three-axis G08 +100° to 40° while X moves U−10 and Z to 120 geared to its angle; G08.6
+/// C120 holds it (M14.6), then +80° to 120°. M15 lets it go back to speed control. (Z's 20 mm
+/// in 100° asks Z for 3600 mm/s² while the spindle ramps, more than its 1500: the slide trails
+/// by up to 0.25 mm then, its drive's lag; how closely a geared move keeps to the spindle is
+/// measured on fixture 015's gentler helix below.)
+#[test]
+fn fixture_004_turns_the_spindle_as_the_c_axis_each_block_asks() {
+    let cfg = config("sim_turnmill");
+    let z = cfg.axis_index("Z").unwrap();
+    let program = format!(
+        "G00 X200 Z100\n{}M15\nM30\n",
+        fixture("004_spindle_c_axis_position_m14_g08")
+    );
+    let mut r = Rig::on(cfg, &program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let mut spindle = Turned {
+        degrees: 0.0,
+        last: r.fb.spindle_angle_deg,
+    };
+    let (mut fins, mut was_fin) = (Vec::new(), false);
+    // The three-axis G08: Z and the spindle where it began, the slide's worst distance
+    // from where the spindle's angle puts it.
+    let (mut geared, mut worst) = (None::<(f64, f64)>, 0.0f64);
+    let mut z_end = 0.0;
+    let ok = r.run_until(60.0, |r| {
+        let a = r.fb.spindle_angle_deg;
+        let turned = spindle.read(a);
+        let orienting = r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;
+        let fin = r.gi.get(g::FIN) && orienting;
+        if fin && !was_fin {
+            fins.push((a, r.fb.spindle_rpm, turned, r.fb.position[z]));
+        }
+        was_fin = fin;
+        let travel = r.nc().read_i32(f::ORIENT_ANGLE);
+        if orienting && travel == 100_000 && fins.len() == 4 {
+            let (z0, t0) = *geared.get_or_insert((r.fb.position[z], turned));
+            let want = z0 + 20.0 * ((turned - t0) / 100.0).clamp(0.0, 1.0);
+            worst = worst.max((r.fb.position[z] - want).abs());
+        }
+        z_end = r.motion.commanded_display()[z];
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!("at each FIN (angle, rpm, turned, Z): {fins:?}; Z off the spindle by {worst:.4}");
+    let want = [
+        (0.0, 0.0),
+        (100.0, 100.0),
+        (330.0, -30.0),
+        (300.0, -780.0),
+        (40.0, -680.0),
+        (40.0, -680.0),
+        (120.0, -600.0),
+    ];
+    assert_eq!(fins.len(), want.len(), "{fins:?}");
+    for (k, ((angle, rpm, turned, _), (a, t))) in fins.iter().zip(want).enumerate() {
+        assert!(
+            (angle - a).abs() < 1e-6 && (turned - t).abs() < 1e-6 && *rpm == 0.0,
+            "positioning {k}: {angle}° after {turned}° at {rpm} rpm, not {a}° after {t}°"
+        );
+    }
+    assert!(geared.is_some(), "the three-axis G08 ran");
+    assert!(
+        (fins[4].3 - fins[3].3 - 20.0).abs() < 0.01,
+        "Z to 120: {fins:?}"
+    );
+    assert_eq!(z_end, 120.0, "Z at 120");
+    assert!(worst < 0.25, "Z off the spindle's angle by {worst} mm");
+    assert_eq!(r.motion.commanded_display()[0], 190.0, "X by U−10");
+    assert!(!r.bit("ORIENT_REQ"), "M15: speed control again");
+}
+
+/// Fixture 015's first listing on the turn-mill: C to 0 at 1000 r/min, the infeed, then three
+/// turns of C at 800 r/min with Z feeding 4.5 mm from Z0: a 1.5 mm helix, which the slide keeps at
+/// every servo tick within the 0.1 mm the rigid tap keeps (`plc_cell_mill.rs`), ending on its
+/// length exactly with C back at 0°.
+#[test]
+fn fixture_015_cuts_three_turns_of_a_helix_with_c_and_z() {
+    let cfg = config("sim_turnmill");
+    let z = cfg.axis_index("Z").unwrap();
+    let listing = fixture("015_g08_rotary_axis_examples");
+    let part = listing.split(".....").next().unwrap();
+    let program = format!("G00 X50 Z0\nG98 F100\n{part}M15\nM30\n");
+    let mut r = Rig::on(cfg, &program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let mut spindle = Turned {
+        degrees: 0.0,
+        last: r.fb.spindle_angle_deg,
+    };
+    let (mut helix, mut worst, mut ends) = (None::<(f64, f64)>, 0.0f64, Vec::new());
+    let ok = r.run_until(60.0, |r| {
+        let turned = spindle.read(r.fb.spindle_angle_deg);
+        let orienting = r.nc().get(f::MF) && r.nc().read_i32(f::M_CODE) == 19;
+        let three_turns = orienting && r.nc().read_i32(f::ORIENT_ANGLE) == 1_080_000;
+        match (helix, three_turns) {
+            (None, true) => helix = Some((r.fb.position[z], turned)),
+            (Some((z0, t0)), true) => {
+                let want = z0 + 4.5 * ((turned - t0) / 1080.0).clamp(0.0, 1.0);
+                worst = worst.max((r.fb.position[z] - want).abs());
+            }
+            (Some(_), false) => {
+                helix = None;
+                ends.push((r.fb.spindle_angle_deg, turned));
+            }
+            (None, false) => {}
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!("helix ends at {ends:?}: Z off the spindle's helix by at most {worst:.4} mm");
+    assert_eq!(ends.len(), 1, "{ends:?}");
+    assert!(
+        ends[0].0.abs() < 1e-6 || (ends[0].0 - 360.0).abs() < 1e-6,
+        "C at 0: {ends:?}"
+    );
+    assert_eq!(r.motion.commanded_display()[z], 4.5, "Z 4.5 mm on");
+    assert!(worst < 0.1, "{worst} mm");
+}
