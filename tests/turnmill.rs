@@ -5,6 +5,7 @@
 //! having turned only the way the block says, and in the three-axis G08 the slides follow
 //! its angle.
 
+mod common;
 #[path = "rig/mod.rs"]
 mod rig;
 
@@ -160,4 +161,59 @@ fn fixture_015_cuts_three_turns_of_a_helix_with_c_and_z() {
     );
     assert_eq!(r.motion.commanded_display()[z], 4.5, "Z 4.5 mm on");
     assert!(worst < 0.1, "{worst} mm");
+}
+
+/// Issue 49, must-show 5 (the part of it built): a part on `sim_turnmill` in the cell over
+/// DDS, as a supervisor runs it: turned, then C indexed to 90°, turned on by 180° and back to
+/// 0° by G08.6; the `axes` topic shows C at each stop, and the part is counted.
+#[test]
+fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
+    use cnc_cell::client::CellClient;
+    use cnc_msgs::msg::MachineState;
+    use std::time::Duration;
+    let cfg = common::machine("sim_turnmill", 188);
+    let cell = cnc::cell::Cell::start(&cfg).unwrap();
+    let mut client = CellClient::new(
+        &cfg.network,
+        "turnmill1",
+        "turnmill_supervisor",
+        ros2_client::ServiceMapping::Enhanced,
+    )
+    .unwrap();
+    client.wait_ready(Duration::from_secs(30)).unwrap();
+    let program = "O0485\nG00 X60 Z5\nM03 S800\nG01 X50 Z0 F300\nZ-20\nG00 X60 Z5\nM05\n\
+                   M14.6\nG08 C90 F500\nG04 X1\nG08 H180 F500\nG04 X1\nG08.6 C0 F500\nM15\nM30\n";
+    let r = client.load_program("o0485.nc", program).unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let r = client.start_program("o0485.nc").unwrap();
+    assert!(r.accepted, "{}", r.message);
+    let c_at = |c: &CellClient| {
+        c.axes
+            .as_ref()
+            .and_then(|a| a.axes.iter().find(|x| x.name == "C"))
+            .map(|x| x.actual_position)
+    };
+    let mut stops = Vec::new();
+    let (done, _) = client.wait_until(Duration::from_secs(60), |c| {
+        if let Some(angle) = c_at(c) {
+            for want in [90.0, 270.0] {
+                if (angle - want).abs() < 1e-3 && !stops.contains(&want) {
+                    stops.push(want);
+                }
+            }
+        }
+        c.state
+            .as_ref()
+            .is_some_and(|s| s.execution == MachineState::PROGRAM_COMPLETED)
+            && c.part_count.as_ref().is_some_and(|p| p.count == 1)
+    });
+    assert!(done, "state {:?}, alarms {:?}", client.state, client.alarms);
+    assert_eq!(stops, [90.0, 270.0], "C on the axes topic at its stops");
+    let (back, _) = client.wait_until(Duration::from_secs(5), |c| {
+        c_at(c).is_some_and(|a| a.abs() < 1e-3 || (a - 360.0).abs() < 1e-3)
+    });
+    assert!(back, "C back at 0: {:?}", client.axes);
+    drop(client);
+    let (_, errors) = cell.stop();
+    assert!(errors.is_empty(), "{errors:?}");
 }

@@ -42,17 +42,8 @@ pub(crate) enum Report {
     Status(MotionStatus, Option<BlockResult>),
     /// A tick later than the warning limit (its interval, µs), or the warning cleared.
     Late(Option<f64>),
-    /// Commanded and actual slide positions.
-    /// Commanded, actual and drive setpoint positions (machine coordinates), a bit per axis
-    /// a lock holds, a bit per referenced axis, and the overtravel switches (+, −).
-    Axes(
-        [f64; MAX_AXES],
-        [f64; MAX_AXES],
-        [f64; MAX_AXES],
-        u32,
-        u32,
-        (u32, u32),
-    ),
+    /// The axes as the `axes` topic shows them.
+    Axes(Box<AxesReport>),
     Alarm(u32, String, u32),
     /// A warning raised with its reason (`Some`) or cleared (`None`).
     Warning(u32, Option<String>),
@@ -201,33 +192,8 @@ fn dds_loop(
                         alarms.clear(number);
                     }
                 }
-                Ok(Report::Axes(commanded, actual, setpoint, locked, referenced, limits)) => {
-                    let n = axes.len();
-                    let axes = axes
-                        .iter()
-                        .enumerate()
-                        .map(|(i, a)| {
-                            let (cmd, act) = (commanded[i] / a.scale(), actual[i] / a.scale());
-                            Axis {
-                                name: a.name.clone(),
-                                commanded_position: cmd,
-                                actual_position: act,
-                                following_error: setpoint[i] / a.scale() - act,
-                                homed: referenced & (1 << i) != 0,
-                                overtravel: i8::from(limits.0 & (1 << i) != 0)
-                                    - i8::from(limits.1 & (1 << i) != 0),
-                                locked: locked & (1 << i) != 0,
-                            }
-                        })
-                        .collect();
-                    publish(
-                        &axes_pub,
-                        AxisState {
-                            stamp: stamp(),
-                            axes,
-                            machine_lock: n > 0 && locked == (1u32 << n) - 1,
-                        },
-                    );
+                Ok(Report::Axes(r)) => {
+                    publish(&axes_pub, axis_state(&r, axes, cfg.machine.spindle_c_axis));
                 }
                 Ok(Report::Stats(s)) => publish(&stats_pub, s),
                 Ok(Report::Answer(id, result)) => publish(&results_pub, answer(id, result)),
@@ -245,6 +211,58 @@ fn dds_loop(
         }
     }
     Ok(())
+}
+
+/// Commanded, actual and drive setpoint positions (machine coordinates), a bit per axis a
+/// lock holds, a bit per referenced axis, the overtravel switches (+, −), and the spindle
+/// encoder's angle (a turn-mill's C axis, D138).
+pub(crate) struct AxesReport {
+    commanded: [f64; MAX_AXES],
+    actual: [f64; MAX_AXES],
+    setpoint: [f64; MAX_AXES],
+    locked: u32,
+    referenced: u32,
+    limits: (u32, u32),
+    spindle_angle: f64,
+}
+
+/// The `axes` topic's message: the configured axes, and on a turn-mill the spindle as C (its
+/// encoder's angle, 0–360°, "displayed always positive", `000` §5.7).
+fn axis_state(r: &AxesReport, axes: &[cnc_motion_core::AxisConfig], c_axis: bool) -> AxisState {
+    let n = axes.len();
+    let mut list: Vec<Axis> = axes
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            let (cmd, act) = (r.commanded[i] / a.scale(), r.actual[i] / a.scale());
+            Axis {
+                name: a.name.clone(),
+                commanded_position: cmd,
+                actual_position: act,
+                following_error: r.setpoint[i] / a.scale() - act,
+                homed: r.referenced & (1 << i) != 0,
+                overtravel: i8::from(r.limits.0 & (1 << i) != 0)
+                    - i8::from(r.limits.1 & (1 << i) != 0),
+                locked: r.locked & (1 << i) != 0,
+            }
+        })
+        .collect();
+    if c_axis {
+        list.push(Axis {
+            name: "C".into(),
+            commanded_position: r.spindle_angle,
+            actual_position: r.spindle_angle,
+            following_error: 0.0,
+            homed: true,
+            overtravel: 0,
+            locked: false,
+        });
+    }
+    AxisState {
+        stamp: stamp(),
+        axes: list,
+        machine_lock: n > 0 && r.locked == (1u32 << n) - 1,
+    }
 }
 
 /// Whether the PLC keeps answering: motion takes its silence as an emergency stop.
@@ -602,9 +620,15 @@ pub(crate) fn report_axes(motion: &Motion, limits: (u32, u32), reports: &Sender<
         .iter()
         .enumerate()
         .fold(0u32, |bits, (i, r)| bits | (u32::from(*r) << i));
-    let _ = reports.send(Report::Axes(
-        commanded, machine, drive, locked, referenced, limits,
-    ));
+    let _ = reports.send(Report::Axes(Box::new(AxesReport {
+        commanded,
+        actual: machine,
+        setpoint: drive,
+        locked,
+        referenced,
+        limits,
+        spindle_angle: motion.spindle_angle(),
+    })));
 }
 
 fn servo_loop(

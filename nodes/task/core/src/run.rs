@@ -274,7 +274,12 @@ impl RunCore {
     /// The axes' commanded positions as motion reports them; a report that is not of this
     /// machine's axes, or not finite, is not a start position.
     pub fn axes(&mut self, commanded: &[f64]) {
-        if commanded.len() == self.base.axes.len() && commanded.iter().all(|x| x.is_finite()) {
+        // The machine's axes come first; a turn-mill's spindle as C follows them (D138).
+        let n = self.base.axes.len();
+        let Some(commanded) = commanded.get(..n) else {
+            return;
+        };
+        if commanded.iter().all(|x| x.is_finite()) {
             self.position = Some(commanded.to_vec());
             self.ready_when_known();
         }

@@ -477,6 +477,11 @@ impl Motion {
     pub fn line(&self) -> u32 {
         self.line
     }
+
+    /// The spindle encoder's angle, degrees 0–360 after its index (a turn-mill's C, D138).
+    pub fn spindle_angle(&self) -> f64 {
+        self.encoder.raw_ahead(0.0)
+    }
     pub fn capacity(&self) -> usize {
         self.cfg.queue_capacity
     }
