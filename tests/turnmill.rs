@@ -217,3 +217,59 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
 }
+
+/// One skip run (G31, D139) on the turn-mill whose simulated probe (its measuring input, the
+/// skip input X11.5) switches with Z at or below −20: the latched Z and the rest of it, and
+/// the Z where the program's `G00 Z10` after it ends (machine coordinates).
+fn skip_run(keeps_actual: bool, skip: &str) -> (bool, f64, f64, f64) {
+    let mut cfg = config("sim_turnmill");
+    cfg.machine.skip_keeps_actual = keeps_actual;
+    cfg.sim.probe = vec![cnc_runtime::config::ProbeTarget {
+        min: vec![-1000.0, -1000.0],
+        max: vec![1000.0, -20.0],
+    }];
+    let z = cfg.axis_index("Z").unwrap();
+    let program = format!("G00 X40 Z10\n{skip}\nG00 Z10\nM30\n");
+    let mut r = Rig::on(cfg, &program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let mut latched = None;
+    let ok = r.run_until(60.0, |r| {
+        if let Some(res) = r.motion.block_result() {
+            latched = Some((res.triggered, res.position[z], res.rest[z]));
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    let (triggered, at, rest) = latched.expect("the skip's result");
+    (triggered, at, rest, r.motion.commanded_display()[z])
+}
+
+/// Issue 49, must-show 4 (G31 on the rig): the skip input ends the move where Z crosses
+/// −20, the latched point within one servo period's travel of it (F100: 0.0067 mm); with
+/// B19.6 = 1 the program goes on from the actual point (`G00 Z10` ends at 10), with B19.6 = 0
+/// the programmed end −50 is written over it (`G00 Z10` ends 30 mm further, at 40). `L`
+/// selects the input active low: the move ends where it switches off, leaving the box.
+#[test]
+fn g31_ends_on_the_skip_input_and_b19_6_decides_the_coordinates() {
+    let period = 100.0 / 60.0 * 0.004;
+    for (keeps, end) in [(true, 10.0), (false, 40.0)] {
+        let (triggered, at, rest, last) = skip_run(keeps, "G31 Z-50 F100");
+        println!("B19.6 keeps {keeps}: latched Z {at}, stood at {rest}, then Z {last}");
+        assert!(triggered, "the skip came");
+        assert!((at + 20.0).abs() <= period, "latched at {at}");
+        // Seen a tick or two after the edge, behind an 8 ms drive lag, then braked.
+        assert!(rest < at && rest > at - 0.05, "braked just past it: {rest}");
+        assert!(
+            (last - end).abs() < 1e-9,
+            "G00 Z10 ends at {last}, not {end}"
+        );
+    }
+    // Active low (L): into the box first (it is on), then out of it: the skip is its falling
+    // edge at Z −20 on the way back up.
+    let (triggered, at, _, _) = skip_run(true, "G00 Z-30\nG31 Z0 L11.5 F100");
+    assert!(
+        triggered && (at + 20.0).abs() <= period,
+        "falling edge at {at}"
+    );
+}

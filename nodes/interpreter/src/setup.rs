@@ -75,6 +75,8 @@ pub fn of_machine(machine: &MachineConfig, start: &[f64]) -> Setup {
     setup.tool_change_macro = machine.tool_change_macro;
     setup.tool_change_with_m6 = machine.tool_change_with_m6;
     setup.spindle_c_axis = machine.spindle_c_axis;
+    setup.skip_input = machine.skip_input.as_deref().and_then(x_input);
+    setup.skip_keeps_actual = machine.skip_keeps_actual;
     setup.active_tool = machine.tool_in_spindle;
     setup.contour_tolerance = machine.contour_tolerance;
     setup.calculator_decimal_point = machine
@@ -104,4 +106,11 @@ pub fn of_machine(machine: &MachineConfig, start: &[f64]) -> Setup {
         }
     }
     setup
+}
+
+/// An X-table input written `X11.5` (byte 11, bit 5; bits 0–7).
+pub fn x_input(text: &str) -> Option<(u32, u32)> {
+    let (byte, bit) = text.trim().strip_prefix(['X', 'x'])?.split_once('.')?;
+    let (byte, bit) = (byte.parse().ok()?, bit.parse().ok()?);
+    (bit < 8).then_some((byte, bit))
 }

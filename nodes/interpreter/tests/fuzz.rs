@@ -32,7 +32,8 @@ const TOKENS: &[&str] = &[
     "G99.1", "G02", "G03", "G05", "G41", "G42", "M98", "M99", "M97", "M30", "P", "Q", "R", "U",
     "W", "X", "Z", "I", "K", "L", "E", "F", "S", "T0101", "#1=", "#100=[", "]", "[", "GOTO", "IF",
     "EQ", "/", "(", ")", ";", "N", "O", "%", "-", ".", "0", "9", "99999999", "1E9", "SQRT", "ATAN",
-    "#[#1]", "/2", "*", "H", "A", "D", "J", "\n", " ", "G08", "G08.6", "M14.6", "M15", "C",
+    "#[#1]", "/2", "*", "H", "A", "D", "J", "\n", " ", "G08", "G08.6", "M14.6", "M15", "C", "G31",
+    "K11.5",
 ];
 
 struct Rng(u64);
@@ -132,8 +133,10 @@ fn run_case(dialect: Dialect, text: String) -> Result<bool, String> {
             let lines = text.lines().count().max(1) as u32;
             let outcome = std::panic::catch_unwind(|| {
                 // The Huaxing lathe as the turn-mill, its C axis fuzzed too (D138).
+                let turn_mill = dialect == Dialect::HuaxingLathe;
                 let setup = Setup {
-                    spindle_c_axis: dialect == Dialect::HuaxingLathe,
+                    spindle_c_axis: turn_mill,
+                    skip_input: turn_mill.then_some((11, 5)),
                     ..Setup::lathe([100.0, 50.0])
                 };
                 check_limited(dialect, &text, setup, Library::new(), LIMIT)

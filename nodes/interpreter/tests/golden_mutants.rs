@@ -92,6 +92,7 @@ const LATHE_TOKENS: &[&str] = &[
     "G42 ", "G40 ", "M98 ", "M99 ", "M97 ", "M30 ", "M03 ", "M05 ", "P", "Q", "R", "U", "W", "X",
     "Z", "I", "K", "L", "E", "F", "S", "T0101", "T0202", "#1=", "#200=[", "]", "[", "GOTO", "IF",
     "EQ", "/", ";", ",L1 ", ",R2 ", "C1 ", "D2 ", "G08 ", "G08.6 ", "M14.6 ", "M15 ", "C", "H",
+    "G31 ", "K11.5 ", "L11.5 ",
 ];
 
 /// A set of seed programs and how they are read.
@@ -166,6 +167,7 @@ fn setup_for(dialect: Dialect) -> Setup {
         Dialect::FanucMill => mill_setup(),
         Dialect::HuaxingLathe => Setup {
             spindle_c_axis: true,
+            skip_input: Some((11, 5)),
             ..lathe_setup()
         },
         _ => lathe_setup(),

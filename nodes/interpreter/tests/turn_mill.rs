@@ -79,8 +79,8 @@ fn fixture_004_positions_c_and_turns_it_with_x_and_z() {
 
 /// Fixture 015's first two listings: to C0, the infeed U−1.5 at the feed, then three turns
 /// of C with Z 4.5 mm along (a 1.5 mm thread's three turns at 800 r/min); the G08.6 form
-/// gives the same stream. Its third listing names Y as the rotary axis (G08.2 Y100): this
-/// machine has no Y, alarm 7 for the word (and M14.2 alone is 7 too: its spindle is C).
+/// gives the same stream. Its third listing makes Y the rotary axis (G08.2 Y100): the
+/// turn-mill's only rotary axis is C, alarm 7 with that reason (M14.2 alone too).
 #[test]
 fn fixture_015_three_turns_of_c_with_z_along() {
     let text = fixture("015_g08_rotary_axis_examples.nc");
@@ -103,7 +103,7 @@ fn fixture_015_three_turns_of_c_with_z_along() {
     }
     let e = run("G08.2 Y100 F1000\n", turn_mill()).unwrap_err();
     assert_eq!(e.number, 7, "{e}");
-    assert!(e.text.contains("address Y"), "{e}");
+    assert!(e.text.contains("G08.1–G08.5"), "{e}");
     assert_eq!(run("M14.2\n", turn_mill()).unwrap_err().number, 7);
 }
 
@@ -125,5 +125,50 @@ fn the_c_axis_alarms() {
     for (text, setup, number, line) in cases {
         let e = run(text, setup).unwrap_err();
         assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
+    }
+}
+
+/// G31 (§5.17, D139): a measuring move that brakes at the skip input's edge, rising with K
+/// (or without a word), falling with L; the input must be the machine's skip input (S#46):
+/// another is 13, K and L together 13, a machine without a skip input 7. Without a machine
+/// the skip is taken as coming at the end, so the program reads on from there.
+#[test]
+fn g31_skips_on_the_machines_skip_input() {
+    let with_skip = || Setup {
+        skip_input: Some((11, 5)),
+        ..turn_mill()
+    };
+    let cmds = run(
+        "G31 Z50 F100\nG31 W-5 K11.5 F50\nG31 W-5 L11.5\nG00 Z60\n",
+        with_skip(),
+    )
+    .unwrap();
+    let probes: Vec<(f64, f64, bool, bool)> = cmds
+        .iter()
+        .filter_map(|c| match &c.command {
+            Command::Probe {
+                end,
+                feed,
+                rising,
+                stop,
+            } => Some((end[1], *feed, *rising, *stop)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        probes,
+        [
+            (50.0, 100.0, true, true),
+            (45.0, 50.0, true, true),
+            (40.0, 50.0, false, true)
+        ]
+    );
+    for (text, setup, number) in [
+        ("G31 Z50 K3.2 F100\n", with_skip(), 13),
+        ("G31 Z50 K11.5 L11.5 F100\n", with_skip(), 13),
+        ("G31 Z50 F100\n", turn_mill(), 7),
+    ] {
+        let e = run(text, setup).unwrap_err();
+        assert_eq!((e.number, e.line), (number, 1), "{text}: {e}");
     }
 }

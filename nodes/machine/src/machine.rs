@@ -70,6 +70,15 @@ pub struct MachineConfig {
     /// (M14.6, G08 on the Huaxing control, `000` §4.2.6–4.2.7, D138).
     #[serde(default)]
     pub spindle_c_axis: bool,
+    /// The X-table input a skip move (the Huaxing's G31) stops on, e.g. `X11.5` (S#46): the
+    /// input wired to the drives' measuring input, which latches the axes at its edge. None:
+    /// the machine has no skip input (D139).
+    #[serde(default)]
+    pub skip_input: Option<String>,
+    /// After a skip, the axes' coordinates stay the actual ones where the input came (B19.6 =
+    /// 1); false: the programmed end point is written over them (B19.6 = 0, D139).
+    #[serde(default = "default_true")]
+    pub skip_keeps_actual: bool,
     /// The tool in the spindle when the kept memory says none (the machine's first power-up,
     /// and `cnc check`/`simulate`, which read no kept memory; `--tool-in-spindle` overrides):
     /// a program that selects its edge before M6 finds the tool it expects (issue 46).

@@ -136,6 +136,13 @@ pub const RULES: &[Rule] = &[
         None,
         "how the tool changer works",
     ),
+    builder("machine.spindle_c_axis", None, "what the machine is"),
+    builder("machine.skip_input", None, "the machine's wiring"),
+    builder(
+        "machine.skip_keeps_actual",
+        None,
+        "where a program goes on after a skip",
+    ),
     builder(
         "machine.reference_order.*",
         None,

@@ -86,6 +86,10 @@ pub struct Setup {
     pub tool_change_with_m6: bool,
     /// The main spindle is also the C axis (a turn-mill lathe, D138).
     pub spindle_c_axis: bool,
+    /// The skip input (G31) as X-table byte and bit, and whether a skip keeps the actual
+    /// coordinates (B19.6, D139).
+    pub skip_input: Option<(u32, u32)>,
+    pub skip_keeps_actual: bool,
     /// The tool in the spindle when the program starts, as the last program or the operator
     /// left it (0: none); a control that keeps it across power-off starts with it.
     pub active_tool: u32,
@@ -126,6 +130,8 @@ impl Setup {
             contour_tolerance: 0.05,
             tool_change_with_m6: false,
             spindle_c_axis: false,
+            skip_input: None,
+            skip_keeps_actual: true,
             active_tool: 0,
         }
     }

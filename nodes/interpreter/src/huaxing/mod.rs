@@ -9,6 +9,7 @@ mod compound;
 mod drilling;
 mod flow;
 mod grooving;
+mod skip;
 mod threads;
 mod tool;
 
@@ -72,6 +73,8 @@ pub enum HuaxingG {
     Rotary {
         orient: Option<u8>,
     },
+    /// G31: a feed move that ends on the skip input (§5.17, D139).
+    Skip,
 }
 
 /// Retained words of a single cycle (G90/G92/G94, §5.21.3).
@@ -99,6 +102,9 @@ pub struct Huaxing {
     pub start_on_index: bool,
     /// The C axis's speed of the last G08, r/min (its F, modal apart from the feed).
     pub rotary_rpm: Option<f64>,
+    /// A skip's programmed end, to be written over the coordinates once the machine has
+    /// told where the skip came (B19.6 = 0, D139).
+    pub skip_end: Option<Vec<f64>>,
 }
 
 impl Family for Huaxing {
@@ -149,6 +155,7 @@ impl Family for Huaxing {
             tool_macro_depth: None,
             start_on_index: false,
             rotary_rpm: None,
+            skip_end: None,
         }
     }
 
@@ -257,6 +264,7 @@ impl Family for Huaxing {
                 | ThreadCycle
                 | Drilling { .. }
                 | Rotary { .. }
+                | Skip
         )
     }
     fn motion_selected(
@@ -272,6 +280,7 @@ impl Family for Huaxing {
         None
     }
     fn words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
+        f.after_skip();
         f.c_words(b)
     }
     fn moves_without_axes(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
@@ -305,6 +314,7 @@ impl Family for Huaxing {
             TappingCycle => f.g33(b),
             TurningCycle | FacingCycle | ThreadCycle => f.single_cycle(b, g),
             Rotary { orient } => f.rotary(b, orient),
+            Skip => f.skip(b),
             other => Err(f.fault(Fault::UndefinedCode, format!("{other:?} is not a motion"))),
         }
     }
@@ -378,7 +388,7 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
         260 => (0, G::Own(CallRange)),
         270 => (0, G::Own(LoopRange)),
         280 => (0, ReferenceReturn),
-        310 => (1, Unsupported("G31 skip needs a skip input in motion")),
+        310 => (1, G::Own(Skip)),
         320 => (1, G::Own(Thread)),
         330 => (1, G::Own(TappingCycle)),
         340 => (1, G::Own(VariableLeadThread)),
