@@ -128,7 +128,7 @@ enum Verb {
     Replay {
         bag: PathBuf,
         /// The launch config whose network section (domain, interfaces) is used: a file, or a
-        /// built-in machine (sim_lathe, sim_mill, sim_mill_802d); default: the built-in sim_lathe.
+        /// built-in machine (sim_lathe, sim_mill, sim_mill_802d, sim_turnmill); default: the built-in sim_lathe.
         #[arg(long)]
         config: Option<PathBuf>,
         #[arg(long)]
@@ -188,7 +188,7 @@ enum AuditVerb {
 struct ProgramArgs {
     program: PathBuf,
     /// The launch config that describes the machine: a file, or a built-in machine
-    /// (sim_lathe, sim_mill, sim_mill_802d); default: the built-in sim_lathe.
+    /// (sim_lathe, sim_mill, sim_mill_802d, sim_turnmill); default: the built-in sim_lathe.
     #[arg(long, visible_alias = "launch")]
     config: Option<PathBuf>,
     /// The program's dialect; default: the config's (`sinumerik` is `sinumerik-802d`).

@@ -13,9 +13,10 @@ use std::collections::VecDeque;
 use std::time::Instant;
 
 use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
+use cnc_io::sim::spindle_position::{Positioning, StopCommand};
 use cnc_motion::path::{self, Point, Segment, MAX_AXES};
 use cnc_motion::{Aux, Block, Command, FromLaunch, Motion, MotionConfig, MotionEvent, RunState};
-use cnc_msgs::signals::{f, g, GImage, SignalTable};
+use cnc_msgs::signals::{f, g, y, GImage, SignalTable, YImage};
 use cnc_runtime::config::ProfileShape;
 use cnc_runtime::LaunchConfig;
 use cnc_task::run::ProgramRun;
@@ -190,8 +191,12 @@ pub fn simulate(
     let mut lathe_path = Vec::new();
     let mut last = motion.commanded_display();
     let mut spindle_rpm = 0.0;
-    // The spindle as an ideal encoder sees it: at the commanded speed at once.
+    // The spindle as an ideal encoder sees it: at the commanded speed at once; positioned
+    // (M19 with a stop position: SPOS, a rigid tap, the turn-mill's C) as the simulated
+    // drive positions it.
     let (mut spindle_dir, mut spindle_angle) = (1.0, 0.0);
+    let mut positioning = IdealPositioning::default();
+    let spindle_acceleration = cfg.sim.spindle_acceleration;
     let max_ticks = (MAX_SIMULATED_SECONDS / period) as u64;
     let mut programmed = ProgrammedPath {
         segments: VecDeque::new(),
@@ -235,9 +240,27 @@ pub fn simulate(
             motion.cycle_start();
             program_stops += 1;
         }
-        // The simulated PLC answers every strobe at once and the spindle is at speed.
+        // The simulated PLC answers every strobe at once and the spindle is at speed; a
+        // positioning once the spindle stands at its angle.
         let fi = *motion.f_image();
-        plc.set(g::FIN, fi.get(f::MF) || fi.get(f::SF) || fi.get(f::TF));
+        let orienting = fi.get(f::MF) && fi.read_i32(f::M_CODE) == 19;
+        if orienting {
+            spindle_dir = 0.0;
+            positioning.take(&fi, spindle_angle, spindle_acceleration);
+        }
+        let rpm = match positioning.turn(&mut spindle_angle, period, spindle_acceleration) {
+            Some(rpm) => rpm,
+            None => {
+                let rpm = spindle_rpm * spindle_dir;
+                spindle_angle = (spindle_angle + rpm / 60.0 * 360.0 * period).rem_euclid(360.0);
+                rpm
+            }
+        };
+        let answered = !orienting || !positioning.moving();
+        plc.set(
+            g::FIN,
+            (fi.get(f::MF) && answered) || fi.get(f::SF) || fi.get(f::TF),
+        );
         if fi.get(f::MF) {
             match fi.read_i32(f::M_CODE) {
                 3 => spindle_dir = 1.0,
@@ -246,8 +269,6 @@ pub fn simulate(
                 _ => {}
             }
         }
-        let rpm = spindle_rpm * spindle_dir;
-        spindle_angle = (spindle_angle + rpm / 60.0 * 360.0 * period).rem_euclid(360.0);
         motion.spindle_feedback(rpm, spindle_angle);
         let before = motion.active_cutting();
         let clock = options.timing.then(Instant::now);
@@ -502,5 +523,48 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.contains("line 2"), "{e}");
+    }
+}
+
+/// The spindle drive's positioning in `cnc simulate`: the simulated drive's own (D100), at its
+/// rated acceleration, on the stop position the ladder would copy from F30–F39 to Y8–Y17.
+#[derive(Debug, Default)]
+struct IdealPositioning {
+    active: Option<Positioning>,
+    /// Degrees turned (unwrapped) and the speed, rpm, while positioning.
+    turned: f64,
+    rpm: f64,
+}
+
+impl IdealPositioning {
+    /// A new stop position (a new count) starts its positioning from `angle`.
+    fn take(&mut self, fi: &cnc_msgs::signals::FImage, angle: f64, acceleration: f64) {
+        let mut yi = YImage::default();
+        yi.bytes[y::ORIENT_ANGLE..y::ORIENT_ANGLE + 10]
+            .copy_from_slice(&fi.bytes[f::ORIENT_ANGLE..f::ORIENT_ANGLE + 10]);
+        let command = StopCommand::of(&yi);
+        if self.active.is_some_and(|p| p.command == command) {
+            return;
+        }
+        self.turned = angle;
+        self.active = Some(Positioning::start(command, angle, 0.0, acceleration));
+    }
+
+    fn moving(&self) -> bool {
+        self.active.is_some()
+    }
+
+    /// One period: the spindle's angle and speed; none when nothing is positioning.
+    fn turn(&mut self, angle: &mut f64, period: f64, acceleration: f64) -> Option<f64> {
+        let p = self.active?;
+        let step = acceleration * period;
+        self.rpm += (p.speed(self.turned, acceleration) - self.rpm).clamp(-step, step);
+        self.turned += self.rpm / 60.0 * 360.0 * period;
+        if p.reached(self.turned, self.rpm) {
+            (self.turned, self.rpm) = (p.goal, 0.0);
+            self.active = None;
+        }
+        *angle = self.turned.rem_euclid(360.0);
+        Some(self.rpm)
     }
 }

@@ -349,3 +349,55 @@ fn check_starts_with_the_tool_in_the_spindle() {
     assert!(!ok, "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 49 (D138): `cnc check --trace` and `cnc simulate` on the turn-mill prove a C-axis
+/// program without the machine: the trace names C's angle, way and speed; the simulation turns
+/// the spindle as the simulated drive positions it, so three turns of C with Z geared to it
+/// take their time and keep every axis within its velocity and acceleration.
+#[test]
+fn check_and_simulate_show_the_turn_mills_c_axis() {
+    let dir = std::env::temp_dir().join(format!("cnc_cli_turnmill_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let program = dir.join("c_axis.nc");
+    std::fs::write(
+        &program,
+        "G00 X50 Z0\nG98 F100\nM14.6\nG08 C90 F1000\nG01 U-1.5\nG08 H1080 Z4.5 F800\nM15\nM30\n",
+    )
+    .unwrap();
+    let path = program.to_string_lossy();
+    let (ok, text) = cnc(&["check", "--config", "sim_turnmill", "--trace", &path]);
+    assert!(ok, "{text}");
+    assert!(
+        text.contains("ROTARY X50.0000 Z0.0000 C90.000 Plus S1000.0"),
+        "{text}"
+    );
+    assert!(
+        text.contains("ROTARY X48.5000 Z4.5000 C1080.000 Incremental S800.0"),
+        "{text}"
+    );
+    let (ok, text) = cnc(&["simulate", "--config", "sim_turnmill", &path]);
+    assert!(ok, "{text}");
+    let number = |key: &str| -> f64 {
+        let line = text.lines().find(|l| l.starts_with(key)).expect(key);
+        line[key.len()..]
+            .trim()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    // Three turns at 800 r/min are 0.225 s; C to 90° and the infeed come on top.
+    assert!(number("cycle time:") > 0.225 + 0.1, "{text}");
+    assert!(number("max axis velocity / limit:") <= 1.0 + 1e-6, "{text}");
+    assert!(
+        number("max axis acceleration / limit:") <= 1.0 + 1e-6,
+        "{text}"
+    );
+    let (ok, text) = cnc(&["check", &path]);
+    assert!(
+        !ok && text.contains("alarm 74 at line 3"),
+        "sim_lathe: {text}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
