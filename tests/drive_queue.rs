@@ -643,8 +643,10 @@ fn motion_killed_stops_the_machine_on_its_path() {
 }
 
 /// Twenty blocks of 3 mm along Z at 50 mm/s, each about 60 ms: the 100 ms queue holds more
-/// than one block's end.
+/// than one block's end. The dwell first gives the test's panel time to be discovered (its
+/// key is a toggle: pressed once, a lost sample is not made good by pressing again).
 const SHORT_BLOCKS: &str = "O0484
+G04 X3
 G00 X60 Z5
 G01 X50 Z0 F3000
 Z-3\nZ-6\nZ-9\nZ-12\nZ-15\nZ-18\nZ-21\nZ-24\nZ-27\nZ-30

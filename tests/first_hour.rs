@@ -128,7 +128,7 @@ fn check_and_simulate_work_from_any_folder() {
     let out = user.run(&["check", "--config", "sim_lathe.yaml", &demo]);
     assert!(!out.status.success());
     assert!(
-        text(&out).contains("sim_lathe.yaml: no such launch config file, nor a built-in machine (sim_lathe, sim_mill, sim_mill_802d)"),
+        text(&out).contains("sim_lathe.yaml: no such launch config file, nor a built-in machine (sim_lathe, sim_mill, sim_mill_802d, sim_turnmill)"),
         "{}",
         text(&out)
     );

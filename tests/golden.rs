@@ -28,7 +28,8 @@ const SETS: [Set; 8] = [
         name: "000_huaxing",
         folder: "../shared/fixtures/000",
         extension: "nc",
-        args: &["--dialect", "huaxing-lathe"],
+        // On the turn-mill, so the C-axis fixtures (004, 015) trace too (D138).
+        args: &["--config", "sim_turnmill", "--dialect", "huaxing-lathe"],
     },
     Set {
         name: "000_iso",
