@@ -238,6 +238,18 @@ impl Cut {
 
     /// Starts the nodes of `machine` on `domain` and `program`.
     pub fn start_on(machine: &Machine, dir: &Path, name: &str, program: &str, domain: u16) -> Cut {
+        Cut::start_queued(machine, dir, name, program, (domain, 100.0))
+    }
+
+    /// Starts the nodes of `machine` on DDS domain `at.0` with a queue of `at.1` ms, and
+    /// `program`.
+    pub fn start_queued(
+        machine: &Machine,
+        dir: &Path,
+        name: &str,
+        program: &str,
+        (domain, queue_ms): (u16, f64),
+    ) -> Cut {
         let trace: PathBuf = dir.join(format!("{name}.csv"));
         let base = format!(
             "{}/launch_configs/{}",
@@ -249,7 +261,7 @@ impl Cut {
         v["network"]["domain_id"] = domain.into();
         v["recorder"]["enabled"] = false.into();
         v["hmi"]["web_address"] = "".into();
-        v["servo"]["drive_queue_ms"] = 100.0.into();
+        v["servo"]["drive_queue_ms"] = queue_ms.into();
         v["servo"]["drive_trace"] = trace.to_string_lossy().to_string().into();
         for file in ["position_file", "memory_file", "parameter_file"] {
             v["machine"][file] = serde_yaml::Value::Null;

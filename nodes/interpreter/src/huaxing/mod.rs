@@ -365,7 +365,9 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
         71 => (
             0,
             // D140: the manual does not define the oscillation's motion.
-            Unsupported("G07.1 thread chip breaking: §5.6 does not define the oscillation's motion"),
+            Unsupported(
+                "G07.1 thread chip breaking: §5.6 does not define the oscillation's motion",
+            ),
         ),
         80 => (1, G::Own(Rotary { orient: None })),
         86 => (1, G::Own(Rotary { orient: Some(6) })),
