@@ -616,7 +616,7 @@ fn g83_g87_drilling() {
         ("G83 X0 F80", 23),           // no hole bottom
         ("G83 X0 Z-5 K0 F80", 13),    // repeat count below 1
         ("G83 X0 Z-5 J2 F80", 13),    // J is 0 or 1
-        ("G83 X0 C90 Z-5 F80", 7),    // no C axis on this lathe
+        ("G83 X0 C90 Z-5 F80", 74),   // no C axis on this lathe (D138)
         ("G83 X0 Z-5 M20 M8 F80", 7), // one clamp code
     ] {
         let e = hx(&format!("G00 X0 Z5\n{bad}\nM30\n")).unwrap_err();
