@@ -144,7 +144,14 @@ impl ThreadCam {
         spindle: &SpindleReading,
         lead: &[f64; MAX_AXES],
     ) -> Option<CamPlay> {
-        let thread = |m| sample(m).filter(|s| s.scaling == ServoSetpoint::SCALE_THREAD);
+        // A thread setpoint whose angle or speed is no number plays by the clock.
+        let thread = |m| {
+            sample(m).filter(|s| {
+                s.scaling == ServoSetpoint::SCALE_THREAD
+                    && s.thread_angle.is_finite()
+                    && s.thread_rpm.is_finite()
+            })
+        };
         let Some(here) = thread(k) else {
             self.anchor = None;
             return None;
@@ -285,6 +292,19 @@ mod tests {
             );
             assert!((c.index - turned / 14.4).abs() < 1e-9, "index {}", c.index);
         }
+    }
+
+    /// A thread setpoint whose angle is no number is played by the clock, not looked up.
+    #[test]
+    fn a_thread_setpoint_that_is_no_number_plays_by_the_clock() {
+        let mut sps = thread(20, 0.0);
+        sps[9].thread_angle = f64::NAN;
+        let sample = |m: u64| sps.iter().find(|s| s.tick == m);
+        let mut cam = ThreadCam::default();
+        let lead = [0.0; MAX_AXES];
+        assert!(cam
+            .follow(10, sample, &reading(144.0, 600.0), &lead)
+            .is_none());
     }
 
     /// Past the thread's last setpoint the clock goes on; before it the cam waits for the

@@ -83,7 +83,12 @@ impl BlockStop {
             if a.line == 0 || b.line == 0 || a.line == b.line {
                 continue;
             }
-            let end = a.tick as f64 + b.block_start.clamp(0.0, 1.0);
+            // A share that is no number (motion sends 0–1) counts as the setpoint itself.
+            let share = match b.block_start.is_finite() {
+                true => b.block_start.clamp(0.0, 1.0),
+                false => 1.0,
+            };
+            let end = a.tick as f64 + share;
             let released = self.released.is_some_and(|r| (r - end).abs() < 1e-9);
             if released || end < index - 1e-12 {
                 continue;
