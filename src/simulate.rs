@@ -16,7 +16,7 @@ use cnc_interpreter::{Canon, Dialect, Interpreter, Library};
 use cnc_io::sim::spindle_position::{Positioning, StopCommand};
 use cnc_motion::path::{self, Point, Segment, MAX_AXES};
 use cnc_motion::{Aux, Block, Command, FromLaunch, Motion, MotionConfig, MotionEvent, RunState};
-use cnc_msgs::signals::{f, g, y, GImage, SignalTable, YImage};
+use cnc_msgs::signals::{f, g, y, FImage, GImage, SignalTable, YImage};
 use cnc_runtime::config::ProfileShape;
 use cnc_runtime::LaunchConfig;
 use cnc_task::run::ProgramRun;
@@ -190,13 +190,11 @@ pub fn simulate(
     let mut ticks = 0u64;
     let mut lathe_path = Vec::new();
     let mut last = motion.commanded_display();
-    let mut spindle_rpm = 0.0;
-    // The spindle as an ideal encoder sees it: at the commanded speed at once; positioned
-    // (M19 with a stop position: SPOS, a rigid tap, the turn-mill's C) as the simulated
-    // drive positions it.
-    let (mut spindle_dir, mut spindle_angle) = (1.0, 0.0);
-    let mut positioning = IdealPositioning::default();
-    let spindle_acceleration = cfg.sim.spindle_acceleration;
+    let mut spindle = IdealSpindle {
+        acceleration: cfg.sim.spindle_acceleration,
+        direction: 1.0,
+        ..IdealSpindle::default()
+    };
     let max_ticks = (MAX_SIMULATED_SECONDS / period) as u64;
     let mut programmed = ProgrammedPath {
         segments: VecDeque::new(),
@@ -214,7 +212,7 @@ pub fn simulate(
         stream
             .feed(done, capacity, |seq, Canon { line, command, .. }, _| {
                 if let Command::Aux(Aux::S(s)) = command {
-                    spindle_rpm = s;
+                    spindle.commanded = s;
                 }
                 programmed.push(seq, &command, &slide, plane);
                 motion.push(Block {
@@ -242,34 +240,8 @@ pub fn simulate(
         }
         // The simulated PLC answers every strobe at once and the spindle is at speed; a
         // positioning once the spindle stands at its angle.
-        let fi = *motion.f_image();
-        let orienting = fi.get(f::MF) && fi.read_i32(f::M_CODE) == 19;
-        if orienting {
-            spindle_dir = 0.0;
-            positioning.take(&fi, spindle_angle, spindle_acceleration);
-        }
-        let rpm = match positioning.turn(&mut spindle_angle, period, spindle_acceleration) {
-            Some(rpm) => rpm,
-            None => {
-                let rpm = spindle_rpm * spindle_dir;
-                spindle_angle = (spindle_angle + rpm / 60.0 * 360.0 * period).rem_euclid(360.0);
-                rpm
-            }
-        };
-        let answered = !orienting || !positioning.moving();
-        plc.set(
-            g::FIN,
-            (fi.get(f::MF) && answered) || fi.get(f::SF) || fi.get(f::TF),
-        );
-        if fi.get(f::MF) {
-            match fi.read_i32(f::M_CODE) {
-                3 => spindle_dir = 1.0,
-                4 => spindle_dir = -1.0,
-                5 => spindle_dir = 0.0,
-                _ => {}
-            }
-        }
-        motion.spindle_feedback(rpm, spindle_angle);
+        let (rpm, angle) = spindle.answer(motion.f_image(), &mut plc, period);
+        motion.spindle_feedback(rpm, angle);
         let before = motion.active_cutting();
         let clock = options.timing.then(Instant::now);
         let commanded = motion.tick(Some(&actual), &plc);
@@ -526,6 +498,56 @@ mod tests {
     }
 }
 
+/// The spindle as `cnc simulate` has it: at the commanded speed at once, positioned (M19 with
+/// a stop position: SPOS, a rigid tap, the turn-mill's C) as the simulated drive positions it.
+#[derive(Debug, Default)]
+struct IdealSpindle {
+    /// The programmed S, rpm, and the direction M03/M04/M05 gave (1, −1, 0).
+    commanded: f64,
+    direction: f64,
+    angle: f64,
+    positioning: IdealPositioning,
+    /// The drive's rated acceleration, rpm/s (`sim.spindle_acceleration`).
+    acceleration: f64,
+}
+
+impl IdealSpindle {
+    /// One period: answers the NC's strobes in `plc` (a positioning's once it stands) and
+    /// returns the encoder's speed and angle.
+    fn answer(&mut self, fi: &FImage, plc: &mut GImage, period: f64) -> (f64, f64) {
+        let orienting = fi.get(f::MF) && fi.read_i32(f::M_CODE) == 19;
+        if orienting {
+            self.direction = 0.0;
+            self.positioning.take(fi, self.angle, self.acceleration);
+        }
+        let rpm = match self
+            .positioning
+            .turn(&mut self.angle, period, self.acceleration)
+        {
+            Some(rpm) => rpm,
+            None => {
+                let rpm = self.commanded * self.direction;
+                self.angle = (self.angle + rpm / 60.0 * 360.0 * period).rem_euclid(360.0);
+                rpm
+            }
+        };
+        let answered = !orienting || !self.positioning.moving();
+        plc.set(
+            g::FIN,
+            (fi.get(f::MF) && answered) || fi.get(f::SF) || fi.get(f::TF),
+        );
+        if fi.get(f::MF) {
+            match fi.read_i32(f::M_CODE) {
+                3 => self.direction = 1.0,
+                4 => self.direction = -1.0,
+                5 => self.direction = 0.0,
+                _ => {}
+            }
+        }
+        (rpm, self.angle)
+    }
+}
+
 /// The spindle drive's positioning in `cnc simulate`: the simulated drive's own (D100), at its
 /// rated acceleration, on the stop position the ladder would copy from F30–F39 to Y8–Y17.
 #[derive(Debug, Default)]
@@ -538,7 +560,7 @@ struct IdealPositioning {
 
 impl IdealPositioning {
     /// A new stop position (a new count) starts its positioning from `angle`.
-    fn take(&mut self, fi: &cnc_msgs::signals::FImage, angle: f64, acceleration: f64) {
+    fn take(&mut self, fi: &FImage, angle: f64, acceleration: f64) {
         let mut yi = YImage::default();
         yi.bytes[y::ORIENT_ANGLE..y::ORIENT_ANGLE + 10]
             .copy_from_slice(&fi.bytes[f::ORIENT_ANGLE..f::ORIENT_ANGLE + 10]);

@@ -386,48 +386,8 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
                 }
             },
         },
-        MotionBlock::KIND_THREAD => {
-            if !(m.lead.is_finite() && m.lead > 0.0 && m.start_angle.is_finite()) {
-                return Err(format!(
-                    "thread lead {} or start angle {} is not valid",
-                    m.lead, m.start_angle
-                ));
-            }
-            Command::Thread {
-                end: m.end.clone(),
-                lead: m.lead,
-                start_angle: m.start_angle,
-            }
-        }
-        MotionBlock::KIND_TAP => {
-            let lead_ok = m.lead.is_finite() && m.lead != 0.0;
-            if !(lead_ok && m.aux_value.is_finite() && m.aux_value > 0.0) {
-                return Err(format!(
-                    "tapping lead {} or spindle speed {} is not valid",
-                    m.lead, m.aux_value
-                ));
-            }
-            Command::Tap {
-                end: m.end.clone(),
-                lead: m.lead,
-                rpm: m.aux_value,
-            }
-        }
-        MotionBlock::KIND_ROTARY => {
-            let way = Turn::from_code(m.aux_code)
-                .filter(|w| w.accepts(m.aux_value))
-                .ok_or_else(|| {
-                    format!(
-                        "rotary move to {} the way {} is not valid",
-                        m.aux_value, m.aux_code
-                    )
-                })?;
-            Command::Rotary {
-                end: m.end.clone(),
-                degrees: m.aux_value,
-                way,
-                rpm: feed()?,
-            }
+        MotionBlock::KIND_THREAD | MotionBlock::KIND_TAP | MotionBlock::KIND_ROTARY => {
+            spindle_locked(m)?
         }
         MotionBlock::KIND_PROBE => Command::Probe {
             end: m.end.clone(),
@@ -490,45 +450,101 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
         MotionBlock::KIND_DWELL => {
             return Err(format!("dwell {} s is not a time", m.dwell_seconds))
         }
-        MotionBlock::KIND_AUX => Command::Aux(match m.aux_kind {
-            MotionBlock::AUX_M => Aux::M(m.aux_code),
-            MotionBlock::AUX_S if m.aux_value.is_finite() && m.aux_value >= 0.0 => {
-                Aux::S(m.aux_value)
-            }
-            MotionBlock::AUX_T => Aux::T(m.aux_code),
-            MotionBlock::AUX_ORIENT => match Turn::from_code(m.aux_code) {
-                Some(way) if way.accepts(m.aux_value) => Aux::Orient {
-                    degrees: m.aux_value,
-                    way,
-                },
-                _ => {
-                    return Err(format!(
-                        "spindle position {} ({}) is no angle the spindle can take",
-                        m.aux_value, m.aux_code
-                    ))
-                }
-            },
-            MotionBlock::AUX_H => match u16::try_from(m.aux_code) {
-                Ok(address) if address <= MAX_H_ADDRESS && m.aux_value.is_finite() => Aux::H {
-                    address,
-                    value: m.aux_value,
-                },
-                _ => {
-                    return Err(format!(
-                        "H{}={} is no H function (H0–H9999, a finite value)",
-                        m.aux_code, m.aux_value
-                    ))
-                }
-            },
-            other => {
-                return Err(format!(
-                    "aux kind {other} with value {} is not an M, S, T, H or spindle position",
-                    m.aux_value
-                ))
-            }
-        }),
+        MotionBlock::KIND_AUX => Command::Aux(aux(m)?),
         MotionBlock::KIND_PROGRAM_END => Command::ProgramEnd,
         other => return Err(format!("unknown block kind {other}")),
+    })
+}
+
+/// A block locked to the spindle: a thread, a rigid tap or a turn of the C axis, checked.
+fn spindle_locked(m: &MotionBlock) -> Result<Command, String> {
+    Ok(match m.kind {
+        MotionBlock::KIND_THREAD => {
+            if !(m.lead.is_finite() && m.lead > 0.0 && m.start_angle.is_finite()) {
+                return Err(format!(
+                    "thread lead {} or start angle {} is not valid",
+                    m.lead, m.start_angle
+                ));
+            }
+            Command::Thread {
+                end: m.end.clone(),
+                lead: m.lead,
+                start_angle: m.start_angle,
+            }
+        }
+        MotionBlock::KIND_TAP => {
+            let lead_ok = m.lead.is_finite() && m.lead != 0.0;
+            if !(lead_ok && m.aux_value.is_finite() && m.aux_value > 0.0) {
+                return Err(format!(
+                    "tapping lead {} or spindle speed {} is not valid",
+                    m.lead, m.aux_value
+                ));
+            }
+            Command::Tap {
+                end: m.end.clone(),
+                lead: m.lead,
+                rpm: m.aux_value,
+            }
+        }
+        MotionBlock::KIND_ROTARY => {
+            let way = Turn::from_code(m.aux_code)
+                .filter(|w| w.accepts(m.aux_value))
+                .ok_or_else(|| {
+                    format!(
+                        "rotary move to {} the way {} is not valid",
+                        m.aux_value, m.aux_code
+                    )
+                })?;
+            Command::Rotary {
+                end: m.end.clone(),
+                degrees: m.aux_value,
+                way,
+                rpm: match m.feed.is_finite() && m.feed > 0.0 {
+                    true => m.feed,
+                    false => return Err(format!("C-axis speed {} is not positive", m.feed)),
+                },
+            }
+        }
+        _ => return Err(format!("block kind {} is not spindle-locked", m.kind)),
+    })
+}
+
+/// An auxiliary block's function: M, S, T, a spindle position or an H function, checked.
+fn aux(m: &MotionBlock) -> Result<Aux, String> {
+    Ok(match m.aux_kind {
+        MotionBlock::AUX_M => Aux::M(m.aux_code),
+        MotionBlock::AUX_S if m.aux_value.is_finite() && m.aux_value >= 0.0 => Aux::S(m.aux_value),
+        MotionBlock::AUX_T => Aux::T(m.aux_code),
+        MotionBlock::AUX_ORIENT => match Turn::from_code(m.aux_code) {
+            Some(way) if way.accepts(m.aux_value) => Aux::Orient {
+                degrees: m.aux_value,
+                way,
+            },
+            _ => {
+                return Err(format!(
+                    "spindle position {} ({}) is no angle the spindle can take",
+                    m.aux_value, m.aux_code
+                ))
+            }
+        },
+        MotionBlock::AUX_H => match u16::try_from(m.aux_code) {
+            Ok(address) if address <= MAX_H_ADDRESS && m.aux_value.is_finite() => Aux::H {
+                address,
+                value: m.aux_value,
+            },
+            _ => {
+                return Err(format!(
+                    "H{}={} is no H function (H0–H9999, a finite value)",
+                    m.aux_code, m.aux_value
+                ))
+            }
+        },
+        other => {
+            return Err(format!(
+                "aux kind {other} with value {} is not an M, S, T, H or spindle position",
+                m.aux_value
+            ))
+        }
     })
 }
 
