@@ -96,6 +96,12 @@ pub enum Command {
     /// timers, once every block before it has finished; the program waits for it (a block
     /// that reads a timer, `$AC_CUTTING_TIME`).
     Sync,
+    /// The turn-mill's C axis in contour control (`on`, polar interpolation G12.1, D141): the
+    /// main spindle, standing in position control at C 0, follows the path's C setpoints (the
+    /// block ends' last coordinate, degrees from where it stood) until `on` is false (G13.1).
+    Contour {
+        on: bool,
+    },
     Dwell {
         seconds: f64,
     },
@@ -309,6 +315,10 @@ pub fn to_motion_block(
             m.flag = *fill;
         }
         Command::Sync => m.kind = MotionBlock::KIND_SYNC,
+        Command::Contour { on } => {
+            m.kind = MotionBlock::KIND_CONTOUR;
+            m.flag = *on;
+        }
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
@@ -424,6 +434,7 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
         MotionBlock::KIND_COMPRESSOR => Command::Compressor { on: m.flag },
         MotionBlock::KIND_FIFO => Command::Fifo { fill: m.flag },
         MotionBlock::KIND_SYNC => Command::Sync,
+        MotionBlock::KIND_CONTOUR => Command::Contour { on: m.flag },
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_PROFILE => Command::Profile {
@@ -591,6 +602,8 @@ mod tests {
             Command::Compressor { on: true },
             Command::Fifo { fill: true },
             Command::Sync,
+            Command::Contour { on: true },
+            Command::Contour { on: false },
             Command::Dwell { seconds: 1.5 },
             Command::Tap {
                 end: vec![10.0, 10.0, -25.0],

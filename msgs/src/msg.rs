@@ -236,6 +236,7 @@ ros_message! {
             KIND_FIFO: u8 = 17,
             KIND_SYNC: u8 = 18,
             KIND_ROTARY: u8 = 19,
+            KIND_CONTOUR: u8 = 20,
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,

@@ -66,6 +66,11 @@ pub struct ServoSetpoint {
     /// Where between the previous setpoint and this one its block began, as a share of the
     /// way (1: at this setpoint): the drives stop a single block exactly there.
     pub block_start: f64,
+    /// 1 while the turn-mill's C axis is in contour control (polar interpolation, D141): the
+    /// main spindle, in position control, follows `c_position` (degrees, unwrapped as the
+    /// spindle's turned angle) as an axis drive follows its setpoint.
+    pub c_contour: u32,
+    pub c_position: f64,
 }
 
 impl ServoSetpoint {
@@ -113,6 +118,8 @@ impl Default for ServoSetpoint {
             thread_rpm: 0.0,
             line: 0,
             block_start: 1.0,
+            c_contour: 0,
+            c_position: 0.0,
         }
     }
 }

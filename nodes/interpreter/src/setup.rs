@@ -74,7 +74,10 @@ pub fn of_machine(machine: &MachineConfig, start: &[f64]) -> Setup {
     setup.front_tool_post = machine.tool_post == cnc_machine::ToolPost::Front;
     setup.tool_change_macro = machine.tool_change_macro;
     setup.tool_change_with_m6 = machine.tool_change_with_m6;
-    setup.spindle_c_axis = machine.spindle_c_axis;
+    if machine.spindle_c_axis {
+        setup = setup.with_spindle_c_axis();
+        setup.c_rapid_rpm = machine.c_axis.max_velocity / 360.0;
+    }
     setup.skip_input = machine.skip_input.as_deref().and_then(x_input);
     setup.skip_keeps_actual = machine.skip_keeps_actual;
     setup.active_tool = machine.tool_in_spindle;

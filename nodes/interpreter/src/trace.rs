@@ -111,6 +111,11 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         }),
         Command::Fifo { fill } => s.push_str(if *fill { "FIFO_FILL" } else { "FIFO_RUN" }),
         Command::Sync => s.push_str("SYNC"),
+        Command::Contour { on } => s.push_str(if *on {
+            "C_CONTOUR_ON"
+        } else {
+            "C_CONTOUR_OFF"
+        }),
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
         }
@@ -421,8 +426,10 @@ impl LinuxCnc {
             Command::ProgramEnd => self.push(out, "PROGRAM_END()"),
             // rs274 has no call for the acceleration profile (its planner's is fixed), the
             // drives' feedforward, an acceleration override, a fixed stop, the compressor or
-            // the look-ahead buffer, or a preprocessing stop that reads the machine.
+            // the look-ahead buffer, a preprocessing stop that reads the machine, or a spindle
+            // in contour control.
             Command::Profile { .. }
+            | Command::Contour { .. }
             | Command::Sync
             | Command::Feedforward { .. }
             | Command::Acceleration { .. }

@@ -5,9 +5,7 @@ use cnc_interpreter::{Aux, Canon, Command, Dialect, ProgramError, Setup, Turn};
 
 /// A turn-mill lathe at X200 Z100 (diameter), its spindle the C axis.
 fn turn_mill() -> Setup {
-    let mut s = Setup::lathe([200.0, 100.0]);
-    s.spindle_c_axis = true;
-    s
+    Setup::lathe([200.0, 100.0]).with_spindle_c_axis()
 }
 
 fn run(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {

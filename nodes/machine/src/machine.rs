@@ -70,6 +70,10 @@ pub struct MachineConfig {
     /// (M14.6, G08 on the Huaxing control, `000` §4.2.6–4.2.7, D138).
     #[serde(default)]
     pub spindle_c_axis: bool,
+    /// The C axis's rates in contour control (polar interpolation, D141): degrees/min and
+    /// degrees/s². Absent: [`CAxisEntry::default`].
+    #[serde(default)]
+    pub c_axis: CAxisEntry,
     /// The X-table input a skip move (the Huaxing's G31) stops on, e.g. `X11.5` (S#46): the
     /// input wired to the drives' measuring input, which latches the axes at its edge. None:
     /// the machine has no skip input (D139).
@@ -212,6 +216,27 @@ pub enum ToolPost {
 
 fn default_arc_plane() -> [String; 2] {
     ["Z".into(), "X".into()]
+}
+
+/// The turn-mill's C axis (the main spindle in position control) as a contouring axis.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CAxisEntry {
+    /// Fastest C turns in contour control, degrees/min (also its rapid, G00 C).
+    pub max_velocity: f64,
+    /// degrees/s².
+    pub max_acceleration: f64,
+}
+
+impl Default for CAxisEntry {
+    /// 100 r/min and 0.1 s to reach it: what a lathe's main spindle gives as a position-
+    /// controlled axis with its gearing.
+    fn default() -> Self {
+        CAxisEntry {
+            max_velocity: 36_000.0,
+            max_acceleration: 6_000.0,
+        }
+    }
 }
 
 /// One axis: limits in display units (X as diameter when `diameter`).

@@ -35,6 +35,7 @@ impl FromLaunch for MotionConfig {
             spindle_max_rpm: cfg.limits.spindle_max_rpm,
             feedback_delay_ticks: cfg.servo.drive_queue_ticks().max(1) as u32,
             time_scaling_at_drives: cfg.servo.drive_queue_ticks() > 0,
+            c_axis: cfg.machine.spindle_c_axis.then_some(cfg.machine.c_axis),
         }
     }
 }

@@ -137,6 +137,7 @@ pub const RULES: &[Rule] = &[
         "how the tool changer works",
     ),
     builder("machine.spindle_c_axis", None, "what the machine is"),
+    builder("machine.c_axis.*", None, "what the spindle's drive can do"),
     builder("machine.skip_input", None, "the machine's wiring"),
     builder(
         "machine.skip_keeps_actual",

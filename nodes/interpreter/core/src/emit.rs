@@ -188,9 +188,8 @@ impl Core {
         // Under the cylinder transformation the position is the basic system's and the
         // command is mapped onto the machine from where the controlled point stands (under
         // compensation `pos` is the programmed point, not the cutter's).
-        let from = self
-            .cylinder
-            .map(|_| std::mem::replace(&mut self.controlled, m.clone()));
+        let from = (self.cylinder.is_some() || self.polar.is_some())
+            .then(|| std::mem::replace(&mut self.controlled, m.clone()));
         // The machine position becomes `m`; the command takes `m` itself (no copy per move).
         self.pos.copy_from_slice(&m);
         let command = match kind {
@@ -233,8 +232,9 @@ impl Core {
                 stop,
             },
         };
-        match (self.cylinder, from) {
-            (Some(c), Some(from)) => self.push_on_cylinder(c, &from, command)?,
+        match (self.cylinder, self.polar, from) {
+            (Some(c), _, Some(from)) => self.push_on_cylinder(c, &from, command)?,
+            (_, Some(p), Some(from)) => self.push_on_polar(p, &from, command)?,
             _ => self.push(command),
         }
         Ok(())

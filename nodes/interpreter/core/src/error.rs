@@ -136,11 +136,17 @@ pub enum Fault {
     WorkOffset,
     /// Unknown axis for reference return.
     NoSuchAxis,
-    /// Three-point arc points collinear.
     /// A rotary-axis move (G08) without its rotary axis's word.
     RotaryWord,
     /// A rotary axis the machine does not have (no C axis, not that axis's spindle).
     RotaryAxis,
+    /// A function polar interpolation does not allow while it is on.
+    PolarMode,
+    /// Polar interpolation's axes are not defined on this machine.
+    PolarAxes,
+    /// Polar interpolation started away from its start (linear axis > 0, rotary axis at 0).
+    PolarStart,
+    /// Three-point arc points collinear.
     ThreePointArc,
     /// Too few blocks between compensation start and cancel.
     CompBlocks,

@@ -28,6 +28,7 @@ pub mod fillet;
 pub mod flow;
 pub mod geometry;
 pub mod measure;
+pub mod polar;
 pub mod rough;
 pub mod setup;
 pub mod state;

@@ -86,6 +86,8 @@ pub struct Setup {
     pub tool_change_with_m6: bool,
     /// The main spindle is also the C axis (a turn-mill lathe, D138).
     pub spindle_c_axis: bool,
+    /// The C axis's rapid rate (G00 C), r/min.
+    pub c_rapid_rpm: f64,
     /// The skip input (G31) as X-table byte and bit, and whether a skip keeps the actual
     /// coordinates (B19.6, D139).
     pub skip_input: Option<(u32, u32)>,
@@ -102,6 +104,22 @@ impl Setup {
     /// A lathe with X (diameter) and Z at the given start position, no offsets.
     pub fn lathe(start: [f64; 2]) -> Setup {
         Setup::new(&['X', 'Z'], &[true, false], &start)
+    }
+
+    /// A turn-mill: the main spindle is also the C axis (D138), which the program sees as its
+    /// last axis, in degrees (at 0 when the program starts), and polar interpolation moves
+    /// as an axis of the path (D141).
+    pub fn with_spindle_c_axis(mut self) -> Setup {
+        self.spindle_c_axis = true;
+        if !self.axes.contains(&'C') {
+            self.axes.push('C');
+            self.diameter.push(false);
+            self.start.push(0.0);
+            self.reference.push(0.0);
+            self.second_reference.push(0.0);
+            self.fixed_points.push(Vec::new());
+        }
+        self
     }
 
     pub fn new(axes: &[char], diameter: &[bool], start: &[f64]) -> Setup {
@@ -130,6 +148,7 @@ impl Setup {
             contour_tolerance: 0.05,
             tool_change_with_m6: false,
             spindle_c_axis: false,
+            c_rapid_rpm: 100.0,
             skip_input: None,
             skip_keeps_actual: true,
             active_tool: 0,

@@ -215,6 +215,8 @@ pub struct Core {
     /// The cylinder surface transformation in force ([`crate::cylinder`]): `pos` is then
     /// the basic system's position.
     pub cylinder: Option<crate::cylinder::Cylinder>,
+    /// Polar interpolation in force ([`crate::polar`]): `pos` is then the face's position.
+    pub polar: Option<crate::polar::Polar>,
     /// Under it, the compensation's offset at the end of the last move, and the one the move
     /// being queued ends with.
     pub(crate) wall: Pt,
@@ -282,6 +284,7 @@ impl Core {
             timers_read: None,
             measured_at: None,
             cylinder: None,
+            polar: None,
             wall: Pt::new(0.0, 0.0),
             out_offset: None,
             controlled: Vec::new(),

@@ -46,6 +46,11 @@ pub fn alarm(f: Fault) -> u32 {
         // "G05/G08 programmed without a rotary axis" and "rotary axis not defined".
         ThreePointArc | RotaryWord => 80,
         RotaryAxis => 74,
+        // "function not allowed in polar interpolation", "S#20 axis definition error",
+        // "G12.1 start: linear axis > 0, rotary axis = 0" (`000` §5.8, alarm table).
+        PolarMode => 106,
+        PolarAxes => 107,
+        PolarStart => 108,
         CompBlocks => 82,
         CompStartNotLine => 85,
         CompNoIntersection | CompInterference => 88,

@@ -4,10 +4,11 @@
 //! revolution the way its sign says, H a travel of any number of turns; X and Z in the same
 //! block move along, geared to its angle (motion's rigid-tap gearing, D101).
 
-use cnc_interpreter_core::{Aux, Fault, MoveKind, ProgramError, Turn};
+use cnc_interpreter_core::{Aux, Fault, ProgramError, Turn};
 
 use super::Huaxing;
 use crate::fanuc::block::Block;
+use crate::fanuc::codes::G;
 use crate::fanuc::{Family, Fanuc};
 
 /// The spindle's axis number on these machines: 6, C (M14.1–M14.5 would name X … B).
@@ -69,39 +70,24 @@ impl Fanuc<Huaxing> {
             ));
         }
         self.d.rotary_rpm = Some(rpm);
-        let (degrees, way) = match (b.get('C'), b.get('H')) {
-            (Some(_), Some(_)) => {
-                return Err(self.fault(Fault::AbsAndInc, "C and H in one G08 block"));
-            }
-            // An absolute C within one revolution, its sign the way: C−750 turns the negative
-            // way to −30°, that is 330° (D138: the manual's "320°" is a slip).
-            (Some(c), None) => {
-                let way = if c < 0.0 { Turn::Minus } else { Turn::Plus };
-                let angle = c.rem_euclid(360.0);
-                (if angle >= 360.0 { 0.0 } else { angle }, way)
-            }
-            (None, Some(h)) => (h, Turn::Incremental),
-            (None, None) => {
-                return Err(self.fault(
-                    Fault::RotaryWord,
-                    "G08 without C or H: no rotary axis programmed",
-                ));
-            }
-        };
-        let end = self.end_point(b)?;
-        self.core.emit(&end, MoveKind::Rotary { degrees, way, rpm })
+        self.turn_c(b, rpm)
     }
 
-    /// C and H program the C axis, in G08 blocks only.
+    /// C and H program the C axis in G08 and G00 blocks, and the face's second coordinate
+    /// in polar interpolation (D141).
     pub(super) fn c_words(&self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
-        let g08 = matches!(
-            b.group(1).unwrap_or(self.motion),
-            crate::fanuc::codes::G::Own(super::HuaxingG::Rotary { .. })
-        );
+        let motion = b.group(1).unwrap_or(self.motion);
+        let c_moves = matches!(
+            motion,
+            G::Own(super::HuaxingG::Rotary { .. }) | G::Rapid
+        ) && self.core.setup.spindle_c_axis;
+        if self.core.polar.is_some() {
+            return Ok(());
+        }
         for c in ['C', 'H'] {
-            if b.get(c).is_some() && !g08 {
+            if b.get(c).is_some() && !c_moves {
                 let why = match self.core.setup.spindle_c_axis {
-                    true => format!("address {c}: the C axis is programmed with G08"),
+                    true => format!("address {c}: the C axis is programmed with G00 or G08"),
                     false => format!("address {c}: no C axis on this machine"),
                 };
                 return Err(self.fault(Fault::RotaryAxis, why));

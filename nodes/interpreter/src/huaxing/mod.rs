@@ -5,6 +5,7 @@
 
 mod alarms;
 mod c_axis;
+mod polar;
 mod compound;
 mod drilling;
 mod flow;
@@ -75,6 +76,9 @@ pub enum HuaxingG {
     },
     /// G31: a feed move that ends on the skip input (§5.17, D139).
     Skip,
+    /// G12.1 / G13.1: polar interpolation on / off (§5.8, D141).
+    PolarOn,
+    PolarOff,
 }
 
 /// Retained words of a single cycle (G90/G92/G94, §5.21.3).
@@ -281,6 +285,7 @@ impl Family for Huaxing {
     }
     fn words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
         f.after_skip();
+        f.polar_restrictions(b)?;
         f.c_words(b)
     }
     fn moves_without_axes(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
@@ -293,6 +298,11 @@ impl Family for Huaxing {
         Ok(())
     }
     fn modal(f: &mut Fanuc<Self>, g: HuaxingG, _b: &Block<Self>) -> Result<(), ProgramError> {
+        match g {
+            HuaxingG::PolarOn => return f.polar_on(),
+            HuaxingG::PolarOff => return f.core.polar_off(),
+            _ => {}
+        }
         if g == HuaxingG::FeedPerRevolutionOnIndex {
             if !f.core.feed_per_rev() {
                 f.core.set_feed_mode(true);
@@ -302,7 +312,7 @@ impl Family for Huaxing {
         Ok(())
     }
     fn before_motion(f: &mut Fanuc<Self>, b: &Block<Self>) -> Option<Result<(), ProgramError>> {
-        f.cut_on_index(b)
+        f.rapid_c(b).or_else(|| f.cut_on_index(b))
     }
     fn motion(f: &mut Fanuc<Self>, g: HuaxingG, b: &Block<Self>) -> Result<(), ProgramError> {
         use HuaxingG::*;
@@ -376,8 +386,8 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
             Unsupported("G08.1–G08.5 make X…B a rotary axis: the turn-mill's is the spindle, C"),
         ),
         90 => (15, ExactStopBlock),
-        121 => (16, Unsupported("G12.1 polar interpolation needs a C axis")),
-        131 => (16, Unsupported("G13.1 polar interpolation needs a C axis")),
+        121 => (16, G::Own(PolarOn)),
+        131 => (16, G::Own(PolarOff)),
         141..=146 => (
             1,
             Unsupported("G14.n live-tool tapping needs a live tool axis"),

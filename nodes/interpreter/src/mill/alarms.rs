@@ -16,13 +16,13 @@ pub fn alarm(f: Fault) -> u32 {
         IllegalMinus => 6,
         DecimalPoint => 7,
         DataFormat | IllegalWord | AbsAndInc | TooManyM | RepeatedWord | AxisAddress
-        | NoSuchAxis | ArcRAndIk | NoSuchAddress | RotaryWord | RotaryAxis => 9,
+        | NoSuchAxis | ArcRAndIk | NoSuchAddress | RotaryWord | RotaryAxis | PolarAxes => 9,
         UndefinedCode | NotSupported | SameGroup | Group00With01 | MissingWord | ThreadLead
         | TaperTooLarge | CssWithoutS | Chamfer | ChamferTooShort | RangeError
         | LoopWithoutStart | NoProgramEnd | CompInCycle | CycleZero | CycleFormat
         | ContourTooLong | ContourData | ContourStart | ContourBeyondStart | ThreadDepthMissing
         | PatternReliefZero | ThreePointArc | CompBlocks | CompDirection | CompRapid
-        | MustStartBlock | SpindleClamp => 10,
+        | MustStartBlock | SpindleClamp | PolarMode | PolarStart => 10,
         FeedRange => 11,
         ArcRadius | ArcEnd => 20,
         PlaneAxis => 21,

@@ -37,11 +37,12 @@ pub fn alarm(f: Fault) -> u32 {
         CompNoIntersection | CompInterference | CompArcVanishes => 10751,
         CompStartNotLine | CompDirection | CompBlocks => 10752,
         CompPlane | CompInCycle | CompRapid => 10753,
-        PlaneAxis | AxisAddress | NoSuchAxis | RotaryWord | RotaryAxis => 14092,
+        PlaneAxis | AxisAddress | NoSuchAxis | RotaryWord | RotaryAxis | PolarAxes => 14092,
         DwellTime => 14800,
         ReferenceCheck | ToolChangePosition => 12140,
         ThreadLead | TaperTooLarge | CssWithoutS | Chamfer | ChamferTooShort | CycleZero
         | CycleFormat | ContourTooLong | ContourData | ContourStart | ContourBeyondStart
         | ThreadDepthMissing | PatternReliefZero | SpindleClamp => 14040,
+        PolarMode | PolarStart => 12140,
     }
 }

@@ -21,7 +21,7 @@ use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{x, y, SignalTable, XImage, YImage};
 
 pub use devices::{DeviceConfig, Devices};
-use spindle_position::{Positioning, StopCommand};
+use spindle_position::{ContourFollow, Positioning, StopCommand};
 
 /// Simulation parameters.
 #[derive(Debug, Clone, PartialEq)]
@@ -105,6 +105,9 @@ pub struct SimLathe {
     spindle_turned: f64,
     /// The drive in position control: its stop position and goal.
     positioning: Option<Positioning>,
+    /// The drive following C's setpoints (polar interpolation, D141), and its speed then.
+    contour: ContourFollow,
+    contour_rpm: f64,
     pub devices: Devices,
     /// The emergency-stop input (the PLC's X image, the spindle's stop).
     emergency_stop: bool,
@@ -150,6 +153,8 @@ impl SimLathe {
             spindle_rpm: 0.0,
             spindle_turned: 0.0,
             positioning: None,
+            contour: ContourFollow::default(),
+            contour_rpm: 0.0,
             emergency_stop: false,
             powered_off: false,
             x_seq: 0,
@@ -273,12 +278,13 @@ impl SimLathe {
                 self.spindle_rpm = 0.0;
             }
         }
+        self.follow_contour(setpoint, dt);
         self.devices.step(y, dt);
         let mut fb = ServoFeedback {
             seq: setpoint.seq,
             setpoint_sent_ns: setpoint.sent_ns,
             axis_count: n as u32,
-            spindle_rpm: self.spindle_rpm,
+            spindle_rpm: self.spindle_rpm + self.contour_rpm,
             spindle_angle_deg: self.spindle_angle(),
             handwheel_count: self.handwheel_count,
             torque_percent: torque,
@@ -382,6 +388,37 @@ impl SimLathe {
     }
 
     /// The drive orients: asked to, with no direction commanded and no emergency stop.
+    /// In contour control the spindle, holding a position, follows C's setpoint (with the
+    /// X drive's lag); the position it holds moves along, so it stays where the path left it.
+    fn follow_contour(&mut self, setpoint: &ServoSetpoint, dt: f64) {
+        let holding = self.spindle_rpm == 0.0
+            && self.positioning.is_some_and(|p| p.goal == self.spindle_turned);
+        let follow = setpoint.c_contour != 0
+            && setpoint.enable != 0
+            && holding
+            && !self.powered_off
+            && !self.emergency_stop;
+        let tau = self.cfg.drive_lag.first().copied().unwrap_or(0.0);
+        let before = self.spindle_turned;
+        match self
+            .contour
+            .step(follow, setpoint.c_position, before, tau, dt)
+        {
+            Some(turned) => {
+                self.spindle_turned = turned;
+                if let Some(p) = self.positioning.as_mut() {
+                    p.goal = turned;
+                }
+                self.contour_rpm = if dt > 0.0 {
+                    (turned - before) / dt / 6.0
+                } else {
+                    0.0
+                };
+            }
+            None => self.contour_rpm = 0.0,
+        }
+    }
+
     fn orienting(&self, yi: &YImage) -> bool {
         yi.get(y::SPINDLE_ORIENT)
             && !yi.get(y::SPINDLE_CW)

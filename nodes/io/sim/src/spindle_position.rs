@@ -153,3 +153,35 @@ mod tests {
         assert_eq!(p.speed(0.0, 3000.0), 600.0);
     }
 }
+
+/// The spindle in contour control (the turn-mill's C axis under polar interpolation, D141):
+/// holding its position, the drive follows C's setpoint every tick as an axis drive follows
+/// its own (a first-order lag of `tau` with the exact response to a ramp between setpoints).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ContourFollow {
+    /// The last setpoint taken, on the unwrapped angle; none outside contour control.
+    last: Option<f64>,
+}
+
+impl ContourFollow {
+    /// The spindle's angle after `dt` following the setpoint `c` (degrees whose value modulo
+    /// 360 is the encoder angle to reach) from `turned`; `None` when not following.
+    pub fn step(&mut self, follow: bool, c: f64, turned: f64, tau: f64, dt: f64) -> Option<f64> {
+        if !follow || !c.is_finite() {
+            self.last = None;
+            return None;
+        }
+        let last = self.last.unwrap_or(turned);
+        // The setpoint's unwrapped value: within half a turn of the last one.
+        let target = last + (c - last + 180.0).rem_euclid(360.0) - 180.0;
+        self.last = Some(target);
+        Some(if tau > 0.0 && dt > 0.0 {
+            let v = (target - last) / dt;
+            let settled = target - v * tau;
+            let off = turned - (last - v * tau);
+            settled + off * (-dt / tau).exp()
+        } else {
+            target
+        })
+    }
+}

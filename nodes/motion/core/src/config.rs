@@ -36,9 +36,20 @@ pub struct MotionConfig {
     /// With the drives' setpoint queue: feed hold and the overrides act at the drives, which
     /// time-scale the queued path (D135); the core plans as if they were off.
     pub time_scaling_at_drives: bool,
+    /// A turn-mill's C axis in contour control (polar interpolation, D141): planned as one
+    /// more axis after the machine's, in degrees; `None` on a machine without it.
+    pub c_axis: Option<cnc_machine::CAxisEntry>,
 }
 
 impl MotionConfig {
+    /// The index the C axis has in blocks and the planner (after the machine's axes), if the
+    /// machine has one and room for it.
+    pub fn contour_axis(&self) -> Option<usize> {
+        self.c_axis
+            .and(Some(self.axes.len()))
+            .filter(|&c| c < MAX_AXES)
+    }
+
     /// The planner's view: limits per axis in slide travel, mm/s.
     pub fn planner(&self) -> PlannerConfig {
         let mut limits = AxisLimits {
@@ -51,6 +62,13 @@ impl MotionConfig {
             limits.velocity[i] = a.max_velocity / 60.0;
             limits.acceleration[i] = a.max_acceleration;
             limits.jerk[i] = a.jerk();
+        }
+        if let Some(c) = self.contour_axis() {
+            let a = self.c_axis.unwrap_or_default();
+            limits.velocity[c] = a.max_velocity / 60.0;
+            limits.acceleration[c] = a.max_acceleration;
+            limits.jerk[c] = a.max_acceleration / cnc_machine::DEFAULT_JERK_TIME;
+            limits.axes = c + 1;
         }
         PlannerConfig {
             limits,

@@ -14,6 +14,7 @@ impl Motion {
         for (i, a) in self.cfg.axes.iter().take(MAX_AXES).enumerate() {
             out[i] = p.get(i).copied().unwrap_or(0.0) * a.scale();
         }
+        self.contour_end(p, &mut out);
         out
     }
 
@@ -125,18 +126,30 @@ impl Motion {
                 self.sync_reached(block.seq);
                 Ok(Active::Dwell { remaining: 0.0 })
             }
+            Command::Contour { on } => {
+                self.contour_block(*on)?;
+                Ok(Active::Dwell { remaining: 0.0 })
+            }
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
                 raised: false,
             }),
-            Command::ProgramEnd => Ok(Active::End),
+            Command::ProgramEnd => {
+                // The end of a program also ends polar interpolation (§5.8: as reset does).
+                self.contour.on = false;
+                Ok(Active::End)
+            }
         }
     }
 
     /// A block's end point and arc centre must name every axis with a finite value.
     pub(super) fn check_block(&self, kind: &Command) -> Result<(), (u32, String)> {
         let n = self.cfg.axes.len();
-        let bad_len = |v: &[f64]| v.len() != n || v.iter().any(|x| !x.is_finite());
+        // A turn-mill's blocks name C after the machine's axes (D141).
+        let with_c = self.cfg.contour_axis().map(|c| c + 1);
+        let bad_len = |v: &[f64]| {
+            (v.len() != n && Some(v.len()) != with_c) || v.iter().any(|x| !x.is_finite())
+        };
         if let Some(end) = kind.end() {
             if bad_len(end) {
                 return Err((

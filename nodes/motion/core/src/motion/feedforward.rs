@@ -86,6 +86,7 @@ impl Motion {
         sp.spindle_acceleration_percent = self.spindle_acceleration_percent();
         sp.torque_limit_percent = self.torque_limits();
         self.fill_scaling(sp);
+        self.fill_contour(sp);
     }
 
     pub fn spindle_acceleration_percent(&self) -> f64 {

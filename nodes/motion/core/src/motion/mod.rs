@@ -32,6 +32,7 @@ mod active;
 mod block_ends;
 mod brake_tail;
 mod compressor;
+mod contour;
 mod drive_fault;
 mod drive_scaling;
 mod feedforward;
@@ -207,6 +208,8 @@ pub struct Motion {
     timers: RunTimers,
     /// A program runs: from its first block to its end, a reset or a dropped run.
     program_running: bool,
+    /// The turn-mill's C axis in the path (polar interpolation, D141).
+    contour: contour::Contour,
 }
 
 impl Motion {
@@ -233,6 +236,7 @@ impl Motion {
             .map(|a| "XYZABC".find(a.name.as_str()).filter(|_| a.name.len() == 1))
             .collect();
         Motion {
+            contour: contour::Contour::default(),
             compressor: false,
             fifo_fill: false,
             timers: RunTimers::default(),
@@ -455,6 +459,7 @@ impl Motion {
         self.jog = None;
         self.release_fixed_stops();
         self.compressor = false;
+        self.contour.on = false;
         self.fifo_fill = false;
         self.handwheel.stop();
         self.hold_where_slides_are();
@@ -834,7 +839,7 @@ impl Motion {
 
     /// The commanded slide position as a planner point.
     fn commanded_point(&self) -> Point {
-        path::point_from(&self.commanded)
+        self.with_contour(path::point_from(&self.commanded))
     }
 }
 

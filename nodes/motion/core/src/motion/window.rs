@@ -57,7 +57,9 @@ impl Motion {
                 break;
             };
             match &next.kind {
-                Command::Linear { .. } if !self.exact_stop => {
+                // Polar interpolation's lines are already within their tolerance of the face's
+                // contour: merged in the machine's X and C they would leave it (D141).
+                Command::Linear { .. } if !self.exact_stop && !self.contour.on => {
                     let start = self.planner.end();
                     let (seg, feed) = self
                         .segment_for(next, &start)

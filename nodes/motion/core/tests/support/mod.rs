@@ -42,6 +42,7 @@ pub fn lathe() -> MotionConfig {
         spindle_max_rpm: 6000.0,
         feedback_delay_ticks: 1,
         time_scaling_at_drives: false,
+        c_axis: None,
     }
 }
 
