@@ -19,7 +19,7 @@ fn turn_mill() -> Setup {
     s
 }
 
-fn run(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
+fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
     cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
 }
 
@@ -130,7 +130,7 @@ fn fixture_016_mills_the_rectangle_on_the_face() {
         "T0101\nG00 X40 Z0\nG98 F100\n{}G02 X40 Z-5 R5\nM30\n",
         fixture("016_g12_1_polar_interpolation.nc")
     );
-    let cmds = run(&text, turn_mill()).unwrap();
+    let cmds = hx(&text, turn_mill()).unwrap();
     let rotary = cmds
         .iter()
         .find_map(|c| match &c.command {
@@ -203,7 +203,7 @@ fn a_hexagon_and_a_slot_near_the_pole_stay_on_the_face() {
         text.push_str(&format!("G01 X{:.6} C{:.6} F300\n", 2.0 * u, v));
     }
     text.push_str("G01 X40 C1\nG01 X-40 C1\nG01 X20 C0\nG03 X-20 C0 R10\nG13.1\nM30\n");
-    let cmds = run(&text, turn_mill()).unwrap();
+    let cmds = hx(&text, turn_mill()).unwrap();
     let lines = contour_lines(&cmds);
     let round = |x: f64| (x * 1e6).round() / 1e6;
     let mut path = vec![(15.0, 0.0)];
@@ -229,7 +229,7 @@ fn a_hexagon_and_a_slot_near_the_pole_stay_on_the_face() {
 }
 
 fn alarm(text: &str, setup: Setup) -> (u32, u32, String) {
-    let e = run(text, setup).expect_err("an alarm");
+    let e = hx(text, setup).expect_err("an alarm");
     (e.number, e.line, e.to_string())
 }
 

@@ -173,8 +173,18 @@ impl Core {
     /// The machine's result of the block the program waits for: the program goes on from
     /// where the axes came to rest. A result that does not name every axis with a number is
     /// an alarm.
-    pub fn machine_result(&mut self, m: Measurement) -> Result<(), ProgramError> {
+    pub fn machine_result(&mut self, mut m: Measurement) -> Result<(), ProgramError> {
         let n = self.pos.len();
+        // A turn-mill's C (the program's last axis, D141) is the spindle, which the machine's
+        // result does not name: it stays where the program has it.
+        if self.setup.spindle_c_axis && self.setup.axes.last() == Some(&'C') {
+            let c = self.pos[n - 1];
+            for v in [&mut m.position, &mut m.rest] {
+                if v.len() + 1 == n {
+                    v.push(c);
+                }
+            }
+        }
         let whole = |v: &[f64]| v.len() == n && v.iter().all(|x| x.is_finite());
         if !whole(&m.rest) || !whole(&m.position) {
             let e = self.fault(

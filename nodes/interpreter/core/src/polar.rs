@@ -1,4 +1,4 @@
-//! Polar interpolation (the Huaxing's G12.1/G13.1, `000` §5.8; decision D141): a program
+//! Polar interpolation (decision D141): a program
 //! written in the face plane's Cartesian coordinates — the linear axis X and the rotary axis C
 //! as a virtual linear axis, both mm — runs on a machine that moves X and turns C. The
 //! program's coordinates, through the offsets, are the basic system (the core's position
@@ -47,7 +47,7 @@ pub struct Polar {
     pub c_origin: f64,
     /// The last machine C given, degrees from the start: the next is taken on its side.
     pub c: f64,
-    /// The plane before G12.1, back at G13.1.
+    /// The plane before the transformation, back after it.
     pub plane: Plane,
 }
 
@@ -98,8 +98,8 @@ pub const POLAR_PLANE: Plane = Plane {
 };
 
 impl Core {
-    /// G12.1: polar interpolation on, X the linear axis and C the rotary one. The tool
-    /// stands at X > 0 with C at 0 (§5.8); the position becomes the face's, C as mm.
+    /// Polar interpolation on, X the linear axis and C the rotary one. The tool stands at
+    /// X > 0 with C at 0; the position becomes the face's, C as mm.
     pub fn polar_on(&mut self) -> Result<(), ProgramError> {
         let (Some(linear), Some(rotary)) = (self.axis('X'), self.axis('C')) else {
             return Err(self.fault(
@@ -108,19 +108,19 @@ impl Core {
             ));
         };
         if self.polar.is_some() {
-            return Err(self.fault(Fault::PolarMode, "G12.1: polar interpolation is on"));
+            return Err(self.fault(Fault::PolarMode, "polar interpolation is on already"));
         }
         if self.comp.is_some() || self.cylinder.is_some() || !self.couplings.is_empty() {
             return Err(self.fault(
                 Fault::PolarMode,
-                "G12.1 starts with no tool-nose compensation, coupling or other \
-                 transformation on (G40 first)",
+                "polar interpolation starts with no radius compensation, coupling or other \
+                 transformation on",
             ));
         }
         if self.feed_per_rev {
             return Err(self.fault(
                 Fault::PolarMode,
-                "G12.1 in G99: polar interpolation feeds per minute (G98 first)",
+                "polar interpolation feeds per minute, not per revolution",
             ));
         }
         let work = self.work_position();
@@ -129,7 +129,7 @@ impl Core {
             return Err(self.fault(
                 Fault::PolarStart,
                 format!(
-                    "G12.1 starts with X above 0 and C at 0: X{} C{}",
+                    "polar interpolation starts with X above 0 and C at 0: X{} C{}",
                     show(work[linear]),
                     show(work[rotary])
                 ),
@@ -157,8 +157,8 @@ impl Core {
         Ok(())
     }
 
-    /// G13.1 (or the end of the program): polar interpolation off, the position the
-    /// machine's again (C in degrees), the plane as before G12.1.
+    /// Polar interpolation off: the position the machine's again (C in degrees), the plane
+    /// as before it.
     pub fn polar_off(&mut self) -> Result<(), ProgramError> {
         let Some(p) = self.polar else {
             return Ok(());
@@ -166,7 +166,7 @@ impl Core {
         if self.comp.is_some() {
             return Err(self.fault(
                 Fault::PolarMode,
-                "G13.1 under tool-nose compensation: G40 first",
+                "polar interpolation ends with radius compensation off",
             ));
         }
         let m = p.machine(&self.pos, p.c);
@@ -226,7 +226,7 @@ impl Core {
             }
             Command::Rapid { .. } => Err(self.fault(
                 Fault::PolarMode,
-                "G00 in polar interpolation: position before G12.1, cut with G01/G02/G03",
+                "a rapid in polar interpolation: position before it, cut with lines and circles",
             )),
             _ => Err(self.fault(
                 Fault::PolarMode,

@@ -83,7 +83,7 @@ impl Motion {
                 }
                 self.planner.reset(start);
                 self.planner
-                    .push(seg, feed, block.seq, block.line, !self.exact_stop, 0.0);
+                    .push(seg, feed, block.seq, block.line, !self.exact_stop, self.contour_used());
                 Ok(Active::Path)
             }
             Command::Probe { .. } => {

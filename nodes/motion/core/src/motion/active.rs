@@ -75,7 +75,6 @@ impl Motion {
                     &mut self.finished,
                 );
                 self.commanded[..n].copy_from_slice(&out[..n]);
-                self.contour_tick(&out);
                 for &seq in &self.finished {
                     self.done_seq = self.done_seq.max(seq);
                 }
@@ -104,6 +103,7 @@ impl Motion {
                     &mut out,
                 );
                 self.commanded[..n].copy_from_slice(&out[..n]);
+                self.contour_tick(&out);
                 for &seq in &self.finished {
                     self.done_seq = self.done_seq.max(seq);
                 }

@@ -11,6 +11,12 @@ use super::*;
 /// degrees (its positioning's in-position band).
 const START_BAND: f64 = 0.001;
 
+/// How far a blended corner may leave the machine's path in contour control: mm of X's
+/// slide, degrees of C (0.07 µm of face at 20 mm from the pole). The machine's tolerance is
+/// mm of every axis; in X and C it would bend the face's contour by more than the
+/// transformation's own 0.25 µm.
+const CONTOUR_BLEND: f64 = 0.000_2;
+
 /// The C axis's state in the path.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Contour {
@@ -89,6 +95,15 @@ impl Motion {
             at: signed,
         };
         Ok(())
+    }
+
+    /// The share of the path tolerance a block's corners may not use: all but
+    /// [`CONTOUR_BLEND`] in contour control, none outside it.
+    pub(super) fn contour_used(&self) -> f64 {
+        match self.contour.on {
+            true => (self.cfg.tolerance - CONTOUR_BLEND).max(0.0),
+            false => 0.0,
+        }
     }
 
     /// This tick's C setpoint from the planner's point `out`.

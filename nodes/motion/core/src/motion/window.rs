@@ -84,7 +84,8 @@ impl Motion {
                         .segment_for(next, &self.planner.end())
                         .map_err(|(n, t)| (n, t, line))?;
                     let blend = !self.exact_stop;
-                    self.planner.push(seg, feed, seq, line, blend, 0.0);
+                    let used = self.contour_used();
+                    self.planner.push(seg, feed, seq, line, blend, used);
                 }
                 Command::FeedMode { per_rev } => {
                     self.feed_per_rev = *per_rev;
