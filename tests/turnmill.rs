@@ -291,17 +291,73 @@ fn off_path(p: (f64, f64), path: &[(f64, f64)]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// What a run in polar interpolation did at the servo rate.
+struct PolarRun {
+    ticks: u32,
+    /// Worst distance of the X/C setpoints, and of the slides' actual X and the spindle's
+    /// angle, from the face's path, mm.
+    worst: f64,
+    worst_actual: f64,
+    /// Fastest C setpoint, °/s, and the slowest face speed at the slot's pole crossing.
+    fastest_c: f64,
+    slowest_near_pole: f64,
+}
+
+/// Runs `program` on the turn-mill rig to its end and measures every tick in polar
+/// interpolation against the face's polyline `path` (cutter centre, mm).
+fn polar_run(program: &str, path: &[(f64, f64)]) -> (Rig, PolarRun) {
+    let mut r = Rig::on(config("sim_turnmill"), program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let face = |x: f64, c: f64| {
+        let (s, co) = c.to_radians().sin_cos();
+        (x / 2.0 * co, x / 2.0 * s)
+    };
+    let mut run = PolarRun {
+        ticks: 0,
+        worst: 0.0,
+        worst_actual: 0.0,
+        fastest_c: 0.0,
+        slowest_near_pole: f64::INFINITY,
+    };
+    let mut last: Option<(f64, (f64, f64))> = None;
+    let ok = r.run_until(120.0, |r| {
+        match r.motion.contour_c() {
+            Some(c) => {
+                let x = r.motion.commanded_display()[0];
+                let p = face(x, c);
+                run.worst = run.worst.max(off_path(p, path));
+                // The drives report X's slide (radius).
+                let actual = face(2.0 * r.fb.position[0], r.fb.spindle_angle_deg);
+                run.worst_actual = run.worst_actual.max(off_path(actual, path));
+                if let Some((c0, p0)) = last {
+                    run.fastest_c = run.fastest_c.max((c - c0).abs() / 0.004);
+                    let speed = (p.0 - p0.0).hypot(p.1 - p0.1) / 0.004;
+                    if (p.1 - 1.0).abs() < 1e-3 && p.0.abs() < 0.2 {
+                        run.slowest_near_pole = run.slowest_near_pole.min(speed);
+                    }
+                }
+                last = Some((c, p));
+                run.ticks += 1;
+            }
+            None => last = None,
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    (r, run)
+}
+
 /// Issue 49, must-show 2: polar interpolation (G12.1, D141) through the planner, the drives
 /// and the PLC at the servo rate. A hexagon of 30 mm across flats about the spindle's centre
 /// and a slot that passes 1 mm from the pole, at F1200: every tick's X and C setpoints,
 /// mapped back to the face, lie within 1 µm of the programmed contour; C never turns faster
 /// than its 36,000°/min, and near the pole the feed drops (to what C's rate and acceleration
-/// allow at 1 mm from it, 3.4 mm/s) rather than the path bending; the spindle, following C, keeps the slide's actual point
-/// near the contour too; G13.1 and M15 end it with C standing where the slot left it.
+/// allow at 1 mm from it, 3.4 mm/s) rather than the path bending; the spindle, following C,
+/// keeps the slide's actual point near the contour too; G13.1 and M15 end it.
 #[test]
 fn polar_interpolation_keeps_every_servo_tick_on_the_face_contour() {
-    let cfg = config("sim_turnmill");
-    let c_rate = cfg.machine.c_axis.max_velocity / 60.0;
+    let c_rate = config("sim_turnmill").machine.c_axis.max_velocity / 60.0;
     let (a, h) = (15.0f64, 15.0 / 3f64.sqrt());
     let corners = [
         (a, h),
@@ -320,50 +376,49 @@ fn polar_interpolation_keeps_every_servo_tick_on_the_face_contour() {
     }
     program.push_str("G01 X40 C1\nG01 X-40 C1\nG13.1\nM15\nM30\n");
     path.extend([(20.0, 1.0), (-20.0, 1.0)]);
-    let mut r = Rig::on(cfg, &program, None);
-    r.run_until(0.1, |_| false);
-    r.started = true;
-    let face = |x: f64, c: f64| {
-        let (s, co) = c.to_radians().sin_cos();
-        (x / 2.0 * co, x / 2.0 * s)
-    };
-    let (mut ticks, mut worst, mut worst_actual) = (0u32, 0.0f64, 0.0f64);
-    let (mut fastest_c, mut slowest_near_pole) = (0.0f64, f64::INFINITY);
-    let mut last: Option<(f64, (f64, f64))> = None;
-    let ok = r.run_until(120.0, |r| {
-        match r.motion.contour_c() {
-            Some(c) => {
-                let x = r.motion.commanded_display()[0];
-                let p = face(x, c);
-                worst = worst.max(off_path(p, &path));
-                // The drives report X's slide (radius).
-                let actual = face(2.0 * r.fb.position[0], r.fb.spindle_angle_deg);
-                worst_actual = worst_actual.max(off_path(actual, &path));
-                if let Some((c0, p0)) = last {
-                    fastest_c = fastest_c.max((c - c0).abs() / 0.004);
-                    let speed = (p.0 - p0.0).hypot(p.1 - p0.1) / 0.004;
-                    if (p.1 - 1.0).abs() < 1e-3 && p.0.abs() < 0.2 {
-                        slowest_near_pole = slowest_near_pole.min(speed);
-                    }
-                }
-                last = Some((c, p));
-                ticks += 1;
-            }
-            None => last = None,
-        }
-        r.program_done()
-    });
-    assert!(ok, "program did not finish; events {:?}", r.events);
+    let (r, run) = polar_run(&program, &path);
     println!(
-        "{ticks} ticks in polar interpolation: setpoints at most {worst:.2e} mm off the face's \
-         contour, the actual point {worst_actual:.4} mm; C at most {fastest_c:.1}°/s (limit \
-         {c_rate}), the slot at the pole at {slowest_near_pole:.2} mm/s (F1200 = 20 mm/s)"
+        "{} ticks in polar interpolation: setpoints at most {:.2e} mm off the face's contour, \
+         the actual point {:.4} mm; C at most {:.1}°/s (limit {c_rate}), the slot at the pole at \
+         {:.2} mm/s (F1200 = 20 mm/s)",
+        run.ticks, run.worst, run.worst_actual, run.fastest_c, run.slowest_near_pole
     );
-    assert!(ticks > 1000, "{ticks}");
-    assert!(worst <= 0.001, "{worst} mm off the contour");
-    assert!(fastest_c <= c_rate * (1.0 + 1e-9), "C at {fastest_c}°/s");
+    assert!(run.ticks > 1000, "{}", run.ticks);
+    assert!(run.worst <= 0.001, "{} mm off the contour", run.worst);
+    assert!(run.fastest_c <= c_rate * (1.0 + 1e-9), "C at {}°/s", run.fastest_c);
     // At 1 mm from the pole C's 600°/s allow 10.5 mm/s: the feed is lowered, not the path.
-    assert!(slowest_near_pole < 11.0, "{slowest_near_pole} mm/s at the pole");
-    assert!(worst_actual < 0.05, "the slide's actual point {worst_actual} mm off");
+    assert!(run.slowest_near_pole < 11.0, "{} mm/s at the pole", run.slowest_near_pole);
+    assert!(run.worst_actual < 0.05, "the slide's actual point {} mm off", run.worst_actual);
     assert!(!r.bit("ORIENT_REQ"), "M15: speed control again");
+}
+
+/// Fixture 016 as printed on the turn-mill, after the live tool's end mill (T0303, radius 4,
+/// tip 0) and M14.6: G00 C0, G12.1, and the rectangle X10…−20 (diameter) by C −10…10 with
+/// G41 — the cutter's centre runs the rectangle 4 mm inside it, every servo tick within 1 µm.
+#[test]
+fn fixture_016_mills_its_rectangle_through_the_machine() {
+    let program = format!(
+        "T0303\nG00 X40 Z5\nM14.6\n{}M15\nM30\n",
+        fixture("016_g12_1_polar_interpolation")
+    );
+    let r = 4.0;
+    let path = [
+        (20.0, 0.0),
+        (15.0, 0.0),
+        (5.0 - r, 0.0),
+        (5.0 - r, 10.0 - r),
+        (-10.0 + r, 10.0 - r),
+        (-10.0 + r, -10.0 + r),
+        (5.0 - r, -10.0 + r),
+        (5.0 - r, 0.0),
+        (15.0, 0.0),
+    ];
+    let (_, run) = polar_run(&program, &path);
+    println!(
+        "fixture 016: {} ticks, setpoints at most {:.2e} mm off the cutter's path, the actual \
+         point {:.4} mm",
+        run.ticks, run.worst, run.worst_actual
+    );
+    assert!(run.ticks > 500, "{}", run.ticks);
+    assert!(run.worst <= 0.001, "{} mm off the cutter's path", run.worst);
 }
