@@ -422,3 +422,50 @@ fn fixture_016_mills_its_rectangle_through_the_machine() {
     assert!(run.ticks > 500, "{}", run.ticks);
     assert!(run.worst <= 0.001, "{} mm off the cutter's path", run.worst);
 }
+
+/// Issue 49, must-show 3 for G14 (D142): fixture 017 as printed on the turn-mill — G14.4 taps
+/// Z0 → −10 at 1 mm a turn with the live tool (A) at 500 r/min, dwells 2 s, comes back. At
+/// every servo tick the tap's setpoints keep Z on the tool's angle by the pitch (the line
+/// gears them), and the slide's actual Z keeps to the tool drive's actual angle within the
+/// 0.1 mm the rigid taps keep (`plc_cell_mill.rs`); the tool turns ten turns in and ten out.
+#[test]
+fn fixture_017_taps_with_the_live_tool_geared_at_every_tick() {
+    let cfg = config("sim_turnmill");
+    let z = cfg.axis_index("Z").unwrap();
+    let program = fixture("017_g14_4_flying_cutter_tapping");
+    let mut r = Rig::on(cfg, &program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let (mut worst_set, mut worst_actual, mut deepest, mut most_turned) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut start: Option<(f64, f64)> = None;
+    let ok = r.run_until(60.0, |r| {
+        let (zs, a_set) = (r.motion.commanded_display()[z], r.motion.live_tool_setpoint());
+        if start.is_none() && r.motion.commanded_display()[0] == 0.0 && zs == 0.0 && r.t > 0.5 {
+            start = Some((r.fb.position[z], r.fb.live_tool_angle));
+        }
+        if let Some((z0, a0)) = start {
+            // At X0 and below Z0 the tap is in its thread: Z = −(turns) × 1 mm (until the
+            // rapid away from it starts).
+            if r.motion.commanded_display()[0] == 0.0 && zs <= 0.0 {
+                worst_set = worst_set.max((zs + a_set / 360.0).abs());
+                let want = z0 - (r.fb.live_tool_angle - a0) / 360.0;
+                worst_actual = worst_actual.max((r.fb.position[z] - want).abs());
+            }
+            deepest = deepest.min(r.fb.position[z]);
+            most_turned = most_turned.max(r.fb.live_tool_angle - a0);
+        }
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!(
+        "G14.4: setpoints off the pitch by at most {worst_set:.2e} mm, the actual Z off the tool's \
+         actual angle by {worst_actual:.2e} mm; deepest Z {deepest:.4}, {most_turned:.1}° turned"
+    );
+    assert!(start.is_some(), "the tap started at X0 Z0");
+    assert!(worst_set < 1e-9, "setpoints {worst_set} mm off the pitch");
+    assert!(worst_actual < 0.1, "the slide {worst_actual} mm off the tool's angle");
+    assert!((deepest + 10.0).abs() < 0.01, "to Z−10: {deepest}");
+    assert!((most_turned - 3600.0).abs() < 1.0, "ten turns: {most_turned}°");
+    assert_eq!(r.motion.commanded_display()[z], 100.0);
+    assert!(r.motion.live_tool_setpoint().abs() < 1e-9, "the tool back at 0°");
+}

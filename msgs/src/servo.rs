@@ -71,6 +71,9 @@ pub struct ServoSetpoint {
     /// spindle's turned angle) as an axis drive follows its setpoint.
     pub c_contour: u32,
     pub c_position: f64,
+    /// The turn-mill's live tool (D142), a drive in position control on the same bus: the
+    /// angle it is to stand at, degrees, unwrapped (it turns by following it).
+    pub live_tool_position: f64,
 }
 
 impl ServoSetpoint {
@@ -120,6 +123,7 @@ impl Default for ServoSetpoint {
             block_start: 1.0,
             c_contour: 0,
             c_position: 0.0,
+            live_tool_position: 0.0,
         }
     }
 }
@@ -230,6 +234,10 @@ pub struct ServoFeedback {
     pub resets_done: u32,
     /// 1 while the drives stand at a block's end for single block, until a cycle start.
     pub block_stop: u32,
+    /// The live tool's drive (D142): degrees turned since power-on (its encoder, unwrapped)
+    /// and its speed, rpm.
+    pub live_tool_angle: f64,
+    pub live_tool_rpm: f64,
 }
 
 impl ServoFeedback {
@@ -272,6 +280,8 @@ impl Default for ServoFeedback {
             dry_tick: 0,
             episode_ended: 0,
             emergency_stop: 0,
+            live_tool_angle: 0.0,
+            live_tool_rpm: 0.0,
             held: 0,
             scale: 1.0,
             setpoint: [0.0; MAX_AXES],

@@ -78,6 +78,11 @@ pub fn of_machine(machine: &MachineConfig, start: &[f64]) -> Setup {
         setup = setup.with_spindle_c_axis();
         setup.c_rapid_rpm = machine.c_axis.max_velocity / 360.0;
     }
+    if let Some(t) = &machine.live_tool {
+        if let Some(n) = t.number() {
+            setup = setup.with_live_tool(t.letter(), n, t.max_rpm);
+        }
+    }
     setup.skip_input = machine.skip_input.as_deref().and_then(x_input);
     setup.skip_keeps_actual = machine.skip_keeps_actual;
     setup.active_tool = machine.tool_in_spindle;

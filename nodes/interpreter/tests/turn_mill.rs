@@ -170,3 +170,103 @@ fn g31_skips_on_the_machines_skip_input() {
         assert_eq!((e.number, e.line), (number, 1), "{text}: {e}");
     }
 }
+
+/// The turn-mill with its live tool as axis A (G14.4), up to 2500 r/min.
+fn with_live_tool() -> Setup {
+    turn_mill().with_live_tool('A', 4, 2500.0)
+}
+
+/// The live tool's taps as (X, Z, tool degrees, feed) of each line that turns it.
+fn taps(cmds: &[Canon]) -> Vec<(f64, f64, f64, f64)> {
+    cmds.iter()
+        .filter_map(|c| match &c.command {
+            Command::Linear { end, feed } if end.len() == 4 => {
+                Some((end[0], end[1], end[3], *feed))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// Fixture 017 as printed (`000` §5.9, D142): G14.4 taps Z0 → −10 at 1 mm a turn with the live
+/// tool at 500 r/min — ten turns, 3600°, in 1.2 s, the line's feed the one that turns the tool
+/// at R — dwells D2 s at the bottom and comes back turning the other way to Z0 and 0°; then
+/// G0 X100 Z100. G14 is modal: a following Z taps again from where the tool stands.
+#[test]
+fn fixture_017_taps_with_the_live_tool_and_back() {
+    let text = fixture("017_g14_4_flying_cutter_tapping.nc");
+    let cmds = run(&text, with_live_tool()).unwrap();
+    let t = taps(&cmds);
+    let feed = 10.0f64.hypot(3600.0) / (10.0 / 500.0);
+    assert_eq!(t.len(), 2, "{t:?}");
+    for (k, want) in [(0.0, -10.0, 3600.0), (0.0, 0.0, 0.0)].iter().enumerate() {
+        let (x, z, a, f) = t[k];
+        assert!(
+            (x, z) == (want.0, want.1) && (a - want.2).abs() < 1e-9 && (f - feed).abs() < 1e-6,
+            "tap line {k}: {:?}",
+            t[k]
+        );
+    }
+    let dwell = cmds
+        .iter()
+        .find_map(|c| match c.command {
+            Command::Dwell { seconds } => Some(seconds),
+            _ => None,
+        })
+        .expect("D2");
+    assert_eq!(dwell, 2.0);
+    let last_rapid = cmds
+        .iter()
+        .filter_map(|c| match &c.command {
+            Command::Rapid { end } => Some(end.clone()),
+            _ => None,
+        })
+        .last()
+        .expect("G0 X100 Z100");
+    assert_eq!(last_rapid, vec![100.0, 100.0, 0.0, 0.0]);
+    // Modal, a slanted thread by X and Z, a left-hand one by F−, inch by I.
+    let modal = run(
+        "G0 X20 Z0\nG14.4 Z-5 R1000 F0.5\nU-6 W-8 F-1.5\nW-4 I20\nG0 X100\nM30\n",
+        with_live_tool(),
+    )
+    .unwrap();
+    let t = taps(&modal);
+    let want = [
+        (20.0, -5.0, 3600.0),
+        (20.0, 0.0, 0.0),
+        // U−6 (diameter: 3 mm) and W−8: √73 mm at 1.5 mm a turn the negative way.
+        (14.0, -8.0, -360.0 * 73f64.sqrt() / 1.5),
+        (20.0, 0.0, 0.0),
+        (20.0, -4.0, 360.0 * 4.0 / (25.4 / 20.0)),
+        (20.0, 0.0, 0.0),
+    ];
+    assert_eq!(t.len(), want.len(), "{t:?}");
+    for (got, want) in t.iter().zip(want) {
+        assert!(
+            (got.0 - want.0).abs() < 1e-9
+                && (got.1 - want.1).abs() < 1e-9
+                && (got.2 - want.2).abs() < 1e-6,
+            "{got:?} is not {want:?}"
+        );
+    }
+}
+
+/// G14's alarms: no live tool on the machine or not axis n (74), R 0 or above S#122's 2500
+/// (73), no pitch (2) or no R (23, a missing word), the live tool's address as a word (74).
+#[test]
+fn live_tool_tap_alarms() {
+    let cases = [
+        ("G14.4 Z-10 R500 F1\n", turn_mill(), 74, 1),
+        ("G14.3 Z-10 R500 F1\n", with_live_tool(), 74, 1),
+        ("G14.4 Z-10 R0 F1\n", with_live_tool(), 73, 1),
+        ("G14.4 Z-10 R3000 F1\n", with_live_tool(), 73, 1),
+        ("G14.4 Z-10 R500\n", with_live_tool(), 2, 1),
+        ("G14.4 Z-10 F1\n", with_live_tool(), 23, 1),
+        ("G00 A90\n", with_live_tool(), 74, 1),
+        ("G14.4 Z-10 R500 F1 I20\n", with_live_tool(), 2, 1),
+    ];
+    for (text, setup, number, line) in cases {
+        let e = run(text, setup).unwrap_err();
+        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
+    }
+}

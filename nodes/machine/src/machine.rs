@@ -74,6 +74,10 @@ pub struct MachineConfig {
     /// degrees/s². Absent: [`CAxisEntry::default`].
     #[serde(default)]
     pub c_axis: CAxisEntry,
+    /// The live tool (飞刀盘, `000` §5.9, D142): a tool spindle on a drive of its own, the
+    /// axis G14.n names. None: the machine has none.
+    #[serde(default)]
+    pub live_tool: Option<LiveToolEntry>,
     /// The X-table input a skip move (the Huaxing's G31) stops on, e.g. `X11.5` (S#46): the
     /// input wired to the drives' measuring input, which latches the axes at its edge. None:
     /// the machine has no skip input (D139).
@@ -236,6 +240,36 @@ impl Default for CAxisEntry {
             max_velocity: 36_000.0,
             max_acceleration: 6_000.0,
         }
+    }
+}
+
+/// A live tool's drive: the axis letter the program's G14.n names (n = 1…6 for X…C), its top
+/// speed (S#122) and the time it takes to reach it (S#123).
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LiveToolEntry {
+    pub axis: String,
+    pub max_rpm: f64,
+    pub time_constant: f64,
+}
+
+impl LiveToolEntry {
+    /// The axis number G14.n names: 1…6 for X, Y, Z, A, B, C.
+    pub fn number(&self) -> Option<u8> {
+        let i = ["X", "Y", "Z", "A", "B", "C"]
+            .iter()
+            .position(|a| *a == self.axis)?;
+        u8::try_from(i + 1).ok()
+    }
+
+    /// The drive's acceleration, degrees/s²: top speed in the time constant.
+    pub fn acceleration(&self) -> f64 {
+        self.max_rpm * 6.0 / self.time_constant.max(1e-3)
+    }
+
+    /// The letter the program's position carries it under.
+    pub fn letter(&self) -> char {
+        self.axis.chars().next().unwrap_or('A')
     }
 }
 
@@ -588,6 +622,33 @@ impl MachineConfig {
                         "machine.work_offsets.{code}: axis {axis:?} not configured or value not finite"
                     ));
                 }
+            }
+        }
+        self.validate_spindle_axes()
+    }
+
+    /// The C axis's rates and the live tool: finite and above 0, the live tool's axis a
+    /// letter the machine's slides do not use (nor C on a turn-mill).
+    fn validate_spindle_axes(&self) -> Result<(), String> {
+        let c = self.c_axis;
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(c.max_velocity) || !positive(c.max_acceleration) {
+            return Err("machine.c_axis: max_velocity and max_acceleration above 0".into());
+        }
+        if let Some(t) = &self.live_tool {
+            let taken = self.axes.iter().any(|a| a.name == t.axis)
+                || (self.spindle_c_axis && t.axis == "C");
+            if t.number().is_none() || taken {
+                return Err(format!(
+                    "machine.live_tool.axis {:?}: one of X Y Z A B C that no slide (nor the \
+                     spindle's C) uses",
+                    t.axis
+                ));
+            }
+            if !positive(t.max_rpm) || t.max_rpm > 30_000.0 || !positive(t.time_constant) {
+                return Err(
+                    "machine.live_tool: max_rpm 0 < … ≤ 30000, time_constant above 0".into()
+                );
             }
         }
         Ok(())

@@ -36,6 +36,7 @@ impl FromLaunch for MotionConfig {
             feedback_delay_ticks: cfg.servo.drive_queue_ticks().max(1) as u32,
             time_scaling_at_drives: cfg.servo.drive_queue_ticks() > 0,
             c_axis: cfg.machine.spindle_c_axis.then_some(cfg.machine.c_axis),
+            live_tool: cfg.machine.live_tool.clone(),
         }
     }
 }

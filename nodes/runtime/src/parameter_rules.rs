@@ -138,6 +138,7 @@ pub const RULES: &[Rule] = &[
     ),
     builder("machine.spindle_c_axis", None, "what the machine is"),
     builder("machine.c_axis.*", None, "what the spindle's drive can do"),
+    builder("machine.live_tool.*", None, "what the machine is"),
     builder("machine.skip_input", None, "the machine's wiring"),
     builder(
         "machine.skip_keeps_actual",

@@ -146,6 +146,8 @@ pub enum Fault {
     PolarAxes,
     /// Polar interpolation started away from its start (linear axis > 0, rotary axis at 0).
     PolarStart,
+    /// A live tool speed of 0 or above the tool's top speed.
+    LiveToolSpeed,
     /// Three-point arc points collinear.
     ThreePointArc,
     /// Too few blocks between compensation start and cancel.

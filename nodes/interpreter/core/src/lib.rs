@@ -27,6 +27,7 @@ pub mod error;
 pub mod fillet;
 pub mod flow;
 pub mod geometry;
+pub mod live_tool;
 pub mod measure;
 pub mod polar;
 pub mod rough;

@@ -47,6 +47,14 @@ impl Offsets {
     }
 }
 
+/// A live tool (D142): its axis letter, the axis number G14.n names, its top speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LiveTool {
+    pub letter: char,
+    pub number: u8,
+    pub max_rpm: f64,
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub struct Setup {
     /// Machine axis letters in machine order, e.g. `['X', 'Z']`.
@@ -88,6 +96,9 @@ pub struct Setup {
     pub spindle_c_axis: bool,
     /// The C axis's rapid rate (G00 C), r/min.
     pub c_rapid_rpm: f64,
+    /// The live tool (D142): the program's last axis, in degrees, which only a live-tool tap
+    /// turns.
+    pub live_tool: Option<LiveTool>,
     /// The skip input (G31) as X-table byte and bit, and whether a skip keeps the actual
     /// coordinates (B19.6, D139).
     pub skip_input: Option<(u32, u32)>,
@@ -122,6 +133,30 @@ impl Setup {
         self
     }
 
+    /// A live tool as axis `letter` (G14.n's n is `number`, 1…6 for X…C), up to `max_rpm`:
+    /// the program's last axis, at 0° when the program starts.
+    pub fn with_live_tool(mut self, letter: char, number: u8, max_rpm: f64) -> Setup {
+        if !self.axes.contains(&letter) {
+            self.axes.push(letter);
+            self.diameter.push(false);
+            self.start.push(0.0);
+            self.reference.push(0.0);
+            self.second_reference.push(0.0);
+            self.fixed_points.push(Vec::new());
+        }
+        self.live_tool = Some(LiveTool {
+            letter,
+            number,
+            max_rpm,
+        });
+        self
+    }
+
+    /// Whether `letter` is the live tool's axis (no program word moves it).
+    pub fn is_live_tool(&self, letter: char) -> bool {
+        self.live_tool.is_some_and(|t| t.letter == letter)
+    }
+
     pub fn new(axes: &[char], diameter: &[bool], start: &[f64]) -> Setup {
         let n = axes.len();
         let start: Vec<f64> = (0..n)
@@ -149,6 +184,7 @@ impl Setup {
             tool_change_with_m6: false,
             spindle_c_axis: false,
             c_rapid_rpm: 100.0,
+            live_tool: None,
             skip_input: None,
             skip_keeps_actual: true,
             active_tool: 0,

@@ -51,6 +51,8 @@ pub fn alarm(f: Fault) -> u32 {
         PolarMode => 106,
         PolarAxes => 107,
         PolarStart => 108,
+        // "M65 spindle/live tool speed 0 or overspeed".
+        LiveToolSpeed => 73,
         CompBlocks => 82,
         CompStartNotLine => 85,
         CompNoIntersection | CompInterference => 88,

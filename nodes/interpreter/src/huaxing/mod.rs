@@ -5,6 +5,7 @@
 
 mod alarms;
 mod c_axis;
+mod live_tool;
 mod polar;
 mod compound;
 mod drilling;
@@ -79,6 +80,10 @@ pub enum HuaxingG {
     /// G12.1 / G13.1: polar interpolation on / off (§5.8, D141).
     PolarOn,
     PolarOff,
+    /// G14.n: a tap with the live tool, axis n (§5.9, D142).
+    LiveTap {
+        axis: u8,
+    },
 }
 
 /// Retained words of a single cycle (G90/G92/G94, §5.21.3).
@@ -109,6 +114,8 @@ pub struct Huaxing {
     /// A skip's programmed end, to be written over the coordinates once the machine has
     /// told where the skip came (B19.6 = 0, D139).
     pub skip_end: Option<Vec<f64>>,
+    /// G14's modal words (D142).
+    pub live_tap: live_tool::LiveTapWords,
 }
 
 impl Family for Huaxing {
@@ -160,6 +167,7 @@ impl Family for Huaxing {
             start_on_index: false,
             rotary_rpm: None,
             skip_end: None,
+            live_tap: live_tool::LiveTapWords::default(),
         }
     }
 
@@ -188,6 +196,7 @@ impl Family for Huaxing {
                     | HuaxingG::ThreadCycle
                     | HuaxingG::TappingCycle
                     | HuaxingG::Rotary { .. }
+                    | HuaxingG::LiveTap { .. }
             )
         ) || b.has_g(G::Own(HuaxingG::MultiThreadCycle))
     }
@@ -269,6 +278,7 @@ impl Family for Huaxing {
                 | Drilling { .. }
                 | Rotary { .. }
                 | Skip
+                | LiveTap { .. }
         )
     }
     fn motion_selected(
@@ -286,14 +296,17 @@ impl Family for Huaxing {
     fn words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
         f.after_skip();
         f.polar_restrictions(b)?;
+        f.live_tool_words(b)?;
         f.c_words(b)
     }
     fn moves_without_axes(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
         matches!(f.motion, G::Own(HuaxingG::Rotary { .. })) && (b.has('C') || b.has('H'))
     }
     fn motion_words(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<(), ProgramError> {
-        if let G::Own(HuaxingG::Drilling { .. }) = f.motion {
-            f.drill_words(b)?;
+        match f.motion {
+            G::Own(HuaxingG::Drilling { .. }) => f.drill_words(b)?,
+            G::Own(HuaxingG::LiveTap { .. }) => f.live_tap_words(b)?,
+            _ => {}
         }
         Ok(())
     }
@@ -325,6 +338,7 @@ impl Family for Huaxing {
             TurningCycle | FacingCycle | ThreadCycle => f.single_cycle(b, g),
             Rotary { orient } => f.rotary(b, orient),
             Skip => f.skip(b),
+            LiveTap { axis } => f.live_tap(b, axis),
             other => Err(f.fault(Fault::UndefinedCode, format!("{other:?} is not a motion"))),
         }
     }
@@ -388,10 +402,7 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
         90 => (15, ExactStopBlock),
         121 => (16, G::Own(PolarOn)),
         131 => (16, G::Own(PolarOff)),
-        141..=146 => (
-            1,
-            Unsupported("G14.n live-tool tapping needs a live tool axis"),
-        ),
+        141..=146 => (1, G::Own(LiveTap { axis: (n - 140) as u8 })),
         170 => (16, PlaneXy),
         180 => (16, PlaneZx),
         190 => (16, PlaneYz),

@@ -22,7 +22,7 @@ pub fn alarm(f: Fault) -> u32 {
         | LoopWithoutStart | NoProgramEnd | CompInCycle | CycleZero | CycleFormat
         | ContourTooLong | ContourData | ContourStart | ContourBeyondStart | ThreadDepthMissing
         | PatternReliefZero | ThreePointArc | CompBlocks | CompDirection | CompRapid
-        | MustStartBlock | SpindleClamp | PolarMode | PolarStart => 10,
+        | MustStartBlock | SpindleClamp | PolarMode | PolarStart | LiveToolSpeed => 10,
         FeedRange => 11,
         ArcRadius | ArcEnd => 20,
         PlaneAxis => 21,

@@ -43,6 +43,6 @@ pub fn alarm(f: Fault) -> u32 {
         ThreadLead | TaperTooLarge | CssWithoutS | Chamfer | ChamferTooShort | CycleZero
         | CycleFormat | ContourTooLong | ContourData | ContourStart | ContourBeyondStart
         | ThreadDepthMissing | PatternReliefZero | SpindleClamp => 14040,
-        PolarMode | PolarStart => 12140,
+        PolarMode | PolarStart | LiveToolSpeed => 12140,
     }
 }

@@ -108,6 +108,9 @@ pub struct SimLathe {
     /// The drive following C's setpoints (polar interpolation, D141), and its speed then.
     contour: ContourFollow,
     contour_rpm: f64,
+    /// The live tool's drive (D142): degrees turned, following its setpoint.
+    live_tool: f64,
+    live_tool_follow: ContourFollow,
     pub devices: Devices,
     /// The emergency-stop input (the PLC's X image, the spindle's stop).
     emergency_stop: bool,
@@ -155,6 +158,8 @@ impl SimLathe {
             positioning: None,
             contour: ContourFollow::default(),
             contour_rpm: 0.0,
+            live_tool: 0.0,
+            live_tool_follow: ContourFollow::default(),
             emergency_stop: false,
             powered_off: false,
             x_seq: 0,
@@ -279,6 +284,8 @@ impl SimLathe {
             }
         }
         self.follow_contour(setpoint, dt);
+        let live_tool_was = self.live_tool;
+        self.follow_live_tool(setpoint, dt);
         self.devices.step(y, dt);
         let mut fb = ServoFeedback {
             seq: setpoint.seq,
@@ -288,6 +295,12 @@ impl SimLathe {
             spindle_angle_deg: self.spindle_angle(),
             handwheel_count: self.handwheel_count,
             torque_percent: torque,
+            live_tool_angle: self.live_tool,
+            live_tool_rpm: if dt > 0.0 {
+                (self.live_tool - live_tool_was) / dt / 6.0
+            } else {
+                0.0
+            },
             ..ServoFeedback::default()
         };
         for (i, was) in before.iter().enumerate().take(n) {
@@ -416,6 +429,22 @@ impl SimLathe {
                 };
             }
             None => self.contour_rpm = 0.0,
+        }
+    }
+
+    /// The live tool's drive in position control follows its setpoint (with the X drive's
+    /// lag), whole turns included; without power it stands.
+    fn follow_live_tool(&mut self, setpoint: &ServoSetpoint, dt: f64) {
+        let on = setpoint.enable != 0 && !self.powered_off && !self.emergency_stop;
+        let tau = self.cfg.drive_lag.first().copied().unwrap_or(0.0);
+        if let Some(a) = self.live_tool_follow.step_unwrapped(
+            on,
+            setpoint.live_tool_position,
+            self.live_tool,
+            tau,
+            dt,
+        ) {
+            self.live_tool = a;
         }
     }
 

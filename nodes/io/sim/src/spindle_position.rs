@@ -167,13 +167,27 @@ impl ContourFollow {
     /// The spindle's angle after `dt` following the setpoint `c` (degrees whose value modulo
     /// 360 is the encoder angle to reach) from `turned`; `None` when not following.
     pub fn step(&mut self, follow: bool, c: f64, turned: f64, tau: f64, dt: f64) -> Option<f64> {
-        if !follow || !c.is_finite() {
+        let last = self.last.unwrap_or(turned);
+        // The setpoint's unwrapped value: within half a turn of the last one.
+        let target = last + (c - last + 180.0).rem_euclid(360.0) - 180.0;
+        self.step_unwrapped(follow, target, turned, tau, dt)
+    }
+
+    /// As [`ContourFollow::step`] with a setpoint on the drive's own unwrapped count (the
+    /// live tool's).
+    pub fn step_unwrapped(
+        &mut self,
+        follow: bool,
+        target: f64,
+        turned: f64,
+        tau: f64,
+        dt: f64,
+    ) -> Option<f64> {
+        if !follow || !target.is_finite() {
             self.last = None;
             return None;
         }
         let last = self.last.unwrap_or(turned);
-        // The setpoint's unwrapped value: within half a turn of the last one.
-        let target = last + (c - last + 180.0).rem_euclid(360.0) - 180.0;
         self.last = Some(target);
         Some(if tau > 0.0 && dt > 0.0 {
             let v = (target - last) / dt;

@@ -39,6 +39,9 @@ pub struct MotionConfig {
     /// A turn-mill's C axis in contour control (polar interpolation, D141): planned as one
     /// more axis after the machine's, in degrees; `None` on a machine without it.
     pub c_axis: Option<cnc_machine::CAxisEntry>,
+    /// A turn-mill's live tool (D142): planned as an axis after C, in degrees, its drive in
+    /// position control following it.
+    pub live_tool: Option<cnc_machine::LiveToolEntry>,
 }
 
 impl MotionConfig {
@@ -48,6 +51,21 @@ impl MotionConfig {
         self.c_axis
             .and(Some(self.axes.len()))
             .filter(|&c| c < MAX_AXES)
+    }
+
+    /// The index the live tool has in blocks and the planner (after C), if the machine has
+    /// one and room for it.
+    pub fn live_tool_axis(&self) -> Option<usize> {
+        let i = self.axes.len() + usize::from(self.c_axis.is_some());
+        self.live_tool.as_ref().and(Some(i)).filter(|&i| i < MAX_AXES)
+    }
+
+    /// How many values a block's end point carries: the machine's axes, then C and the live
+    /// tool where the machine has them.
+    pub fn block_axes(&self) -> usize {
+        self.live_tool_axis()
+            .or(self.contour_axis())
+            .map_or(self.axes.len(), |i| i + 1)
     }
 
     /// The planner's view: limits per axis in slide travel, mm/s.
@@ -68,8 +86,13 @@ impl MotionConfig {
             limits.velocity[c] = a.max_velocity / 60.0;
             limits.acceleration[c] = a.max_acceleration;
             limits.jerk[c] = a.max_acceleration / cnc_machine::DEFAULT_JERK_TIME;
-            limits.axes = c + 1;
         }
+        if let (Some(i), Some(t)) = (self.live_tool_axis(), &self.live_tool) {
+            limits.velocity[i] = t.max_rpm * 6.0;
+            limits.acceleration[i] = t.acceleration();
+            limits.jerk[i] = t.acceleration() / cnc_machine::DEFAULT_JERK_TIME;
+        }
+        limits.axes = self.block_axes().min(MAX_AXES);
         PlannerConfig {
             limits,
             shape: self.shape,

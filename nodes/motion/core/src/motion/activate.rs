@@ -15,6 +15,7 @@ impl Motion {
             out[i] = p.get(i).copied().unwrap_or(0.0) * a.scale();
         }
         self.contour_end(p, &mut out);
+        self.live_tool_end(p, &mut out);
         out
     }
 
@@ -145,11 +146,10 @@ impl Motion {
     /// A block's end point and arc centre must name every axis with a finite value.
     pub(super) fn check_block(&self, kind: &Command) -> Result<(), (u32, String)> {
         let n = self.cfg.axes.len();
-        // A turn-mill's blocks name C after the machine's axes (D141).
-        let with_c = self.cfg.contour_axis().map(|c| c + 1);
-        let bad_len = |v: &[f64]| {
-            (v.len() != n && Some(v.len()) != with_c) || v.iter().any(|x| !x.is_finite())
-        };
+        // A turn-mill's blocks name C and the live tool after the machine's axes (D141, D142).
+        let all = self.cfg.block_axes();
+        let bad_len =
+            |v: &[f64]| !(n..=all).contains(&v.len()) || v.iter().any(|x| !x.is_finite());
         if let Some(end) = kind.end() {
             if bad_len(end) {
                 return Err((
@@ -182,6 +182,7 @@ impl Motion {
                 let feed = self.feed_mm_per_min(*feed)?;
                 self.check_limits(end)?;
                 let end = self.to_slide(end);
+                self.check_live_tool_move(start, &end)?;
                 Ok((Segment::Line { start: *start, end }, feed / 60.0))
             }
             Command::Arc {

@@ -104,6 +104,7 @@ impl Motion {
                 );
                 self.commanded[..n].copy_from_slice(&out[..n]);
                 self.contour_tick(&out);
+                self.live_tool_tick(&out);
                 for &seq in &self.finished {
                     self.done_seq = self.done_seq.max(seq);
                 }

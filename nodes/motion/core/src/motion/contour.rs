@@ -1,4 +1,6 @@
-//! The turn-mill's C axis in contour control (polar interpolation, D141): between the
+//! The turn-mill's spindle-driven axes in the path: C in contour control and the live tool.
+//!
+//! C (polar interpolation, D141): between the
 //! interpreter's `Contour { on: true }` and `Contour { on: false }` the main spindle, standing
 //! in position control at C 0, is one more path axis — planned after the machine's axes, in
 //! degrees, at its own rate and acceleration — and follows each tick's C setpoint as an axis
@@ -113,16 +115,82 @@ impl Motion {
         }
     }
 
-    /// What the drives get for C: whether the spindle follows, and where to.
+    /// What the drives get for C (whether the spindle follows, and where to) and the live
+    /// tool.
     pub fn fill_contour(&self, sp: &mut cnc_msgs::servo::ServoSetpoint) {
         let follow = self.contour.on && self.locked == 0;
         sp.c_contour = u32::from(follow);
         sp.c_position = if follow { self.contour.at } else { 0.0 };
+        sp.live_tool_position = self.live.at;
     }
 
     /// C's setpoint while contour control is on (degrees from where polar interpolation
     /// started), for the path view and the tests.
     pub fn contour_c(&self) -> Option<f64> {
         self.contour.on.then_some(self.contour.at - self.contour.base)
+    }
+}
+
+/// The live tool in the path (D142): its drive in position control follows the planner's
+/// angle, so a tap with the live tool (G14.n) is one move of the slides and the tool's angle,
+/// geared by the interpolation itself. The program's angle starts at 0 with every run; `base`
+/// is where the drive stood then.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct LiveTool {
+    /// The drive's setpoint, degrees since power-on.
+    pub(super) at: f64,
+    base: f64,
+}
+
+impl Motion {
+    /// A block end's live tool angle in the planner's units.
+    pub(super) fn live_tool_end(&self, p: &[f64], out: &mut Point) {
+        if let Some(i) = self.cfg.live_tool_axis() {
+            out[i] = match p.get(i) {
+                Some(v) => self.live.base + v,
+                None => self.live.at,
+            };
+        }
+    }
+
+    /// A run starts: the program's live tool angle 0 is where the drive stands.
+    pub(super) fn live_tool_run(&mut self) {
+        self.live.base = self.live.at;
+    }
+
+    /// The planner's point with the live tool where it stands.
+    pub(super) fn with_live_tool(&self, mut p: Point) -> Point {
+        if let Some(i) = self.cfg.live_tool_axis() {
+            p[i] = self.live.at;
+        }
+        p
+    }
+
+    /// This tick's live tool setpoint from the planner's point `out`.
+    pub(super) fn live_tool_tick(&mut self, out: &Point) {
+        if let Some(i) = self.cfg.live_tool_axis() {
+            if self.locked == 0 {
+                self.live.at = out[i];
+            }
+        }
+    }
+
+    /// A line that turns the live tool (a tap, G14.n) is refused with the drives' setpoint
+    /// queue, whose time-scaling does not turn the tool along (D142).
+    pub(super) fn check_live_tool_move(&self, start: &Point, end: &Point) -> Result<(), (u32, String)> {
+        match self.cfg.live_tool_axis() {
+            Some(i) if self.cfg.time_scaling_at_drives && end[i] != start[i] => Err((
+                alarm::BAD_BLOCK,
+                "a live tool tap is not built for the drives' setpoint queue \
+                 (servo.drive_queue_ms 0)"
+                    .into(),
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The live tool's angle setpoint, degrees since power-on.
+    pub fn live_tool_setpoint(&self) -> f64 {
+        self.live.at
     }
 }

@@ -210,6 +210,8 @@ pub struct Motion {
     program_running: bool,
     /// The turn-mill's C axis in the path (polar interpolation, D141).
     contour: contour::Contour,
+    /// The turn-mill's live tool in the path (D142).
+    live: contour::LiveTool,
 }
 
 impl Motion {
@@ -237,6 +239,7 @@ impl Motion {
             .collect();
         Motion {
             contour: contour::Contour::default(),
+            live: contour::LiveTool::default(),
             compressor: false,
             fifo_fill: false,
             timers: RunTimers::default(),
@@ -351,6 +354,7 @@ impl Motion {
                 return;
             }
             self.run_id = block.run_id;
+            self.live_tool_run();
             self.queue.clear();
             self.merged.clear();
             self.active = None;
@@ -839,7 +843,7 @@ impl Motion {
 
     /// The commanded slide position as a planner point.
     fn commanded_point(&self) -> Point {
-        self.with_contour(path::point_from(&self.commanded))
+        self.with_live_tool(self.with_contour(path::point_from(&self.commanded)))
     }
 }
 

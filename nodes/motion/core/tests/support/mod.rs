@@ -43,6 +43,7 @@ pub fn lathe() -> MotionConfig {
         feedback_delay_ticks: 1,
         time_scaling_at_drives: false,
         c_axis: None,
+        live_tool: None,
     }
 }
 
