@@ -385,10 +385,22 @@ fn polar_interpolation_keeps_every_servo_tick_on_the_face_contour() {
     );
     assert!(run.ticks > 1000, "{}", run.ticks);
     assert!(run.worst <= 0.001, "{} mm off the contour", run.worst);
-    assert!(run.fastest_c <= c_rate * (1.0 + 1e-9), "C at {}°/s", run.fastest_c);
+    assert!(
+        run.fastest_c <= c_rate * (1.0 + 1e-9),
+        "C at {}°/s",
+        run.fastest_c
+    );
     // At 1 mm from the pole C's 600°/s allow 10.5 mm/s: the feed is lowered, not the path.
-    assert!(run.slowest_near_pole < 11.0, "{} mm/s at the pole", run.slowest_near_pole);
-    assert!(run.worst_actual < 0.05, "the slide's actual point {} mm off", run.worst_actual);
+    assert!(
+        run.slowest_near_pole < 11.0,
+        "{} mm/s at the pole",
+        run.slowest_near_pole
+    );
+    assert!(
+        run.worst_actual < 0.05,
+        "the slide's actual point {} mm off",
+        run.worst_actual
+    );
     assert!(!r.bit("ORIENT_REQ"), "M15: speed control again");
 }
 
@@ -436,10 +448,14 @@ fn fixture_017_taps_with_the_live_tool_geared_at_every_tick() {
     let mut r = Rig::on(cfg, &program, None);
     r.run_until(0.1, |_| false);
     r.started = true;
-    let (mut worst_set, mut worst_actual, mut deepest, mut most_turned) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut worst_set, mut worst_actual, mut deepest, mut most_turned) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut start: Option<(f64, f64)> = None;
     let ok = r.run_until(60.0, |r| {
-        let (zs, a_set) = (r.motion.commanded_display()[z], r.motion.live_tool_setpoint());
+        let (zs, a_set) = (
+            r.motion.commanded_display()[z],
+            r.motion.live_tool_setpoint(),
+        );
         if start.is_none() && r.motion.commanded_display()[0] == 0.0 && zs == 0.0 && r.t > 0.5 {
             start = Some((r.fb.position[z], r.fb.live_tool_angle));
         }
@@ -463,9 +479,18 @@ fn fixture_017_taps_with_the_live_tool_geared_at_every_tick() {
     );
     assert!(start.is_some(), "the tap started at X0 Z0");
     assert!(worst_set < 1e-9, "setpoints {worst_set} mm off the pitch");
-    assert!(worst_actual < 0.1, "the slide {worst_actual} mm off the tool's angle");
+    assert!(
+        worst_actual < 0.1,
+        "the slide {worst_actual} mm off the tool's angle"
+    );
     assert!((deepest + 10.0).abs() < 0.01, "to Z−10: {deepest}");
-    assert!((most_turned - 3600.0).abs() < 1.0, "ten turns: {most_turned}°");
+    assert!(
+        (most_turned - 3600.0).abs() < 1.0,
+        "ten turns: {most_turned}°"
+    );
     assert_eq!(r.motion.commanded_display()[z], 100.0);
-    assert!(r.motion.live_tool_setpoint().abs() < 1e-9, "the tool back at 0°");
+    assert!(
+        r.motion.live_tool_setpoint().abs() < 1e-9,
+        "the tool back at 0°"
+    );
 }

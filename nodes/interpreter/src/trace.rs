@@ -111,11 +111,7 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         }),
         Command::Fifo { fill } => s.push_str(if *fill { "FIFO_FILL" } else { "FIFO_RUN" }),
         Command::Sync => s.push_str("SYNC"),
-        Command::Contour { on } => s.push_str(if *on {
-            "C_CONTOUR_ON"
-        } else {
-            "C_CONTOUR_OFF"
-        }),
+        Command::Contour { on } => s.push_str(if *on { "C_CONTOUR_ON" } else { "C_CONTOUR_OFF" }),
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
         }

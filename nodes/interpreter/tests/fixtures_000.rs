@@ -692,9 +692,10 @@ fn fixture_003_g96_surface_speed_is_kept_through_g97() {
 #[test]
 fn fixtures_004_014_to_017_need_the_c_axis_or_live_tool_this_lathe_lacks() {
     // The plain lathe (`sim_lathe`) has X and Z only: its spindle is no C axis (M14.6, G08,
-    // C words: alarm 74 "rotary axis not defined", D138; `sim_turnmill` runs them, see
-    // `turn_mill.rs`). No live tool (G14.n) and no oscillation in motion (G07.1): alarm 7,
-    // `000` §3.1's unlicensed option. Every line of 004 is an independent example.
+    // C words: alarm 74 "rotary axis not defined", D138) and it has no live tool (G14.4: 74,
+    // D142); `sim_turnmill` runs them, see `c_axis_and_live_tool.rs` and `polar.rs`. G07.1's
+    // oscillation is not defined by the manual: alarm 7 (D140). Every line of 004 is an
+    // independent example.
     let text = fixture("004_spindle_c_axis_position_m14_g08.nc");
     for l in lines(&text) {
         let e = run(&l, HOME).unwrap_err();
@@ -704,7 +705,7 @@ fn fixtures_004_014_to_017_need_the_c_axis_or_live_tool_this_lathe_lacks() {
         ("014_g07_1_thread_chip_break.nc", "N0020", 7),
         ("015_g08_rotary_axis_examples.nc", "M14.6", 74),
         ("016_g12_1_polar_interpolation.nc", "G00 C0", 74),
-        ("017_g14_4_flying_cutter_tapping.nc", "N0020", 7),
+        ("017_g14_4_flying_cutter_tapping.nc", "N0020", 74),
     ] {
         let text = fixture(name);
         let e = run(&text, HOME).unwrap_err();

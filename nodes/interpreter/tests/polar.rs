@@ -100,7 +100,14 @@ fn assert_on_face_path(lines: &[(Vec<f64>, Vec<f64>, f64)], path: &[(f64, f64)],
         }
         // The face's length of the piece: the machine line mapped back, finely sampled (it
         // lies on the face's line or circle).
-        let at = |s: f64| face(&a.iter().zip(b).map(|(x, y)| x + s * (y - x)).collect::<Vec<_>>());
+        let at = |s: f64| {
+            face(
+                &a.iter()
+                    .zip(b)
+                    .map(|(x, y)| x + s * (y - x))
+                    .collect::<Vec<_>>(),
+            )
+        };
         let face_len: f64 = (0..256)
             .map(|k| {
                 let (p, q) = (at(f64::from(k) / 256.0), at(f64::from(k + 1) / 256.0));
@@ -117,7 +124,10 @@ fn assert_on_face_path(lines: &[(Vec<f64>, Vec<f64>, f64)], path: &[(f64, f64)],
             );
         }
     }
-    println!("{} machine lines, worst {worst:.2e} mm off the face", lines.len());
+    println!(
+        "{} machine lines, worst {worst:.2e} mm off the face",
+        lines.len()
+    );
 }
 
 /// Fixture 016 after the tool's offset and a position at X40: C to 0 (G00 C0 at C's rapid),
@@ -177,8 +187,15 @@ fn fixture_016_mills_the_rectangle_on_the_face() {
             _ => None,
         })
         .expect("G02 after G13.1");
-    assert!((arc[0] - 40.0).abs() < 1e-9 && (arc[1] + 5.0).abs() < 1e-9, "{arc:?}");
-    assert!(arc[2].abs() < 1e-9 || (arc[2] - 360.0).abs() < 1e-9, "C {}", arc[2]);
+    assert!(
+        (arc[0] - 40.0).abs() < 1e-9 && (arc[1] + 5.0).abs() < 1e-9,
+        "{arc:?}"
+    );
+    assert!(
+        arc[2].abs() < 1e-9 || (arc[2] - 360.0).abs() < 1e-9,
+        "C {}",
+        arc[2]
+    );
 }
 
 /// A hexagon of 30 mm across flats centred on the spindle, a slot that passes 1 mm from the
@@ -217,7 +234,10 @@ fn a_hexagon_and_a_slot_near_the_pole_stay_on_the_face() {
     assert_on_face_path(&lines, &path, 300.0);
     let last = &lines.last().expect("lines").1;
     // C went once round with the hexagon, then half a turn on the circle: 540°.
-    assert!((last[0] - 20.0).abs() < 1e-9 && (last[2] - 540.0).abs() < 1e-9, "{last:?}");
+    assert!(
+        (last[0] - 20.0).abs() < 1e-9 && (last[2] - 540.0).abs() < 1e-9,
+        "{last:?}"
+    );
     let slot_cs: Vec<f64> = lines
         .iter()
         .filter(|(_, b, _)| (face(b).1 - 1.0).abs() < 1e-6 && face(b).0.abs() < 1.0)
@@ -225,7 +245,10 @@ fn a_hexagon_and_a_slot_near_the_pole_stay_on_the_face() {
         .collect();
     let turned = slot_cs.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
         - slot_cs.iter().cloned().fold(f64::INFINITY, f64::min);
-    assert!(turned > 89.7, "C turns {turned}° within 1 mm either side of the pole");
+    assert!(
+        turned > 89.7,
+        "C turns {turned}° within 1 mm either side of the pole"
+    );
 }
 
 fn alarm(text: &str, setup: Setup) -> (u32, u32, String) {

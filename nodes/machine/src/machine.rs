@@ -647,7 +647,7 @@ impl MachineConfig {
             }
             if !positive(t.max_rpm) || t.max_rpm > 30_000.0 || !positive(t.time_constant) {
                 return Err(
-                    "machine.live_tool: max_rpm 0 < … ≤ 30000, time_constant above 0".into()
+                    "machine.live_tool: max_rpm 0 < … ≤ 30000, time_constant above 0".into(),
                 );
             }
         }

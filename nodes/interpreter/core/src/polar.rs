@@ -94,7 +94,10 @@ pub const POLAR_PLANE: Plane = Plane {
     h: 'X',
     v: 'C',
     normal: Some('Z'),
-    missing: (Fault::PolarAxes, "polar interpolation needs the X and C axes"),
+    missing: (
+        Fault::PolarAxes,
+        "polar interpolation needs the X and C axes",
+    ),
 };
 
 impl Core {

@@ -77,10 +77,8 @@ impl Fanuc<Huaxing> {
     /// in polar interpolation (D141).
     pub(super) fn c_words(&self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         let motion = b.group(1).unwrap_or(self.motion);
-        let c_moves = matches!(
-            motion,
-            G::Own(super::HuaxingG::Rotary { .. }) | G::Rapid
-        ) && self.core.setup.spindle_c_axis;
+        let c_moves = matches!(motion, G::Own(super::HuaxingG::Rotary { .. }) | G::Rapid)
+            && self.core.setup.spindle_c_axis;
         if self.core.polar.is_some() {
             return Ok(());
         }

@@ -63,12 +63,12 @@ impl Fanuc<Huaxing> {
             }
         }
         let words = self.d.live_tap;
-        let rpm = words.rpm.ok_or_else(|| {
-            self.fault(Fault::MissingWord, "G14 needs R, the live tool's speed")
-        })?;
-        let lead = words.lead.ok_or_else(|| {
-            self.fault(Fault::ThreadLead, "G14 needs the pitch F (or I)")
-        })?;
+        let rpm = words
+            .rpm
+            .ok_or_else(|| self.fault(Fault::MissingWord, "G14 needs R, the live tool's speed"))?;
+        let lead = words
+            .lead
+            .ok_or_else(|| self.fault(Fault::ThreadLead, "G14 needs the pitch F (or I)"))?;
         let here = self.core.work_position();
         let end = self.end_point(b)?;
         self.core.live_tool_tap(&end, lead, rpm)?;

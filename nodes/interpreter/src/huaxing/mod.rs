@@ -5,12 +5,12 @@
 
 mod alarms;
 mod c_axis;
-mod live_tool;
-mod polar;
 mod compound;
 mod drilling;
 mod flow;
 mod grooving;
+mod live_tool;
+mod polar;
 mod skip;
 mod threads;
 mod tool;
@@ -402,7 +402,12 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
         90 => (15, ExactStopBlock),
         121 => (16, G::Own(PolarOn)),
         131 => (16, G::Own(PolarOff)),
-        141..=146 => (1, G::Own(LiveTap { axis: (n - 140) as u8 })),
+        141..=146 => (
+            1,
+            G::Own(LiveTap {
+                axis: (n - 140) as u8,
+            }),
+        ),
         170 => (16, PlaneXy),
         180 => (16, PlaneZx),
         190 => (16, PlaneYz),

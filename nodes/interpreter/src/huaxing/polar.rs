@@ -97,10 +97,7 @@ impl Fanuc<Huaxing> {
             }
             (None, Some(h)) => (h, Turn::Incremental),
             (None, None) => {
-                return Err(self.fault(
-                    Fault::RotaryWord,
-                    "no rotary axis programmed: C or H",
-                ));
+                return Err(self.fault(Fault::RotaryWord, "no rotary axis programmed: C or H"));
             }
         };
         if !degrees.is_finite() || degrees.abs() > 999_999.0 {

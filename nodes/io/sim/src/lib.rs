@@ -405,7 +405,9 @@ impl SimLathe {
     /// X drive's lag); the position it holds moves along, so it stays where the path left it.
     fn follow_contour(&mut self, setpoint: &ServoSetpoint, dt: f64) {
         let holding = self.spindle_rpm == 0.0
-            && self.positioning.is_some_and(|p| p.goal == self.spindle_turned);
+            && self
+                .positioning
+                .is_some_and(|p| p.goal == self.spindle_turned);
         let follow = setpoint.c_contour != 0
             && setpoint.enable != 0
             && holding

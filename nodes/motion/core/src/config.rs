@@ -57,7 +57,10 @@ impl MotionConfig {
     /// one and room for it.
     pub fn live_tool_axis(&self) -> Option<usize> {
         let i = self.axes.len() + usize::from(self.c_axis.is_some());
-        self.live_tool.as_ref().and(Some(i)).filter(|&i| i < MAX_AXES)
+        self.live_tool
+            .as_ref()
+            .and(Some(i))
+            .filter(|&i| i < MAX_AXES)
     }
 
     /// How many values a block's end point carries: the machine's axes, then C and the live

@@ -83,8 +83,14 @@ impl Motion {
                     return Ok(Active::Path);
                 }
                 self.planner.reset(start);
-                self.planner
-                    .push(seg, feed, block.seq, block.line, !self.exact_stop, self.contour_used());
+                self.planner.push(
+                    seg,
+                    feed,
+                    block.seq,
+                    block.line,
+                    !self.exact_stop,
+                    self.contour_used(),
+                );
                 Ok(Active::Path)
             }
             Command::Probe { .. } => {
@@ -148,8 +154,7 @@ impl Motion {
         let n = self.cfg.axes.len();
         // A turn-mill's blocks name C and the live tool after the machine's axes (D141, D142).
         let all = self.cfg.block_axes();
-        let bad_len =
-            |v: &[f64]| !(n..=all).contains(&v.len()) || v.iter().any(|x| !x.is_finite());
+        let bad_len = |v: &[f64]| !(n..=all).contains(&v.len()) || v.iter().any(|x| !x.is_finite());
         if let Some(end) = kind.end() {
             if bad_len(end) {
                 return Err((

@@ -127,7 +127,9 @@ impl Motion {
     /// C's setpoint while contour control is on (degrees from where polar interpolation
     /// started), for the path view and the tests.
     pub fn contour_c(&self) -> Option<f64> {
-        self.contour.on.then_some(self.contour.at - self.contour.base)
+        self.contour
+            .on
+            .then_some(self.contour.at - self.contour.base)
     }
 }
 
@@ -177,7 +179,11 @@ impl Motion {
 
     /// A line that turns the live tool (a tap, G14.n) is refused with the drives' setpoint
     /// queue, whose time-scaling does not turn the tool along (D142).
-    pub(super) fn check_live_tool_move(&self, start: &Point, end: &Point) -> Result<(), (u32, String)> {
+    pub(super) fn check_live_tool_move(
+        &self,
+        start: &Point,
+        end: &Point,
+    ) -> Result<(), (u32, String)> {
         match self.cfg.live_tool_axis() {
             Some(i) if self.cfg.time_scaling_at_drives && end[i] != start[i] => Err((
                 alarm::BAD_BLOCK,

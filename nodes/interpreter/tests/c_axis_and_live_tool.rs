@@ -8,7 +8,7 @@ fn turn_mill() -> Setup {
     Setup::lathe([200.0, 100.0]).with_spindle_c_axis()
 }
 
-fn run(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
+fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
     cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
 }
 
@@ -55,7 +55,7 @@ fn position_mode(c: &Command) -> bool {
 #[test]
 fn fixture_004_positions_c_and_turns_it_with_x_and_z() {
     let text = fixture("004_spindle_c_axis_position_m14_g08.nc");
-    let cmds = run(&text, turn_mill()).unwrap();
+    let cmds = hx(&text, turn_mill()).unwrap();
     let c: Vec<&Command> = cmds.iter().map(|c| &c.command).collect();
     assert!(position_mode(c[0]), "{:?}", c[0]);
     let want = [
@@ -83,8 +83,8 @@ fn fixture_004_positions_c_and_turns_it_with_x_and_z() {
 fn fixture_015_three_turns_of_c_with_z_along() {
     let text = fixture("015_g08_rotary_axis_examples.nc");
     let parts: Vec<&str> = text.split(".....").collect();
-    let first = run(parts[0], turn_mill()).unwrap();
-    let second = run(parts[1].split("(例:)").next().unwrap(), turn_mill()).unwrap();
+    let first = hx(parts[0], turn_mill()).unwrap();
+    let second = hx(parts[1].split("(例:)").next().unwrap(), turn_mill()).unwrap();
     for cmds in [&first, &second] {
         let c: Vec<&Command> = cmds.iter().map(|c| &c.command).collect();
         assert!(position_mode(c[0]));
@@ -99,10 +99,10 @@ fn fixture_015_three_turns_of_c_with_z_along() {
             Some((198.5, 4.5, 1080.0, Turn::Incremental, 800.0))
         );
     }
-    let e = run("G08.2 Y100 F1000\n", turn_mill()).unwrap_err();
+    let e = hx("G08.2 Y100 F1000\n", turn_mill()).unwrap_err();
     assert_eq!(e.number, 7, "{e}");
     assert!(e.text.contains("G08.1–G08.5"), "{e}");
-    assert_eq!(run("M14.2\n", turn_mill()).unwrap_err().number, 7);
+    assert_eq!(hx("M14.2\n", turn_mill()).unwrap_err().number, 7);
 }
 
 /// The section's alarms: G08 without C or H is 80; C and H together 9; the first G08
@@ -121,7 +121,7 @@ fn the_c_axis_alarms() {
         ("M14.3\n", turn_mill(), 7, 1),
     ];
     for (text, setup, number, line) in cases {
-        let e = run(text, setup).unwrap_err();
+        let e = hx(text, setup).unwrap_err();
         assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
     }
 }
@@ -136,7 +136,7 @@ fn g31_skips_on_the_machines_skip_input() {
         skip_input: Some((11, 5)),
         ..turn_mill()
     };
-    let cmds = run(
+    let cmds = hx(
         "G31 Z50 F100\nG31 W-5 K11.5 F50\nG31 W-5 L11.5\nG00 Z60\n",
         with_skip(),
     )
@@ -166,7 +166,7 @@ fn g31_skips_on_the_machines_skip_input() {
         ("G31 Z50 K11.5 L11.5 F100\n", with_skip(), 13),
         ("G31 Z50 F100\n", turn_mill(), 7),
     ] {
-        let e = run(text, setup).unwrap_err();
+        let e = hx(text, setup).unwrap_err();
         assert_eq!((e.number, e.line), (number, 1), "{text}: {e}");
     }
 }
@@ -195,7 +195,7 @@ fn taps(cmds: &[Canon]) -> Vec<(f64, f64, f64, f64)> {
 #[test]
 fn fixture_017_taps_with_the_live_tool_and_back() {
     let text = fixture("017_g14_4_flying_cutter_tapping.nc");
-    let cmds = run(&text, with_live_tool()).unwrap();
+    let cmds = hx(&text, with_live_tool()).unwrap();
     let t = taps(&cmds);
     let feed = 10.0f64.hypot(3600.0) / (10.0 / 500.0);
     assert_eq!(t.len(), 2, "{t:?}");
@@ -225,7 +225,7 @@ fn fixture_017_taps_with_the_live_tool_and_back() {
         .expect("G0 X100 Z100");
     assert_eq!(last_rapid, vec![100.0, 100.0, 0.0, 0.0]);
     // Modal, a slanted thread by X and Z, a left-hand one by F−, inch by I.
-    let modal = run(
+    let modal = hx(
         "G0 X20 Z0\nG14.4 Z-5 R1000 F0.5\nU-6 W-8 F-1.5\nW-4 I20\nG0 X100\nM30\n",
         with_live_tool(),
     )
@@ -266,7 +266,7 @@ fn live_tool_tap_alarms() {
         ("G14.4 Z-10 R500 F1 I20\n", with_live_tool(), 2, 1),
     ];
     for (text, setup, number, line) in cases {
-        let e = run(text, setup).unwrap_err();
+        let e = hx(text, setup).unwrap_err();
         assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
     }
 }
