@@ -494,3 +494,63 @@ fn fixture_017_taps_with_the_live_tool_geared_at_every_tick() {
         "the tool back at 0°"
     );
 }
+
+/// Issue 49, must-show 3 (D142): rigid tapping on the turn-mill, face and side, through the
+/// rig. M29 S800 makes the live tool the tapping spindle; G84 taps four face holes at X20 on
+/// C 0°, 90°, 180°, 270° from Z5 to Z−10 at 1.25 mm a turn, G88 a side hole at Z−10, C45 from
+/// X60 to X30 at 1 mm. At every servo tick of a tap the drilling axis's actual position keeps
+/// to the live tool drive's actual angle by the pitch within the 0.1 mm the rigid taps keep
+/// (`plc_cell_mill.rs`), the setpoints exactly; at each hole's bottom C stands at its angle.
+#[test]
+fn rigid_taps_face_and_side_keep_the_slide_on_the_live_tools_angle() {
+    let cfg = config("sim_turnmill");
+    let (x, z) = (cfg.axis_index("X").unwrap(), cfg.axis_index("Z").unwrap());
+    let program = "T0101\nG00 X60 Z5\nM14.6\nG00 C0\nM29 S800\n\
+                   G84 X20 C0 Z-10 P500 F1.25 M20\nH90 K3 M20\nG00 X60 Z-10\nM29 S800\n\
+                   G88 Z-10 C45 X30 F1\nG80\nG00 X100 Z50\nM15\nM30\n";
+    let mut r = Rig::on(cfg, program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let (mut worst_set, mut worst_actual) = (0.0f64, 0.0f64);
+    let mut bottoms: Vec<(f64, f64)> = Vec::new();
+    let (mut last_a, mut rising) = (0.0f64, false);
+    let ok = r.run_until(120.0, |r| {
+        let set = r.motion.commanded_display();
+        let a_set = r.motion.live_tool_setpoint();
+        let a = r.fb.live_tool_angle;
+        let tapping = a_set.abs() > 1e-9;
+        if set[x] == 20.0 && tapping {
+            // Face: Z = 5 − 1.25 × turns.
+            worst_set = worst_set.max((set[z] - (5.0 - 1.25 * a_set / 360.0)).abs());
+            worst_actual = worst_actual.max((r.fb.position[z] - (5.0 - 1.25 * a / 360.0)).abs());
+        }
+        if set[z] == -10.0 && set[x] != 20.0 && tapping {
+            // Side: X (diameter) = 60 − 2 × 1 × turns.
+            worst_set = worst_set.max((set[x] - (60.0 - 2.0 * a_set / 360.0)).abs());
+            let x_dia = 2.0 * r.fb.position[x];
+            worst_actual = worst_actual.max((x_dia - (60.0 - 2.0 * a / 360.0)).abs());
+        }
+        // A hole's bottom: where the tool's setpoint turns back.
+        if rising && a_set < last_a {
+            bottoms.push((r.fb.spindle_angle_deg, last_a));
+        }
+        if a_set != last_a {
+            rising = a_set > last_a;
+        }
+        last_a = a_set;
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!(
+        "rigid taps: setpoints off the pitch by {worst_set:.2e} mm, the actual slide off the \
+         tool's actual angle by {worst_actual:.2e} mm; C and the tool at each bottom {bottoms:?}"
+    );
+    assert!(worst_set < 1e-9, "setpoints {worst_set} mm off");
+    assert!(worst_actual < 0.1, "the slide {worst_actual} mm off the tool's angle");
+    let angles: Vec<f64> = bottoms.iter().map(|b| (b.0 * 1e3).round() / 1e3).collect();
+    assert_eq!(angles, [0.0, 90.0, 180.0, 270.0, 45.0], "{bottoms:?}");
+    for (k, want) in [4320.0, 4320.0, 4320.0, 4320.0, 5400.0].iter().enumerate() {
+        assert!((bottoms[k].1 - want).abs() < 1e-6, "hole {k}: {bottoms:?}");
+    }
+    assert!(!r.bit("ORIENT_REQ"), "M15");
+}

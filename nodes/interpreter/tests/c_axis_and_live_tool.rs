@@ -270,3 +270,83 @@ fn live_tool_tap_alarms() {
         assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
     }
 }
+
+/// What a rigid tapping program queues, in short: rapids and rotaries by their ends, taps as
+/// (X, Z, C, tool degrees), M codes, dwells.
+fn steps(cmds: &[Canon]) -> Vec<String> {
+    cmds.iter()
+        .filter_map(|c| match &c.command {
+            Command::Rapid { end } => Some(format!("G00 X{} Z{}", end[0], end[1])),
+            Command::Rotary {
+                degrees, way, rpm, ..
+            } => Some(format!("C {degrees} {way:?} {rpm}")),
+            Command::Linear { end, .. } if end.len() == 4 => Some(format!(
+                "TAP X{} Z{} C{} A{:.3}",
+                end[0], end[1], end[2], end[3]
+            )),
+            Command::Aux(Aux::M(m)) => Some(format!("M{m}")),
+            Command::Dwell { seconds } => Some(format!("DWELL {seconds}")),
+            _ => None,
+        })
+        .collect()
+}
+
+/// `000` §5.23.4 on the turn-mill (D142): M29 S800 makes the live tool the tapping spindle;
+/// G84 taps a face hole at X20, C0 to Z−10 at 1.25 mm a turn (12 turns from Z5: 4320°), the
+/// clamp M20 around it (M21 unclamps) and P500 at the bottom; `H90 K3 M20` taps three more
+/// holes 90° apart, each clamped;
+/// G00 ends rigid tapping (another group-01 code), so M29 again before G88, which taps a
+/// side hole at Z−10, C45 from X60 to X30 (15 mm, 15 turns at F1), no clamp; G80 ends it
+/// and G00 moves again.
+#[test]
+fn g84_and_g88_tap_face_and_side_holes_with_the_live_tool() {
+    let text = "T0101\nG00 X60 Z5\nM14.6\nM29 S800\nG84 X20 C0 Z-10 P500 F1.25 M20\nH90 K3 M20\n\
+                G00 X60 Z-10\nM29 S800\nG88 Z-10 C45 X30 F1 P0\nG80\nG00 X100\nM30\n";
+    let cmds = hx(text, with_live_tool()).unwrap();
+    let s = steps(&cmds);
+    let hole = |c: f64, rotary: &str| {
+        vec![
+            rotary.to_string(),
+            "M20".to_string(),
+            format!("TAP X20 Z-10 C{c} A4320.000"),
+            "DWELL 0.5".to_string(),
+            format!("TAP X20 Z5 C{c} A0.000"),
+            "M21".to_string(),
+        ]
+    };
+    let mut want = vec!["G00 X60 Z5".to_string(), "G00 X20 Z5".to_string()];
+    want.extend(hole(0.0, "C 0 Plus 100"));
+    for c in [90.0, 180.0, 270.0] {
+        want.extend(hole(c, "C 90 Incremental 100"));
+    }
+    want.extend([
+        "G00 X60 Z-10".to_string(),
+        "C 45 Plus 100".to_string(),
+        "TAP X30 Z-10 C45 A5400.000".to_string(),
+        "TAP X60 Z-10 C45 A0.000".to_string(),
+        "G00 X100 Z-10".to_string(),
+    ]);
+    let s: Vec<String> = s.into_iter().filter(|l| l != "M14" && l != "M30").collect();
+    assert_eq!(s, want);
+}
+
+/// Rigid tapping's alarms: M29 on a lathe without a live tool (74), G84 without M29 (23) or
+/// without a pitch (2) or a bottom (23), M29 without S (23), a tap speed above the live
+/// tool's 2500 r/min (73), K out of range (13), G84 after a G00 ended rigid tapping (23).
+#[test]
+fn rigid_tapping_alarms() {
+    let cases = [
+        ("M29 S800\n", turn_mill(), 74, 1),
+        ("G84 X20 C0 Z-10 F1\n", with_live_tool(), 23, 1),
+        ("M29 S800\nG84 X20 C0 Z-10\n", with_live_tool(), 2, 2),
+        ("M29 S800\nG84 X20 C0 F1\n", with_live_tool(), 23, 2),
+        ("M29\n", with_live_tool(), 23, 1),
+        ("M29 S3000\nG84 X20 Z-10 F1\n", with_live_tool(), 73, 2),
+        ("M29 S800\nG84 X20 Z-10 F1 K0\n", with_live_tool(), 13, 2),
+        ("M29 S800\nG84 X20 C0 Z-10 F1\nG00 X30\nG84 X20 Z-10\n", with_live_tool(), 23, 4),
+    ];
+    for (text, setup, number, line) in cases {
+        let e = hx(text, setup).unwrap_err();
+        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
+    }
+}

@@ -85,6 +85,7 @@ pub fn sim_config(cfg: &LaunchConfig) -> SimConfig {
                     .map(|s| s.at * a.scale())
             })
             .collect(),
+        live_tool_lag: cfg.machine.live_tool.as_ref().map_or(0.0, |t| t.drive_lag),
     }
 }
 

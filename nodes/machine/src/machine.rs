@@ -251,6 +251,14 @@ pub struct LiveToolEntry {
     pub axis: String,
     pub max_rpm: f64,
     pub time_constant: f64,
+    /// Simulated drive time constant, s: a tool spindle's position loop is slower than a
+    /// slide's.
+    #[serde(default = "default_live_tool_lag")]
+    pub drive_lag: f64,
+}
+
+fn default_live_tool_lag() -> f64 {
+    0.012
 }
 
 impl LiveToolEntry {

@@ -73,19 +73,23 @@ impl Fanuc<Huaxing> {
         self.turn_c(b, rpm)
     }
 
-    /// C and H program the C axis in G08 and G00 blocks, and the face's second coordinate
-    /// in polar interpolation (D141).
+    /// C and H program the C axis in G08, G00 and G84/G88 blocks, and the face's second
+    /// coordinate in polar interpolation (D141).
     pub(super) fn c_words(&self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         let motion = b.group(1).unwrap_or(self.motion);
-        let c_moves = matches!(motion, G::Own(super::HuaxingG::Rotary { .. }) | G::Rapid)
-            && self.core.setup.spindle_c_axis;
+        let c_moves = matches!(
+            motion,
+            G::Own(super::HuaxingG::Rotary { .. } | super::HuaxingG::RigidTap { .. }) | G::Rapid
+        ) && self.core.setup.spindle_c_axis;
         if self.core.polar.is_some() {
             return Ok(());
         }
         for c in ['C', 'H'] {
             if b.get(c).is_some() && !c_moves {
                 let why = match self.core.setup.spindle_c_axis {
-                    true => format!("address {c}: the C axis is programmed with G00 or G08"),
+                    true => format!(
+                        "address {c}: the C axis is programmed with G00, G08 or G84/G88"
+                    ),
                     false => format!("address {c}: no C axis on this machine"),
                 };
                 return Err(self.fault(Fault::RotaryAxis, why));

@@ -171,7 +171,7 @@ impl Fanuc<Huaxing> {
     }
 
     /// The spindle clamp code Mα of a drilling block, if it has one.
-    fn clamp_code(&self, b: &Block<Huaxing>, name: &str) -> Result<Option<i32>, ProgramError> {
+    pub(super) fn clamp_code(&self, b: &Block<Huaxing>, name: &str) -> Result<Option<i32>, ProgramError> {
         let mut codes =
             b.m.iter()
                 .filter(|(m, _)| matches!(m, M::AuxBefore | M::AuxAfter))
@@ -196,7 +196,7 @@ impl Fanuc<Huaxing> {
         }
     }
 
-    fn rapid_unless_there(&mut self, target: &[f64]) -> Result<(), ProgramError> {
+    pub(super) fn rapid_unless_there(&mut self, target: &[f64]) -> Result<(), ProgramError> {
         let here = self.core.work_position();
         if here.iter().zip(target).any(|(a, b)| (a - b).abs() > 1e-9) {
             self.core.emit(target, MoveKind::Rapid)?;

@@ -11,6 +11,7 @@ mod flow;
 mod grooving;
 mod live_tool;
 mod polar;
+mod rigid_tap;
 mod skip;
 mod threads;
 mod tool;
@@ -84,6 +85,12 @@ pub enum HuaxingG {
     LiveTap {
         axis: u8,
     },
+    /// G84 (face, `side` false) / G88 (side): rigid tapping after M29 (§5.23.4, D142).
+    RigidTap {
+        side: bool,
+    },
+    /// G80: rigid tapping off.
+    CancelRigid,
 }
 
 /// Retained words of a single cycle (G90/G92/G94, §5.21.3).
@@ -116,6 +123,8 @@ pub struct Huaxing {
     pub skip_end: Option<Vec<f64>>,
     /// G14's modal words (D142).
     pub live_tap: live_tool::LiveTapWords,
+    /// M29's rigid tapping and G84/G88's modal words (D142).
+    pub rigid: rigid_tap::RigidTap,
 }
 
 impl Family for Huaxing {
@@ -168,6 +177,7 @@ impl Family for Huaxing {
             rotary_rpm: None,
             skip_end: None,
             live_tap: live_tool::LiveTapWords::default(),
+            rigid: rigid_tap::RigidTap::default(),
         }
     }
 
@@ -197,6 +207,7 @@ impl Family for Huaxing {
                     | HuaxingG::TappingCycle
                     | HuaxingG::Rotary { .. }
                     | HuaxingG::LiveTap { .. }
+                    | HuaxingG::RigidTap { .. }
             )
         ) || b.has_g(G::Own(HuaxingG::MultiThreadCycle))
     }
@@ -204,10 +215,11 @@ impl Family for Huaxing {
         f.huaxing_tool_word(t)
     }
     fn m_in_cycle(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
-        // In a G83/G87 block an M word is the spindle clamp code of the cycle (§5.22.7).
+        // In a G83/G87 (G84/G88) block an M word is the spindle clamp code of the cycle
+        // (§5.22.7, §5.23.4).
         matches!(
             b.group(1).unwrap_or(f.motion),
-            G::Own(HuaxingG::Drilling { .. })
+            G::Own(HuaxingG::Drilling { .. } | HuaxingG::RigidTap { .. })
         ) && f.has_axis_words(b)
     }
     fn own_m_before(
@@ -215,7 +227,10 @@ impl Family for Huaxing {
         m: ToolMacro,
         b: &Block<Self>,
     ) -> Result<(), ProgramError> {
-        f.tool_macro_code(m, b)
+        match m {
+            ToolMacro::RigidTapping => f.rigid_mode_on(),
+            _ => f.tool_macro_code(m, b),
+        }
     }
     fn flow_waits(_f: &Fanuc<Self>, b: &Block<Self>) -> bool {
         b.has_g(G::Own(HuaxingG::Finishing))
@@ -279,6 +294,7 @@ impl Family for Huaxing {
                 | Rotary { .. }
                 | Skip
                 | LiveTap { .. }
+                | RigidTap { .. }
         )
     }
     fn motion_selected(
@@ -288,8 +304,12 @@ impl Family for Huaxing {
         _b: &Block<Self>,
     ) -> Option<Result<(), ProgramError>> {
         if changed {
-            // A new cycle or motion code drops the retained cycle words.
+            // A new cycle or motion code drops the retained cycle words; another group-01
+            // code than G84/G88 ends rigid tapping (§5.23.4).
             f.d.cycle = CycleWords::default();
+            if !matches!(_new, G::Own(HuaxingG::RigidTap { .. })) {
+                f.d.rigid = rigid_tap::RigidTap::default();
+            }
         }
         None
     }
@@ -306,6 +326,7 @@ impl Family for Huaxing {
         match f.motion {
             G::Own(HuaxingG::Drilling { .. }) => f.drill_words(b)?,
             G::Own(HuaxingG::LiveTap { .. }) => f.live_tap_words(b)?,
+            G::Own(HuaxingG::RigidTap { .. }) => f.rigid_tap_words(b)?,
             _ => {}
         }
         Ok(())
@@ -314,6 +335,8 @@ impl Family for Huaxing {
         match g {
             HuaxingG::PolarOn => return f.polar_on(),
             HuaxingG::PolarOff => return f.core.polar_off(),
+            HuaxingG::RigidTap { .. } => f.rigid_tap_selected(f.motion),
+            HuaxingG::CancelRigid => f.rigid_tap_cancel(),
             _ => {}
         }
         if g == HuaxingG::FeedPerRevolutionOnIndex {
@@ -339,6 +362,7 @@ impl Family for Huaxing {
             Rotary { orient } => f.rotary(b, orient),
             Skip => f.skip(b),
             LiveTap { axis } => f.live_tap(b, axis),
+            RigidTap { side } => f.rigid_tap(b, side),
             other => Err(f.fault(Fault::UndefinedCode, format!("{other:?} is not a motion"))),
         }
     }
@@ -455,16 +479,11 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
             0,
             Unsupported("G77 clears an absolute encoder's multi-turn count"),
         ),
-        800 => (
-            1,
-            Unsupported("G80 cancels rigid tapping, which needs a position spindle"),
-        ),
+        800 => (1, G::Own(CancelRigid)),
         830 => (1, G::Own(Drilling { radial: false })),
         870 => (1, G::Own(Drilling { radial: true })),
-        840 | 880 => (
-            1,
-            Unsupported("G84/G88 rigid tapping needs a position spindle"),
-        ),
+        840 => (1, G::Own(RigidTap { side: false })),
+        880 => (1, G::Own(RigidTap { side: true })),
         850 | 860 | 890 => (1, Unsupported("not described in the manual")),
         900 => (1, G::Own(TurningCycle)),
         920 => (1, G::Own(ThreadCycle)),
@@ -497,7 +516,7 @@ pub fn m_code(n: u32) -> Option<M<ToolMacro>> {
         990 => SubprogramReturn,
         146 => Own(ToolMacro::PositionMode(6)),
         141..=145 => Unsupported("M14.1–M14.5 give X…B the spindle's angle: the turn-mill's is C"),
-        290 => Unsupported("M29 rigid tapping needs a position spindle"),
+        290 => Own(ToolMacro::RigidTapping),
         500 => Unsupported("M50 bar feed drives outputs directly, not through the PLC"),
         510 => Unsupported("M51 sets the start block in MDI"),
         520 => Own(ToolMacro::ReadTool),

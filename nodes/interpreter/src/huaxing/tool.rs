@@ -25,6 +25,8 @@ pub enum ToolMacro {
     RaiseAlarm,
     /// M14.n: the spindle into position control, its angle axis n's coordinate (§4.2.7, D138).
     PositionMode(u8),
+    /// M29 S: rigid tapping with the tapping spindle in position control (§5.23.4, D142).
+    RigidTapping,
 }
 
 impl Fanuc<Huaxing> {
@@ -114,6 +116,8 @@ impl<D: Family<M = ToolMacro>> Fanuc<D> {
                 Ok(())
             }
             ToolMacro::PositionMode(n) => self.position_mode(n),
+            // The Huaxing takes M29 itself (`rigid_tap.rs`); no other dialect has it.
+            ToolMacro::RigidTapping => Ok(()),
             ToolMacro::RaiseAlarm => {
                 let n = need_k(self)?;
                 let mut e = self.fault(

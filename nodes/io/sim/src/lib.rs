@@ -44,6 +44,8 @@ pub struct SimConfig {
     pub probe: Vec<probe::Target>,
     /// Per axis, a mechanical stop its slide cannot pass (slide travel, machine coordinates).
     pub fixed_stops: Vec<Option<f64>>,
+    /// The live tool drive's time constant, s (D142).
+    pub live_tool_lag: f64,
 }
 
 /// An incremental encoder and its reference dog, in slide travel (mm): the encoder counts
@@ -438,7 +440,7 @@ impl SimLathe {
     /// lag), whole turns included; without power it stands.
     fn follow_live_tool(&mut self, setpoint: &ServoSetpoint, dt: f64) {
         let on = setpoint.enable != 0 && !self.powered_off && !self.emergency_stop;
-        let tau = self.cfg.drive_lag.first().copied().unwrap_or(0.0);
+        let tau = self.cfg.live_tool_lag;
         if let Some(a) = self.live_tool_follow.step_unwrapped(
             on,
             setpoint.live_tool_position,
@@ -483,6 +485,7 @@ mod tests {
             overtravel: Vec::new(),
             probe: Vec::new(),
             fixed_stops: Vec::new(),
+            live_tool_lag: 0.0,
         }
     }
 
@@ -708,6 +711,7 @@ mod tests {
                 overtravel: Vec::new(),
                 probe: Vec::new(),
                 fixed_stops: Vec::new(),
+                live_tool_lag: 0.0,
             },
             &[60.0],
         );
@@ -752,6 +756,7 @@ mod tests {
         let mut m = SimLathe::new(
             SimConfig {
                 fixed_stops: vec![None, Some(15.0)],
+                live_tool_lag: 0.0,
                 ..config()
             },
             &[10.0, 20.0],

@@ -121,7 +121,7 @@ impl Motion {
         let follow = self.contour.on && self.locked == 0;
         sp.c_contour = u32::from(follow);
         sp.c_position = if follow { self.contour.at } else { 0.0 };
-        sp.live_tool_position = self.live.at;
+        sp.live_tool_position = self.live_tool_lead();
     }
 
     /// C's setpoint while contour control is on (degrees from where polar interpolation
@@ -141,6 +141,8 @@ impl Motion {
 pub(super) struct LiveTool {
     /// The drive's setpoint, degrees since power-on.
     pub(super) at: f64,
+    /// Last tick's, for the tool's speed.
+    last: f64,
     base: f64,
 }
 
@@ -170,11 +172,26 @@ impl Motion {
 
     /// This tick's live tool setpoint from the planner's point `out`.
     pub(super) fn live_tool_tick(&mut self, out: &Point) {
+        self.live.last = self.live.at;
         if let Some(i) = self.cfg.live_tool_axis() {
             if self.locked == 0 {
                 self.live.at = out[i];
             }
         }
+    }
+
+    /// The setpoint the live tool's drive gets: ahead of the path by the time its position
+    /// loop lags the slides' more (its drive lag less theirs, the commissioning values in the
+    /// config), so the tool's actual angle keeps to the slides' actual travel as a tap
+    /// needs — what matched loop gains do on a control's rigid tapping.
+    fn live_tool_lead(&self) -> f64 {
+        let Some(t) = &self.cfg.live_tool else {
+            return self.live.at;
+        };
+        let n = self.cfg.axes.len().max(1) as f64;
+        let slides = self.cfg.axes.iter().map(|a| a.drive_lag).sum::<f64>() / n;
+        let speed = (self.live.at - self.live.last) / self.cfg.period;
+        self.live.at + speed * (t.drive_lag - slides)
     }
 
     /// A line that turns the live tool (a tap, G14.n) is refused with the drives' setpoint
