@@ -163,9 +163,11 @@ fn fixture_015_cuts_three_turns_of_a_helix_with_c_and_z() {
     assert!(worst < 0.1, "{worst} mm");
 }
 
-/// Issue 49, must-show 5 (the part of it built): a part on `sim_turnmill` in the cell over
-/// DDS, as a supervisor runs it: turned, then C indexed to 90°, turned on by 180° and back to
-/// 0° by G08.6; the `axes` topic shows C at each stop, and the part is counted.
+/// Issue 49, must-show 5: a turn-mill part on `sim_turnmill` in the cell over DDS, as a
+/// supervisor runs it: turned; C indexed to 90°, turned on by 180° and back to 0° by G08.6; a
+/// hexagon milled on the face by polar interpolation; four face holes and a side hole tapped
+/// rigidly with the live tool (G84/G88 after M29). The `axes` topic shows C at each stop and
+/// under polar interpolation, the live tool (A) turning, and the part is counted.
 #[test]
 fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     use cnc_cell::client::CellClient;
@@ -181,9 +183,31 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     )
     .unwrap();
     client.wait_ready(Duration::from_secs(30)).unwrap();
-    let program = "O0485\nG00 X60 Z5\nM03 S800\nG01 X50 Z0 F300\nZ-20\nG00 X60 Z5\nM05\n\
-                   M14.6\nG08 C90 F500\nG04 X1\nG08 H180 F500\nG04 X1\nG08.6 C0 F500\nM15\nM30\n";
-    let r = client.load_program("o0485.nc", program).unwrap();
+    let mut program = String::from(
+        "O0485\nG00 X60 Z5\nM03 S800\nG01 X50 Z0 F300\nZ-20\nG00 X60 Z5\nM05\n\
+         M14.6\nG08 C90 F500\nG04 X1\nG08 H180 F500\nG04 X1\nG08.6 C0 F500\n\
+         T0303\nG00 X40 Z0\nG00 C0\nG12.1\nG98\nG01 X30 F900\n",
+    );
+    // The hexagon of 30 mm across flats on the face, by polar interpolation.
+    let h = 15.0 / 3f64.sqrt();
+    for (u, v) in [
+        (15.0, h),
+        (0.0, 2.0 * h),
+        (-15.0, h),
+        (-15.0, -h),
+        (0.0, -2.0 * h),
+        (15.0, -h),
+        (15.0, h),
+    ] {
+        program.push_str(&format!("G01 X{:.4} C{:.4}\n", 2.0 * u, v));
+    }
+    // Four face holes tapped rigidly by the live tool on C 0°, 90°, 180°, 270°, a side hole
+    // at C45, then C back to speed control.
+    program.push_str(
+        "G01 X40 C0\nG13.1\nM29 S800\nG84 X20 C0 Z-10 P200 F1.25 M20\nH90 K3 M20\n\
+         G00 X60 Z-10\nM29 S800\nG88 Z-10 C45 X30 F1\nG80\nG00 X100 Z50\nM15\nM30\n",
+    );
+    let r = client.load_program("o0485.nc", &program).unwrap();
     assert!(r.accepted, "{}", r.message);
     let r = client.start_program("o0485.nc").unwrap();
     assert!(r.accepted, "{}", r.message);
@@ -193,13 +217,29 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
             .and_then(|a| a.axes.iter().find(|x| x.name == "C"))
             .map(|x| x.actual_position)
     };
-    let mut stops = Vec::new();
-    let (done, _) = client.wait_until(Duration::from_secs(60), |c| {
+    let tool_at = |c: &CellClient| {
+        c.axes
+            .as_ref()
+            .and_then(|a| a.axes.iter().find(|x| x.name == "A"))
+            .map(|x| x.actual_position)
+    };
+    let (mut stops, mut c_angles, mut tool_angles) = (Vec::new(), Vec::new(), Vec::new());
+    let (done, _) = client.wait_until(Duration::from_secs(90), |c| {
         if let Some(angle) = c_at(c) {
             for want in [90.0, 270.0] {
                 if (angle - want).abs() < 1e-3 && !stops.contains(&want) {
                     stops.push(want);
                 }
+            }
+            let tenth = (angle * 10.0).round() as i64;
+            if !c_angles.contains(&tenth) {
+                c_angles.push(tenth);
+            }
+        }
+        if let Some(angle) = tool_at(c) {
+            let whole = angle.round() as i64;
+            if !tool_angles.contains(&whole) {
+                tool_angles.push(whole);
             }
         }
         c.state
@@ -209,10 +249,27 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     });
     assert!(done, "state {:?}, alarms {:?}", client.state, client.alarms);
     assert_eq!(stops, [90.0, 270.0], "C on the axes topic at its stops");
+    println!(
+        "the axes topic showed C at {} angles and the live tool A at {} angles",
+        c_angles.len(),
+        tool_angles.len()
+    );
+    // The axes topic comes every tenth tick (40 ms): polar interpolation turns C through
+    // hundreds of tenths of a degree, the taps the live tool through most of its turn.
+    assert!(
+        c_angles.len() > 100,
+        "C under polar interpolation: {c_angles:?}"
+    );
+    assert!(
+        tool_angles.len() > 50,
+        "the live tool turning: {tool_angles:?}"
+    );
+    // C stands where the side hole left it, the live tool where it started.
     let (back, _) = client.wait_until(Duration::from_secs(5), |c| {
-        c_at(c).is_some_and(|a| a.abs() < 1e-3 || (a - 360.0).abs() < 1e-3)
+        c_at(c).is_some_and(|a| (a - 45.0).abs() < 1e-3)
+            && tool_at(c).is_some_and(|a| a.abs() < 1e-6 || (a - 360.0).abs() < 1e-6)
     });
-    assert!(back, "C back at 0: {:?}", client.axes);
+    assert!(back, "C at 45°, the live tool at 0°: {:?}", client.axes);
     drop(client);
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
@@ -546,7 +603,10 @@ fn rigid_taps_face_and_side_keep_the_slide_on_the_live_tools_angle() {
          tool's actual angle by {worst_actual:.2e} mm; C and the tool at each bottom {bottoms:?}"
     );
     assert!(worst_set < 1e-9, "setpoints {worst_set} mm off");
-    assert!(worst_actual < 0.1, "the slide {worst_actual} mm off the tool's angle");
+    assert!(
+        worst_actual < 0.1,
+        "the slide {worst_actual} mm off the tool's angle"
+    );
     let angles: Vec<f64> = bottoms.iter().map(|b| (b.0 * 1e3).round() / 1e3).collect();
     assert_eq!(angles, [0.0, 90.0, 180.0, 270.0, 45.0], "{bottoms:?}");
     for (k, want) in [4320.0, 4320.0, 4320.0, 4320.0, 5400.0].iter().enumerate() {

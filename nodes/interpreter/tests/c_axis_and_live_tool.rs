@@ -343,7 +343,12 @@ fn rigid_tapping_alarms() {
         ("M29\n", with_live_tool(), 23, 1),
         ("M29 S3000\nG84 X20 Z-10 F1\n", with_live_tool(), 73, 2),
         ("M29 S800\nG84 X20 Z-10 F1 K0\n", with_live_tool(), 13, 2),
-        ("M29 S800\nG84 X20 C0 Z-10 F1\nG00 X30\nG84 X20 Z-10\n", with_live_tool(), 23, 4),
+        (
+            "M29 S800\nG84 X20 C0 Z-10 F1\nG00 X30\nG84 X20 Z-10\n",
+            with_live_tool(),
+            23,
+            4,
+        ),
     ];
     for (text, setup, number, line) in cases {
         let e = hx(text, setup).unwrap_err();

@@ -193,7 +193,7 @@ fn dds_loop(
                     }
                 }
                 Ok(Report::Axes(r)) => {
-                    publish(&axes_pub, axis_state(&r, axes, cfg.machine.spindle_c_axis));
+                    publish(&axes_pub, axis_state(&r, cfg));
                 }
                 Ok(Report::Stats(s)) => publish(&stats_pub, s),
                 Ok(Report::Answer(id, result)) => publish(&results_pub, answer(id, result)),
@@ -224,11 +224,14 @@ pub(crate) struct AxesReport {
     referenced: u32,
     limits: (u32, u32),
     spindle_angle: f64,
+    /// The live tool's setpoint and actual angle, degrees (D142).
+    live_tool: Option<(f64, f64)>,
 }
 
 /// The `axes` topic's message: the configured axes, and on a turn-mill the spindle as C (its
 /// encoder's angle, 0–360°, "displayed always positive", `000` §5.7).
-fn axis_state(r: &AxesReport, axes: &[cnc_motion_core::AxisConfig], c_axis: bool) -> AxisState {
+fn axis_state(r: &AxesReport, cfg: &cnc_runtime::LaunchConfig) -> AxisState {
+    let (axes, c_axis) = (&cfg.machine.axes, cfg.machine.spindle_c_axis);
     let n = axes.len();
     let mut list: Vec<Axis> = axes
         .iter()
@@ -253,6 +256,18 @@ fn axis_state(r: &AxesReport, axes: &[cnc_motion_core::AxisConfig], c_axis: bool
             commanded_position: r.spindle_angle,
             actual_position: r.spindle_angle,
             following_error: 0.0,
+            homed: true,
+            overtravel: 0,
+            locked: false,
+        });
+    }
+    // The live tool's angle, 0–360° as C's (D142).
+    if let (Some((set, actual)), Some(t)) = (r.live_tool, &cfg.machine.live_tool) {
+        list.push(Axis {
+            name: t.axis.clone(),
+            commanded_position: set.rem_euclid(360.0),
+            actual_position: actual.rem_euclid(360.0),
+            following_error: set - actual,
             homed: true,
             overtravel: 0,
             locked: false,
@@ -360,6 +375,8 @@ fn publish<M: ros2_client::Message + std::fmt::Debug + Send + Sync + 'static>(
 pub(crate) struct Latest {
     pub(crate) actual: [f64; MAX_AXES],
     spindle: (f64, f64),
+    /// The live tool's angle, degrees turned (D142).
+    live_tool: f64,
     /// The dogs and index marks; a mark is passed on once.
     reference: ReferenceInputs,
     /// The overtravel switches (+, −).
@@ -374,6 +391,7 @@ impl Latest {
         Latest {
             actual: fb.position,
             spindle: (fb.spindle_rpm, fb.spindle_angle_deg),
+            live_tool: fb.live_tool_angle,
             reference: ReferenceInputs::default(),
             overtravel: (fb.overtravel_plus, fb.overtravel_minus),
             handwheel: fb.handwheel_count,
@@ -384,6 +402,7 @@ impl Latest {
     pub(crate) fn read(&mut self, fb: &ServoFeedback, n: usize) {
         self.actual = fb.position;
         self.spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
+        self.live_tool = fb.live_tool_angle;
         self.reference.dog = fb.reference_dog;
         self.overtravel = (fb.overtravel_plus, fb.overtravel_minus);
         self.handwheel = fb.handwheel_count;
@@ -402,6 +421,7 @@ impl Latest {
     pub(crate) fn give(&mut self, motion: &mut Motion, have_feedback: bool) {
         if have_feedback {
             motion.spindle_feedback(self.spindle.0, self.spindle.1);
+            motion.live_tool_feedback(self.live_tool);
         }
         motion.reference_inputs(self.reference);
         self.reference.marker = 0;
@@ -628,6 +648,11 @@ pub(crate) fn report_axes(motion: &Motion, limits: (u32, u32), reports: &Sender<
         referenced,
         limits,
         spindle_angle: motion.spindle_angle(),
+        live_tool: motion
+            .config()
+            .live_tool
+            .as_ref()
+            .map(|_| (motion.live_tool_setpoint(), motion.live_tool_actual())),
     })));
 }
 

@@ -175,14 +175,14 @@ impl Core {
     /// an alarm.
     pub fn machine_result(&mut self, mut m: Measurement) -> Result<(), ProgramError> {
         let n = self.pos.len();
-        // A turn-mill's C (the program's last axis, D141) is the spindle, which the machine's
-        // result does not name: it stays where the program has it.
-        if self.setup.spindle_c_axis && self.setup.axes.last() == Some(&'C') {
-            let c = self.pos[n - 1];
-            for v in [&mut m.position, &mut m.rest] {
-                if v.len() + 1 == n {
-                    v.push(c);
-                }
+        // A turn-mill's C and live tool (the program's last axes, D141, D142) are spindles,
+        // which the machine's result does not name: they stay where the program has them.
+        let spindles = usize::from(self.setup.spindle_c_axis && self.axis('C').is_some())
+            + usize::from(self.setup.live_tool.is_some());
+        for v in [&mut m.position, &mut m.rest] {
+            if v.len() + spindles == n {
+                let k = v.len();
+                v.extend_from_slice(&self.pos[k..]);
             }
         }
         let whole = |v: &[f64]| v.len() == n && v.iter().all(|x| x.is_finite());

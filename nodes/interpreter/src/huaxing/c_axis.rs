@@ -87,9 +87,9 @@ impl Fanuc<Huaxing> {
         for c in ['C', 'H'] {
             if b.get(c).is_some() && !c_moves {
                 let why = match self.core.setup.spindle_c_axis {
-                    true => format!(
-                        "address {c}: the C axis is programmed with G00, G08 or G84/G88"
-                    ),
+                    true => {
+                        format!("address {c}: the C axis is programmed with G00, G08 or G84/G88")
+                    }
                     false => format!("address {c}: no C axis on this machine"),
                 };
                 return Err(self.fault(Fault::RotaryAxis, why));

@@ -171,7 +171,11 @@ impl Fanuc<Huaxing> {
     }
 
     /// The spindle clamp code Mα of a drilling block, if it has one.
-    pub(super) fn clamp_code(&self, b: &Block<Huaxing>, name: &str) -> Result<Option<i32>, ProgramError> {
+    pub(super) fn clamp_code(
+        &self,
+        b: &Block<Huaxing>,
+        name: &str,
+    ) -> Result<Option<i32>, ProgramError> {
         let mut codes =
             b.m.iter()
                 .filter(|(m, _)| matches!(m, M::AuxBefore | M::AuxAfter))

@@ -100,7 +100,10 @@ impl Fanuc<Huaxing> {
             ));
         };
         let lead = self.d.rigid.lead.ok_or_else(|| {
-            self.fault(Fault::ThreadLead, format!("{name} needs the pitch F (or I)"))
+            self.fault(
+                Fault::ThreadLead,
+                format!("{name} needs the pitch F (or I)"),
+            )
         })?;
         let (xi, zi) = self.core.xz()?;
         // G84 taps along Z at the hole (X, C); G88 along X at (Z, C).
@@ -132,7 +135,11 @@ impl Fanuc<Huaxing> {
         };
         let clamp = self.clamp_code(b, name)?;
         let c = self.core.axis('C');
-        let step = if b.has(hole_inc) { end[hole] - here[hole] } else { 0.0 };
+        let step = if b.has(hole_inc) {
+            end[hole] - here[hole]
+        } else {
+            0.0
+        };
         let c_step = b.get('H').unwrap_or(0.0);
         let mut at = here.clone();
         at[hole] = end[hole];
@@ -190,7 +197,6 @@ impl Fanuc<Huaxing> {
             degrees
         };
         let rpm = self.core.setup.c_rapid_rpm;
-        self.core
-            .emit(at, MoveKind::Rotary { degrees, way, rpm })
+        self.core.emit(at, MoveKind::Rotary { degrees, way, rpm })
     }
 }

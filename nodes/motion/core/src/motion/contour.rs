@@ -141,9 +141,11 @@ impl Motion {
 pub(super) struct LiveTool {
     /// The drive's setpoint, degrees since power-on.
     pub(super) at: f64,
-    /// Last tick's, for the tool's speed.
-    last: f64,
+    /// The setpoint before this tick, for the tool's speed.
+    pub(super) last: f64,
     base: f64,
+    /// The drive's actual angle, as its feedback says.
+    actual: f64,
 }
 
 impl Motion {
@@ -172,7 +174,6 @@ impl Motion {
 
     /// This tick's live tool setpoint from the planner's point `out`.
     pub(super) fn live_tool_tick(&mut self, out: &Point) {
-        self.live.last = self.live.at;
         if let Some(i) = self.cfg.live_tool_axis() {
             if self.locked == 0 {
                 self.live.at = out[i];
@@ -210,6 +211,18 @@ impl Motion {
             )),
             _ => Ok(()),
         }
+    }
+
+    /// The live tool drive's reported angle.
+    pub fn live_tool_feedback(&mut self, angle: f64) {
+        if angle.is_finite() {
+            self.live.actual = angle;
+        }
+    }
+
+    /// The live tool's actual angle, degrees since power-on.
+    pub fn live_tool_actual(&self) -> f64 {
+        self.live.actual
     }
 
     /// The live tool's angle setpoint, degrees since power-on.

@@ -583,6 +583,7 @@ impl Motion {
     /// Returns the setpoint for the drives: the new commanded slide position, unless machine
     /// lock holds them.
     pub fn tick(&mut self, actual: Option<&[f64]>, plc: &GImage) -> &[f64] {
+        self.live.last = self.live.at;
         self.tick_machine(actual, plc);
         if self.at_drives.on {
             self.mark_block_start();
