@@ -456,6 +456,7 @@ fn check(args: &ProgramArgs, trace: Option<&str>) -> Result<(), String> {
     let errors = diagnose(dialect, &text, setup.clone(), lib.clone());
     if let Some(format) = trace {
         use std::io::Write;
+        let setup_axes = setup.axes.clone();
         let mut interp = cnc_interpreter::Interpreter::with_library(dialect, &text, setup, lib);
         let diameter: Vec<bool> = cfg.machine.axes.iter().map(|a| a.diameter).collect();
         let plane = cfg
@@ -477,7 +478,8 @@ fn check(args: &ProgramArgs, trace: Option<&str>) -> Result<(), String> {
                 linuxcnc.write(&c, &mut calls);
                 out.write_all(calls.as_bytes())
             } else {
-                writeln!(out, "{}", cnc_interpreter::trace::line(&letters, &c))
+                // The program's axes: a turn-mill's C and live tool too (D141, D142).
+                writeln!(out, "{}", cnc_interpreter::trace::line(&setup_axes, &c))
             };
             written.map_err(|e| format!("stdout: {e}"))?;
         }

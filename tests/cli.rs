@@ -353,7 +353,8 @@ fn check_starts_with_the_tool_in_the_spindle() {
 /// Issue 49 (D138): `cnc check --trace` and `cnc simulate` on the turn-mill prove a C-axis
 /// program without the machine: the trace names C's angle, way and speed; the simulation turns
 /// the spindle as the simulated drive positions it, so three turns of C with Z geared to it
-/// take their time and keep every axis within its velocity and acceleration.
+/// take their time and keep every axis within its velocity and acceleration. Polar
+/// interpolation and a live tool tap show C and the live tool in the trace.
 #[test]
 fn check_and_simulate_show_the_turn_mills_c_axis() {
     let dir = std::env::temp_dir().join(format!("cnc_cli_turnmill_{}", std::process::id()));
@@ -368,11 +369,11 @@ fn check_and_simulate_show_the_turn_mills_c_axis() {
     let (ok, text) = cnc(&["check", "--config", "sim_turnmill", "--trace", &path]);
     assert!(ok, "{text}");
     assert!(
-        text.contains("ROTARY X50.0000 Z0.0000 C90.000 Plus S1000.0"),
+        text.contains("ROTARY X50.0000 Z0.0000 C90.0000 A0.0000 TO90.000 Plus S1000.0"),
         "{text}"
     );
     assert!(
-        text.contains("ROTARY X48.5000 Z4.5000 C1080.000 Incremental S800.0"),
+        text.contains("ROTARY X48.5000 Z4.5000 C1170.0000 A0.0000 BY1080.000 Incremental S800.0"),
         "{text}"
     );
     let (ok, text) = cnc(&["simulate", "--config", "sim_turnmill", &path]);
@@ -399,5 +400,29 @@ fn check_and_simulate_show_the_turn_mills_c_axis() {
         !ok && text.contains("alarm 74 at line 3"),
         "sim_lathe: {text}"
     );
+    // Polar interpolation and a live tool tap (D141, D142): the trace shows C in degrees on
+    // the face's lines and the live tool's A turning with the tap; simulate runs them.
+    let face = dir.join("face.nc");
+    std::fs::write(
+        &face,
+        "T0303\nG00 X40 Z0\nM14.6\nG00 C0\nG12.1\nG98\nG01 X30 F600\nG01 C15\nG13.1\n\
+         G00 X0 Z5\nG14.4 Z-5 R500 F1\nG00 X100\nM15\nM30\n",
+    )
+    .unwrap();
+    let face = face.to_string_lossy();
+    let (ok, text) = cnc(&["check", "--config", "sim_turnmill", "--trace", &face]);
+    assert!(ok, "{text}");
+    // The line to C15 at X30 (radius 15) ends at 45° and X 2·√(15² + 15²).
+    let end = format!("LINEAR X{:.4} Z0.0000 C45.0000", 60.0 / 2f64.sqrt());
+    assert!(
+        text.contains("C_CONTOUR_ON") && text.contains(&end),
+        "{text}"
+    );
+    assert!(
+        text.contains("LINEAR X0.0000 Z-5.0000 C45.0000 A3600.0000"),
+        "{text}"
+    );
+    let (ok, text) = cnc(&["simulate", "--config", "sim_turnmill", &face]);
+    assert!(ok, "{text}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -77,7 +77,13 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         } => {
             s.push_str("ROTARY");
             axes(&mut s, letters, end, "");
-            let _ = write!(s, " C{degrees:.3} {way:?} S{rpm:.1}");
+            // The spindle's angle to reach (TO) or its travel (BY, incremental), degrees.
+            let to = if *way == Turn::Incremental {
+                "BY"
+            } else {
+                "TO"
+            };
+            let _ = write!(s, " {to}{degrees:.3} {way:?} S{rpm:.1}");
         }
         Command::Probe {
             end,

@@ -33,7 +33,7 @@ const TOKENS: &[&str] = &[
     "W", "X", "Z", "I", "K", "L", "E", "F", "S", "T0101", "#1=", "#100=[", "]", "[", "GOTO", "IF",
     "EQ", "/", "(", ")", ";", "N", "O", "%", "-", ".", "0", "9", "99999999", "1E9", "SQRT", "ATAN",
     "#[#1]", "/2", "*", "H", "A", "D", "J", "\n", " ", "G08", "G08.6", "M14.6", "M15", "C", "G31",
-    "K11.5", "G12.1", "G13.1",
+    "K11.5", "G12.1", "G13.1", "G14.4", "M29", "G84", "G88",
 ];
 
 struct Rng(u64);
@@ -132,12 +132,16 @@ fn run_case(dialect: Dialect, text: String) -> Result<bool, String> {
         .spawn(move || {
             let lines = text.lines().count().max(1) as u32;
             let outcome = std::panic::catch_unwind(|| {
-                // The Huaxing lathe as the turn-mill, its C axis fuzzed too (D138).
+                // The Huaxing lathe as the turn-mill, its C axis and live tool fuzzed too (D138,
+                // D142).
                 let turn_mill = dialect == Dialect::HuaxingLathe;
+                let lathe = Setup::lathe([100.0, 50.0]);
                 let setup = Setup {
-                    spindle_c_axis: turn_mill,
                     skip_input: turn_mill.then_some((11, 5)),
-                    ..Setup::lathe([100.0, 50.0])
+                    ..match turn_mill {
+                        true => lathe.with_spindle_c_axis().with_live_tool('A', 4, 2500.0),
+                        false => lathe,
+                    }
                 };
                 check_limited(dialect, &text, setup, Library::new(), LIMIT)
             });

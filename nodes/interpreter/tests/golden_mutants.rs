@@ -92,7 +92,7 @@ const LATHE_TOKENS: &[&str] = &[
     "G42 ", "G40 ", "M98 ", "M99 ", "M97 ", "M30 ", "M03 ", "M05 ", "P", "Q", "R", "U", "W", "X",
     "Z", "I", "K", "L", "E", "F", "S", "T0101", "T0202", "#1=", "#200=[", "]", "[", "GOTO", "IF",
     "EQ", "/", ";", ",L1 ", ",R2 ", "C1 ", "D2 ", "G08 ", "G08.6 ", "M14.6 ", "M15 ", "C", "H",
-    "G31 ", "K11.5 ", "L11.5 ", "G12.1 ", "G13.1 ", "G00 C0 ",
+    "G31 ", "K11.5 ", "L11.5 ", "G12.1 ", "G13.1 ", "G00 C0 ", "G14.4 ", "M29 ", "G84 ", "G88 ",
 ];
 
 /// A set of seed programs and how they are read.
@@ -165,10 +165,12 @@ fn lathe_setup() -> Setup {
 fn setup_for(dialect: Dialect) -> Setup {
     match dialect {
         Dialect::FanucMill => mill_setup(),
+        // The Huaxing lathe as the turn-mill: C, the live tool (A, G14.4), the skip input.
         Dialect::HuaxingLathe => Setup {
-            spindle_c_axis: true,
             skip_input: Some((11, 5)),
             ..lathe_setup()
+                .with_spindle_c_axis()
+                .with_live_tool('A', 4, 2500.0)
         },
         _ => lathe_setup(),
     }

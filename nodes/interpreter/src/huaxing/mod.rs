@@ -527,8 +527,15 @@ pub fn m_code(n: u32) -> Option<M<ToolMacro>> {
         // M56 moves the turret toward the change position: the PLC's.
         560 => AuxBefore,
         550 => Unsupported("M55 writes PLC F026–F029, which the PLC program does not read"),
-        590 | 600 | 660 | 850 | 860 | 870 | 880 | 890 => {
-            Unsupported("NC-internal M code of multi-channel or live-tool machines")
+        // D142: the live tool's position control comes with G14.n and M29; its speed mode
+        // (M65 as the table's NC code, geared to the spindle by alarm 73's "electronic gear
+        // ratio") has no words in any section.
+        660 => Unsupported(
+            "M66 live tool position mode: no section gives its words (G14.n and M29 position \
+             the live tool themselves)",
+        ),
+        590 | 600 | 850 | 860 | 870 | 880 | 890 => {
+            Unsupported("NC-internal M code of multi-channel machines")
         }
         90000..=99990 if n.is_multiple_of(10) => Unsupported(
             "M9000–M9999 call programs through an address table the manual does not give",
