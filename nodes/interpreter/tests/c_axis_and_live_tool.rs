@@ -217,11 +217,11 @@ fn fixture_017_taps_with_the_live_tool_and_back() {
     assert_eq!(dwell, 2.0);
     let last_rapid = cmds
         .iter()
-        .filter_map(|c| match &c.command {
+        .rev()
+        .find_map(|c| match &c.command {
             Command::Rapid { end } => Some(end.clone()),
             _ => None,
         })
-        .last()
         .expect("G0 X100 Z100");
     assert_eq!(last_rapid, vec![100.0, 100.0, 0.0, 0.0]);
     // Modal, a slanted thread by X and Z, a left-hand one by F−, inch by I.

@@ -8,9 +8,9 @@ use crate::show;
 use crate::state::Core;
 
 impl Core {
-    /// The slides to the work point `end` with the live tool turning `lead` mm a turn (signed:
-    /// + the tool's positive way) at `rpm`; the tool's angle goes on by the tap's degrees,
-    /// which it returns.
+    /// The slides to the work point `end` with the live tool turning `lead` mm a turn (signed,
+    /// positive the tool's positive way) at `rpm`; the tool's angle goes on by the tap's
+    /// degrees, which it returns.
     pub fn live_tool_tap(&mut self, end: &[f64], lead: f64, rpm: f64) -> Result<f64, ProgramError> {
         let Some(tool) = self.setup.live_tool else {
             return Err(self.fault(Fault::RotaryAxis, "this machine has no live tool"));
