@@ -608,6 +608,12 @@ impl MachineConfig {
                 ));
             }
         }
+        self.validate_offsets()?;
+        self.validate_spindle_axes()
+    }
+
+    /// The offset page and the work offsets: finite values of configured axes.
+    fn validate_offsets(&self) -> Result<(), String> {
         for (n, t) in &self.tools {
             let finite = [t.x, t.z, t.wear_x, t.wear_z, t.radius]
                 .iter()
@@ -632,7 +638,7 @@ impl MachineConfig {
                 }
             }
         }
-        self.validate_spindle_axes()
+        Ok(())
     }
 
     /// The C axis's rates and the live tool: finite and above 0, the live tool's axis a

@@ -218,6 +218,34 @@ mod tests {
         }
     }
 
+    /// The turn-mill's live tool (D142): an axis letter no slide nor C uses, a top speed and
+    /// time constant above 0; the C axis's rates above 0 (D141).
+    #[test]
+    fn the_live_tool_is_an_axis_of_its_own_with_a_speed() {
+        let text = include_str!("../../../../launch_configs/sim_turnmill.yaml");
+        let cfg = LaunchConfig::from_yaml(text).expect("sim_turnmill");
+        let tool = cfg.machine.live_tool.as_ref().expect("a live tool");
+        assert_eq!(
+            (tool.number(), tool.acceleration().round()),
+            (Some(4), 62762.0)
+        );
+        let live = "live_tool: { axis: A, max_rpm: 2500.0, time_constant: 0.239 }";
+        for bad in [
+            "live_tool: { axis: X, max_rpm: 2500.0, time_constant: 0.239 }",
+            "live_tool: { axis: C, max_rpm: 2500.0, time_constant: 0.239 }",
+            "live_tool: { axis: Q, max_rpm: 2500.0, time_constant: 0.239 }",
+            "live_tool: { axis: A, max_rpm: 0.0, time_constant: 0.239 }",
+            "live_tool: { axis: A, max_rpm: 2500.0, time_constant: 0.0 }",
+            "c_axis: { max_velocity: 0.0, max_acceleration: 100.0 }",
+        ] {
+            let e = LaunchConfig::from_yaml(&text.replacen(live, bad, 1)).unwrap_err();
+            assert!(
+                e.contains("machine.live_tool") || e.contains("machine.c_axis"),
+                "{bad}: {e}"
+            );
+        }
+    }
+
     /// The MSG service's file (D120): taken from the config's folder, one of the manual's
     /// three sizes.
     #[test]
