@@ -78,6 +78,10 @@ pub struct View {
     path_reset: bool,
     signals: Option<PlcSignals>,
     signals_sent: u64,
+    /// A turn-mill's polar interpolation blocks (run, seq, on) as they come (D141): while
+    /// the last one done is on, the path shows the face, X and C as Cartesian.
+    contour: Vec<(u64, u64, bool)>,
+    face: bool,
 }
 
 /// Which machine axes a 2-D tool path shows: a lathe's Z across and X (as radius) up; a mill's
@@ -121,22 +125,58 @@ impl View {
     }
 
     pub fn on_block(&mut self, b: MotionBlock) {
+        if b.kind == MotionBlock::KIND_CONTOUR {
+            self.contour.push((b.run_id, b.seq, b.flag));
+            if self.contour.len() > BLOCKS_KEPT {
+                self.contour.remove(0);
+            }
+        }
         self.blocks.insert((b.run_id, b.seq), b);
         while self.blocks.len() > BLOCKS_KEPT {
             self.blocks.pop_first();
         }
     }
 
-    pub fn on_axes(&mut self, a: AxisState) {
+    /// Whether polar interpolation is on: the last contour block motion has done says so.
+    fn face_now(&self) -> bool {
+        let run = self.status.run_id;
+        self.contour
+            .iter()
+            .filter(|(r, seq, _)| *r == run && *seq <= self.status.done_seq)
+            .max_by_key(|(_, seq, _)| *seq)
+            .is_some_and(|(_, _, on)| *on)
+    }
+
+    /// The point the path shows for `a`: the plot's two axes (a diameter axis at its
+    /// radius), or under polar interpolation the face's point of X (radius) and C.
+    fn path_point(&self, a: &AxisState) -> Option<[f64; 2]> {
+        let by_name = |n: &str| a.axes.iter().find(|x| x.name == n);
+        if self.face {
+            let (x, c) = (by_name("X")?, by_name("C")?);
+            let r = x.actual_position * 0.5;
+            let (sin, cos) = c.actual_position.to_radians().sin_cos();
+            return Some([r * cos, r * sin]);
+        }
         let (h, v) = self.plot;
-        if let (Some(ah), Some(av)) = (a.axes.get(h), a.axes.get(v)) {
-            // A diameter axis is drawn at the radius.
-            let scale = if self.diameter.get(v).copied().unwrap_or(false) {
-                0.5
-            } else {
-                1.0
-            };
-            let p = [ah.actual_position, av.actual_position * scale];
+        let (ah, av) = (a.axes.get(h)?, a.axes.get(v)?);
+        let scale = if self.diameter.get(v).copied().unwrap_or(false) {
+            0.5
+        } else {
+            1.0
+        };
+        Some([ah.actual_position, av.actual_position * scale])
+    }
+
+    pub fn on_axes(&mut self, a: AxisState) {
+        let face = self.face_now();
+        if face != self.face {
+            // The face's drawing replaces the turning one, and back.
+            self.face = face;
+            self.path.clear();
+            self.path_sent = 0;
+            self.path_reset = true;
+        }
+        if let Some(p) = self.path_point(&a) {
             let moved = self
                 .path
                 .last()
@@ -273,7 +313,10 @@ impl View {
             "type": "state",
             "machine": machine,
             "axes": self.positions(),
-            "plot": [self.names.get(self.plot.0), self.names.get(self.plot.1)],
+            "plot": match self.face {
+                true => json!(["X", "C (face)"]),
+                false => json!([self.names.get(self.plot.0), self.names.get(self.plot.1)]),
+            },
             "feed": feed,
             "spindle": self.spindle.as_ref().map(|s| json!({
                 "commanded_rpm": s.commanded_rpm,
@@ -382,6 +425,60 @@ mod tests {
             axes: vec![axis("X", x), axis("Z", z)],
             ..AxisState::default()
         }
+    }
+
+    /// A turn-mill's polar interpolation (D141): once motion has done the contour-on block the
+    /// path shows the face — X (diameter 30: radius 15) and C (90°) as the point (0, 15) — in
+    /// a new drawing labelled X and C; once it has done the contour-off block, Z and X again.
+    #[test]
+    fn the_path_shows_the_face_while_polar_interpolation_runs() {
+        let mut v = View::new(vec!["X".into(), "Z".into()], vec![true, false]);
+        let with_c = |x: f64, c: f64| {
+            let mut a = axes(x, 0.0);
+            let mut axis = a.axes[0].clone();
+            axis.name = "C".into();
+            axis.actual_position = c;
+            a.axes.push(axis);
+            a
+        };
+        let status = |done_seq| MotionStatus {
+            run_id: 3,
+            done_seq,
+            ..MotionStatus::default()
+        };
+        for (seq, on) in [(2, true), (10, false)] {
+            v.on_block(MotionBlock {
+                run_id: 3,
+                seq,
+                kind: MotionBlock::KIND_CONTOUR,
+                flag: on,
+                ..MotionBlock::default()
+            });
+        }
+        v.on_motion_status(status(1));
+        v.on_axes(with_c(40.0, 0.0));
+        let f = v.frame();
+        assert_eq!(
+            (f["plot"].clone(), f["path"][0].clone()),
+            (json!(["Z", "X"]), json!([0.0, 20.0]))
+        );
+        v.on_motion_status(status(2));
+        v.on_axes(with_c(30.0, 90.0));
+        let f = v.frame();
+        assert_eq!(f["plot"], json!(["X", "C (face)"]));
+        assert_eq!(f["path_reset"], true);
+        let p = &f["path"][0];
+        assert!(
+            p[0].as_f64().unwrap().abs() < 1e-12 && (p[1].as_f64().unwrap() - 15.0).abs() < 1e-12,
+            "{p}"
+        );
+        v.on_motion_status(status(10));
+        v.on_axes(with_c(30.0, 90.0));
+        let f = v.frame();
+        assert_eq!(
+            (f["plot"].clone(), f["path"][0].clone()),
+            (json!(["Z", "X"]), json!([0.0, 15.0]))
+        );
     }
 
     #[test]
