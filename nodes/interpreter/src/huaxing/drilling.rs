@@ -97,16 +97,7 @@ impl Fanuc<Huaxing> {
                 format!("{name} needs the hole bottom {bottom}({bottom_inc})"),
             ));
         }
-        let repeats = match b.get('K') {
-            None => 1,
-            Some(k) if (1.0..=MAX_REPEATS).contains(&k) && k.fract() == 0.0 => k as u32,
-            Some(k) => {
-                return Err(self.fault(
-                    Fault::OutOfRange,
-                    format!("{name} K{}: repeat count 1–9999", show(k)),
-                ))
-            }
-        };
+        let repeats = self.repeat_count(b, name)?;
         let clamp = self.clamp_code(b, name)?;
         let here = self.core.work_position();
         let end = self.end_point(b)?;
@@ -168,6 +159,18 @@ impl Fanuc<Huaxing> {
             hole += step;
         }
         Ok(())
+    }
+
+    /// K of a drilling or tapping block: how many holes, 1–9999 (§3.3.2), 1 without it.
+    pub(super) fn repeat_count(&self, b: &Block<Huaxing>, name: &str) -> Result<u32, ProgramError> {
+        match b.get('K') {
+            None => Ok(1),
+            Some(k) if (1.0..=MAX_REPEATS).contains(&k) && k.fract() == 0.0 => Ok(k as u32),
+            Some(k) => Err(self.fault(
+                Fault::OutOfRange,
+                format!("{name} K{}: repeat count 1–9999", show(k)),
+            )),
+        }
     }
 
     /// The spindle clamp code Mα of a drilling block, if it has one.

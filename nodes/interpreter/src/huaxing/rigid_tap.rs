@@ -7,7 +7,7 @@
 //! times, an incremental position (U/W, H) stepping to the next hole. G80, another group-01
 //! code or reset ends it; G80 restores the motion code before it.
 
-use cnc_interpreter_core::{show, Command, Fault, MoveKind, ProgramError, Turn};
+use cnc_interpreter_core::{Command, Fault, MoveKind, ProgramError, Turn};
 
 use super::{Huaxing, HuaxingG};
 use crate::fanuc::block::Block;
@@ -28,9 +28,6 @@ pub struct RigidTap {
     /// The group-01 code before G84/G88.
     before: Option<G<HuaxingG>>,
 }
-
-/// Most holes one block taps (K, as G83's).
-const MAX_REPEATS: f64 = 9999.0;
 
 impl Fanuc<Huaxing> {
     /// M29 S: the tapping spindle into position control at the speed S (the block's or the
@@ -123,16 +120,7 @@ impl Fanuc<Huaxing> {
                 format!("{name} needs the hole bottom {bottom_abs}({bottom_inc})"),
             )
         })?;
-        let repeats = match b.get('K') {
-            None => 1,
-            Some(k) if (1.0..=MAX_REPEATS).contains(&k) && k.fract() == 0.0 => k as u32,
-            Some(k) => {
-                return Err(self.fault(
-                    Fault::OutOfRange,
-                    format!("{name} K{}: repeat count 1–9999", show(k)),
-                ))
-            }
-        };
+        let repeats = self.repeat_count(b, name)?;
         let clamp = self.clamp_code(b, name)?;
         let c = self.core.axis('C');
         let step = if b.has(hole_inc) {
