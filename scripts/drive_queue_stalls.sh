@@ -30,4 +30,4 @@ LOAD_PID=$!
 set +m
 echo "load: cargo build (pid $LOAD_PID); $CNC_STALLS stalls per length"
 ip netns exec "$NS" cargo test --test drive_queue stall_table -- --ignored --nocapture 2>&1 \
-    | grep -E "^(machine|lathe1|mill1) |test result|panicked"
+    | grep -E -A4 "^(machine|lathe1|mill1) |test result|panicked"
