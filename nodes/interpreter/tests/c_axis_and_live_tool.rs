@@ -1,6 +1,10 @@
 //! The Huaxing turn-mill's C axis (`000` §4.2.6–4.2.7, §5.7; decision D138) on the canonical
 //! stream: the manual's fixtures 004 and 015 block by block, and the section's alarms.
 
+#[path = "support/huaxing.rs"]
+mod huaxing;
+use huaxing::fixture;
+
 use cnc_interpreter::{Aux, Canon, Command, Dialect, ProgramError, Setup, Turn};
 
 /// A turn-mill lathe at X200 Z100 (diameter), its spindle the C axis.
@@ -10,18 +14,6 @@ fn turn_mill() -> Setup {
 
 fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
     cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
-}
-
-fn fixture(name: &str) -> String {
-    let path = format!(
-        "{}/../../../shared/fixtures/000/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    text.split("(--- listing as printed ---)")
-        .nth(1)
-        .expect("listing marker")
-        .to_string()
 }
 
 /// A rotary move as (X, Z, degrees, way, rpm).

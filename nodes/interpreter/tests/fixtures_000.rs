@@ -1,24 +1,16 @@
 //! The Huaxing manual's example programs (`../shared/fixtures/000/`), with what each header
 //! says, checked on the canonical stream and, for cutting cycles, on the swept 2-D stock.
 
+#[path = "support/huaxing.rs"]
+mod huaxing;
+use huaxing::fixture;
+
 use cnc_interpreter::{Aux, Canon, Command, Dialect, Library, ProgramError, Setup};
 
 mod support;
 use support::contour_at;
 
 const HOME: [f64; 2] = [200.0, 100.0];
-
-fn fixture(name: &str) -> String {
-    let path = format!(
-        "{}/../../../shared/fixtures/000/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    text.split("(--- listing as printed ---)")
-        .nth(1)
-        .expect("listing marker")
-        .to_string()
-}
 
 /// The 1-based line of the listing that starts with `start`.
 fn line_of(text: &str, start: &str) -> u32 {

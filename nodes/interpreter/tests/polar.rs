@@ -2,6 +2,10 @@
 //! stream: the manual's fixture 016, a hexagon and a slot near the pole mapped back from the
 //! machine's X and C to the face, and the section's alarms 106, 107 and 108.
 
+#[path = "support/huaxing.rs"]
+mod huaxing;
+use huaxing::fixture;
+
 use cnc_interpreter::{Canon, Command, Dialect, ProgramError, Setup};
 use cnc_interpreter_core::setup::ToolOffset;
 
@@ -21,18 +25,6 @@ fn turn_mill() -> Setup {
 
 fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
     cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
-}
-
-fn fixture(name: &str) -> String {
-    let path = format!(
-        "{}/../../../shared/fixtures/000/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    text.split("(--- listing as printed ---)")
-        .nth(1)
-        .expect("listing marker")
-        .to_string()
 }
 
 /// The face point (mm) of a machine point X (diameter), C (degrees).
