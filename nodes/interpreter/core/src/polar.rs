@@ -264,7 +264,8 @@ impl Core {
             let m1 = loop {
                 let t1 = (t0 + dt).min(1.0);
                 let q = point(t1);
-                if p.face(&q).z.hypot(p.face(&q).r) < POLE {
+                let f = p.face(&q);
+                if f.z.hypot(f.r) < POLE {
                     return Err(self.fault(
                         Fault::PolarMode,
                         format!(

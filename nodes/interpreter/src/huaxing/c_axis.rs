@@ -2,9 +2,10 @@
 //! spindle, switched into position control by M14.6 (or G08.6), is the C axis, its angle
 //! counted from the encoder's Z pulse. G08 turns it at F r/min: C an angle reached within one
 //! revolution the way its sign says, H a travel of any number of turns; X and Z in the same
-//! block move along, geared to its angle (motion's rigid-tap gearing, D101).
+//! block move along, geared to its angle (motion's rigid-tap gearing, D101). `G00 C…` turns it
+//! the same way at its rapid (D141), as does a tapping block's C (D142).
 
-use cnc_interpreter_core::{Aux, Fault, ProgramError, Turn};
+use cnc_interpreter_core::{show, Aux, Fault, MoveKind, ProgramError, Turn};
 
 use super::Huaxing;
 use crate::fanuc::block::Block;
@@ -96,5 +97,54 @@ impl Fanuc<Huaxing> {
             }
         }
         Ok(())
+    }
+
+    /// `G00 C…` / `G00 H…` on a turn-mill outside polar interpolation: C positioned at its
+    /// rapid rate as G08 turns it (C within one turn the way its sign says, H any travel),
+    /// X and Z along; how a program brings C to 0 before G12.1 (the manual's example).
+    pub(super) fn rapid_c(&mut self, b: &Block<Huaxing>) -> Option<Result<(), ProgramError>> {
+        let rapid = b.group(1).unwrap_or(self.motion) == G::Rapid;
+        if !rapid || !(b.has('C') || b.has('H')) || self.core.polar.is_some() {
+            return None;
+        }
+        if !self.core.setup.spindle_c_axis {
+            return None; // `c_words` has refused it
+        }
+        self.motion = G::Rapid;
+        let rpm = self.core.setup.c_rapid_rpm;
+        Some(self.turn_c(b, rpm))
+    }
+
+    /// C to the block's C (or by H) at `rpm`, X and Z geared to its angle (G08's move).
+    pub(super) fn turn_c(&mut self, b: &Block<Huaxing>, rpm: f64) -> Result<(), ProgramError> {
+        let c_index = self.core.axis('C');
+        let (degrees, way) = match (b.get('C'), b.get('H')) {
+            (Some(_), Some(_)) => {
+                return Err(self.fault(Fault::AbsAndInc, "C and H in one block"));
+            }
+            // An absolute C within one revolution, its sign the way: C−750 turns the negative
+            // way to −30°, that is 330° (D138: the manual's "320°" is a slip).
+            (Some(c), None) => {
+                let way = if c < 0.0 { Turn::Minus } else { Turn::Plus };
+                let angle = c.rem_euclid(360.0);
+                (if angle >= 360.0 { 0.0 } else { angle }, way)
+            }
+            (None, Some(h)) => (h, Turn::Incremental),
+            (None, None) => {
+                return Err(self.fault(Fault::RotaryWord, "no rotary axis programmed: C or H"));
+            }
+        };
+        if !degrees.is_finite() || degrees.abs() > 999_999.0 {
+            return Err(self.fault(
+                Fault::OutOfRange,
+                format!("C axis travel {}°", show(degrees)),
+            ));
+        }
+        let mut end = self.end_point(b)?;
+        // The program's C is the angle the spindle stands at (absolute C), or goes on by H.
+        if let (Some(i), Turn::Plus | Turn::Minus) = (c_index, way) {
+            end[i] = degrees;
+        }
+        self.core.emit(&end, MoveKind::Rotary { degrees, way, rpm })
     }
 }
