@@ -146,6 +146,20 @@ pub(super) struct LiveTool {
     base: f64,
     /// The drive's actual angle, as its feedback says.
     actual: f64,
+    /// How much longer the tool's drive lags than the slides', s (the config's lags).
+    lead_time: f64,
+}
+
+impl LiveTool {
+    /// The live tool of `cfg`, standing at 0°.
+    pub(super) fn of(cfg: &MotionConfig) -> LiveTool {
+        let n = cfg.axes.len().max(1) as f64;
+        let slides = cfg.axes.iter().map(|a| a.drive_lag).sum::<f64>() / n;
+        LiveTool {
+            lead_time: cfg.live_tool.as_ref().map_or(0.0, |t| t.drive_lag - slides),
+            ..LiveTool::default()
+        }
+    }
 }
 
 impl Motion {
@@ -186,13 +200,8 @@ impl Motion {
     /// config), so the tool's actual angle keeps to the slides' actual travel as a tap
     /// needs — what matched loop gains do on a control's rigid tapping.
     fn live_tool_lead(&self) -> f64 {
-        let Some(t) = &self.cfg.live_tool else {
-            return self.live.at;
-        };
-        let n = self.cfg.axes.len().max(1) as f64;
-        let slides = self.cfg.axes.iter().map(|a| a.drive_lag).sum::<f64>() / n;
         let speed = (self.live.at - self.live.last) / self.cfg.period;
-        self.live.at + speed * (t.drive_lag - slides)
+        self.live.at + speed * self.live.lead_time
     }
 
     /// A line that turns the live tool (a tap, G14.n) is refused with the drives' setpoint

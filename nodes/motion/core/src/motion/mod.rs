@@ -239,7 +239,7 @@ impl Motion {
             .collect();
         Motion {
             contour: contour::Contour::default(),
-            live: contour::LiveTool::default(),
+            live: contour::LiveTool::of(&cfg),
             compressor: false,
             fifo_fill: false,
             timers: RunTimers::default(),
