@@ -102,6 +102,13 @@ pub enum Command {
     Contour {
         on: bool,
     },
+    /// The turn-mill's live tool in speed mode at `rpm` (its positive way; the Huaxing M65
+    /// S…, D143), or, at 0, out of it: the tool brakes at its time constant and stands in
+    /// position control where it stopped, its program angle 0 there (M66). The program
+    /// waits until the tool turns at the speed (or stands).
+    LiveTool {
+        rpm: f64,
+    },
     Dwell {
         seconds: f64,
     },
@@ -319,6 +326,10 @@ pub fn to_motion_block(
             m.kind = MotionBlock::KIND_CONTOUR;
             m.flag = *on;
         }
+        Command::LiveTool { rpm } => {
+            m.kind = MotionBlock::KIND_LIVE_TOOL;
+            m.aux_value = *rpm;
+        }
         Command::Dwell { seconds } => {
             m.kind = MotionBlock::KIND_DWELL;
             m.dwell_seconds = *seconds;
@@ -435,6 +446,9 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
         MotionBlock::KIND_FIFO => Command::Fifo { fill: m.flag },
         MotionBlock::KIND_SYNC => Command::Sync,
         MotionBlock::KIND_CONTOUR => Command::Contour { on: m.flag },
+        MotionBlock::KIND_LIVE_TOOL if m.aux_value.is_finite() && m.aux_value >= 0.0 => {
+            Command::LiveTool { rpm: m.aux_value }
+        }
         MotionBlock::KIND_FEED_MODE => Command::FeedMode { per_rev: m.flag },
         MotionBlock::KIND_PATH_MODE => Command::PathMode { exact_stop: m.flag },
         MotionBlock::KIND_PROFILE => Command::Profile {
@@ -460,6 +474,12 @@ pub fn from_motion_block(m: &MotionBlock) -> Result<Command, String> {
         }
         MotionBlock::KIND_DWELL => {
             return Err(format!("dwell {} s is not a time", m.dwell_seconds))
+        }
+        MotionBlock::KIND_LIVE_TOOL => {
+            return Err(format!(
+                "live tool speed {} r/min is not a speed",
+                m.aux_value
+            ))
         }
         MotionBlock::KIND_AUX => Command::Aux(aux(m)?),
         MotionBlock::KIND_PROGRAM_END => Command::ProgramEnd,
@@ -604,6 +624,8 @@ mod tests {
             Command::Sync,
             Command::Contour { on: true },
             Command::Contour { on: false },
+            Command::LiveTool { rpm: 1500.0 },
+            Command::LiveTool { rpm: 0.0 },
             Command::Dwell { seconds: 1.5 },
             Command::Tap {
                 end: vec![10.0, 10.0, -25.0],

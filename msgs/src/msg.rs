@@ -237,6 +237,7 @@ ros_message! {
             KIND_SYNC: u8 = 18,
             KIND_ROTARY: u8 = 19,
             KIND_CONTOUR: u8 = 20,
+            KIND_LIVE_TOOL: u8 = 21,
             AUX_M: u8 = 1,
             AUX_S: u8 = 2,
             AUX_T: u8 = 3,

@@ -118,6 +118,11 @@ pub fn line(letters: &[char], c: &Canon) -> String {
         Command::Fifo { fill } => s.push_str(if *fill { "FIFO_FILL" } else { "FIFO_RUN" }),
         Command::Sync => s.push_str("SYNC"),
         Command::Contour { on } => s.push_str(if *on { "C_CONTOUR_ON" } else { "C_CONTOUR_OFF" }),
+        // The live tool turning at a speed (D143), or standing again in position control.
+        Command::LiveTool { rpm } if *rpm > 0.0 => {
+            let _ = write!(s, "LIVE_TOOL S{rpm:.1}");
+        }
+        Command::LiveTool { .. } => s.push_str("LIVE_TOOL_STOP"),
         Command::Dwell { seconds } => {
             let _ = write!(s, "DWELL {seconds:.3}");
         }
@@ -362,6 +367,8 @@ impl LinuxCnc {
             // rs274 has no spindle-positioned move: the axes' end as a feed at the rotary
             // speed's share is no honest equivalent, so nothing is written (D138).
             Command::Rotary { .. } => {}
+            // rs274 has one spindle: the live tool's speed has no call of its own (D143).
+            Command::LiveTool { .. } => {}
             // LinuxCNC's G38.2: a straight probe at the feed.
             Command::Probe { end, feed, .. } => {
                 self.set_feed(out, *feed);

@@ -3,14 +3,9 @@
 
 #[path = "support/huaxing.rs"]
 mod huaxing;
-use huaxing::fixture;
+use huaxing::{fixture, turn_mill, with_live_tool};
 
 use cnc_interpreter::{Aux, Canon, Command, Dialect, ProgramError, Setup, Turn};
-
-/// A turn-mill lathe at X200 Z100 (diameter), its spindle the C axis.
-fn turn_mill() -> Setup {
-    Setup::lathe([200.0, 100.0]).with_spindle_c_axis()
-}
 
 fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
     cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
@@ -161,11 +156,6 @@ fn g31_skips_on_the_machines_skip_input() {
         let e = hx(text, setup).unwrap_err();
         assert_eq!((e.number, e.line), (number, 1), "{text}: {e}");
     }
-}
-
-/// The turn-mill with its live tool as axis A (G14.4), up to 2500 r/min.
-fn with_live_tool() -> Setup {
-    turn_mill().with_live_tool('A', 4, 2500.0)
 }
 
 /// The live tool's taps as (X, Z, tool degrees, feed) of each line that turns it.

@@ -1,6 +1,8 @@
-//! A tap with the live tool (decision D142): the slides go to the hole's end while the live
-//! tool turns the tap's turns, as one machine line of the slides and the tool's angle, so the
-//! interpolation itself gears them (any two slides may move: a slanted thread).
+//! The live tool. A tap with it (decision D142): the slides go to the hole's end while the
+//! live tool turns the tap's turns, as one machine line of the slides and the tool's angle,
+//! so the interpolation itself gears them (any two slides may move: a slanted thread). Its
+//! speed mode (D143): it turns at a speed for drilling and milling while the slides feed,
+//! and stands in position control again at speed 0.
 
 use crate::canon::Command;
 use crate::error::{Fault, ProgramError};
@@ -18,6 +20,13 @@ impl Core {
         let Some(a) = self.axis(tool.letter) else {
             return Err(self.fault(Fault::RotaryAxis, "this machine has no live tool"));
         };
+        if self.live_tool_rpm > 0.0 {
+            return Err(self.fault(
+                Fault::LiveToolSpeed,
+                "a tap needs the live tool in position control: it turns in speed mode (M66 \
+                 first)",
+            ));
+        }
         if self.comp.is_some() || self.polar.is_some() || self.cylinder.is_some() {
             return Err(self.fault(
                 Fault::CompInCycle,
@@ -66,5 +75,28 @@ impl Core {
         self.pos.copy_from_slice(&m);
         self.push(Command::Linear { end: m, feed });
         Ok(degrees)
+    }
+
+    /// The live tool into speed mode at `rpm` (its positive way), or at 0 out of it: it
+    /// stands again in position control. Above 0 and at most the tool's top speed.
+    pub fn live_tool_speed(&mut self, rpm: f64) -> Result<(), ProgramError> {
+        let Some(tool) = self.setup.live_tool else {
+            return Err(self.fault(Fault::RotaryAxis, "this machine has no live tool"));
+        };
+        if rpm != 0.0 && !(rpm > 0.0 && rpm <= tool.max_rpm) {
+            return Err(self.fault(
+                Fault::LiveToolSpeed,
+                format!(
+                    "live tool speed {} r/min: above 0 and at most {}",
+                    show(rpm),
+                    show(tool.max_rpm)
+                ),
+            ));
+        }
+        if rpm != self.live_tool_rpm {
+            self.live_tool_rpm = rpm;
+            self.push(Command::LiveTool { rpm });
+        }
+        Ok(())
     }
 }

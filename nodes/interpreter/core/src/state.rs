@@ -217,6 +217,8 @@ pub struct Core {
     pub cylinder: Option<crate::cylinder::Cylinder>,
     /// Polar interpolation in force ([`crate::polar`]): `pos` is then the face's position.
     pub polar: Option<crate::polar::Polar>,
+    /// The live tool's speed in speed mode, r/min; 0 in position control (D143).
+    pub live_tool_rpm: f64,
     /// Under it, the compensation's offset at the end of the last move, and the one the move
     /// being queued ends with.
     pub(crate) wall: Pt,
@@ -285,6 +287,7 @@ impl Core {
             measured_at: None,
             cylinder: None,
             polar: None,
+            live_tool_rpm: 0.0,
             wall: Pt::new(0.0, 0.0),
             out_offset: None,
             controlled: Vec::new(),

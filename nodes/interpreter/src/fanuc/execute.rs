@@ -88,6 +88,7 @@ impl<D: Family> Fanuc<D> {
         for &(m, code) in &b.m {
             match m {
                 M::AuxBefore | M::AuxAfter if m_in_cycle => {}
+                M::AuxBefore if D::m_to_nc(self, code)? => {}
                 M::AuxBefore => {
                     D::m_before(self, code)?;
                     self.track_spindle(code);
@@ -103,6 +104,7 @@ impl<D: Family> Fanuc<D> {
         for &(m, code) in &b.m {
             match m {
                 M::AuxBefore | M::AuxAfter if m_in_cycle => {}
+                M::AuxAfter if D::m_to_nc(self, code)? => {}
                 M::AuxAfter | M::Stop => {
                     self.track_spindle(code);
                     self.core.aux(Aux::M((code / 10) as i32));
@@ -143,6 +145,9 @@ impl<D: Family> Fanuc<D> {
     }
 
     fn spindle_words(&mut self, b: &Block<D>) -> Result<(), ProgramError> {
+        if D::speed_word(self, b)? {
+            return Ok(());
+        }
         let s = b.get('S');
         // G50 S is the clamp, not a speed.
         if b.has_g(G::SetCoordinate) {

@@ -130,6 +130,16 @@ pub trait Family: Sized + Send + 'static {
     fn m_in_cycle(_f: &Fanuc<Self>, _b: &Block<Self>) -> bool {
         false
     }
+    /// S words the dialect's NC takes itself on this machine (the turn-mill's live tool in
+    /// speed mode, D143): true when it took them.
+    fn speed_word(_f: &mut Fanuc<Self>, _b: &Block<Self>) -> Result<bool, ProgramError> {
+        Ok(false)
+    }
+    /// An M code of the table the dialect's NC takes on this machine instead of the PLC (the
+    /// turn-mill's M65, D143): true when it took it.
+    fn m_to_nc(_f: &mut Fanuc<Self>, _code: u32) -> Result<bool, ProgramError> {
+        Ok(false)
+    }
     /// An M code sent before the block's motion, as it is sent (the mill's M06 check).
     fn m_before(_f: &mut Fanuc<Self>, _code: u32) -> Result<(), ProgramError> {
         Ok(())

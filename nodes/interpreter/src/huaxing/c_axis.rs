@@ -74,13 +74,17 @@ impl Fanuc<Huaxing> {
         self.turn_c(b, rpm)
     }
 
-    /// C and H program the C axis in G08, G00 and G84/G88 blocks, and the face's second
-    /// coordinate in polar interpolation (D141).
+    /// C and H program the C axis in G08, G00, G83/G87 and G84/G88 blocks, and the face's
+    /// second coordinate in polar interpolation (D141).
     pub(super) fn c_words(&self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         let motion = b.group(1).unwrap_or(self.motion);
         let c_moves = matches!(
             motion,
-            G::Own(super::HuaxingG::Rotary { .. } | super::HuaxingG::RigidTap { .. }) | G::Rapid
+            G::Own(
+                super::HuaxingG::Rotary { .. }
+                    | super::HuaxingG::RigidTap { .. }
+                    | super::HuaxingG::Drilling { .. }
+            ) | G::Rapid
         ) && self.core.setup.spindle_c_axis;
         if self.core.polar.is_some() {
             return Ok(());
@@ -89,7 +93,10 @@ impl Fanuc<Huaxing> {
             if b.get(c).is_some() && !c_moves {
                 let why = match self.core.setup.spindle_c_axis {
                     true => {
-                        format!("address {c}: the C axis is programmed with G00, G08 or G84/G88")
+                        format!(
+                            "address {c}: the C axis is programmed with G00, G08, G83/G87 or \
+                             G84/G88"
+                        )
                     }
                     false => format!("address {c}: no C axis on this machine"),
                 };

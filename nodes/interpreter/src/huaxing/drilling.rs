@@ -1,6 +1,8 @@
 //! G83 axial and G87 radial peck drilling (`000` §5.22.7).
 //!
-//! The tool goes to the hole position at the level where the block starts, pecks down to the
+//! The tool goes to the hole position at the level where the block starts (on a turn-mill C
+//! too: the block's C, H the step from hole to hole, indexed as the tapping cycles index
+//! it, D143), pecks down to the
 //! bottom (high-speed: back off R after each peck, J0; deep-hole: all the way out, J1), dwells
 //! P ms, and returns to the hole position at the start level, K times. The manual's figures
 //! give the pecks in least-input increments (Q, decision D12) and R in mm, both radius values.
@@ -10,9 +12,9 @@ use cnc_interpreter_core::cycles::{pecks, Pecking};
 use cnc_interpreter_core::{show, Aux, Command, Fault, MoveKind, ProgramError};
 
 use super::compound::MAX_CYCLE_STEPS;
-use super::Huaxing;
+use super::{Huaxing, HuaxingG};
 use crate::fanuc::block::Block;
-use crate::fanuc::codes::M;
+use crate::fanuc::codes::{G, M};
 use crate::fanuc::Fanuc;
 
 /// The cycle's modal words; positions, K and M are not modal.
@@ -26,6 +28,9 @@ pub struct DrillWords {
     retract: f64,
     /// J1: deep-hole pecking, out of the hole after every peck.
     deep_hole: bool,
+    /// The hole's bottom (work coordinate of the drilling axis): modal while the cycle stays
+    /// selected (§5.22.7: every word but the position, K and M is modal).
+    bottom: Option<f64>,
 }
 
 impl Default for DrillWords {
@@ -35,6 +40,7 @@ impl Default for DrillWords {
             peck: 0.0,
             retract: 1.0,
             deep_hole: false,
+            bottom: None,
         }
     }
 }
@@ -43,6 +49,14 @@ impl Default for DrillWords {
 const MAX_REPEATS: f64 = 9999.0;
 
 impl Fanuc<Huaxing> {
+    /// G83/G87 selected: a bottom kept from another cycle (or before another motion code)
+    /// does not carry over.
+    pub(super) fn drilling_selected(&mut self, radial: bool) {
+        if !matches!(self.motion, G::Own(HuaxingG::Drilling { radial: r }) if r == radial) {
+            self.d.drill.bottom = None;
+        }
+    }
+
     /// Takes the modal words P, Q, R and J of a G83/G87 block.
     pub(super) fn drill_words(&mut self, b: &Block<Huaxing>) -> Result<(), ProgramError> {
         if let Some(p) = b.get('P') {
@@ -91,16 +105,19 @@ impl Fanuc<Huaxing> {
         } else {
             ('Z', 'W', 'U')
         };
-        if !b.has(bottom) && !b.has(bottom_inc) {
+        let here = self.core.work_position();
+        let end = self.end_point(b)?;
+        if b.has(bottom) || b.has(bottom_inc) {
+            self.d.drill.bottom = Some(end[drill_axis]);
+        }
+        let Some(bottom_at) = self.d.drill.bottom else {
             return Err(self.fault(
                 Fault::MissingWord,
                 format!("{name} needs the hole bottom {bottom}({bottom_inc})"),
             ));
-        }
+        };
         let repeats = self.repeat_count(b, name)?;
         let clamp = self.clamp_code(b, name)?;
-        let here = self.core.work_position();
-        let end = self.end_point(b)?;
         // With an incremental hole position each repetition drills the next hole.
         let step = if b.has(hole_inc) {
             end[hole_axis] - here[hole_axis]
@@ -108,10 +125,7 @@ impl Fanuc<Huaxing> {
             0.0
         };
         let s = if radial { self.core.x_scale() } else { 1.0 };
-        let (top, depth) = (
-            here[drill_axis] * s,
-            end[drill_axis] * s - here[drill_axis] * s,
-        );
+        let (top, depth) = (here[drill_axis] * s, bottom_at * s - here[drill_axis] * s);
         let words = self.d.drill;
         if words.peck > 0.0
             && (depth.abs() / words.peck + 1.0) * f64::from(repeats) > MAX_CYCLE_STEPS as f64
@@ -121,15 +135,23 @@ impl Fanuc<Huaxing> {
                 format!("{name} gives more than {MAX_CYCLE_STEPS} pecks"),
             ));
         }
-        let mut hole = end[hole_axis];
-        for _ in 0..repeats {
+        // The hole: its position on the hole axis and C (`000` §5.22.7: "rapid to (X, C)"),
+        // the drilling axis at the start point.
+        let (c, c_step) = (self.core.axis('C'), b.get('H').unwrap_or(0.0));
+        let mut top_at = here.clone();
+        top_at[hole_axis] = end[hole_axis];
+        top_at[drill_axis] = top / s;
+        for k in 0..repeats {
+            if k > 0 {
+                top_at[hole_axis] += step;
+            }
+            self.rapid_unless_there(&top_at)?;
+            self.index_c(b, &mut top_at, c, k, c_step)?;
             let at = |p: f64| {
-                let mut v = here.clone();
-                v[hole_axis] = hole;
+                let mut v = top_at.clone();
                 v[drill_axis] = p / s;
                 v
             };
-            self.rapid_unless_there(&at(top))?;
             if let Some(m) = clamp {
                 self.core.aux(Aux::M(m));
             }
@@ -151,12 +173,11 @@ impl Fanuc<Huaxing> {
                     seconds: words.dwell_ms / 1000.0,
                 });
             }
-            self.core.emit(&at(top), MoveKind::Rapid)?;
+            self.core.emit(&top_at, MoveKind::Rapid)?;
             if let Some(m) = clamp {
                 // The unclamp code is the clamp code + 1 (decision D45).
                 self.core.aux(Aux::M(m + 1));
             }
-            hole += step;
         }
         Ok(())
     }

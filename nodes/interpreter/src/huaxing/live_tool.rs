@@ -4,6 +4,11 @@
 //! while the tool turns (any two slides: a slanted thread), dwell, and come back turning the
 //! other way. G14 is modal: each following block with a position taps again. No program
 //! word moves the live tool's axis itself.
+//!
+//! Speed mode (§4.1.5's M65/M66, decision D143): on a machine with a live tool, `M65 S…`
+//! turns it at S r/min for drilling and milling, and while it turns every S word is its
+//! speed; M66 stops it into position control, and so does M05 (B12.7 = 0: it stops with the
+//! spindle). A machine without one keeps M65 as the second spindle's stop.
 
 use cnc_interpreter_core::{show, Command, Fault, ProgramError};
 
@@ -92,6 +97,58 @@ impl Fanuc<Huaxing> {
                 ),
             )),
             _ => Ok(()),
+        }
+    }
+
+    /// The S word of an `M65` block, or any S while the live tool turns: its speed (D143).
+    /// True when the S was the live tool's.
+    pub(super) fn live_tool_speed_word(
+        &mut self,
+        b: &Block<Huaxing>,
+    ) -> Result<bool, ProgramError> {
+        if self.core.setup.live_tool.is_none() {
+            return Ok(false);
+        }
+        let m65 = b.m.iter().any(|&(_, code)| code == 650);
+        // M29's S is the tap's speed, and a tap needs the tool in position control.
+        if b.m.iter().any(|&(_, code)| code == 290) && self.core.live_tool_rpm > 0.0 {
+            return Err(self.fault(
+                Fault::LiveToolSpeed,
+                "M29: a tap needs the live tool in position control; it turns in speed mode \
+                 (M66 first)",
+            ));
+        }
+        match b.get('S') {
+            Some(s) if s > 0.0 && (m65 || self.core.live_tool_rpm > 0.0) => {
+                self.core.live_tool_speed(s)?;
+                Ok(true)
+            }
+            Some(_) | None if m65 => Err(self.fault(
+                Fault::LiveToolSpeed,
+                "M65 turns the live tool at the block's S: a speed above 0 r/min",
+            )),
+            Some(s) if self.core.live_tool_rpm > 0.0 => Err(self.fault(
+                Fault::LiveToolSpeed,
+                format!(
+                    "S{}: the live tool turns in speed mode; M66 stops it",
+                    show(s)
+                ),
+            )),
+            _ => Ok(false),
+        }
+    }
+
+    /// An M code of the table the live tool takes (D143): M65 is its speed mode (its S was
+    /// taken with the block's S), M05 stops it with the spindle (B12.7 = 0). True when the
+    /// PLC does not get the code.
+    pub(super) fn live_tool_m(&mut self, code: u32) -> Result<bool, ProgramError> {
+        if self.core.setup.live_tool.is_none() {
+            return Ok(false);
+        }
+        match code {
+            650 => Ok(true),
+            50 => self.core.live_tool_speed(0.0).map(|()| false),
+            _ => Ok(false),
         }
     }
 }

@@ -214,6 +214,12 @@ impl Family for Huaxing {
     fn tool_word(f: &mut Fanuc<Self>, t: f64) -> Result<(), ProgramError> {
         f.huaxing_tool_word(t)
     }
+    fn speed_word(f: &mut Fanuc<Self>, b: &Block<Self>) -> Result<bool, ProgramError> {
+        f.live_tool_speed_word(b)
+    }
+    fn m_to_nc(f: &mut Fanuc<Self>, code: u32) -> Result<bool, ProgramError> {
+        f.live_tool_m(code)
+    }
     fn m_in_cycle(f: &Fanuc<Self>, b: &Block<Self>) -> bool {
         // In a G83/G87 (G84/G88) block an M word is the spindle clamp code of the cycle
         // (§5.22.7, §5.23.4).
@@ -336,6 +342,7 @@ impl Family for Huaxing {
             HuaxingG::PolarOn => return f.polar_on(),
             HuaxingG::PolarOff => return f.core.polar_off(),
             HuaxingG::RigidTap { .. } => f.rigid_tap_selected(f.motion),
+            HuaxingG::Drilling { radial } => f.drilling_selected(radial),
             HuaxingG::CancelRigid => f.rigid_tap_cancel(),
             _ => {}
         }
@@ -527,13 +534,9 @@ pub fn m_code(n: u32) -> Option<M<ToolMacro>> {
         // M56 moves the turret toward the change position: the PLC's.
         560 => AuxBefore,
         550 => Unsupported("M55 writes PLC F026–F029, which the PLC program does not read"),
-        // D142: the live tool's position control comes with G14.n and M29; its speed mode
-        // (M65 as the table's NC code, geared to the spindle by alarm 73's "electronic gear
-        // ratio") has no words in any section.
-        660 => Unsupported(
-            "M66 live tool position mode: no section gives its words (G14.n and M29 position \
-             the live tool themselves)",
-        ),
+        // M66: the live tool into position control (D143); M65 is in the table above (the
+        // second spindle's stop) and the live tool's speed mode on a turn-mill (`m_to_nc`).
+        660 => Own(ToolMacro::LiveToolPosition),
         590 | 600 | 850 | 860 | 870 | 880 | 890 => {
             Unsupported("NC-internal M code of multi-channel machines")
         }

@@ -156,8 +156,9 @@ impl Fanuc<Huaxing> {
         Ok(())
     }
 
-    /// The hole's C: the block's C (first hole) or H (every hole), at C's rapid.
-    fn index_c(
+    /// The hole's C: the block's C (first hole) or H (every hole), at C's rapid (the drilling
+    /// and tapping cycles' "(X, C)" and "(Z, C)").
+    pub(super) fn index_c(
         &mut self,
         b: &Block<Huaxing>,
         at: &mut [f64],

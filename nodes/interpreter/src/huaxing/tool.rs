@@ -27,6 +27,8 @@ pub enum ToolMacro {
     PositionMode(u8),
     /// M29 S: rigid tapping with the tapping spindle in position control (§5.23.4, D142).
     RigidTapping,
+    /// M66: the live tool out of speed mode into position control (§4.1.5, D143).
+    LiveToolPosition,
 }
 
 impl Fanuc<Huaxing> {
@@ -118,6 +120,7 @@ impl<D: Family<M = ToolMacro>> Fanuc<D> {
             ToolMacro::PositionMode(n) => self.position_mode(n),
             // The Huaxing takes M29 itself (`rigid_tap.rs`); no other dialect has it.
             ToolMacro::RigidTapping => Ok(()),
+            ToolMacro::LiveToolPosition => self.core.live_tool_speed(0.0),
             ToolMacro::RaiseAlarm => {
                 let n = need_k(self)?;
                 let mut e = self.fault(

@@ -1,4 +1,5 @@
-//! What the tests of the Huaxing manual's example programs share: the fixture's text.
+//! What the tests of the Huaxing manual's example programs share: the fixture's text and the
+//! turn-mill's setups.
 #![allow(dead_code)]
 
 /// The listing of fixture `name` of `../shared/fixtures/000`, below its header.
@@ -12,4 +13,14 @@ pub fn fixture(name: &str) -> String {
         .nth(1)
         .expect("listing marker")
         .to_string()
+}
+
+/// A turn-mill lathe at X200 Z100 (diameter), its spindle the C axis.
+pub fn turn_mill() -> cnc_interpreter::Setup {
+    cnc_interpreter::Setup::lathe([200.0, 100.0]).with_spindle_c_axis()
+}
+
+/// The turn-mill with its live tool as axis A (G14.4), up to 2500 r/min.
+pub fn with_live_tool() -> cnc_interpreter::Setup {
+    turn_mill().with_live_tool('A', 4, 2500.0)
 }

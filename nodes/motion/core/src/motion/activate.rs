@@ -43,7 +43,7 @@ impl Motion {
                 ));
             }
         }
-        Ok(())
+        self.check_live_tool_spin(p)
     }
 
     /// Turns a block into its active form; soft limits are checked here, before any motion.
@@ -137,6 +137,10 @@ impl Motion {
                 self.contour_block(*on)?;
                 Ok(Active::Dwell { remaining: 0.0 })
             }
+            Command::LiveTool { rpm } => {
+                self.live_tool_block(*rpm)?;
+                Ok(Active::LiveTool)
+            }
             Command::Aux(code) => Ok(Active::Aux {
                 code: *code,
                 raised: false,
@@ -144,6 +148,8 @@ impl Motion {
             Command::ProgramEnd => {
                 // The end of a program also ends polar interpolation (§5.8: as reset does).
                 self.contour.on = false;
+                // And it stops the live tool: a robot reaches into the machine next.
+                self.stop_live_tool();
                 Ok(Active::End)
             }
         }

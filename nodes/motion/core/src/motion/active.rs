@@ -28,6 +28,8 @@ pub(super) enum Active {
     },
     /// Rigid tapping: the axes follow the positioned spindle (D101).
     Tap(tapping::Tap),
+    /// Waits until the live tool turns at its new speed or stands (D143).
+    LiveTool,
     /// Waits for the axes to settle, then sends the strobe and waits for FIN.
     Aux {
         code: Aux,
@@ -169,7 +171,9 @@ impl Motion {
                 }
                 done
             }
-            Active::End => in_pos,
+            Active::LiveTool => self.live_tool_at_speed(),
+            // The program's end waits for the live tool to stand too.
+            Active::End => in_pos && self.live_tool_at_speed(),
         }
     }
 

@@ -39,6 +39,7 @@ mod feedforward;
 mod fixed_stop;
 pub mod handwheel;
 pub mod jog;
+mod live_tool;
 mod overtravel;
 mod panel;
 mod probe;
@@ -211,7 +212,7 @@ pub struct Motion {
     /// The turn-mill's C axis in the path (polar interpolation, D141).
     contour: contour::Contour,
     /// The turn-mill's live tool in the path (D142).
-    live: contour::LiveTool,
+    live: live_tool::LiveTool,
 }
 
 impl Motion {
@@ -239,7 +240,7 @@ impl Motion {
             .collect();
         Motion {
             contour: contour::Contour::default(),
-            live: contour::LiveTool::of(&cfg),
+            live: live_tool::LiveTool::of(&cfg),
             compressor: false,
             fifo_fill: false,
             timers: RunTimers::default(),
@@ -464,6 +465,8 @@ impl Motion {
         self.release_fixed_stops();
         self.compressor = false;
         self.contour.on = false;
+        // Reset stops the live tool (`000` B08.6).
+        self.stop_live_tool();
         self.fifo_fill = false;
         self.handwheel.stop();
         self.hold_where_slides_are();
@@ -585,6 +588,10 @@ impl Motion {
     pub fn tick(&mut self, actual: Option<&[f64]>, plc: &GImage) -> &[f64] {
         self.live.last = self.live.at;
         self.tick_machine(actual, plc);
+        if self.servo_off || self.emergency_stop {
+            self.stop_live_tool();
+        }
+        self.spin_live_tool();
         if self.at_drives.on {
             self.mark_block_start();
         }
