@@ -164,10 +164,12 @@ fn fixture_015_cuts_three_turns_of_a_helix_with_c_and_z() {
 }
 
 /// Issue 49, must-show 5: a turn-mill part on `sim_turnmill` in the cell over DDS, as a
-/// supervisor runs it: turned; C indexed to 90°, turned on by 180° and back to 0° by G08.6; a
-/// hexagon milled on the face by polar interpolation; four face holes and a side hole tapped
-/// rigidly with the live tool (G84/G88 after M29). The `axes` topic shows C at each stop and
-/// under polar interpolation, the live tool (A) turning, and the part is counted.
+/// supervisor runs it: turned; C indexed to 90°, turned on by 180° and back to 0° by G08.6; two
+/// cross holes drilled at C0 and C180 with the live tool turning at 1400 r/min (M65 S1400,
+/// G87, D143); a hexagon milled on the face by polar interpolation; four face holes and a side
+/// hole tapped rigidly with the live tool (G84/G88 after M29). The `axes` topic shows C at
+/// each stop and under polar interpolation, the live tool (A) at its speed and turning in the
+/// taps, and the part is counted.
 #[test]
 fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     use cnc_cell::client::CellClient;
@@ -186,6 +188,7 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     let mut program = String::from(
         "O0485\nG00 X60 Z5\nM03 S800\nG01 X50 Z0 F300\nZ-20\nG00 X60 Z5\nM05\n\
          M14.6\nG08 C90 F500\nG04 X1\nG08 H180 F500\nG04 X1\nG08.6 C0 F500\n\
+         G00 X60 Z-10\nM65 S1400\nG87 Z-10 C0 X44 F300 M20\nH180 M20\nG00 X60 Z5\nM66\n\
          T0303\nG00 X40 Z0\nG00 C0\nG12.1\nG98\nG01 X30 F900\n",
     );
     // The hexagon of 30 mm across flats on the face, by polar interpolation.
@@ -224,6 +227,9 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
             .map(|x| x.actual_position)
     };
     let (mut stops, mut c_angles, mut tool_angles) = (Vec::new(), Vec::new(), Vec::new());
+    // The live tool at 1400 r/min turns 336° between two messages of the axes topic (every
+    // tenth 4 ms tick): how often the topic showed it so.
+    let (mut last_tool, mut spinning) = (None::<f64>, 0);
     let (done, _) = client.wait_until(Duration::from_secs(90), |c| {
         if let Some(angle) = c_at(c) {
             for want in [90.0, 270.0] {
@@ -237,6 +243,12 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
             }
         }
         if let Some(angle) = tool_at(c) {
+            if let Some(last) = last_tool.replace(angle) {
+                let turned = (angle - last).rem_euclid(360.0);
+                if (turned - 336.0).abs() < 0.5 {
+                    spinning += 1;
+                }
+            }
             let whole = angle.round() as i64;
             if !tool_angles.contains(&whole) {
                 tool_angles.push(whole);
@@ -250,10 +262,13 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     assert!(done, "state {:?}, alarms {:?}", client.state, client.alarms);
     assert_eq!(stops, [90.0, 270.0], "C on the axes topic at its stops");
     println!(
-        "the axes topic showed C at {} angles and the live tool A at {} angles",
+        "the axes topic showed C at {} angles and the live tool A at {} angles, {spinning} \
+         times turning 336° from the last (1400 r/min)",
         c_angles.len(),
         tool_angles.len()
     );
+    // Two cross holes of 8 mm at 300 mm/min, 1.6 s each, with the tool at speed.
+    assert!(spinning > 20, "the live tool drilling at 1400 r/min: {spinning}");
     // The axes topic comes every tenth tick (40 ms): polar interpolation turns C through
     // hundreds of tenths of a degree, the taps the live tool through most of its turn.
     assert!(
@@ -264,12 +279,16 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
         tool_angles.len() > 50,
         "the live tool turning: {tool_angles:?}"
     );
-    // C stands where the side hole left it, the live tool where it started.
+    // C stands where the side hole left it; the live tool stands (where M66 stopped it, the
+    // taps' turns undone), the same angle half a second later.
     let (back, _) = client.wait_until(Duration::from_secs(5), |c| {
         c_at(c).is_some_and(|a| (a - 45.0).abs() < 1e-3)
-            && tool_at(c).is_some_and(|a| a.abs() < 1e-6 || (a - 360.0).abs() < 1e-6)
     });
-    assert!(back, "C at 45°, the live tool at 0°: {:?}", client.axes);
+    assert!(back, "C at 45°: {:?}", client.axes);
+    let stood = tool_at(&client).expect("A on the axes topic");
+    client.wait_until(Duration::from_millis(500), |_| false);
+    let still = tool_at(&client).expect("A on the axes topic");
+    assert!((still - stood).abs() < 1e-6, "the live tool at {stood}°, then {still}°");
     drop(client);
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
@@ -613,4 +632,59 @@ fn rigid_taps_face_and_side_keep_the_slide_on_the_live_tools_angle() {
         assert!((bottoms[k].1 - want).abs() < 1e-6, "hole {k}: {bottoms:?}");
     }
     assert!(!r.bit("ORIENT_REQ"), "M15");
+}
+
+/// Issue 49, must-show 5's cross holes (D143): the live tool in speed mode drills. M65 S1500
+/// turns it; G87 drills four cross holes at Z−10 from X60 to X30 on C 0°, 90°, 180°, 270°
+/// (H90 K3) at F60 mm/min, clamped by M20; M66 stops it. Through motion, the PLC and the
+/// simulated drives: at every servo tick the slide feeds into a hole the tool's drive turns
+/// at 1500 r/min (its actual speed, by its encoder) and C stands at the hole's angle; no
+/// slide moves before the tool is at speed; after M66 and at the end the tool stands.
+#[test]
+fn cross_holes_are_drilled_with_the_live_tool_turning_at_its_speed() {
+    let cfg = config("sim_turnmill");
+    let (x, z) = (cfg.axis_index("X").unwrap(), cfg.axis_index("Z").unwrap());
+    let program = "T0101\nG98\nG00 X60 Z5\nM14.6\nG00 C0\nM65 S1500\nG00 Z-10\n\
+                   G87 Z-10 C0 X30 F60 M20\nH90 K3 M20\nG00 X60 Z5\nM66\nG00 X100 Z50\nM15\nM30\n";
+    let mut r = Rig::on(cfg, program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let (mut feeding, mut slowest, mut fastest) = (0usize, f64::MAX, 0.0f64);
+    let mut holes: Vec<f64> = Vec::new();
+    let mut moved_before_speed = false;
+    let mut last_x = f64::NAN;
+    let ok = r.run_until(120.0, |r| {
+        let set = r.motion.commanded_display();
+        let rpm = r.fb.live_tool_rpm;
+        if r.motion.live_tool_rpm() > 0.0 && r.motion.live_tool_rpm() < 1500.0 && set[z] != 5.0 {
+            moved_before_speed = true;
+        }
+        // Feeding into a hole: X between the hole's top and bottom, going in.
+        if set[z] == -10.0 && set[x] < 60.0 - 1e-6 && set[x] > 30.0 && set[x] < last_x {
+            feeding += 1;
+            slowest = slowest.min(rpm);
+            fastest = fastest.max(rpm);
+            let c = (r.fb.spindle_angle_deg * 1e3).round() / 1e3;
+            if !holes.contains(&c) {
+                holes.push(c);
+            }
+        }
+        last_x = set[x];
+        r.program_done()
+    });
+    assert!(ok, "program did not finish; events {:?}", r.events);
+    println!(
+        "G87 with the live tool: {feeding} ticks feeding, its drive at {slowest:.3}…{fastest:.3} \
+         r/min, C at {holes:?}"
+    );
+    // 15 mm of X (radius) at 60 mm/min is 15 s a hole: four holes, 15,000 ticks.
+    assert!(feeding > 14_000, "{feeding} ticks");
+    assert!(
+        (slowest - 1500.0).abs() < 0.01 && (fastest - 1500.0).abs() < 0.01,
+        "the tool at {slowest}…{fastest} r/min"
+    );
+    assert_eq!(holes, [0.0, 90.0, 180.0, 270.0]);
+    assert!(!moved_before_speed, "a slide moved while the tool ran up");
+    assert_eq!(r.motion.live_tool_rpm(), 0.0, "M66");
+    assert!(r.fb.live_tool_rpm.abs() < 1e-6, "{}", r.fb.live_tool_rpm);
 }
