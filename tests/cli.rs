@@ -400,13 +400,15 @@ fn check_and_simulate_show_the_turn_mills_c_axis() {
         !ok && text.contains("alarm 74 at line 3"),
         "sim_lathe: {text}"
     );
-    // Polar interpolation and a live tool tap (D141, D142): the trace shows C in degrees on
-    // the face's lines and the live tool's A turning with the tap; simulate runs them.
+    // Polar interpolation, a live tool tap and a cross hole (D141, D142, D143): the trace shows
+    // C in degrees on the face's lines, the live tool's A turning with the tap and its speed
+    // for the drilling; simulate runs them.
     let face = dir.join("face.nc");
     std::fs::write(
         &face,
         "T0303\nG00 X40 Z0\nM14.6\nG00 C0\nG12.1\nG98\nG01 X30 F600\nG01 C15\nG13.1\n\
-         G00 X0 Z5\nG14.4 Z-5 R500 F1\nG00 X100\nM15\nM30\n",
+         G00 X0 Z5\nG14.4 Z-5 R500 F1\nG00 X60 Z-5\nM65 S1200\nG87 Z-5 C90 X40 F200\nM66\n\
+         G00 X100\nM15\nM30\n",
     )
     .unwrap();
     let face = face.to_string_lossy();
@@ -422,6 +424,15 @@ fn check_and_simulate_show_the_turn_mills_c_axis() {
         text.contains("LINEAR X0.0000 Z-5.0000 C45.0000 A3600.0000"),
         "{text}"
     );
+    // A cross hole with the live tool turning (D143): its speed, the hole at C90, the stop.
+    for want in [
+        "LIVE_TOOL S1200.0",
+        "ROTARY X60.0000 Z-5.0000 C90.0000 A0.0000 TO90.000 Plus",
+        "LINEAR X40.0000 Z-5.0000 C90.0000 A0.0000 F200.0000",
+        "LIVE_TOOL_STOP",
+    ] {
+        assert!(text.contains(want), "{want}: {text}");
+    }
     let (ok, text) = cnc(&["simulate", "--config", "sim_turnmill", &face]);
     assert!(ok, "{text}");
     let _ = std::fs::remove_dir_all(&dir);
