@@ -268,7 +268,10 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
         tool_angles.len()
     );
     // Two cross holes of 8 mm at 300 mm/min, 1.6 s each, with the tool at speed.
-    assert!(spinning > 20, "the live tool drilling at 1400 r/min: {spinning}");
+    assert!(
+        spinning > 20,
+        "the live tool drilling at 1400 r/min: {spinning}"
+    );
     // The axes topic comes every tenth tick (40 ms): polar interpolation turns C through
     // hundreds of tenths of a degree, the taps the live tool through most of its turn.
     assert!(
@@ -288,7 +291,10 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     let stood = tool_at(&client).expect("A on the axes topic");
     client.wait_until(Duration::from_millis(500), |_| false);
     let still = tool_at(&client).expect("A on the axes topic");
-    assert!((still - stood).abs() < 1e-6, "the live tool at {stood}°, then {still}°");
+    assert!(
+        (still - stood).abs() < 1e-6,
+        "the live tool at {stood}°, then {still}°"
+    );
     drop(client);
     let (_, errors) = cell.stop();
     assert!(errors.is_empty(), "{errors:?}");
