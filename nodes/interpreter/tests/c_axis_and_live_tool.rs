@@ -64,8 +64,10 @@ fn fixture_004_positions_c_and_turns_it_with_x_and_z() {
 
 /// Fixture 015's first two listings: to C0, the infeed U−1.5 at the feed, then three turns
 /// of C with Z 4.5 mm along (a 1.5 mm thread's three turns at 800 r/min); the G08.6 form
-/// gives the same stream. Its third listing makes Y the rotary axis (G08.2 Y100): the
-/// turn-mill's only rotary axis is C, alarm 7 with that reason (M14.2 alone too).
+/// gives the same stream. Its third listing makes Y the spindle's axis (G08.2 Y100), for a
+/// machine built so: this turn-mill has no Y (its address is alarm 7, as on any lathe
+/// without one), and G08.2 C100 or M14.2 is alarm 74 ("rotary axis not defined"): its
+/// spindle's axis is C.
 #[test]
 fn fixture_015_three_turns_of_c_with_z_along() {
     let text = fixture("015_g08_rotary_axis_examples.nc");
@@ -88,13 +90,16 @@ fn fixture_015_three_turns_of_c_with_z_along() {
     }
     let e = hx("G08.2 Y100 F1000\n", turn_mill()).unwrap_err();
     assert_eq!(e.number, 7, "{e}");
-    assert!(e.text.contains("G08.1–G08.5"), "{e}");
-    assert_eq!(hx("M14.2\n", turn_mill()).unwrap_err().number, 7);
+    assert!(e.text.contains("address Y"), "{e}");
+    let e = hx("G08.2 C100 F1000\n", turn_mill()).unwrap_err();
+    assert_eq!(e.number, 74, "{e}");
+    assert!(e.text.contains("not axis Y"), "{e}");
+    assert_eq!(hx("M14.2\n", turn_mill()).unwrap_err().number, 74);
 }
 
 /// The section's alarms: G08 without C or H is 80; C and H together 9; the first G08
 /// without F 23; F above 3000 r/min 13; a C word outside G08 74; on a lathe whose spindle
-/// is no C axis G08 and M14.6 are 74; M14.3 (Z as the spindle's axis) 7: only C is built.
+/// is no C axis G08 and M14.6 are 74, and so is M14.3 (Z as the spindle's axis) on this one.
 #[test]
 fn the_c_axis_alarms() {
     let cases = [
@@ -105,7 +110,7 @@ fn the_c_axis_alarms() {
         ("G01 Z10 C10 F100\n", turn_mill(), 74, 1),
         ("G08 C10 F100\n", Setup::lathe([200.0, 100.0]), 74, 1),
         ("M14.6\n", Setup::lathe([200.0, 100.0]), 74, 1),
-        ("M14.3\n", turn_mill(), 7, 1),
+        ("M14.3\n", turn_mill(), 74, 1),
     ];
     for (text, setup, number, line) in cases {
         let e = hx(text, setup).unwrap_err();

@@ -425,10 +425,13 @@ pub fn g_code(n: u32) -> Option<GCode<HuaxingG>> {
             ),
         ),
         80 => (1, G::Own(Rotary { orient: None })),
-        86 => (1, G::Own(Rotary { orient: Some(6) })),
-        81..=85 => (
+        // G08.n names axis n (1…6, X…C) as the spindle's: on a machine whose spindle is
+        // another axis, alarm 74 "rotary axis not defined" (`position_mode`, D138).
+        81..=86 => (
             1,
-            Unsupported("G08.1–G08.5 make X…B a rotary axis: the turn-mill's is the spindle, C"),
+            G::Own(Rotary {
+                orient: Some((n - 80) as u8),
+            }),
         ),
         90 => (15, ExactStopBlock),
         121 => (16, G::Own(PolarOn)),
@@ -521,8 +524,8 @@ pub fn m_code(n: u32) -> Option<M<ToolMacro>> {
         480 => AuxAfter,
         980 => SubprogramCall,
         990 => SubprogramReturn,
-        146 => Own(ToolMacro::PositionMode(6)),
-        141..=145 => Unsupported("M14.1–M14.5 give X…B the spindle's angle: the turn-mill's is C"),
+        // M14.n as G08.n: axis n must be the machine's spindle axis (alarm 74 otherwise).
+        141..=146 => Own(ToolMacro::PositionMode((n - 140) as u8)),
         290 => Own(ToolMacro::RigidTapping),
         500 => Unsupported("M50 bar feed drives outputs directly, not through the PLC"),
         510 => Unsupported("M51 sets the start block in MDI"),
