@@ -694,3 +694,57 @@ fn cross_holes_are_drilled_with_the_live_tool_turning_at_its_speed() {
     assert_eq!(r.motion.live_tool_rpm(), 0.0, "M66");
     assert!(r.fb.live_tool_rpm.abs() < 1e-6, "{}", r.fb.live_tool_rpm);
 }
+
+/// D143's stop through the standard ladder: the door opened while the live tool drills. The
+/// ladder raises the door alarm (A3.0), holds the feed (*SP) and stops the live tool by
+/// *SSTP (G29.6, B09.5 = 0): its drive brakes to a stand within its time constant while the
+/// slide stands; closing the door does not restart it, reset does not either (the tool stays
+/// standing: reset stops speed mode).
+#[test]
+fn the_door_opened_while_the_live_tool_drills_stops_it_through_the_ladder() {
+    let cfg = config("sim_turnmill");
+    let x = cfg.axis_index("X").unwrap();
+    let program =
+        "T0101\nG98\nG00 X60 Z-10\nM14.6\nG00 C0\nM65 S2000\nG87 Z-10 C0 X30 F30\nM66\nM30\n";
+    let mut r = Rig::on(cfg, program, None);
+    r.run_until(0.1, |_| false);
+    r.started = true;
+    let drilling = r.run_until(20.0, |r| r.motion.commanded_display()[x] < 55.0);
+    assert!(drilling, "the drill in the hole");
+    assert!(
+        (r.fb.live_tool_rpm - 2000.0).abs() < 0.01,
+        "{}",
+        r.fb.live_tool_rpm
+    );
+    r.sim.devices.door_forced_open = true;
+    let opened = r.t;
+    assert!(
+        r.run_until(0.1, |r| r.message("A3.0").is_some()),
+        "door alarm"
+    );
+    assert!(!r.gi.get(g::SSTP_N), "*SSTP low");
+    // The alarm within a scan or two (30 ms), 2000 r/min of 2500 in 0.239 s (0.19 s), the
+    // drive's 12 ms lag and its last r/min (60 ms): 0.3 s.
+    let stood = r.run_until(0.5, |r| {
+        r.motion.live_tool_rpm() == 0.0 && r.fb.live_tool_rpm.abs() < 1.0
+    });
+    let after = r.t - opened;
+    assert!(stood, "the tool still at {} r/min", r.fb.live_tool_rpm);
+    assert!(after < 0.3, "stood after {after:.3} s");
+    let held = r.motion.commanded_display();
+    r.sim.devices.door_forced_open = false;
+    r.run_until(1.0, |_| false);
+    assert_eq!(r.motion.commanded_display(), held, "the slide stands");
+    assert!(
+        r.fb.live_tool_rpm.abs() < 1e-6,
+        "the tool stands: {}",
+        r.fb.live_tool_rpm
+    );
+    r.motion.reset();
+    r.run_until(1.0, |_| false);
+    assert_eq!(r.motion.live_tool_rpm(), 0.0, "reset ends speed mode");
+    println!(
+        "the door open: the live tool stood after {after:.3} s, the slide at X{:.3}",
+        held[x]
+    );
+}

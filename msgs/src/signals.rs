@@ -134,6 +134,7 @@ impl GImage {
         let mut g = GImage::default();
         g.set(g::ESP_N, true);
         g.set(g::SP_N, true);
+        g.set(g::SSTP_N, true);
         g.bytes[g::FEED_OVERRIDE as usize] = 100;
         g.bytes[g::SPINDLE_OVERRIDE as usize] = 100;
         g
@@ -276,6 +277,10 @@ pub mod g {
     pub const SP_N: Bit = bit(8, 5);
     /// Emergency stop, active low.
     pub const ESP_N: Bit = bit(8, 4);
+    /// Spindle stop `*SSTP`, active low (`000` §9.5 G29.6): the NC's spindle output, which on
+    /// a turn-mill is the live tool's, stops while it is low and comes back when it rises
+    /// (B09.5 = 0: a spindle stop stops the live tool too; D143).
+    pub const SSTP_N: Bit = bit(29, 6);
     /// Feed override, percent in binary (FANUC's `*FV` bits in positive logic).
     pub const FEED_OVERRIDE: u16 = 12;
     pub const ROV1: Bit = bit(14, 0);

@@ -178,8 +178,10 @@ impl Motion {
     }
 
     /// One tick of speed mode: the speed ramps toward the target at the tool's acceleration
-    /// and the angle turns on; once it stands again the program's angle 0 is there.
-    pub(super) fn spin_live_tool(&mut self) {
+    /// and the angle turns on; once it stands again the program's angle 0 is there. While the
+    /// PLC's `*SSTP` is low (`allowed` false) the target is 0 and a block waiting for the
+    /// speed waits; when it rises the tool runs up to the programmed speed again.
+    pub(super) fn spin_live_tool(&mut self, allowed: bool) {
         let Some(tool) = self.cfg.live_tool.as_ref() else {
             return;
         };
@@ -188,7 +190,8 @@ impl Motion {
         }
         let dt = self.cfg.period;
         let step = tool.acceleration() * dt;
-        let (from, to) = (self.live.speed, self.live.target);
+        let to = if allowed { self.live.target } else { 0.0 };
+        let from = self.live.speed;
         let speed = match to - from {
             d if d.abs() <= step => to,
             d => from + step * d.signum(),

@@ -591,7 +591,7 @@ impl Motion {
         if self.servo_off || self.emergency_stop {
             self.stop_live_tool();
         }
-        self.spin_live_tool();
+        self.spin_live_tool(plc.get(g::SSTP_N));
         if self.at_drives.on {
             self.mark_block_start();
         }
