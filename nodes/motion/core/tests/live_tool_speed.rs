@@ -5,7 +5,7 @@
 
 use cnc_machine::LiveToolEntry;
 use cnc_motion_core::{Block, Command, Motion, RunState};
-use cnc_msgs::signals::GImage;
+use cnc_msgs::signals::{g, GImage, SignalTable};
 
 mod support;
 use support::*;
@@ -192,4 +192,28 @@ fn speed_mode_is_refused_above_the_top_speed_without_a_live_tool_and_with_the_dr
     ticks(&mut queued, &g, 3);
     assert_eq!(alarms(&mut queued), [(111, 9)]);
     assert_eq!(queued.live_tool_rpm(), 0.0);
+}
+
+#[test]
+fn the_plcs_spindle_stop_brakes_the_tool_and_lets_it_run_up_again() {
+    let mut plc = GImage::released();
+    let mut m = turn_mill();
+    for b in program(vec![
+        Command::LiveTool { rpm: 1000.0 },
+        Command::Dwell { seconds: 10.0 },
+    ]) {
+        m.push(b);
+    }
+    ticks(&mut m, &plc, 100);
+    assert_eq!(m.live_tool_rpm(), 1000.0);
+    plc.set(g::SSTP_N, false);
+    // 1000 r/min at 10,000 r/min a second: 25 ticks.
+    ticks(&mut m, &plc, 25);
+    assert_eq!(m.live_tool_rpm(), 0.0, "braked by *SSTP");
+    let stood = m.live_tool_setpoint();
+    ticks(&mut m, &plc, 50);
+    assert_eq!(m.live_tool_setpoint(), stood, "standing while *SSTP is low");
+    plc.set(g::SSTP_N, true);
+    ticks(&mut m, &plc, 25);
+    assert_eq!(m.live_tool_rpm(), 1000.0, "at the programmed speed again");
 }
