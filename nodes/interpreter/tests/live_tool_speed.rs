@@ -92,14 +92,28 @@ fn cross_and_face_holes_are_drilled_with_the_live_tool_turning() {
     );
 }
 
-/// While the tool turns every S is its speed; after M66 S is the spindle's again. On a lathe
+/// While the tool turns every S is its speed (but G50's and G97's); after M66 S is the
+/// spindle's again. On a lathe
 /// without a live tool M65 stays the second spindle's stop for the PLC.
 #[test]
 fn s_is_the_live_tools_speed_while_it_turns_and_m65_is_the_plcs_elsewhere() {
-    let cmds = hx("M65 S1000\nS1800\nM66\nS500 M03\nM30\n", with_live_tool()).unwrap();
+    // G50's S stays the spindle's clamp and G97's its r/min, also while the tool turns.
+    let cmds = hx(
+        "M65 S1000\nS1800\nG50 S2000\nG97 S300\nM66\nS500 M03\nM30\n",
+        with_live_tool(),
+    )
+    .unwrap();
     assert_eq!(
         steps(&cmds),
-        ["LIVE 1000", "LIVE 1800", "LIVE 0", "S500", "M3", "M30"]
+        [
+            "LIVE 1000",
+            "LIVE 1800",
+            "S300",
+            "LIVE 0",
+            "S500",
+            "M3",
+            "M30"
+        ]
     );
     let plain = Setup::lathe([200.0, 100.0]);
     let cmds = hx("M63\nS1000 M65\nM30\n", plain).unwrap();

@@ -14,6 +14,7 @@ use cnc_interpreter_core::{show, Command, Fault, ProgramError};
 
 use super::Huaxing;
 use crate::fanuc::block::Block;
+use crate::fanuc::codes::G;
 use crate::fanuc::Fanuc;
 
 /// G14's modal words.
@@ -118,7 +119,10 @@ impl Fanuc<Huaxing> {
                  (M66 first)",
             ));
         }
-        match b.get('S') {
+        // G50's S is the spindle's clamp, G96/G97's its surface speed or r/min: never the
+        // live tool's.
+        let spindles = b.has_g(G::SetCoordinate) || b.group(2).is_some();
+        match b.get('S').filter(|_| !spindles) {
             Some(s) if s > 0.0 && (m65 || self.core.live_tool_rpm > 0.0) => {
                 self.core.live_tool_speed(s)?;
                 Ok(true)
