@@ -39,16 +39,7 @@ impl Core {
                 format!("tapping pitch {} is not valid", show(lead)),
             ));
         }
-        if !(rpm > 0.0 && rpm <= tool.max_rpm) {
-            return Err(self.fault(
-                Fault::LiveToolSpeed,
-                format!(
-                    "live tool speed {} r/min: above 0 and at most {}",
-                    show(rpm),
-                    show(tool.max_rpm)
-                ),
-            ));
-        }
+        self.check_live_tool_rpm(tool.max_rpm, rpm)?;
         let mut m = self.to_machine(end);
         m[a] = self.pos[a];
         // The slides' travel in mm (a diameter axis counts half), the tool's turns from it.
@@ -83,20 +74,28 @@ impl Core {
         let Some(tool) = self.setup.live_tool else {
             return Err(self.fault(Fault::RotaryAxis, "this machine has no live tool"));
         };
-        if rpm != 0.0 && !(rpm > 0.0 && rpm <= tool.max_rpm) {
-            return Err(self.fault(
-                Fault::LiveToolSpeed,
-                format!(
-                    "live tool speed {} r/min: above 0 and at most {}",
-                    show(rpm),
-                    show(tool.max_rpm)
-                ),
-            ));
+        if rpm != 0.0 {
+            self.check_live_tool_rpm(tool.max_rpm, rpm)?;
         }
         if rpm != self.live_tool_rpm {
             self.live_tool_rpm = rpm;
             self.push(Command::LiveTool { rpm });
         }
         Ok(())
+    }
+
+    /// A live tool speed must be above 0 and at most the tool's top speed (S#122): alarm 73.
+    fn check_live_tool_rpm(&self, max_rpm: f64, rpm: f64) -> Result<(), ProgramError> {
+        match rpm > 0.0 && rpm <= max_rpm {
+            true => Ok(()),
+            false => Err(self.fault(
+                Fault::LiveToolSpeed,
+                format!(
+                    "live tool speed {} r/min: above 0 and at most {}",
+                    show(rpm),
+                    show(max_rpm)
+                ),
+            )),
+        }
     }
 }

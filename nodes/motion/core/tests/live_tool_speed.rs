@@ -4,7 +4,7 @@
 //! a tap after it turns from where it stopped. Program end and reset stop it.
 
 use cnc_machine::LiveToolEntry;
-use cnc_motion_core::{Block, Command, Motion, RunState};
+use cnc_motion_core::{Block, Command, Motion, MotionConfig, RunState};
 use cnc_msgs::signals::{g, GImage, SignalTable};
 
 mod support;
@@ -13,7 +13,7 @@ use support::*;
 const PERIOD: f64 = 0.004;
 
 /// The lathe with a live tool A: 2500 r/min top speed in 0.25 s.
-fn turn_mill() -> Motion {
+fn with_live_tool() -> MotionConfig {
     let mut cfg = lathe();
     cfg.live_tool = Some(LiveToolEntry {
         axis: "A".into(),
@@ -21,7 +21,11 @@ fn turn_mill() -> Motion {
         time_constant: 0.25,
         drive_lag: 0.008,
     });
-    Motion::new(cfg, &[50.0, 0.0])
+    cfg
+}
+
+fn turn_mill() -> Motion {
+    Motion::new(with_live_tool(), &[50.0, 0.0])
 }
 
 fn program(kinds: Vec<Command>) -> Vec<Block> {
@@ -179,13 +183,7 @@ fn speed_mode_is_refused_above_the_top_speed_without_a_live_tool_and_with_the_dr
     plain.push(block(1, 8, Command::LiveTool { rpm: 1000.0 }));
     ticks(&mut plain, &g, 3);
     assert_eq!(alarms(&mut plain), [(111, 8)]);
-    let mut cfg = lathe();
-    cfg.live_tool = Some(LiveToolEntry {
-        axis: "A".into(),
-        max_rpm: 2500.0,
-        time_constant: 0.25,
-        drive_lag: 0.008,
-    });
+    let mut cfg = with_live_tool();
     cfg.time_scaling_at_drives = true;
     let mut queued = Motion::new(cfg, &[50.0, 0.0]);
     queued.push(block(1, 9, Command::LiveTool { rpm: 1000.0 }));
