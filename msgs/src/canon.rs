@@ -357,17 +357,22 @@ pub fn to_motion_block(
         }
         Command::Aux(aux) => {
             m.kind = MotionBlock::KIND_AUX;
-            (m.aux_kind, m.aux_code, m.aux_value) = match *aux {
-                Aux::M(code) => (MotionBlock::AUX_M, code, 0.0),
-                Aux::S(value) => (MotionBlock::AUX_S, 0, value),
-                Aux::T(code) => (MotionBlock::AUX_T, code, 0.0),
-                Aux::Orient { degrees, way } => (MotionBlock::AUX_ORIENT, way as i32, degrees),
-                Aux::H { address, value } => (MotionBlock::AUX_H, i32::from(address), value),
-            };
+            (m.aux_kind, m.aux_code, m.aux_value) = aux_wire(*aux);
         }
         Command::ProgramEnd => m.kind = MotionBlock::KIND_PROGRAM_END,
     }
     m
+}
+
+/// An auxiliary function's wire fields: its kind, code and value.
+fn aux_wire(aux: Aux) -> (u8, i32, f64) {
+    match aux {
+        Aux::M(code) => (MotionBlock::AUX_M, code, 0.0),
+        Aux::S(value) => (MotionBlock::AUX_S, 0, value),
+        Aux::T(code) => (MotionBlock::AUX_T, code, 0.0),
+        Aux::Orient { degrees, way } => (MotionBlock::AUX_ORIENT, way as i32, degrees),
+        Aux::H { address, value } => (MotionBlock::AUX_H, i32::from(address), value),
+    }
 }
 
 /// The command a block carries. Anyone on the DDS domain can publish blocks, so every value is
