@@ -324,8 +324,14 @@ fn print_progress(c: &CellClient, done: u32) {
                 .join(" ")
         })
         .unwrap_or_default();
+    // A turn-mill's live tool (D143), where the machine has one.
+    let live = c
+        .live_tool
+        .as_ref()
+        .map(|t| format!(" | live tool {:>5.0} rpm", t.actual_rpm))
+        .unwrap_or_default();
     println!(
-        "{:<17} {} line {:>4} | {} | spindle {:>6.0} rpm (cmd {:.0}) | parts {} | cycles done {}",
+        "{:<17} {} line {:>4} | {} | spindle {:>6.0} rpm (cmd {:.0}){live} | parts {} | cycles done {}",
         s.map(|s| s.execution_name.as_str()).unwrap_or("-"),
         s.map(|s| s.program.as_str()).unwrap_or(""),
         s.map(|s| s.line).unwrap_or(0),

@@ -230,6 +230,9 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     // The live tool at 1400 r/min turns 336° between two messages of the axes topic (every
     // tenth 4 ms tick): how often the topic showed it so.
     let (mut last_tool, mut spinning) = (None::<f64>, 0);
+    // The `live_tool` topic: messages (by their stamps) that showed it at 1400 r/min, asked
+    // and actual.
+    let (mut at_speed, mut last_stamp) = (0, None);
     let (done, _) = client.wait_until(Duration::from_secs(90), |c| {
         if let Some(angle) = c_at(c) {
             for want in [90.0, 270.0] {
@@ -240,6 +243,15 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
             let tenth = (angle * 10.0).round() as i64;
             if !c_angles.contains(&tenth) {
                 c_angles.push(tenth);
+            }
+        }
+        if let Some(t) = &c.live_tool {
+            let stamp = Some((t.stamp.sec, t.stamp.nanosec));
+            let new = stamp != last_stamp;
+            last_stamp = stamp;
+            if new && t.commanded_rpm == 1400.0 && t.at_speed && (t.actual_rpm - 1400.0).abs() < 1.0
+            {
+                at_speed += 1;
             }
         }
         if let Some(angle) = tool_at(c) {
@@ -263,7 +275,8 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     assert_eq!(stops, [90.0, 270.0], "C on the axes topic at its stops");
     println!(
         "the axes topic showed C at {} angles and the live tool A at {} angles, {spinning} \
-         times turning 336° from the last (1400 r/min)",
+         times turning 336° from the last (1400 r/min); the live_tool topic {at_speed} times at \
+         1400 r/min",
         c_angles.len(),
         tool_angles.len()
     );
@@ -271,6 +284,10 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     assert!(
         spinning > 20,
         "the live tool drilling at 1400 r/min: {spinning}"
+    );
+    assert!(
+        at_speed > 20,
+        "the live_tool topic at 1400 r/min: {at_speed}"
     );
     // The axes topic comes every tenth tick (40 ms): polar interpolation turns C through
     // hundreds of tenths of a degree, the taps the live tool through most of its turn.
@@ -294,6 +311,11 @@ fn a_turn_mill_part_runs_in_the_cell_with_c_on_the_axes_topic() {
     assert!(
         (still - stood).abs() < 1e-6,
         "the live tool at {stood}°, then {still}°"
+    );
+    let live = client.live_tool.as_ref().expect("the live_tool topic");
+    assert!(
+        live.positioned && live.commanded_rpm == 0.0 && live.actual_rpm < 1e-6,
+        "{live:?}"
     );
     drop(client);
     let (_, errors) = cell.stop();

@@ -29,6 +29,7 @@ pub struct CellClient {
     overrides: Door<SetOverridesRequest, SetOverridesResponse>,
     machine: Newest<MachineState>,
     spindle_sub: Newest<SpindleState>,
+    live_tool_sub: Newest<SpindleState>,
     parts: Newest<PartCount>,
     alarms_sub: Newest<ActiveAlarms>,
     axes_sub: Newest<AxisState>,
@@ -36,6 +37,8 @@ pub struct CellClient {
     handshake_sub: Newest<RobotHandshake>,
     pub state: Option<MachineState>,
     pub spindle: Option<SpindleState>,
+    /// A turn-mill's live tool (D143): none on a machine without one.
+    pub live_tool: Option<SpindleState>,
     pub part_count: Option<PartCount>,
     pub alarms: Option<ActiveAlarms>,
     pub axes: Option<AxisState>,
@@ -145,6 +148,7 @@ impl CellClient {
                 qos::state().history(History::KeepLast { depth: 64 }),
             )?),
             spindle_sub: Newest::new(ros.dds_subscription(&topics::SPINDLE)?),
+            live_tool_sub: Newest::new(ros.dds_subscription(&topics::LIVE_TOOL)?),
             parts: Newest::new(ros.dds_subscription(&topics::PART_COUNT)?),
             alarms_sub: Newest::new(ros.dds_subscription(&topics::ALARMS)?),
             axes_sub: Newest::new(ros.dds_subscription(&topics::AXES)?),
@@ -156,6 +160,7 @@ impl CellClient {
             timeout: Duration::from_secs(20),
             state: None,
             spindle: None,
+            live_tool: None,
             part_count: None,
             alarms: None,
             axes: None,
@@ -220,6 +225,7 @@ impl CellClient {
         }
         let heard = [
             self.spindle_sub.take_into(&mut self.spindle),
+            self.live_tool_sub.take_into(&mut self.live_tool),
             self.parts.take_into(&mut self.part_count),
             self.alarms_sub.take_into(&mut self.alarms),
             self.axes_sub.take_into(&mut self.axes),

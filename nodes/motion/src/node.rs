@@ -10,6 +10,7 @@ use std::time::Duration;
 use cnc_msgs::canon::from_motion_block;
 use cnc_msgs::msg::{
     Alarm, Axis, AxisState, CommandResult, MotionBlock, MotionCommand, MotionStatus, ServoStats,
+    SpindleState,
 };
 use cnc_msgs::servo::{ServoFeedback, ServoSetpoint, MAX_AXES};
 use cnc_msgs::signals::{FImage, GImage};
@@ -113,6 +114,11 @@ fn dds_loop(
     let status_pub = ros.publisher::<MotionStatus>(&topics::MOTION_STATUS)?;
     let axes_pub = ros.publisher::<AxisState>(&topics::AXES)?;
     let stats_pub = ros.publisher::<ServoStats>(&topics::SERVO_STATS)?;
+    // A turn-mill's live tool as a spindle (D143).
+    let live_pub = match cfg.machine.live_tool {
+        Some(_) => Some(ros.publisher::<SpindleState>(&topics::LIVE_TOOL)?),
+        None => None,
+    };
     let alarms = AlarmReporter::new(&mut ros, "motion")?;
     let axes = &cfg.machine.axes;
     // Motion's alarms are latched, as the manuals' are: they stay until reset (`000` §2.4,
@@ -194,6 +200,9 @@ fn dds_loop(
                 }
                 Ok(Report::Axes(r)) => {
                     publish(&axes_pub, axis_state(&r, cfg));
+                    if let (Some(p), Some(live)) = (&live_pub, &r.live_tool) {
+                        publish(p, live_tool_state(live));
+                    }
                 }
                 Ok(Report::Stats(s)) => publish(&stats_pub, s),
                 Ok(Report::Answer(id, result)) => publish(&results_pub, answer(id, result)),
@@ -224,8 +233,18 @@ pub(crate) struct AxesReport {
     referenced: u32,
     limits: (u32, u32),
     spindle_angle: f64,
-    /// The live tool's setpoint and actual angle, degrees (D142).
-    live_tool: Option<(f64, f64)>,
+    /// The live tool's, on a turn-mill (D142, D143).
+    live_tool: Option<LiveToolReport>,
+}
+
+/// The live tool as the `axes` and `live_tool` topics show it.
+pub(crate) struct LiveToolReport {
+    /// Setpoint and actual angle, degrees turned.
+    angle: (f64, f64),
+    /// The speed mode's speed, r/min (0: position control), and the drive's actual speed.
+    rpm: (f64, f64),
+    /// It turns at the speed asked for (stands, in position control).
+    at_speed: bool,
 }
 
 /// The `axes` topic's message: the configured axes, and on a turn-mill the spindle as C (its
@@ -262,7 +281,8 @@ fn axis_state(r: &AxesReport, cfg: &cnc_runtime::LaunchConfig) -> AxisState {
         });
     }
     // The live tool's angle, 0–360° as C's (D142).
-    if let (Some((set, actual)), Some(t)) = (r.live_tool, &cfg.machine.live_tool) {
+    if let (Some(live), Some(t)) = (&r.live_tool, &cfg.machine.live_tool) {
+        let (set, actual) = live.angle;
         list.push(Axis {
             name: t.axis.clone(),
             commanded_position: set.rem_euclid(360.0),
@@ -277,6 +297,26 @@ fn axis_state(r: &AxesReport, cfg: &cnc_runtime::LaunchConfig) -> AxisState {
         stamp: stamp(),
         axes: list,
         machine_lock: n > 0 && r.locked == (1u32 << n) - 1,
+    }
+}
+
+/// The `live_tool` topic's message: the tool as a spindle, turning its positive way in speed
+/// mode, positioned in position control (D143).
+fn live_tool_state(live: &LiveToolReport) -> SpindleState {
+    let (commanded, actual) = live.rpm;
+    SpindleState {
+        stamp: stamp(),
+        commanded_rpm: commanded,
+        actual_rpm: actual.abs(),
+        direction: match commanded > 0.0 {
+            true => SpindleState::DIRECTION_CW,
+            false => SpindleState::DIRECTION_STOP,
+        },
+        load: 0.0,
+        override_percent: 100.0,
+        at_speed: live.at_speed,
+        positioned: commanded == 0.0 && live.at_speed,
+        position_deg: live.angle.1.rem_euclid(360.0),
     }
 }
 
@@ -375,8 +415,8 @@ fn publish<M: ros2_client::Message + std::fmt::Debug + Send + Sync + 'static>(
 pub(crate) struct Latest {
     pub(crate) actual: [f64; MAX_AXES],
     spindle: (f64, f64),
-    /// The live tool's angle, degrees turned (D142).
-    live_tool: f64,
+    /// The live tool's angle, degrees turned (D142), and speed, r/min (D143).
+    live_tool: (f64, f64),
     /// The dogs and index marks; a mark is passed on once.
     reference: ReferenceInputs,
     /// The overtravel switches (+, −).
@@ -391,7 +431,7 @@ impl Latest {
         Latest {
             actual: fb.position,
             spindle: (fb.spindle_rpm, fb.spindle_angle_deg),
-            live_tool: fb.live_tool_angle,
+            live_tool: (fb.live_tool_angle, fb.live_tool_rpm),
             reference: ReferenceInputs::default(),
             overtravel: (fb.overtravel_plus, fb.overtravel_minus),
             handwheel: fb.handwheel_count,
@@ -402,7 +442,7 @@ impl Latest {
     pub(crate) fn read(&mut self, fb: &ServoFeedback, n: usize) {
         self.actual = fb.position;
         self.spindle = (fb.spindle_rpm, fb.spindle_angle_deg);
-        self.live_tool = fb.live_tool_angle;
+        self.live_tool = (fb.live_tool_angle, fb.live_tool_rpm);
         self.reference.dog = fb.reference_dog;
         self.overtravel = (fb.overtravel_plus, fb.overtravel_minus);
         self.handwheel = fb.handwheel_count;
@@ -421,7 +461,7 @@ impl Latest {
     pub(crate) fn give(&mut self, motion: &mut Motion, have_feedback: bool) {
         if have_feedback {
             motion.spindle_feedback(self.spindle.0, self.spindle.1);
-            motion.live_tool_feedback(self.live_tool);
+            motion.live_tool_feedback(self.live_tool.0, self.live_tool.1);
         }
         motion.reference_inputs(self.reference);
         self.reference.marker = 0;
@@ -648,11 +688,14 @@ pub(crate) fn report_axes(motion: &Motion, limits: (u32, u32), reports: &Sender<
         referenced,
         limits,
         spindle_angle: motion.spindle_angle(),
-        live_tool: motion
-            .config()
-            .live_tool
-            .as_ref()
-            .map(|_| (motion.live_tool_setpoint(), motion.live_tool_actual())),
+        live_tool: motion.config().live_tool.as_ref().map(|_| {
+            let (rpm, at_speed) = motion.live_tool_mode();
+            LiveToolReport {
+                angle: (motion.live_tool_setpoint(), motion.live_tool_actual()),
+                rpm: (rpm, motion.live_tool_actual_rpm()),
+                at_speed,
+            }
+        }),
     })));
 }
 

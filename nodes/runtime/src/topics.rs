@@ -57,6 +57,8 @@ pub const MACHINE_STATE: Topic = topic(
 );
 pub const SPINDLE: Topic = topic("spindle", "cnc_msgs/msg/SpindleState", Delivery::State);
 pub const AXES: Topic = topic("axes", "cnc_msgs/msg/AxisState", Delivery::State);
+/// A turn-mill's live tool as a spindle: its speed in speed mode, its angle (D143).
+pub const LIVE_TOOL: Topic = topic("live_tool", "cnc_msgs/msg/SpindleState", Delivery::State);
 pub const PART_COUNT: Topic = topic("part_count", "cnc_msgs/msg/PartCount", Delivery::State);
 pub const ALARMS: Topic = topic("alarms", "cnc_msgs/msg/ActiveAlarms", Delivery::State);
 pub const ALARM_EVENTS: Topic = topic(
@@ -155,6 +157,7 @@ pub const ALL: &[Topic] = &[
     MACHINE_STATE,
     SPINDLE,
     AXES,
+    LIVE_TOOL,
     PART_COUNT,
     ALARMS,
     ALARM_EVENTS,

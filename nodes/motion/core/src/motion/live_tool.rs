@@ -24,6 +24,8 @@ pub(super) struct LiveTool {
     base: f64,
     /// The drive's actual angle, as its feedback says.
     actual: f64,
+    /// The drive's actual speed, r/min, as its feedback says.
+    actual_rpm: f64,
     /// How much longer the tool's drive lags than the slides', s (the config's lags).
     lead_time: f64,
     /// Speed mode: the speed asked for, degrees/s (0: stand).
@@ -204,11 +206,25 @@ impl Motion {
         }
     }
 
-    /// The live tool drive's reported angle.
-    pub fn live_tool_feedback(&mut self, angle: f64) {
+    /// The live tool drive's reported angle (degrees turned) and speed (r/min).
+    pub fn live_tool_feedback(&mut self, angle: f64, rpm: f64) {
         if angle.is_finite() {
             self.live.actual = angle;
         }
+        if rpm.is_finite() {
+            self.live.actual_rpm = rpm;
+        }
+    }
+
+    /// The live tool drive's reported speed, r/min.
+    pub fn live_tool_actual_rpm(&self) -> f64 {
+        self.live.actual_rpm
+    }
+
+    /// The live tool's speed mode: the speed its last block asked for, r/min (0: position
+    /// control), and whether it turns at it (stands, for 0).
+    pub fn live_tool_mode(&self) -> (f64, bool) {
+        (self.live.target / 6.0, self.live_tool_at_speed())
     }
 
     /// The live tool's actual angle, degrees since power-on.
