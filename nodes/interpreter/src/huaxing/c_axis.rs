@@ -122,24 +122,21 @@ impl Fanuc<Huaxing> {
         Some(self.turn_c(b, rpm))
     }
 
-    /// C to the block's C (or by H) at `rpm`, X and Z geared to its angle (G08's move).
-    pub(super) fn turn_c(&mut self, b: &Block<Huaxing>, rpm: f64) -> Result<(), ProgramError> {
-        let c_index = self.core.axis('C');
+    /// The block's C as a turn of the C axis: an absolute C within one revolution, its sign
+    /// the way (C−750 turns the negative way to −30°, that is 330°; D138: the manual's "320°"
+    /// is a slip), or H a travel of any number of turns; none without either.
+    pub(super) fn c_target(&self, b: &Block<Huaxing>) -> Result<Option<(f64, Turn)>, ProgramError> {
         let (degrees, way) = match (b.get('C'), b.get('H')) {
             (Some(_), Some(_)) => {
                 return Err(self.fault(Fault::AbsAndInc, "C and H in one block"));
             }
-            // An absolute C within one revolution, its sign the way: C−750 turns the negative
-            // way to −30°, that is 330° (D138: the manual's "320°" is a slip).
             (Some(c), None) => {
                 let way = if c < 0.0 { Turn::Minus } else { Turn::Plus };
                 let angle = c.rem_euclid(360.0);
                 (if angle >= 360.0 { 0.0 } else { angle }, way)
             }
             (None, Some(h)) => (h, Turn::Incremental),
-            (None, None) => {
-                return Err(self.fault(Fault::RotaryWord, "no rotary axis programmed: C or H"));
-            }
+            (None, None) => return Ok(None),
         };
         if !degrees.is_finite() || degrees.abs() > 999_999.0 {
             return Err(self.fault(
@@ -147,6 +144,15 @@ impl Fanuc<Huaxing> {
                 format!("C axis travel {}°", show(degrees)),
             ));
         }
+        Ok(Some((degrees, way)))
+    }
+
+    /// C to the block's C (or by H) at `rpm`, X and Z geared to its angle (G08's move).
+    pub(super) fn turn_c(&mut self, b: &Block<Huaxing>, rpm: f64) -> Result<(), ProgramError> {
+        let c_index = self.core.axis('C');
+        let Some((degrees, way)) = self.c_target(b)? else {
+            return Err(self.fault(Fault::RotaryWord, "no rotary axis programmed: C or H"));
+        };
         let mut end = self.end_point(b)?;
         // The program's C is the angle the spindle stands at (absolute C), or goes on by H.
         if let (Some(i), Turn::Plus | Turn::Minus) = (c_index, way) {

@@ -137,7 +137,6 @@ impl Fanuc<Huaxing> {
         }
         // The hole: its position on the hole axis and C (`000` §5.22.7: "rapid to (X, C)"),
         // the drilling axis at the start point.
-        let (c, c_step) = (self.core.axis('C'), b.get('H').unwrap_or(0.0));
         let mut top_at = here.clone();
         top_at[hole_axis] = end[hole_axis];
         top_at[drill_axis] = top / s;
@@ -146,7 +145,7 @@ impl Fanuc<Huaxing> {
                 top_at[hole_axis] += step;
             }
             self.rapid_unless_there(&top_at)?;
-            self.index_c(b, &mut top_at, c, k, c_step)?;
+            self.index_c(b, &mut top_at, k)?;
             let at = |p: f64| {
                 let mut v = top_at.clone();
                 v[drill_axis] = p / s;

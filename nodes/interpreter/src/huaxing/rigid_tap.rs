@@ -122,13 +122,11 @@ impl Fanuc<Huaxing> {
         })?;
         let repeats = self.repeat_count(b, name)?;
         let clamp = self.clamp_code(b, name)?;
-        let c = self.core.axis('C');
         let step = if b.has(hole_inc) {
             end[hole] - here[hole]
         } else {
             0.0
         };
-        let c_step = b.get('H').unwrap_or(0.0);
         let mut at = here.clone();
         at[hole] = end[hole];
         for k in 0..repeats {
@@ -136,7 +134,7 @@ impl Fanuc<Huaxing> {
                 at[hole] += step;
             }
             self.rapid_unless_there(&at)?;
-            self.index_c(b, &mut at, c, k, c_step)?;
+            self.index_c(b, &mut at, k)?;
             if let Some(m) = clamp {
                 self.core.aux(cnc_interpreter_core::Aux::M(m));
             }
@@ -156,28 +154,20 @@ impl Fanuc<Huaxing> {
         Ok(())
     }
 
-    /// The hole's C: the block's C (first hole) or H (every hole), at C's rapid (the drilling
-    /// and tapping cycles' "(X, C)" and "(Z, C)").
+    /// Hole `k`'s C in a drilling or tapping cycle (the sections' "(X, C)" and "(Z, C)"):
+    /// the block's absolute C for the first hole, its H for every hole, at C's rapid.
     pub(super) fn index_c(
         &mut self,
         b: &Block<Huaxing>,
         at: &mut [f64],
-        c: Option<usize>,
         k: u32,
-        c_step: f64,
     ) -> Result<(), ProgramError> {
-        let (degrees, way) = match (b.get('C'), b.get('H')) {
-            (Some(v), None) if k == 0 => {
-                let way = if v < 0.0 { Turn::Minus } else { Turn::Plus };
-                (v.rem_euclid(360.0) % 360.0, way)
-            }
-            (None, Some(_)) => (c_step, Turn::Incremental),
-            (Some(_), Some(_)) => {
-                return Err(self.fault(Fault::AbsAndInc, "C and H in one block"));
-            }
-            _ => return Ok(()),
+        let (degrees, way) = match self.c_target(b)? {
+            Some((_, Turn::Plus | Turn::Minus)) if k > 0 => return Ok(()),
+            Some(target) => target,
+            None => return Ok(()),
         };
-        let Some(c) = c else {
+        let Some(c) = self.core.axis('C') else {
             return Err(self.fault(Fault::RotaryAxis, "address C: no C axis on this machine"));
         };
         at[c] = if way == Turn::Incremental {
