@@ -16,13 +16,11 @@ use cnc_runtime::{LaunchConfig, Shutdown};
 use crate::bag::{offered_qos, rotate, Bag, BagOptions, BagTopic};
 use crate::mcap::Compression;
 
-/// The topics of `cfg` the recorder records: those its machine publishes (the live tool's
-/// only on a machine with one) that the config does not leave out.
+/// The topics of `cfg` the recorder records: those its machine publishes that the config
+/// does not leave out.
 pub fn recorded_topics(cfg: &LaunchConfig) -> Vec<Topic> {
-    topics::ALL
-        .iter()
-        .copied()
-        .filter(|t| t.path != topics::LIVE_TOOL.path || cfg.machine.live_tool.is_some())
+    topics::published_by(cfg)
+        .into_iter()
         .filter(|t| cfg.recorder.records(t.path))
         .collect()
 }

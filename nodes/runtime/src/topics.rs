@@ -151,8 +151,8 @@ pub const MOTION_STATUS: Topic = topic(
 /// directly); the machine itself publishes nothing on them.
 pub const INPUTS: &[Topic] = &[SIM_INPUT];
 
-/// Every topic the machine's nodes publish (on the machine bus, and the public ones on DDS):
-/// what the recorder records.
+/// Every topic a machine's nodes may publish (on the machine bus, and the public ones on DDS);
+/// [`published_by`] says which a given machine does, and the recorder records those.
 pub const ALL: &[Topic] = &[
     MACHINE_STATE,
     SPINDLE,
@@ -178,6 +178,15 @@ pub const ALL: &[Topic] = &[
     MOTION_STATUS,
     PANEL_OVERRIDES,
 ];
+
+/// The topics `cfg`'s machine publishes: [`ALL`] but those of parts it lacks (the live
+/// tool's only on a machine with one).
+pub fn published_by(cfg: &crate::LaunchConfig) -> Vec<Topic> {
+    ALL.iter()
+        .copied()
+        .filter(|t| t.path != LIVE_TOOL.path || cfg.machine.live_tool.is_some())
+        .collect()
+}
 
 /// Whether `path` matches `pattern`: `*` stands for any run of characters (also `/`).
 pub fn matches(pattern: &str, path: &str) -> bool {
