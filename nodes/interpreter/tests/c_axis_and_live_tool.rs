@@ -3,13 +3,9 @@
 
 #[path = "support/huaxing.rs"]
 mod huaxing;
-use huaxing::{fixture, turn_mill, with_live_tool};
+use huaxing::{assert_alarms, fixture, hx, turn_mill, with_live_tool};
 
-use cnc_interpreter::{Aux, Canon, Command, Dialect, ProgramError, Setup, Turn};
-
-fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
-    cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
-}
+use cnc_interpreter::{Aux, Canon, Command, Setup, Turn};
 
 /// A rotary move as (X, Z, degrees, way, rpm).
 fn rotary(c: &Command) -> Option<(f64, f64, f64, Turn, f64)> {
@@ -112,10 +108,7 @@ fn the_c_axis_alarms() {
         ("M14.6\n", Setup::lathe([200.0, 100.0]), 74, 1),
         ("M14.3\n", turn_mill(), 74, 1),
     ];
-    for (text, setup, number, line) in cases {
-        let e = hx(text, setup).unwrap_err();
-        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
-    }
+    assert_alarms(cases);
 }
 
 /// G31 (§5.17, D139): a measuring move that brakes at the skip input's edge, rising with K
@@ -252,10 +245,7 @@ fn live_tool_tap_alarms() {
         ("G00 A90\n", with_live_tool(), 74, 1),
         ("G14.4 Z-10 R500 F1 I20\n", with_live_tool(), 2, 1),
     ];
-    for (text, setup, number, line) in cases {
-        let e = hx(text, setup).unwrap_err();
-        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
-    }
+    assert_alarms(cases);
 }
 
 /// What a rigid tapping program queues, in short: rapids and rotaries by their ends, taps as
@@ -337,8 +327,5 @@ fn rigid_tapping_alarms() {
             4,
         ),
     ];
-    for (text, setup, number, line) in cases {
-        let e = hx(text, setup).unwrap_err();
-        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
-    }
+    assert_alarms(cases);
 }

@@ -170,6 +170,7 @@ fn coverage() -> BTreeMap<(&'static str, char, u32), Vec<String>> {
                 Dialect::Gtc2eLathe
             } else if body.contains("HuaxingLathe")
                 || body.contains("hx(")
+                || body.contains("assert_alarms(")
                 || file_name.contains("000")
             {
                 Dialect::HuaxingLathe

@@ -4,13 +4,9 @@
 
 #[path = "support/huaxing.rs"]
 mod huaxing;
-use huaxing::{turn_mill, with_live_tool};
+use huaxing::{assert_alarms, hx, turn_mill, with_live_tool};
 
-use cnc_interpreter::{Aux, Canon, Command, Dialect, ProgramError, Setup};
-
-fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
-    cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
-}
+use cnc_interpreter::{Aux, Canon, Command, Setup};
 
 /// The stream in short: rapids and feeds by their ends (X, Z, C), rotaries, the live tool's
 /// speed, M and S codes for the PLC.
@@ -145,8 +141,5 @@ fn live_tool_speed_alarms() {
             2,
         ),
     ];
-    for (text, setup, number, line) in cases {
-        let e = hx(text, setup).unwrap_err();
-        assert_eq!((e.number, e.line), (number, line), "{text}: {e}");
-    }
+    assert_alarms(cases);
 }

@@ -4,9 +4,9 @@
 
 #[path = "support/huaxing.rs"]
 mod huaxing;
-use huaxing::fixture;
+use huaxing::{fixture, hx};
 
-use cnc_interpreter::{Canon, Command, Dialect, ProgramError, Setup};
+use cnc_interpreter::{Canon, Command, Setup};
 use cnc_interpreter_core::setup::ToolOffset;
 
 /// A turn-mill at X200 Z100, tool 1 an end mill of radius 3 (tip 0) with no length offset.
@@ -21,10 +21,6 @@ fn turn_mill() -> Setup {
         },
     );
     s
-}
-
-fn hx(text: &str, setup: Setup) -> Result<Vec<Canon>, ProgramError> {
-    cnc_interpreter::check(Dialect::HuaxingLathe, text, setup)
 }
 
 /// The face point (mm) of a machine point X (diameter), C (degrees).
