@@ -4,7 +4,7 @@
 //! a tap after it turns from where it stopped. Program end and reset stop it.
 
 use cnc_machine::LiveToolEntry;
-use cnc_motion_core::{Block, Command, Motion, MotionConfig, RunState};
+use cnc_motion_core::{Command, Motion, MotionConfig, RunState};
 use cnc_msgs::signals::{g, GImage, SignalTable};
 
 mod support;
@@ -28,13 +28,13 @@ fn turn_mill() -> Motion {
     Motion::new(with_live_tool(), &[50.0, 0.0])
 }
 
-fn program(kinds: Vec<Command>) -> Vec<Block> {
-    let n = kinds.len() as u32;
-    kinds
-        .into_iter()
-        .zip(1..=n)
-        .map(|(k, i)| block(u64::from(i), i, k))
-        .collect()
+/// The turn-mill with `kinds` queued as one program, a block a line.
+fn running(kinds: Vec<Command>) -> Motion {
+    let mut m = turn_mill();
+    for (i, kind) in (1..).zip(kinds) {
+        m.push(block(u64::from(i), i, kind));
+    }
+    m
 }
 
 /// One tick of the run: (Z setpoint, the tool's angle setpoint, its speed in r/min).
@@ -51,8 +51,7 @@ fn tick(m: &mut Motion, g: &GImage) -> (f64, f64, f64) {
 fn the_tool_turns_at_its_speed_while_the_slide_drills_and_a_tap_after_m66_starts_where_it_stopped()
 {
     let g = GImage::released();
-    let mut m = turn_mill();
-    for b in program(vec![
+    let mut m = running(vec![
         Command::LiveTool { rpm: 1500.0 },
         Command::Linear {
             end: vec![50.0, -10.0, 0.0],
@@ -66,9 +65,7 @@ fn the_tool_turns_at_its_speed_while_the_slide_drills_and_a_tap_after_m66_starts
             feed: 2f64.hypot(720.0) / 0.002,
         },
         Command::ProgramEnd,
-    ]) {
-        m.push(b);
-    }
+    ]);
     let mut seen = Vec::new();
     for _ in 0..5_000 {
         seen.push(tick(&mut m, &g));
@@ -125,16 +122,13 @@ fn the_tool_turns_at_its_speed_while_the_slide_drills_and_a_tap_after_m66_starts
 #[test]
 fn a_block_that_turns_the_spinning_tool_is_refused_and_reset_stops_it() {
     let g = GImage::released();
-    let mut m = turn_mill();
-    for b in program(vec![
+    let mut m = running(vec![
         Command::LiveTool { rpm: 2000.0 },
         Command::Linear {
             end: vec![50.0, -2.0, 360.0],
             feed: 100.0,
         },
-    ]) {
-        m.push(b);
-    }
+    ]);
     for _ in 0..200 {
         ticks(&mut m, &g, 1);
     }
@@ -154,14 +148,11 @@ fn a_block_that_turns_the_spinning_tool_is_refused_and_reset_stops_it() {
 #[test]
 fn the_program_end_stops_the_tool_and_waits_for_it() {
     let g = GImage::released();
-    let mut m = turn_mill();
-    for b in program(vec![
+    let mut m = running(vec![
         Command::LiveTool { rpm: 2500.0 },
         Command::Dwell { seconds: 0.1 },
         Command::ProgramEnd,
-    ]) {
-        m.push(b);
-    }
+    ]);
     let mut n = 0;
     while m.state() != RunState::Idle && n < 1000 {
         ticks(&mut m, &g, 1);
@@ -195,13 +186,10 @@ fn speed_mode_is_refused_above_the_top_speed_without_a_live_tool_and_with_the_dr
 #[test]
 fn the_plcs_spindle_stop_brakes_the_tool_and_lets_it_run_up_again() {
     let mut plc = GImage::released();
-    let mut m = turn_mill();
-    for b in program(vec![
+    let mut m = running(vec![
         Command::LiveTool { rpm: 1000.0 },
         Command::Dwell { seconds: 10.0 },
-    ]) {
-        m.push(b);
-    }
+    ]);
     ticks(&mut m, &plc, 100);
     assert_eq!(m.live_tool_rpm(), 1000.0);
     plc.set(g::SSTP_N, false);
